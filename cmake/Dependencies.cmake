@@ -1,0 +1,26 @@
+# Finds the Debian 12 packages listed in scripts/install-deps.sh.
+find_package(TBB REQUIRED)
+find_package(hwy REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(nlohmann_json REQUIRED)
+find_package(PkgConfig REQUIRED)
+
+# OpenSubdiv 3.5's package config is broken on Debian 12 (its targets file names static
+# libraries that are not shipped) and there is no pkg-config file: import osdCPU by hand.
+find_path(OPENSUBDIV_INCLUDE_DIR opensubdiv/version.h REQUIRED)
+find_library(OPENSUBDIV_CPU_LIBRARY osdCPU REQUIRED)
+add_library(PatchcullDeps::OpenSubdiv UNKNOWN IMPORTED)
+set_target_properties(PatchcullDeps::OpenSubdiv PROPERTIES
+  IMPORTED_LOCATION "${OPENSUBDIV_CPU_LIBRARY}"
+  INTERFACE_INCLUDE_DIRECTORIES "${OPENSUBDIV_INCLUDE_DIR}")
+
+# libstb already contains the implementations: never define STB_*_IMPLEMENTATION.
+pkg_check_modules(STB REQUIRED IMPORTED_TARGET stb)
+add_library(PatchcullDeps::stb ALIAS PkgConfig::STB)
+
+if(PATCHCULL_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()
+if(PATCHCULL_BUILD_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+endif()

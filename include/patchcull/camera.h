@@ -1,0 +1,60 @@
+// patchcull/camera.h: perspective cameras and seeded random view generators.
+//
+// View modes (seed 000 §6.2, seed 001 §7):
+// - ViewMode::contain: every view contains the whole object: the camera looks at a point near
+//   the object's centre from a random direction, far enough that the object's bounding sphere
+//   lies inside the view volume, near and far planes included.
+// - ViewMode::free: the camera is anywhere around or inside the object's (enlarged) bounding box
+//   and looks in a random direction, with a random near distance down to 0.2% of the object's
+//   size: parts leave the view and the near and far planes cut patches.
+// Generators are deterministic for a seed on every platform (their own uniform conversion).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "patchcull/math.h"
+#include "patchcull/mesh.h"
+
+namespace patchcull {
+
+struct Camera {
+    Vec3 eye{0, 0, 5};
+    Vec3 target{0, 0, 0};
+    Vec3 up{0, 1, 0};
+    float fovy_radians = 1.0471976f;  ///< 60 degrees
+    float aspect = 1.0f;
+    float z_near = 0.1f;
+    float z_far = 100.0f;
+
+    Mat4 view() const { return look_at(eye, target, up); }
+    Mat4 projection() const { return perspective(fovy_radians, aspect, z_near, z_far); }
+    /// projection() * view(): object (world) space to clip space.
+    Mat4 view_projection() const { return projection() * view(); }
+};
+
+enum class ViewMode { contain, free };
+const char* view_mode_name(ViewMode mode);
+bool parse_view_mode(const char* text, ViewMode& mode);
+
+class ViewGenerator {
+public:
+    ViewGenerator(const Bounds& object, ViewMode mode, std::uint64_t seed, float aspect = 1.0f);
+    Camera next();
+
+private:
+    float uniform();  // [0, 1)
+    Vec3 unit_vector();
+
+    Bounds object_;
+    ViewMode mode_;
+    std::uint64_t state_;
+    float aspect_;
+};
+
+/// frames cameras on a circle around the object, turning degrees_per_frame each frame, for
+/// temporal tests; the whole object stays in view.
+std::vector<Camera> orbit_sequence(const Bounds& object, int frames, float degrees_per_frame,
+                                   float aspect = 1.0f);
+
+}  // namespace patchcull

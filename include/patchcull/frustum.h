@@ -1,0 +1,58 @@
+// patchcull/frustum.h: view-frustum cull kernels over patch batches (seed 000 §4.1.1, seed 002).
+//
+// Clip space as in math.h: inside means -w <= x <= w, -w <= y <= w, 0 <= z <= w. A patch is
+// culled (culled[i] = 1) only when no point of the (displaced) patch can be inside; otherwise
+// culled[i] = 0. Both kernels are plane tests in homogeneous clip space, so they stay correct
+// when control points straddle w <= 0 (behind the eye): no division by w ever happens.
+//
+// - frustum (seed 000 §4.1.1): the clip-space bounds of the control points. For a polynomial or
+//   rational patch with positive weights, the patch lies in the convex hull of its homogeneous
+//   control points, so if every control point is outside one clip plane the patch is too. With
+//   w > 0 this equals "the NDC bounding box of the control points misses the clip cube".
+//   Displacement up to max_displacement[i] along a unit normal moves a plane value by at most
+//   |D| * |plane row xyz|, which the kernel adds as a margin (scaled by each point's weight).
+// - frustum-disp (seed 002): the object-space AABB of the control points grown by max |D| on
+//   every side; its 8 corners are transformed to clip space and tested against the clip planes
+//   (the NDC in-out test, done as homogeneous comparisons).
+//
+// Contracts: culled must hold patches.count bytes; max_displacement is null (no displacement) or
+// holds patches.count values >= 0. Kernels never allocate or throw; scalar and SIMD versions give
+// identical decisions (tests/core/frustum_simd_test).
+#pragma once
+
+#include <cstdint>
+
+#include "patchcull/math.h"
+#include "patchcull/patch.h"
+
+namespace patchcull {
+
+/// The six clip planes as rows over object-space homogeneous points: plane k's value for a point
+/// P is dot(rows[k], P) and P is inside when every value is >= 0. Order: left (w+x), right (w-x),
+/// bottom (w+y), top (w-y), near (z), far (w-z).
+struct FrustumPlanes {
+    Vec4 rows[6];
+    float normal_length[6];  ///< |rows[k].xyz|: bound on the change per unit object-space motion
+};
+
+/// Planes of the clip volume of object_to_clip (projection * view * model).
+FrustumPlanes make_frustum_planes(const Mat4& object_to_clip);
+
+/// frustum kernel, scalar reference.
+void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement,
+                         const FrustumPlanes& planes, std::uint8_t* culled);
+/// frustum kernel, SIMD (Highway, best instruction set chosen once at run time).
+void cull_frustum_simd(const PatchBatchView& patches, const float* max_displacement,
+                       const FrustumPlanes& planes, std::uint8_t* culled);
+
+/// frustum-disp kernel (seed 002), scalar reference.
+void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement,
+                              const Mat4& object_to_clip, std::uint8_t* culled);
+/// frustum-disp kernel, SIMD.
+void cull_frustum_disp_simd(const PatchBatchView& patches, const float* max_displacement,
+                            const Mat4& object_to_clip, std::uint8_t* culled);
+
+/// Name of the instruction set the SIMD kernels dispatch to on this machine (e.g. "AVX2").
+const char* simd_target_name();
+
+}  // namespace patchcull

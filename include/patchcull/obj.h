@@ -1,0 +1,25 @@
+// patchcull/obj.h: a strict Wavefront OBJ reader for subdivision control meshes.
+//
+// Reads v, vt and f records (f with v, v/vt, v//vn or v/vt/vn corners, negative indices allowed);
+// ignores vn, o, g, s, usemtl, mtllib, l, comments and blank lines. Strict by design: every
+// malformed number, non-finite coordinate, out-of-range index or face with fewer than 3 corners
+// is a patchcull::Error naming "file:line". (tinyobjloader, tried first, reads "abc" and "nan"
+// as 0 and only warns on out-of-range indices: a silently wrong mesh, so it is not used.)
+#pragma once
+
+#include <istream>
+#include <string>
+
+#include "patchcull/mesh.h"
+
+namespace patchcull {
+
+/// Loads an OBJ file. Throws patchcull::Error ("path: cannot open ...", "path:line: ...").
+/// A mesh where some faces have texture coordinates and others not drops them all and says so in
+/// ControlMesh::warnings: displacement then falls back to each patch's own (u,v) domain.
+ControlMesh load_obj(const std::string& path);
+
+/// Parses OBJ text from a stream; name is used in error messages.
+ControlMesh parse_obj(std::istream& in, const std::string& name);
+
+}  // namespace patchcull

@@ -1,0 +1,39 @@
+// patchcull/scene.h: loading a model by name for tools: an OBJ path or "teapot".
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "patchcull/displacement.h"
+#include "patchcull/subdivision.h"
+
+namespace patchcull {
+
+struct LoadedModel {
+    std::string name;                        ///< path or "teapot"
+    std::optional<SubdivisionModel> subdiv;  ///< absent for the built-in teapot (already Bezier)
+    int split_levels = 0;
+    PatchFrame rest;                         ///< patches at rest, after split_levels splits
+    std::vector<std::string> warnings;
+};
+
+/// Loads spec ("teapot" or an OBJ path), builds patches with scheme (ignored for the teapot) and
+/// applies split_levels 1-to-4 splits. Throws patchcull::Error naming the file and line.
+LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels);
+
+/// Re-evaluates the model's patches for animated control-mesh positions (the teapot is static:
+/// frame is rest). out keeps its storage between frames.
+void evaluate_frame(const LoadedModel& model, const std::vector<Vec3>& positions, PatchFrame& out);
+
+/// Per-patch displacement ranges [D_min, D_max] (seed 002's pre-processing), or all zero when
+/// map is null or empty.
+std::vector<DisplacementRange> displacement_ranges(const PatchFrame& frame, const DisplacementMap* map);
+
+/// Bounds of the Cartesian control points of all patches (holds the whole surface).
+Bounds patch_bounds(const PatchFrame& frame);
+
+/// Path of a model shipped with patchcull (data/models/NAME), e.g. "bigguy.obj".
+std::string shipped_model_path(const std::string& file_name);
+
+}  // namespace patchcull

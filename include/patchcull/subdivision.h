@@ -1,0 +1,98 @@
+// patchcull/subdivision.h: Catmull-Clark control meshes to bicubic Bezier patches.
+//
+// Two schemes (seeds 000, 001, 002):
+// - Scheme::acc: Loop & Schaefer's approximate Catmull-Clark patches (ACC, seed 002): one
+//   bicubic patch per quad, exact on regular quads; extraordinary patches also get ACC tangent
+//   patches for a continuous normal field. A mesh with non-quad faces first gets one uniform
+//   Catmull-Clark refinement (OpenSubdiv Far), so every face becomes a quad.
+// - Scheme::osd: the exact limit surface through OpenSubdiv Far feature-adaptive refinement,
+//   B-spline-basis end caps, converted to Bezier. Handles boundaries, creases, triangles, n-gons.
+//
+// Both schemes are linear in the control-mesh positions, so a model stores each Bezier control
+// point as a stencil (weighted sum of control vertices). Animation deforms the control mesh and
+// re-applies the stencils each frame: nothing per patch is precomputed from positions.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "patchcull/math.h"
+#include "patchcull/mesh.h"
+#include "patchcull/patch.h"
+
+namespace patchcull {
+
+enum class Scheme { acc, osd };
+
+const char* scheme_name(Scheme scheme);
+/// Parses "acc" or "osd"; returns false otherwise.
+bool parse_scheme(const std::string& text, Scheme& scheme);
+
+/// Row r of a stencil table is sum_k weights[k] * vertex[indices[k]], k in [offsets[r], offsets[r+1]).
+struct PointStencils {
+    std::vector<std::uint32_t> offsets{0};
+    std::vector<std::uint32_t> indices;
+    std::vector<float> weights;
+
+    std::size_t rows() const { return offsets.size() - 1; }
+    /// Appends a row from (index, weight) pairs; duplicate indices are merged.
+    void add_row(const std::vector<std::pair<std::uint32_t, float>>& terms);
+    /// out must hold rows() points.
+    void apply(const Vec3* vertices, Vec3* out) const;
+};
+
+/// Per-patch data that is not geometry.
+struct PatchInfo {
+    /// Texture coordinates at the patch corners (u,v) = (0,0), (1,0), (0,1), (1,1). The texture
+    /// parameterization is bilinear over the patch domain (seed 002's pre-processing step).
+    Vec2 uv[4] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
+    std::uint32_t base_face = 0;     ///< control-mesh face the patch comes from
+    bool extraordinary = false;      ///< acc: touches an extraordinary vertex; osd: end-cap patch
+    std::int32_t tangent_index = -1; ///< row block in SubdivisionModel::tangent_points, or -1
+};
+
+struct SubdivisionModel {
+    std::string name;
+    Scheme scheme = Scheme::acc;
+    ControlMesh mesh;                ///< the control mesh; animation deforms mesh.positions
+    PointStencils patch_points;      ///< 16 rows per patch, control point 4*j + i (patch.h)
+    PointStencils tangent_points;    ///< 24 rows per tangent block: 12 du rows, then 12 dv rows
+    std::vector<PatchInfo> patches;
+
+    std::size_t patch_count() const { return patches.size(); }
+    std::size_t extraordinary_count() const;
+};
+
+/// Builds the patches of mesh under scheme. Throws patchcull::Error for meshes the scheme cannot
+/// take (e.g. non-manifold topology), naming mesh.name.
+SubdivisionModel build_model(const ControlMesh& mesh, Scheme scheme);
+
+/// Patches of one frame.
+struct PatchFrame {
+    std::vector<BezierPatch> patches;
+    std::vector<TangentPatches> tangents;  ///< indexed by info[i].tangent_index
+    std::vector<PatchInfo> info;
+};
+
+/// Evaluates the model's patches for control-mesh positions (model.mesh.positions or an animated
+/// copy of the same size), then applies split_levels uniform 1-to-4 splits (seed 001's
+/// MonsterFrog with 5168 patches is 1292 quads after one split). Child texture coordinates are
+/// the bilinear interpolation of the parent's.
+void evaluate_patches(const SubdivisionModel& model, const std::vector<Vec3>& positions,
+                      int split_levels, PatchFrame& out);
+
+// Scheme back ends (src/import/acc.cpp, src/import/osd.cpp); build_model dispatches to them.
+SubdivisionModel build_acc_model(const ControlMesh& mesh);
+SubdivisionModel build_osd_model(const ControlMesh& mesh);
+
+/// One uniform Catmull-Clark refinement of a mesh with OpenSubdiv Far, as stencils over the
+/// original vertices: refined positions = stencils.apply(original positions). Texture
+/// coordinates are refined linearly (face-varying, linear interpolation everywhere).
+struct RefinedMesh {
+    ControlMesh mesh;          ///< all-quad mesh; positions already evaluated at rest
+    PointStencils stencils;    ///< one row per refined vertex
+};
+RefinedMesh refine_uniform_once(const ControlMesh& mesh);
+
+}  // namespace patchcull

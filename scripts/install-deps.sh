@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Installs every Debian package patchcull needs to build, run and test (see ../shared/PLATFORM.md).
+# Nothing else is downloaded at build time.
+set -euo pipefail
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+PACKAGES=(
+  g++ cmake make pkg-config
+  libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev glslang-tools
+  libosd-dev libstb-dev libtbb-dev libhwy-dev libcli11-dev nlohmann-json3-dev
+  libgtest-dev libbenchmark-dev
+)
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends "${missing[@]}"

@@ -1,0 +1,82 @@
+// Model loading by name for tools (patchcull/scene.h).
+#include "patchcull/scene.h"
+
+#include <algorithm>
+#include <cstdlib>
+
+#include "patchcull/error.h"
+#include "patchcull/obj.h"
+#include "patchcull/teapot.h"
+
+namespace patchcull {
+namespace {
+
+void split_in_place(PatchFrame& frame, int levels, const std::string& name) {
+    if (levels < 0 || levels > 4) throw Error(name + ": --split must be between 0 and 4");
+    if (levels == 0) return;
+    // evaluate_patches() splits subdivision models; the teapot is split through a one-patch-per-
+    // control-point stencil model so both share one split path.
+    SubdivisionModel model;
+    model.name = name;
+    std::vector<Vec3> points;
+    for (std::size_t p = 0; p < frame.patches.size(); ++p)
+        for (int k = 0; k < kPatchPoints; ++k) {
+            points.push_back(cartesian(frame.patches[p].cp[k]));
+            model.patch_points.add_row({{static_cast<std::uint32_t>(points.size() - 1), 1.0f}});
+        }
+    model.patches = frame.info;
+    evaluate_patches(model, points, levels, frame);
+}
+
+}  // namespace
+
+LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels) {
+    LoadedModel model;
+    model.name = spec;
+    model.split_levels = split_levels;
+    if (split_levels < 0 || split_levels > 4) throw Error("--split: must be between 0 and 4, got " + std::to_string(split_levels));
+    if (spec == "teapot") {
+        model.rest.patches = teapot_patches();
+        model.rest.info.assign(model.rest.patches.size(), PatchInfo{});
+        for (std::size_t p = 0; p < model.rest.info.size(); ++p) model.rest.info[p].base_face = static_cast<std::uint32_t>(p);
+        split_in_place(model.rest, split_levels, spec);
+        return model;
+    }
+    ControlMesh mesh = load_obj(spec);
+    model.warnings = mesh.warnings;
+    model.subdiv = build_model(mesh, scheme);
+    for (const std::string& w : model.subdiv->mesh.warnings)
+        if (std::find(model.warnings.begin(), model.warnings.end(), w) == model.warnings.end()) model.warnings.push_back(w);
+    evaluate_patches(*model.subdiv, model.subdiv->mesh.positions, split_levels, model.rest);
+    return model;
+}
+
+void evaluate_frame(const LoadedModel& model, const std::vector<Vec3>& positions, PatchFrame& out) {
+    if (!model.subdiv) {
+        out = model.rest;
+        return;
+    }
+    evaluate_patches(*model.subdiv, positions, model.split_levels, out);
+}
+
+std::vector<DisplacementRange> displacement_ranges(const PatchFrame& frame, const DisplacementMap* map) {
+    std::vector<DisplacementRange> ranges(frame.patches.size());
+    if (!map || map->empty()) return ranges;
+    for (std::size_t p = 0; p < ranges.size(); ++p) ranges[p] = map->patch_range(frame.info[p].uv);
+    return ranges;
+}
+
+Bounds patch_bounds(const PatchFrame& frame) {
+    std::vector<Vec3> points;
+    points.reserve(frame.patches.size() * kPatchPoints);
+    for (const BezierPatch& p : frame.patches)
+        for (const Vec4& c : p.cp) points.push_back(cartesian(c));
+    return compute_bounds(points);
+}
+
+std::string shipped_model_path(const std::string& file_name) {
+    if (const char* dir = std::getenv("PATCHCULL_DATA_DIR")) return std::string(dir) + "/models/" + file_name;
+    return std::string(PATCHCULL_DATA_DIR) + "/models/" + file_name;
+}
+
+}  // namespace patchcull

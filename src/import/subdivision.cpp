@@ -1,0 +1,107 @@
+// Scheme dispatch, stencil tables and per-frame patch evaluation (patchcull/subdivision.h).
+#include "patchcull/subdivision.h"
+
+#include <algorithm>
+#include <map>
+
+#include "patchcull/error.h"
+
+namespace patchcull {
+
+const char* scheme_name(Scheme scheme) { return scheme == Scheme::acc ? "acc" : "osd"; }
+
+bool parse_scheme(const std::string& text, Scheme& scheme) {
+    if (text == "acc") scheme = Scheme::acc;
+    else if (text == "osd") scheme = Scheme::osd;
+    else return false;
+    return true;
+}
+
+void PointStencils::add_row(const std::vector<std::pair<std::uint32_t, float>>& terms) {
+    std::map<std::uint32_t, float> merged;
+    for (const auto& [index, weight] : terms) merged[index] += weight;
+    for (const auto& [index, weight] : merged) {
+        if (weight == 0.0f) continue;
+        indices.push_back(index);
+        weights.push_back(weight);
+    }
+    offsets.push_back(static_cast<std::uint32_t>(indices.size()));
+}
+
+void PointStencils::apply(const Vec3* vertices, Vec3* out) const {
+    const std::size_t n = rows();
+    for (std::size_t r = 0; r < n; ++r) {
+        Vec3 p{};
+        for (std::uint32_t k = offsets[r]; k < offsets[r + 1]; ++k) p += vertices[indices[k]] * weights[k];
+        out[r] = p;
+    }
+}
+
+std::size_t SubdivisionModel::extraordinary_count() const {
+    return static_cast<std::size_t>(
+        std::count_if(patches.begin(), patches.end(), [](const PatchInfo& p) { return p.extraordinary; }));
+}
+
+SubdivisionModel build_model(const ControlMesh& mesh, Scheme scheme) {
+    if (mesh.face_count() == 0) throw Error(mesh.name + ": mesh has no faces");
+    return scheme == Scheme::acc ? build_acc_model(mesh) : build_osd_model(mesh);
+}
+
+namespace {
+
+// One uniform 1-to-4 split of a whole frame.
+void split_frame(const PatchFrame& in, PatchFrame& out) {
+    out.patches.resize(in.patches.size() * 4);
+    out.info.resize(in.info.size() * 4);
+    out.tangents.resize(in.tangents.size() * 4);
+    for (std::size_t p = 0; p < in.patches.size(); ++p) {
+        split_patch(in.patches[p], &out.patches[4 * p]);
+        const PatchInfo& parent = in.info[p];
+        // Children in split_patch order: (u low, v low), (u high, v low), (u low, v high), (u high, v high).
+        for (int c = 0; c < 4; ++c) {
+            const float u0 = (c & 1) ? 0.5f : 0.0f;
+            const float v0 = (c & 2) ? 0.5f : 0.0f;
+            PatchInfo child = parent;
+            for (int k = 0; k < 4; ++k) {
+                const float u = u0 + ((k & 1) ? 0.5f : 0.0f);
+                const float v = v0 + ((k & 2) ? 0.5f : 0.0f);
+                const Vec2 bottom = parent.uv[0] * (1 - u) + parent.uv[1] * u;
+                const Vec2 top = parent.uv[2] * (1 - u) + parent.uv[3] * u;
+                child.uv[k] = bottom * (1 - v) + top * v;
+            }
+            child.tangent_index = parent.tangent_index < 0 ? -1 : 4 * parent.tangent_index + c;
+            out.info[4 * p + c] = child;
+        }
+    }
+    for (std::size_t t = 0; t < in.tangents.size(); ++t) split_tangents(in.tangents[t], &out.tangents[4 * t]);
+}
+
+}  // namespace
+
+void evaluate_patches(const SubdivisionModel& model, const std::vector<Vec3>& positions, int split_levels,
+                      PatchFrame& out) {
+    const std::size_t n = model.patch_count();
+    std::vector<Vec3> points(model.patch_points.rows());
+    model.patch_points.apply(positions.data(), points.data());
+    out.patches.resize(n);
+    for (std::size_t p = 0; p < n; ++p)
+        for (int k = 0; k < kPatchPoints; ++k) out.patches[p].cp[k] = homogeneous(points[kPatchPoints * p + k]);
+
+    std::vector<Vec3> tangent_points(model.tangent_points.rows());
+    model.tangent_points.apply(positions.data(), tangent_points.data());
+    out.tangents.resize(tangent_points.size() / 24);
+    for (std::size_t t = 0; t < out.tangents.size(); ++t)
+        for (int k = 0; k < 12; ++k) {
+            out.tangents[t].du[k] = tangent_points[24 * t + k];
+            out.tangents[t].dv[k] = tangent_points[24 * t + 12 + k];
+        }
+    out.info = model.patches;
+
+    PatchFrame scratch;
+    for (int level = 0; level < split_levels; ++level) {
+        split_frame(out, scratch);
+        std::swap(out, scratch);
+    }
+}
+
+}  // namespace patchcull
