@@ -61,10 +61,13 @@ Camera ViewGenerator::next() {
         cam.z_near = std::max(1e-4f * radius, (distance - radius) * 0.9f);
         cam.z_far = (distance + radius) * 1.1f;
     } else {
-        // Anywhere in the object's box enlarged 3x, often inside the object; random direction;
+        // Anywhere around or inside the object; random direction;
         // near planes from 0.2% to 20% of the object's size so they cut patches; far planes that
         // sometimes cut the object too.
-        const Vec3 half = (object_.max - object_.min) * 1.5f;
+        // 40% of eyes inside the object's own box (the hard cases: patches all around, near
+        // plane cutting through), the rest in the box enlarged 3x.
+        const float spread = uniform() < 0.4f ? 0.5f : 1.5f;
+        const Vec3 half = (object_.max - object_.min) * spread;
         cam.eye = c + Vec3{(2 * uniform() - 1) * half.x, (2 * uniform() - 1) * half.y, (2 * uniform() - 1) * half.z};
         const Vec3 toward_centre = normalize(c - cam.eye);
         const Vec3 dir = normalize(toward_centre * (uniform() < 0.6f ? 1.0f : 0.0f) + unit_vector() * 0.8f);

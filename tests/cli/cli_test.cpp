@@ -1,0 +1,162 @@
+// The CLI contract (issue 2): `info` and `cull` JSON shapes and counts, and one-line errors with
+// exit status 2 for every kind of bad input.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+struct Run {
+    int status = -1;
+    std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+const std::string& scratch_dir() {
+    static const std::string dir = [] {
+        std::string d = (std::filesystem::temp_directory_path() / ("patchcull_cli_" + std::to_string(getpid()))).string();
+        std::filesystem::create_directories(d);
+        return d;
+    }();
+    return dir;
+}
+
+Run run(const std::string& args) {
+    const std::string out = scratch_dir() + "/stdout", err = scratch_dir() + "/stderr";
+    const std::string cmd = std::string(PATCHCULL_CLI) + " " + args + " >" + out + " 2>" + err + " </dev/null";
+    const int raw = std::system(cmd.c_str());
+    Run r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+std::string model(const char* name) { return std::string(PATCHCULL_SOURCE_DIR) + "/data/models/" + name; }
+
+std::string write_file(const std::string& name, const std::string& content) {
+    const std::string path = scratch_dir() + "/" + name;
+    std::ofstream(path, std::ios::binary) << content;
+    return path;
+}
+
+// The error must be exactly one line, name the culprit, and exit with status 2.
+void expect_one_line_error(const Run& r, const std::string& must_contain) {
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    ASSERT_FALSE(r.err.empty());
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
+    EXPECT_NE(r.err.find(must_contain), std::string::npos) << r.err;
+}
+
+}  // namespace
+
+TEST(Cli, InfoBigGuyAcc) {
+    const Run r = run("info " + model("bigguy.obj") + " --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["patches"], 1450);
+    EXPECT_EQ(j["scheme"], "acc");
+    EXPECT_EQ(j["extraordinary_patches"], 592);
+}
+
+TEST(Cli, InfoMonsterFrogSplitOnce) {
+    const Run r = run("info " + model("monsterfrog.obj") + " --scheme acc --split 1 --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["patches"], 5168);
+    EXPECT_EQ(j["extraordinary_patches"], 4 * 764);
+}
+
+TEST(Cli, InfoOsdScheme) {
+    const Run r = run("info " + model("bigguy.obj") + " --scheme osd --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["scheme"], "osd");
+    EXPECT_GT(j["patches"].get<int>(), 1450);  // adaptive refinement around extraordinary vertices
+    EXPECT_GT(j["extraordinary_patches"].get<int>(), 0);
+}
+
+TEST(Cli, InfoTeapot) {
+    const Run r = run("info teapot --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["patches"], 32);
+}
+
+TEST(Cli, CullPrintsTheContractShapeWithNoFalseCulls) {
+    const Run r = run("cull teapot --views 50 --seed 3 --view-mode free --methods frustum,frustum-disp --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["model"], "teapot");
+    EXPECT_EQ(j["patches"], 32);
+    EXPECT_EQ(j["views"], 50);
+    for (const char* m : {"frustum", "frustum-disp"}) {
+        const auto& mj = j["methods"][m];
+        ASSERT_TRUE(mj.is_object()) << m;
+        EXPECT_GE(mj["cull_rate"].get<double>(), 0.0);
+        EXPECT_LE(mj["cull_rate"].get<double>(), 1.0);
+        EXPECT_GT(mj["cull_rate"].get<double>(), 0.05) << m << ": free views must cull something";
+        EXPECT_EQ(mj["false_culls"], 0) << m;
+        EXPECT_GT(mj["ns_per_patch"].get<double>(), 0.0);
+    }
+    // frustum tests the convex hull, frustum-disp its AABB: the hull is never culled less.
+    EXPECT_GE(j["methods"]["frustum"]["cull_rate"].get<double>(), j["methods"]["frustum-disp"]["cull_rate"].get<double>());
+}
+
+TEST(Cli, CullWithProceduralDisplacementOnARealModel) {
+    const Run r = run("cull " + model("bigguy.obj") + " --views 30 --view-mode free --displace procedural "
+                      "--displace-scale 0.5 --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["methods"]["frustum"]["false_culls"], 0);
+    EXPECT_EQ(j["methods"]["frustum-disp"]["false_culls"], 0);
+}
+
+TEST(Cli, MissingFile) {
+    expect_one_line_error(run("info /nonexistent/model.obj --json"), "/nonexistent/model.obj: cannot open file");
+}
+
+TEST(Cli, MalformedObj) {
+    const std::string path = write_file("malformed.obj", "v 0 0 0\nv 1 0 0\nv 1 x 0\nf 1 2 3\n");
+    expect_one_line_error(run("info " + path + " --json"), path + ":3: malformed number 'x'");
+}
+
+TEST(Cli, NonFiniteCoordinates) {
+    const std::string path = write_file("nan.obj", "v 0 0 0\nv 1 0 0\nv 1 inf 0\nf 1 2 3\n");
+    expect_one_line_error(run("cull " + path + " --views 1 --json"), path + ":3: non-finite coordinate 'inf'");
+}
+
+TEST(Cli, FaceIndexOutOfRange) {
+    const std::string path = write_file("range.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 9\n");
+    expect_one_line_error(run("info " + path), path + ":5: vertex index 9 out of range (have 4)");
+}
+
+TEST(Cli, UnreadableImage) {
+    expect_one_line_error(run("cull teapot --views 1 --displace /nonexistent/height.png --json"),
+                          "/nonexistent/height.png: cannot read image");
+    const std::string garbage = write_file("garbage.png", "this is not a png");
+    expect_one_line_error(run("cull teapot --views 1 --displace " + garbage + " --json"),
+                          garbage + ": cannot read image");
+}
+
+TEST(Cli, UnknownFlagAndBadValues) {
+    expect_one_line_error(run("info teapot --bogus-flag"), "--bogus-flag");
+    expect_one_line_error(run("cull teapot --methods frustum,warp --json"), "--methods: unknown cull method 'warp'");
+    expect_one_line_error(run("cull teapot --view-mode sideways"), "--view-mode");
+    expect_one_line_error(run("info teapot --split 9"), "--split");
+    expect_one_line_error(run("cull teapot --views -3"), "--views");
+    expect_one_line_error(run("cull teapot --displace procedural --displace-scale nan"), "--displace-scale");
+    expect_one_line_error(run("frobnicate"), "frobnicate");
+}

@@ -1,0 +1,115 @@
+// Strict OBJ reader: accepted forms, and one-line file:line errors for every malformed input.
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "patchcull/error.h"
+#include "patchcull/obj.h"
+
+using namespace patchcull;
+
+namespace {
+
+ControlMesh parse(const std::string& text) {
+    std::istringstream in(text);
+    return parse_obj(in, "mesh.obj");
+}
+
+std::string error_of(const std::string& text) {
+    try {
+        parse(text);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+}  // namespace
+
+TEST(Obj, ReadsQuadWithTexcoordsAndNegativeIndices) {
+    const ControlMesh m = parse(
+        "# comment\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+        "vn 0 0 1\ng group\ns 1\nf -4/-4/1 -3/-3/1 -2/-2/1 -1/-1/1\n");
+    ASSERT_EQ(m.positions.size(), 4u);
+    ASSERT_EQ(m.face_count(), 1u);
+    EXPECT_EQ(m.face_size(0), 4u);
+    EXPECT_TRUE(m.has_texcoords());
+    EXPECT_EQ(m.face_vertices, (std::vector<std::uint32_t>{0, 1, 2, 3}));
+    EXPECT_EQ(m.face_texcoords, (std::vector<std::uint32_t>{0, 1, 2, 3}));
+    EXPECT_TRUE(m.all_quads());
+}
+
+TEST(Obj, ReadsMixedPolygonsWithoutTexcoords) {
+    const ControlMesh m = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2 5 3\nf 1//1 2//1 3//1\n");
+    EXPECT_EQ(m.face_count(), 3u);
+    EXPECT_FALSE(m.has_texcoords());
+    EXPECT_FALSE(m.all_quads());
+}
+
+TEST(Obj, DropsTexcoordsWhenOnlySomeFacesHaveThemAndWarns) {
+    const ControlMesh m = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3/1\nf 1 3 2\n");
+    EXPECT_FALSE(m.has_texcoords());
+    ASSERT_EQ(m.warnings.size(), 1u);
+}
+
+TEST(Obj, ReadsCreaseAndCornerTags) {
+    const ControlMesh m =
+        parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt crease 2/1/0 0 1 2.5\nt corner 1/1/0 3 10\n");
+    ASSERT_EQ(m.creases.size(), 1u);
+    EXPECT_EQ(m.creases[0].v0, 0u);
+    EXPECT_EQ(m.creases[0].v1, 1u);
+    EXPECT_FLOAT_EQ(m.creases[0].sharpness, 2.5f);
+    ASSERT_EQ(m.corners.size(), 1u);
+    EXPECT_EQ(m.corners[0].v0, 3u);
+}
+
+TEST(Obj, MalformedNumberNamesFileAndLine) {
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 abc 0\n"), "mesh.obj:2: malformed number 'abc'");
+}
+
+TEST(Obj, NonFiniteCoordinatesAreErrors) {
+    EXPECT_EQ(error_of("v 0 0 0\nv nan 0 0\n"), "mesh.obj:2: non-finite coordinate 'nan'");
+    EXPECT_EQ(error_of("v inf 0 0\n"), "mesh.obj:1: non-finite coordinate 'inf'");
+    EXPECT_EQ(error_of("v 1e999 0 0\n"), "mesh.obj:1: number out of range '1e999'");
+    EXPECT_EQ(error_of("v 0 0 0\nvt 0 -nan\n"), "mesh.obj:2: non-finite coordinate '-nan'");
+}
+
+TEST(Obj, FaceIndexOutOfRangeIsAnError) {
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 4\n"), "mesh.obj:4: vertex index 4 out of range (have 3)");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 0\n"), "mesh.obj:4: vertex index 0 out of range (have 3)");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 1 1 0\nf -4 1 2\n"), "mesh.obj:4: vertex index -4 out of range (have 3)");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2/2 3/1\n"),
+              "mesh.obj:5: texture coordinate index 2 out of range (have 1)");
+}
+
+TEST(Obj, OtherMalformedLines) {
+    EXPECT_EQ(error_of("v 0 0\n"), "mesh.obj:1: vertex needs 3 coordinates");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nf 1 2\n"), "mesh.obj:3: face needs at least 3 vertices");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nf 1 2 1\n"), "mesh.obj:3: face uses vertex 1 twice");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 x 3\n"), "mesh.obj:4: malformed vertex index 'x'");
+    EXPECT_EQ(error_of("hello world\n"), "mesh.obj:1: unknown record 'hello'");
+    EXPECT_EQ(error_of("v 0 0 0\n"), "mesh.obj: no faces");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nt crease 2/1/0 0 7 1\n"),
+              "mesh.obj:5: tag vertex index 7 out of range (have 3)");
+}
+
+TEST(Obj, MissingFileNamesThePath) {
+    try {
+        load_obj("/nonexistent/dir/model.obj");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_STREQ(e.what(), "/nonexistent/dir/model.obj: cannot open file");
+    }
+}
+
+TEST(Obj, LoadsShippedModels) {
+    const ControlMesh bigguy = load_obj(std::string(PATCHCULL_SOURCE_DIR) + "/data/models/bigguy.obj");
+    EXPECT_EQ(bigguy.positions.size(), 1452u);
+    EXPECT_EQ(bigguy.face_count(), 1450u);
+    EXPECT_TRUE(bigguy.all_quads());
+    EXPECT_TRUE(bigguy.has_texcoords());
+    const ControlMesh frog = load_obj(std::string(PATCHCULL_SOURCE_DIR) + "/data/models/monsterfrog.obj");
+    EXPECT_EQ(frog.positions.size(), 1308u);
+    EXPECT_EQ(frog.face_count(), 1292u);
+    EXPECT_TRUE(frog.all_quads());
+}
