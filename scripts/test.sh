@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# README command 2: runs every test. Installs the Debian packages if missing, builds the core
+# tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs them, then builds everything
+# in Release and runs the whole suite (ctest's summary line comes last).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+JOBS="$(nproc)"
+
+./scripts/install-deps.sh
+
+echo "== core tests under ASan + UBSan =="
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DPATCHCULL_SANITIZE=ON -DPATCHCULL_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build build-asan -j"$JOBS" --target patchcull_core_tests patchcull_cli patchcull_cli_tests
+ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -L "core|cli" --output-on-failure
+
+echo "== full suite (Release) =="
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$JOBS"
+ctest --test-dir build --output-on-failure
