@@ -26,4 +26,17 @@ void sample_displaced_patch(const BezierPatch& patch, const TangentPatches* tang
 /// 0<=z<=w, w>0), evaluated in double precision.
 bool any_point_in_clip_volume(const Mat4& object_to_clip, const Vec3* points, std::size_t count);
 
+/// A sphere holding a set of points (not the smallest one; any holding sphere is exact for the
+/// test below).
+struct SampleSphere {
+    Vec3 center;
+    float radius = 0;
+};
+SampleSphere bounding_sphere(const Vec3* points, std::size_t count);
+
+/// True when the whole sphere lies strictly outside one clip plane of object_to_clip, so none of
+/// the points it holds can be in the clip volume. A fast, exact pre-check for
+/// any_point_in_clip_volume (double precision, with a relative safety margin).
+bool sphere_outside_clip_volume(const Mat4& object_to_clip, const SampleSphere& sphere);
+
 }  // namespace patchcull

@@ -85,11 +85,13 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
     const int grid = options.ground_truth_grid;
     const std::size_t per_patch = static_cast<std::size_t>(grid) * grid;
     std::vector<Vec3> samples(n * per_patch);
+    std::vector<SampleSphere> spheres(n);
     parallel_for_ranges(n, 64, [&](std::size_t first, std::size_t last) {
         for (std::size_t p = first; p < last; ++p) {
             const PatchInfo& info = frame.info[p];
             const TangentPatches* t = info.tangent_index >= 0 ? &frame.tangents[info.tangent_index] : nullptr;
             sample_displaced_patch(frame.patches[p], t, info.uv, displacement, grid, &samples[p * per_patch]);
+            spheres[p] = bounding_sphere(&samples[p * per_patch], per_patch);
         }
     });
 
@@ -120,6 +122,7 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
             for (std::size_t p = 0; p < n; ++p) {
                 if (!culled[p]) continue;
                 ++r.culled;
+                if (sphere_outside_clip_volume(ctx.object_to_clip, spheres[p])) continue;  // exact shortcut
                 if (any_point_in_clip_volume(ctx.object_to_clip, &samples[p * per_patch], per_patch)) ++r.false_culls;
             }
         }

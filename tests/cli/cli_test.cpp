@@ -12,7 +12,7 @@
 
 namespace {
 
-struct Run {
+struct CliRun {
     int status = -1;
     std::string out, err;
 };
@@ -33,11 +33,11 @@ const std::string& scratch_dir() {
     return dir;
 }
 
-Run run(const std::string& args) {
+CliRun run(const std::string& args) {
     const std::string out = scratch_dir() + "/stdout", err = scratch_dir() + "/stderr";
     const std::string cmd = std::string(PATCHCULL_CLI) + " " + args + " >" + out + " 2>" + err + " </dev/null";
     const int raw = std::system(cmd.c_str());
-    Run r;
+    CliRun r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
     r.out = slurp(out);
     r.err = slurp(err);
@@ -53,7 +53,7 @@ std::string write_file(const std::string& name, const std::string& content) {
 }
 
 // The error must be exactly one line, name the culprit, and exit with status 2.
-void expect_one_line_error(const Run& r, const std::string& must_contain) {
+void expect_one_line_error(const CliRun& r, const std::string& must_contain) {
     EXPECT_EQ(r.status, 2) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
     ASSERT_FALSE(r.err.empty());
@@ -64,7 +64,7 @@ void expect_one_line_error(const Run& r, const std::string& must_contain) {
 }  // namespace
 
 TEST(Cli, InfoBigGuyAcc) {
-    const Run r = run("info " + model("bigguy.obj") + " --json");
+    const CliRun r = run("info " + model("bigguy.obj") + " --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["patches"], 1450);
@@ -73,7 +73,7 @@ TEST(Cli, InfoBigGuyAcc) {
 }
 
 TEST(Cli, InfoMonsterFrogSplitOnce) {
-    const Run r = run("info " + model("monsterfrog.obj") + " --scheme acc --split 1 --json");
+    const CliRun r = run("info " + model("monsterfrog.obj") + " --scheme acc --split 1 --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["patches"], 5168);
@@ -81,7 +81,7 @@ TEST(Cli, InfoMonsterFrogSplitOnce) {
 }
 
 TEST(Cli, InfoOsdScheme) {
-    const Run r = run("info " + model("bigguy.obj") + " --scheme osd --json");
+    const CliRun r = run("info " + model("bigguy.obj") + " --scheme osd --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["scheme"], "osd");
@@ -90,13 +90,13 @@ TEST(Cli, InfoOsdScheme) {
 }
 
 TEST(Cli, InfoTeapot) {
-    const Run r = run("info teapot --json");
+    const CliRun r = run("info teapot --json");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["patches"], 32);
 }
 
 TEST(Cli, CullPrintsTheContractShapeWithNoFalseCulls) {
-    const Run r = run("cull teapot --views 50 --seed 3 --view-mode free --methods frustum,frustum-disp --json");
+    const CliRun r = run("cull teapot --views 50 --seed 3 --view-mode free --methods frustum,frustum-disp --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["model"], "teapot");
@@ -116,7 +116,7 @@ TEST(Cli, CullPrintsTheContractShapeWithNoFalseCulls) {
 }
 
 TEST(Cli, CullWithProceduralDisplacementOnARealModel) {
-    const Run r = run("cull " + model("bigguy.obj") + " --views 30 --view-mode free --displace procedural "
+    const CliRun r = run("cull " + model("bigguy.obj") + " --views 30 --view-mode free --displace procedural "
                       "--displace-scale 0.5 --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);

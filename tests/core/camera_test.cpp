@@ -78,3 +78,30 @@ TEST(Camera, OrbitSequenceTurnsAroundTheObject) {
             EXPECT_TRUE(any_point_in_clip_volume(c.view_projection(), &corner, 1));
         }
 }
+
+TEST(GroundTruth, SphereShortcutNeverHidesAVisiblePoint) {
+    // For random point clouds and views: whenever the sphere test says "outside", no point may be
+    // inside; and the shortcut must fire sometimes (or it would be useless, not wrong).
+    std::uint32_t state = 12345;
+    auto next = [&state]() {
+        state = state * 1664525u + 1013904223u;
+        return (state >> 8) * (1.0f / 16777216.0f);
+    };
+    const Bounds b{{-1, -1, -1}, {1, 1, 1}};
+    ViewGenerator views(b, ViewMode::free, 3);
+    int fired = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        const Mat4 m = views.next().view_projection();
+        Vec3 pts[40];
+        const Vec3 c{4 * next() - 2, 4 * next() - 2, 4 * next() - 2};
+        const float spread = 0.5f * next();
+        for (Vec3& p : pts) p = c + Vec3{spread * (next() - 0.5f), spread * (next() - 0.5f), spread * (next() - 0.5f)};
+        const SampleSphere s = bounding_sphere(pts, 40);
+        for (const Vec3& p : pts) ASSERT_LE(length(p - s.center), s.radius);
+        if (sphere_outside_clip_volume(m, s)) {
+            ++fired;
+            ASSERT_FALSE(any_point_in_clip_volume(m, pts, 40)) << trial;
+        }
+    }
+    EXPECT_GT(fired, 500);
+}

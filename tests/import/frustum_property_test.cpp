@@ -51,7 +51,7 @@ TEST(FrustumProperty, MonsterFrogAccDisplaced) {
 TEST(FrustumProperty, BigGuyOsdDisplaced) {
     const LoadedModel m = load_model(shipped_model_path("bigguy.obj"), Scheme::osd, 0);
     const DisplacementMap d = strong_displacement(m.rest);
-    expect_conservative(m.rest, &d, ViewMode::free, 600, 31, 0.2);
+    expect_conservative(m.rest, &d, ViewMode::free, 1500, 31, 0.2);
 }
 
 TEST(FrustumProperty, TeapotWithDegeneratePatchesSplitTwice) {
