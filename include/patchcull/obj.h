@@ -1,7 +1,8 @@
 // patchcull/obj.h: a strict Wavefront OBJ reader for subdivision control meshes.
 //
 // Reads v, vt and f records (f with v, v/vt, v//vn or v/vt/vn corners, negative indices allowed);
-// ignores vn, o, g, s, usemtl, mtllib, l, comments and blank lines. Strict by design: every
+// accepts vertex weights and colours (x y z [w] or x y z r g b [a], ignored); ignores vn, o, g,
+// s, usemtl, mtllib, l, p, comments and blank lines. Strict by design: every
 // malformed number, non-finite coordinate, out-of-range index or face with fewer than 3 corners
 // is a patchcull::Error naming "file:line". (tinyobjloader, tried first, reads "abc" and "nan"
 // as 0 and only warns on out-of-range indices: a silently wrong mesh, so it is not used.)

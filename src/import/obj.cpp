@@ -109,11 +109,13 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
         if (tokens.empty()) continue;
         const std::string_view key = tokens[0];
         if (key == "v") {
-            // x y z [w]; a w weight is accepted and ignored (control meshes are polynomial).
-            if (tokens.size() < 4 || tokens.size() > 5) ctx.fail("vertex needs 3 coordinates");
+            // x y z, optionally followed by a weight w (x y z w) or a vertex colour (x y z r g b
+            // [a]); both are checked and ignored (control meshes are polynomial, colour unused).
+            const std::size_t values = tokens.size() - 1;
+            if (values != 3 && values != 4 && values != 6 && values != 7) ctx.fail("vertex needs 3 coordinates");
             mesh.positions.push_back({parse_float(tokens[1], ctx), parse_float(tokens[2], ctx),
                                       parse_float(tokens[3], ctx)});
-            if (tokens.size() == 5) parse_float(tokens[4], ctx);
+            for (std::size_t k = 4; k < tokens.size(); ++k) parse_float(tokens[k], ctx);
         } else if (key == "vt") {
             if (tokens.size() < 3 || tokens.size() > 4) ctx.fail("texture coordinate needs 2 values");
             mesh.texcoords.push_back({parse_float(tokens[1], ctx), parse_float(tokens[2], ctx)});
@@ -158,8 +160,8 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
         } else if (key == "t") {
             parse_tag(tokens, mesh, ctx);
         } else if (key == "o" || key == "g" || key == "s" || key == "usemtl" || key == "mtllib" || key == "l" ||
-                   key == "vp" || key == "cstype" || key == "deg") {
-            // Grouping, materials, lines: no effect on a control mesh.
+                   key == "p" || key == "vp" || key == "cstype" || key == "deg") {
+            // Grouping, materials, points and lines: no effect on a control mesh.
         } else {
             ctx.fail("unknown record '" + std::string(key) + "'");
         }

@@ -113,3 +113,12 @@ TEST(Obj, LoadsShippedModels) {
     EXPECT_EQ(frog.face_count(), 1292u);
     EXPECT_TRUE(frog.all_quads());
 }
+
+TEST(Obj, AcceptsVertexColoursAndPointRecords) {
+    const ControlMesh m = parse("v 0 0 0 0.5 0.4 0.3\nv 1 0 0 1 1 1 1\nv 1 1 0 1.0\np 1 2\nl 1 2\nf 1 2 3\n");
+    EXPECT_EQ(m.positions.size(), 3u);
+    EXPECT_EQ(m.positions[1].x, 1.0f);
+    EXPECT_EQ(m.face_count(), 1u);
+    EXPECT_EQ(error_of("v 0 0 0 1 nan 1\n"), "mesh.obj:1: non-finite coordinate 'nan'");
+    EXPECT_EQ(error_of("v 0 0 0 1 1\n"), "mesh.obj:1: vertex needs 3 coordinates");
+}
