@@ -5,8 +5,13 @@
 //   bicubic patch per quad, exact on regular quads; extraordinary patches also get ACC tangent
 //   patches for a continuous normal field. A mesh with non-quad faces first gets one uniform
 //   Catmull-Clark refinement (OpenSubdiv Far), so every face becomes a quad.
-// - Scheme::osd: the exact limit surface through OpenSubdiv Far feature-adaptive refinement,
-//   B-spline-basis end caps, converted to Bezier. Handles boundaries, creases, triangles, n-gons.
+// - Scheme::osd: the limit surface through OpenSubdiv Far feature-adaptive refinement
+//   (isolation level 2), B-spline-basis end caps, converted to Bezier. Exact everywhere except
+//   the end caps next to extraordinary vertices, which are OpenSubdiv's own B-spline
+//   approximation (about 0.15% of the model's radius at level 2; our patches equal OpenSubdiv's
+//   evaluation of them to float precision). Handles boundaries, creases, triangles, n-gons.
+//   PatchInfo::extraordinary marks every patch that is not one regular patch covering a whole
+//   base quad (patches from adaptive isolation, including the end caps).
 //
 // Both schemes are linear in the control-mesh positions, so a model stores each Bezier control
 // point as a stencil (weighted sum of control vertices). Animation deforms the control mesh and
