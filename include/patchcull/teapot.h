@@ -10,7 +10,8 @@
 
 namespace patchcull {
 
-/// The 32 patches (rim, body, lid, handle, spout, bottom), z up as in Newell's data, w = 1.
+/// The 32 patches in the data set's order: rim 0-3, body 4-11, handle 12-15, spout 16-19,
+/// lid knob 20-23, lid 24-27, bottom 28-31; z up as in Newell's data, w = 1, du x dv outward.
 std::vector<BezierPatch> teapot_patches();
 
 }  // namespace patchcull
