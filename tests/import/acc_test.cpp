@@ -333,7 +333,7 @@ TEST_P(AccModels, CornersAreLimitPositionsAndTangentNormalsAreLimitNormals) {
     const float radius = compute_bounds(mesh.positions).radius();
 
     float max_pos = 0, max_angle = 0;
-    std::size_t normals = 0;
+    std::size_t normals = 0, same_sense = 0;
     for (std::size_t p = 0; p < model.patch_count(); ++p) {
         const std::uint32_t f = model.patches[p].base_face;
         for (int q = 0; q < 4; ++q) {
@@ -346,6 +346,7 @@ TEST_P(AccModels, CornersAreLimitPositionsAndTangentNormalsAreLimitNormals) {
             // ours faces outwards below.
             const float a = angle_between(n, limit.normal[v]);
             max_angle = std::max(max_angle, std::min(a, 3.14159265f - a));
+            same_sense += dot(n, limit.normal[v]) > 0;
             ++normals;
         }
     }
@@ -354,6 +355,7 @@ TEST_P(AccModels, CornersAreLimitPositionsAndTangentNormalsAreLimitNormals) {
     EXPECT_LT(max_pos, 1e-6f * radius);
     EXPECT_GT(normals, 0u);
     EXPECT_LT(max_angle, 1e-4f) << "tangent-patch normal at a corner must be the limit normal";
+    EXPECT_TRUE(same_sense == 0 || same_sense == normals) << "normals must agree with OpenSubdiv's in sense everywhere";
 }
 
 TEST_P(AccModels, NormalsFaceOutwardsAndTexcoordsFollowCorners) {
@@ -617,4 +619,35 @@ TEST(Acc, AnimatedPositionsMoveThePatchesLinearly) {
             EXPECT_LT(length(b.tangents[t].du[k] - a.tangents[t].du[k]), 1e-5f);
             EXPECT_LT(length(b.tangents[t].dv[k] - a.tangents[t].dv[k]), 1e-5f);
         }
+}
+
+TEST(Acc, SmallClosedMeshes) {
+    // Cube: every vertex has valence 3, so every patch is extraordinary at all four corners.
+    const ControlMesh cube = make_mesh("cube", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},
+                                       {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}});
+    const SubdivisionModel model = build_acc_model(cube);
+    EXPECT_EQ(model.extraordinary_count(), 6u);
+    const PatchFrame frame = evaluate(model);
+    const SeamReport r = seams(model, frame);
+    EXPECT_EQ(r.edges, 12u);
+    EXPECT_LT(r.max_gap, 1e-6f);
+    EXPECT_LT(r.max_normal_angle, 2e-4f);
+    const VertexLimit limit = osd_vertex_limits(cube);
+    for (std::size_t p = 0; p < 6; ++p)
+        for (int q = 0; q < 4; ++q) {
+            const std::uint32_t v = cube.face_vertices[4 * p + q];
+            EXPECT_LT(length(xyz(frame.patches[p].cp[kCornerCp[q]]) - limit.position[v]), 1e-6f);
+            const Vec3 n = patch_normal(frame, p, kCornerU[q], kCornerV[q]);
+            EXPECT_GT(dot(n, limit.position[v] - Vec3{0.5f, 0.5f, 0.5f}), 0.0f);  // outwards
+            EXPECT_LT(angle_between(n, limit.position[v] - Vec3{0.5f, 0.5f, 0.5f}), 1e-4f);  // symmetric cube
+        }
+
+    // Pillow: two quads on the same four edges, valence-2 vertices. Degenerate, but builds finite
+    // points (the tangent-patch normal may vanish at the valence-2 corners, which patch.h allows).
+    const ControlMesh pillow = make_mesh("pillow", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 1, 2, 3}, {3, 2, 1, 0}});
+    const PatchFrame pf = evaluate(build_acc_model(pillow));
+    for (const BezierPatch& p : pf.patches)
+        for (const Vec4& c : p.cp) EXPECT_TRUE(is_finite(xyz(c)));
+    for (const TangentPatches& t : pf.tangents)
+        for (int k = 0; k < 12; ++k) EXPECT_TRUE(is_finite(t.du[k]) && is_finite(t.dv[k]));
 }
