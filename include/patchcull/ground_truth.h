@@ -26,6 +26,28 @@ void sample_displaced_patch(const BezierPatch& patch, const TangentPatches* tang
 /// 0<=z<=w, w>0), evaluated in double precision.
 bool any_point_in_clip_volume(const Mat4& object_to_clip, const Vec3* points, std::size_t count);
 
+// ---- back-facing ground truth (seed 001) --------------------------------------------------
+
+/// A homogeneous plane in double precision.
+struct PlaneD {
+    double x = 0, y = 0, z = 0, w = 0;
+};
+
+/// Parametric tangent planes T(u,v) = cross4(B, B_u, B_v) (object space; seed 001 eq. 1) of the
+/// patch at a grid x grid lattice (row v, column u), computed directly in double precision.
+/// For a polynomial patch T = (n, -n.p) with n = B_u x B_v, so e . T = n . (e - p).
+void sample_tangent_planes(const BezierPatch& patch, int grid, PlaneD* out);
+
+/// True when some sampled tangent plane faces the eye: e . T > tolerance, where the tolerance
+/// (1e-5 relative to |T.xyz| (|e| + |T.w|/|T.xyz|)) absorbs the float rounding of the kernels.
+/// A culled patch with a facing sample is a false back-patch cull.
+bool any_plane_faces_eye(const PlaneD* planes, std::size_t count, Vec3 eye);
+
+/// True when some triangle of the uniform level-(grid-1) tessellation of the grid of surface
+/// points (row v, column u) faces the eye. Both diagonals of every cell are tried, so the result
+/// holds whatever triangulation the tessellator picks. Double precision, same tolerance rule.
+bool any_tessellation_triangle_faces_eye(const Vec3* grid_points, int grid, Vec3 eye);
+
 /// A sphere holding a set of points (not the smallest one; any holding sphere is exact for the
 /// test below).
 struct SampleSphere {

@@ -39,6 +39,94 @@ bool any_point_in_clip_volume(const Mat4& m, const Vec3* points, std::size_t cou
     return false;
 }
 
+namespace {
+
+struct V4 {
+    double x, y, z, w;
+};
+
+double det3(double a0, double a1, double a2, double b0, double b1, double b2, double c0, double c1, double c2) {
+    return a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0);
+}
+
+// cross4 of seed 001 Appendix A: the plane through homogeneous points a, b, c (rows are the
+// components, columns the points).
+PlaneD cross4(const V4& a, const V4& b, const V4& c) {
+    return {det3(a.y, b.y, c.y, a.z, b.z, c.z, a.w, b.w, c.w), -det3(a.x, b.x, c.x, a.z, b.z, c.z, a.w, b.w, c.w),
+            det3(a.x, b.x, c.x, a.y, b.y, c.y, a.w, b.w, c.w), -det3(a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z)};
+}
+
+void bernstein3d(double t, double b[4], double d[4]) {
+    const double s = 1 - t;
+    b[0] = s * s * s;
+    b[1] = 3 * t * s * s;
+    b[2] = 3 * t * t * s;
+    b[3] = t * t * t;
+    d[0] = -3 * s * s;
+    d[1] = 3 * s * s - 6 * t * s;
+    d[2] = 6 * t * s - 3 * t * t;
+    d[3] = 3 * t * t;
+}
+
+double facing_tolerance(double nx, double ny, double nz, double nw, Vec3 eye) {
+    const double n = std::sqrt(nx * nx + ny * ny + nz * nz);
+    const double e = std::sqrt(double(eye.x) * eye.x + double(eye.y) * eye.y + double(eye.z) * eye.z);
+    return 1e-5 * (n * e + std::abs(nw));
+}
+
+}  // namespace
+
+void sample_tangent_planes(const BezierPatch& patch, int grid, PlaneD* out) {
+    for (int j = 0; j < grid; ++j)
+        for (int i = 0; i < grid; ++i) {
+            const double u = grid > 1 ? double(i) / (grid - 1) : 0.5, v = grid > 1 ? double(j) / (grid - 1) : 0.5;
+            double bu[4], du[4], bv[4], dv[4];
+            bernstein3d(u, bu, du);
+            bernstein3d(v, bv, dv);
+            V4 p{0, 0, 0, 0}, pu{0, 0, 0, 0}, pv{0, 0, 0, 0};
+            for (int b = 0; b < 4; ++b)
+                for (int a = 0; a < 4; ++a) {
+                    const Vec4 c = patch.cp[4 * b + a];
+                    const double w0 = bu[a] * bv[b], w1 = du[a] * bv[b], w2 = bu[a] * dv[b];
+                    p = {p.x + w0 * c.x, p.y + w0 * c.y, p.z + w0 * c.z, p.w + w0 * c.w};
+                    pu = {pu.x + w1 * c.x, pu.y + w1 * c.y, pu.z + w1 * c.z, pu.w + w1 * c.w};
+                    pv = {pv.x + w2 * c.x, pv.y + w2 * c.y, pv.z + w2 * c.z, pv.w + w2 * c.w};
+                }
+            out[j * grid + i] = cross4(p, pu, pv);
+        }
+}
+
+bool any_plane_faces_eye(const PlaneD* planes, std::size_t count, Vec3 eye) {
+    for (std::size_t k = 0; k < count; ++k) {
+        const PlaneD& t = planes[k];
+        const double value = t.x * eye.x + t.y * eye.y + t.z * eye.z + t.w;
+        if (value > 0 && value > facing_tolerance(t.x, t.y, t.z, t.w, eye)) return true;
+    }
+    return false;
+}
+
+bool any_tessellation_triangle_faces_eye(const Vec3* pts, int grid, Vec3 eye) {
+    auto faces = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+        const double e1[3] = {double(b.x) - a.x, double(b.y) - a.y, double(b.z) - a.z};
+        const double e2[3] = {double(c.x) - a.x, double(c.y) - a.y, double(c.z) - a.z};
+        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        const double value = n[0] * (eye.x - double(a.x)) + n[1] * (eye.y - double(a.y)) + n[2] * (eye.z - double(a.z));
+        const double nw = n[0] * a.x + n[1] * a.y + n[2] * a.z;
+        return value > 0 && value > facing_tolerance(n[0], n[1], n[2], nw, eye);
+    };
+    for (int j = 0; j + 1 < grid; ++j)
+        for (int i = 0; i + 1 < grid; ++i) {
+            const Vec3& p00 = pts[j * grid + i];
+            const Vec3& p10 = pts[j * grid + i + 1];
+            const Vec3& p01 = pts[(j + 1) * grid + i];
+            const Vec3& p11 = pts[(j + 1) * grid + i + 1];
+            // Counter-clockwise in (u,v), so a front face has its normal along du x dv.
+            if (faces(p00, p10, p11) || faces(p00, p11, p01) || faces(p00, p10, p01) || faces(p10, p11, p01))
+                return true;
+        }
+    return false;
+}
+
 SampleSphere bounding_sphere(const Vec3* points, std::size_t count) {
     SampleSphere s;
     if (count == 0) return s;

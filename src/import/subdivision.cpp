@@ -31,9 +31,16 @@ void PointStencils::add_row(const std::vector<std::pair<std::uint32_t, float>>& 
 void PointStencils::apply(const Vec3* vertices, Vec3* out) const {
     const std::size_t n = rows();
     for (std::size_t r = 0; r < n; ++r) {
-        Vec3 p{};
-        for (std::uint32_t k = offsets[r]; k < offsets[r + 1]; ++k) p += vertices[indices[k]] * weights[k];
-        out[r] = p;
+        // Double accumulation: extraordinary stencils have dozens of terms of both signs.
+        double x = 0, y = 0, z = 0;
+        for (std::uint32_t k = offsets[r]; k < offsets[r + 1]; ++k) {
+            const Vec3 v = vertices[indices[k]];
+            const double w = weights[k];
+            x += w * v.x;
+            y += w * v.y;
+            z += w * v.z;
+        }
+        out[r] = {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)};
     }
 }
 
