@@ -1,0 +1,4 @@
+// Entry point of patchcull_bench: every bench/*.cpp registers its benchmarks; this runs them.
+#include <benchmark/benchmark.h>
+
+BENCHMARK_MAIN();

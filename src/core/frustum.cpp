@@ -1,0 +1,150 @@
+// View-frustum cull kernels: plane extraction and the scalar reference kernels
+// (patchcull/frustum.h). The SIMD kernels live in frustum_simd.cpp.
+//
+// Bit-exact agreement with the SIMD kernels (tests/core/frustum_test.cpp) rests on three rules
+// that both files follow operation by operation:
+// - every multiply-add the SIMD code does with MulAdd is std::fma here (one rounding); every
+//   other product and sum is a separate, individually rounded operation (the build uses ISO C++
+//   mode, where GCC does not contract a*b+c on its own);
+// - min/max are written as `a < b ? a : b` / `a > b ? a : b`, which is what x86 minps/maxps
+//   (Highway Min/Max) return for every input, signed zeros included;
+// - the same order of accumulation (points 0..15, planes 0..5, corners in the same order).
+// Decisions only look at the sign of the final values (< 0), so they are identical.
+#include "patchcull/frustum.h"
+
+#include <cmath>
+#include <limits>
+
+// The reference uses std::fma. Compiled for the x86-64 baseline that is a call into libm per
+// multiply-add, which would make the reference look ~10x slower than it is. On GCC/Clang for
+// x86-64 a second clone of each scalar kernel is compiled with FMA enabled (std::fma becomes one
+// vfmadd instruction) and picked once at load time (ifunc). Results are identical by definition:
+// fma is exactly rounded either way.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__SANITIZE_ADDRESS__)
+#define PATCHCULL_SCALAR_CLONES __attribute__((target_clones("fma", "default")))
+#else
+#define PATCHCULL_SCALAR_CLONES
+#endif
+
+namespace patchcull {
+namespace {
+
+inline float min_like_simd(float a, float b) { return a < b ? a : b; }
+inline float max_like_simd(float a, float b) { return a > b ? a : b; }
+
+// Index of component c of control point k (frustum.h / patch.h layout).
+inline const float* comp(const PatchBatchView& v, int k, int c) { return v.component(k, c); }
+
+}  // namespace
+
+FrustumPlanes make_frustum_planes(const Mat4& object_to_clip) {
+    const Vec4 x = object_to_clip.row(0);
+    const Vec4 y = object_to_clip.row(1);
+    const Vec4 z = object_to_clip.row(2);
+    const Vec4 w = object_to_clip.row(3);
+    FrustumPlanes planes;
+    planes.rows[0] = w + x;  // left:   w + x >= 0
+    planes.rows[1] = w - x;  // right:  w - x >= 0
+    planes.rows[2] = w + y;  // bottom: w + y >= 0
+    planes.rows[3] = w - y;  // top:    w - y >= 0
+    planes.rows[4] = z;      // near:   z >= 0
+    planes.rows[5] = w - z;  // far:    w - z >= 0
+    for (int q = 0; q < 6; ++q) {
+        const Vec4 r = planes.rows[q];
+        const double xx = r.x, yy = r.y, zz = r.z;
+        planes.normal_length[q] = static_cast<float>(std::sqrt(xx * xx + yy * yy + zz * zz));
+    }
+    return planes;
+}
+
+// frustum: culled when, for some plane q, every control point P_k has
+//   value = ((r.x*X + r.y*Y) + r.z*Z) + c*W < 0,  c = fma(D, |r.xyz|, r.w)
+// i.e. dot(r, P_k) + W_k * D * |r.xyz| < 0 (the margin scaled by the point's weight). Evaluated
+// as mul, fma, fma, fma (the SIMD kernel does exactly this).
+PATCHCULL_SCALAR_CLONES
+void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement,
+                         const FrustumPlanes& planes, std::uint8_t* culled) {
+    for (std::size_t p = 0; p < patches.count; ++p) {
+        const float d = max_displacement ? max_displacement[p] : 0.0f;
+        float c[6], mx[6];
+        for (int q = 0; q < 6; ++q) {
+            c[q] = std::fma(d, planes.normal_length[q], planes.rows[q].w);
+            mx[q] = -std::numeric_limits<float>::infinity();
+        }
+        for (int k = 0; k < kPatchPoints; ++k) {
+            const float X = comp(patches, k, 0)[p];
+            const float Y = comp(patches, k, 1)[p];
+            const float Z = comp(patches, k, 2)[p];
+            const float W = comp(patches, k, 3)[p];
+            for (int q = 0; q < 6; ++q) {
+                const Vec4 r = planes.rows[q];
+                float v = r.x * X;
+                v = std::fma(r.y, Y, v);
+                v = std::fma(r.z, Z, v);
+                v = std::fma(c[q], W, v);
+                mx[q] = max_like_simd(mx[q], v);
+            }
+        }
+        bool out = false;
+        for (int q = 0; q < 6; ++q) out |= mx[q] < 0.0f;
+        culled[p] = out ? 1 : 0;
+    }
+}
+
+// frustum-disp: AABB of the Cartesian control points (X/W, Y/W, Z/W, exact IEEE division),
+// grown by D on every side; the 8 corners go to clip space with
+//   clip_r = fma(m(r,0), x, fma(m(r,1), y, fma(m(r,2), z, m(r,3))))
+// and the patch is culled when all 8 corners fail the same clip-plane inequality.
+PATCHCULL_SCALAR_CLONES
+void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement,
+                              const Mat4& object_to_clip, std::uint8_t* culled) {
+    const Mat4& m = object_to_clip;
+    for (std::size_t p = 0; p < patches.count; ++p) {
+        const float d = max_displacement ? max_displacement[p] : 0.0f;
+        float lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) lo[a] = hi[a] = comp(patches, 0, a)[p] / comp(patches, 0, 3)[p];
+        for (int k = 1; k < kPatchPoints; ++k) {
+            const float W = comp(patches, k, 3)[p];
+            for (int a = 0; a < 3; ++a) {
+                const float v = comp(patches, k, a)[p] / W;
+                lo[a] = min_like_simd(lo[a], v);
+                hi[a] = max_like_simd(hi[a], v);
+            }
+        }
+        float box[3][2];  // [axis][0 = low, 1 = high]
+        for (int a = 0; a < 3; ++a) {
+            box[a][0] = lo[a] - d;
+            box[a][1] = hi[a] + d;
+        }
+        // Corner index i*4 + j*2 + s: x from box[0][i], y from box[1][j], z from box[2][s].
+        float clip[4][8];
+        for (int r = 0; r < 4; ++r) {
+            float tz[2], tyz[4];
+            for (int s = 0; s < 2; ++s) tz[s] = std::fma(m.at(r, 2), box[2][s], m.at(r, 3));
+            for (int j = 0; j < 2; ++j)
+                for (int s = 0; s < 2; ++s) tyz[j * 2 + s] = std::fma(m.at(r, 1), box[1][j], tz[s]);
+            for (int i = 0; i < 2; ++i)
+                for (int js = 0; js < 4; ++js) clip[r][i * 4 + js] = std::fma(m.at(r, 0), box[0][i], tyz[js]);
+        }
+        auto plane_values = [&clip](int corner, float v[6]) {
+            const float cx = clip[0][corner], cy = clip[1][corner], cz = clip[2][corner], cw = clip[3][corner];
+            v[0] = cw + cx;
+            v[1] = cw - cx;
+            v[2] = cw + cy;
+            v[3] = cw - cy;
+            v[4] = cz;
+            v[5] = cw - cz;
+        };
+        float mx[6], v[6];
+        plane_values(0, mx);
+        for (int corner = 1; corner < 8; ++corner) {
+            plane_values(corner, v);
+            for (int q = 0; q < 6; ++q) mx[q] = max_like_simd(mx[q], v[q]);
+        }
+        bool out = false;
+        for (int q = 0; q < 6; ++q) out |= mx[q] < 0.0f;
+        culled[p] = out ? 1 : 0;
+    }
+}
+
+}  // namespace patchcull
