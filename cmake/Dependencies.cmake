@@ -24,3 +24,11 @@ endif()
 if(PATCHCULL_BUILD_BENCHMARKS)
   find_package(benchmark REQUIRED)
 endif()
+
+# OpenGL renderer (src/gl): EGL + GL through libepoxy (which loads libEGL/libOpenGL at run time;
+# find_package(OpenGL) checks that the GL/EGL development packages are installed), shaders
+# validated at build time with glslangValidator.
+find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL)
+pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
+add_library(PatchcullDeps::epoxy ALIAS PkgConfig::EPOXY)
+find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)

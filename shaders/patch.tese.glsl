@@ -1,0 +1,70 @@
+// Patch tessellation evaluation shader: evaluates the bicubic (rational) Bezier patch at the
+// tessellator's (u, v), control point (i, j) = tcs_point[4*j + i] (patch.h), and optionally
+// displaces it along the unit normal by D(s,t) = scale * (h(s,t) - midlevel) from the height map,
+// (s,t) interpolated bilinearly from the patch's corner texcoords (displacement.h).
+#version 450 core
+#include "shared.h"
+
+layout(quads, equal_spacing, ccw) in;
+
+layout(std430, binding = kBindingPatchTexcoords) readonly buffer PatchTexcoords {
+    vec2 patch_texcoords[];  // 4 per patch: (u,v) = (0,0), (1,0), (0,1), (1,1)
+};
+
+uniform mat4 u_object_to_clip;
+uniform bool u_displace;
+uniform float u_displacement_scale;
+uniform float u_displacement_midlevel;
+layout(binding = kTextureUnitDisplacement) uniform sampler2D u_displacement_map;
+
+in vec4 tcs_point[];
+patch in uint tcs_patch;
+
+out vec3 tes_position;  // object space, displaced
+out vec3 tes_normal;    // object space, unnormalized (zero at degenerate points)
+flat out uint tes_patch;
+
+void bernstein(float t, out vec4 b, out vec4 db) {
+    const float s = 1.0 - t;
+    b = vec4(s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t);
+    db = vec4(-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t);
+}
+
+void main() {
+    const float u = gl_TessCoord.x;
+    const float v = gl_TessCoord.y;
+    vec4 bu, dbu, bv, dbv;
+    bernstein(u, bu, dbu);
+    bernstein(v, bv, dbv);
+
+    vec4 h = vec4(0.0), hu = vec4(0.0), hv = vec4(0.0);
+    for (int j = 0; j < 4; ++j) {
+        vec4 row = vec4(0.0), row_du = vec4(0.0);
+        for (int i = 0; i < 4; ++i) {
+            row += bu[i] * tcs_point[4 * j + i];
+            row_du += dbu[i] * tcs_point[4 * j + i];
+        }
+        h += bv[j] * row;
+        hu += bv[j] * row_du;
+        hv += dbv[j] * row;
+    }
+    // Cartesian position and derivatives (quotient rule for rational patches, weights > 0).
+    const vec3 p = h.xyz / h.w;
+    const vec3 pu = (hu.xyz - p * hu.w) / h.w;
+    const vec3 pv = (hv.xyz - p * hv.w) / h.w;
+    const vec3 n = cross(pu, pv);
+    const float len = length(n);
+
+    vec3 position = p;
+    if (u_displace && len > 0.0) {
+        const uint base = 4u * tcs_patch;
+        const vec2 st = mix(mix(patch_texcoords[base], patch_texcoords[base + 1u], u),
+                            mix(patch_texcoords[base + 2u], patch_texcoords[base + 3u], u), v);
+        const float height = texture(u_displacement_map, st).r;
+        position += (u_displacement_scale * (height - u_displacement_midlevel) / len) * n;
+    }
+    tes_position = position;
+    tes_normal = n;
+    tes_patch = tcs_patch;
+    gl_Position = u_object_to_clip * vec4(position, 1.0);
+}

@@ -1,0 +1,199 @@
+// Headless EGL context (patchcull/gl_renderer.h: GlContext).
+//
+// libepoxy dispatches EGL and GL; it loads libEGL.so.1 and libOpenGL.so.0 / libGL.so.1 at run
+// time, and aborts the process when they are missing, so create_headless() dlopen()s them first
+// and throws a one-line patchcull::Error instead. EGL extension entry points come from
+// eglGetProcAddress: with libepoxy, calling eglGetPlatformDisplay(EXT) through its dispatch before
+// any display exists aborts (../shared/PLATFORM.md).
+#include <dlfcn.h>
+#include <epoxy/egl.h>
+#include <epoxy/gl.h>
+
+#include <cstdio>
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "patchcull/error.h"
+#include "patchcull/gl_renderer.h"
+
+namespace patchcull::gl {
+
+struct GlContext::Impl {
+    EGLDisplay display = EGL_NO_DISPLAY;
+    EGLContext context = EGL_NO_CONTEXT;
+    std::string renderer, vendor, version, platform;
+    bool software = false;
+    ~Impl();
+};
+
+namespace {
+
+// EGL displays are process-wide and eglTerminate ends every context on one: count our users.
+std::mutex g_display_mutex;
+std::map<EGLDisplay, int> g_display_users;
+
+void acquire_display(EGLDisplay d) {
+    std::lock_guard<std::mutex> lock(g_display_mutex);
+    ++g_display_users[d];
+}
+void release_display(EGLDisplay d) {
+    std::lock_guard<std::mutex> lock(g_display_mutex);
+    if (--g_display_users[d] == 0) {
+        g_display_users.erase(d);
+        eglTerminate(d);
+    }
+}
+
+std::string hex(unsigned value) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "0x%04X", value);
+    return buf;
+}
+
+bool has_extension(const char* list, const char* name) {
+    if (!list) return false;
+    const std::string s = std::string(" ") + list + " ";
+    return s.find(std::string(" ") + name + " ") != std::string::npos;
+}
+
+void require_library(const char* const* names, const char* what) {
+    for (const char* const* n = names; *n; ++n)
+        if (dlopen(*n, RTLD_LAZY | RTLD_GLOBAL)) return;
+    throw Error(std::string("EGL: no display: cannot load ") + what + " (" + names[0] +
+                "; install libegl1 libopengl0 and Mesa's libegl-mesa0 libgl1-mesa-dri)");
+}
+
+struct Candidate {
+    EGLenum platform;
+    void* native;
+    std::string name;  // "device", "surfaceless", "software-device"
+    std::string label; // for messages
+};
+
+// Tries to make a GL 4.5 core context on candidate c; returns an empty string on success (and
+// fills impl), else the reason.
+std::string try_candidate(const Candidate& c, PFNEGLGETPLATFORMDISPLAYEXTPROC get_platform_display,
+                          GlContext::Impl& impl) {
+    EGLDisplay display = get_platform_display(c.platform, c.native, nullptr);
+    if (display == EGL_NO_DISPLAY) return c.label + ": eglGetPlatformDisplayEXT failed (" + hex(eglGetError()) + ")";
+    EGLint major = 0, minor = 0;
+    if (!eglInitialize(display, &major, &minor))
+        return c.label + ": eglInitialize failed (" + hex(eglGetError()) + ")";
+    acquire_display(display);
+    auto fail = [&](const std::string& why) {
+        release_display(display);
+        return c.label + ": " + why + " (" + hex(eglGetError()) + ")";
+    };
+    const char* exts = eglQueryString(display, EGL_EXTENSIONS);
+    if (!has_extension(exts, "EGL_KHR_surfaceless_context")) return fail("no EGL_KHR_surfaceless_context");
+    if (!eglBindAPI(EGL_OPENGL_API)) return fail("eglBindAPI(EGL_OPENGL_API) failed");
+    EGLConfig config = EGL_NO_CONFIG_KHR;
+    if (!has_extension(exts, "EGL_KHR_no_config_context") && !has_extension(exts, "EGL_MESA_configless_context")) {
+        const EGLint attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
+        EGLint n = 0;
+        if (!eglChooseConfig(display, attribs, &config, 1, &n) || n < 1) return fail("no OpenGL EGLConfig");
+    }
+    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
+                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, ctx_attribs);
+    if (context == EGL_NO_CONTEXT) return fail("no OpenGL 4.5 core context");
+    if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)) {
+        eglDestroyContext(display, context);
+        return fail("eglMakeCurrent failed");
+    }
+    if (epoxy_gl_version() < 45) {
+        eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        eglDestroyContext(display, context);
+        return fail("context is not OpenGL 4.5");
+    }
+    auto str = [](GLenum e) {
+        const GLubyte* s = glGetString(e);
+        return s ? std::string(reinterpret_cast<const char*>(s)) : std::string();
+    };
+    impl.display = display;
+    impl.context = context;
+    impl.renderer = str(GL_RENDERER);
+    impl.vendor = str(GL_VENDOR);
+    impl.version = str(GL_VERSION);
+    impl.platform = c.name;
+    impl.software = impl.renderer.find("llvmpipe") != std::string::npos ||
+                    impl.renderer.find("softpipe") != std::string::npos ||
+                    impl.renderer.find("swrast") != std::string::npos;
+    return {};
+}
+
+}  // namespace
+
+GlContext::Impl::~Impl() {
+    if (context != EGL_NO_CONTEXT) {
+        if (eglGetCurrentContext() == context) eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        eglDestroyContext(display, context);
+    }
+    if (display != EGL_NO_DISPLAY) release_display(display);
+}
+
+GlContext GlContext::create_headless() {
+    static const char* const egl_names[] = {"libEGL.so.1", "libEGL.so", nullptr};
+    static const char* const gl_names[] = {"libOpenGL.so.0", "libGL.so.1", "libOpenGL.so", "libGL.so", nullptr};
+    require_library(egl_names, "the EGL library");
+    require_library(gl_names, "the OpenGL library");
+
+    const char* client_exts = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
+        eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (!client_exts || !get_platform_display || !has_extension(client_exts, "EGL_EXT_platform_base"))
+        throw Error("EGL: no display: EGL_EXT_platform_base is missing (no EGL vendor library installed?)");
+
+    std::vector<Candidate> hardware, software;
+    if (has_extension(client_exts, "EGL_EXT_platform_device")) {
+        auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+        auto query_string =
+            reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+        EGLint n = 0;
+        if (query_devices && query_string && query_devices(0, nullptr, &n) && n > 0) {
+            std::vector<EGLDeviceEXT> devices(static_cast<std::size_t>(n));
+            query_devices(n, devices.data(), &n);
+            for (EGLint i = 0; i < n; ++i) {
+                const char* dev_exts = query_string(devices[i], EGL_EXTENSIONS);
+                const bool soft = has_extension(dev_exts, "EGL_MESA_device_software");
+                Candidate c{EGL_PLATFORM_DEVICE_EXT, devices[i], soft ? "software-device" : "device",
+                            std::string(soft ? "software device " : "device ") + std::to_string(i)};
+                (soft ? software : hardware).push_back(c);
+            }
+        }
+    }
+    std::vector<Candidate> candidates = hardware;
+    if (has_extension(client_exts, "EGL_MESA_platform_surfaceless"))
+        candidates.push_back({EGL_PLATFORM_SURFACELESS_MESA, nullptr, "surfaceless", "surfaceless"});
+    candidates.insert(candidates.end(), software.begin(), software.end());
+    if (candidates.empty())
+        throw Error("EGL: no display: neither EGL_EXT_platform_device nor EGL_MESA_platform_surfaceless is available");
+
+    std::string reasons;
+    for (const Candidate& c : candidates) {
+        auto impl = std::make_unique<Impl>();
+        const std::string why = try_candidate(c, get_platform_display, *impl);
+        if (why.empty()) return GlContext(std::move(impl));
+        reasons += (reasons.empty() ? "" : "; ") + why;
+    }
+    throw Error("EGL: no OpenGL 4.5 core context: " + reasons);
+}
+
+GlContext::GlContext(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+GlContext::GlContext(GlContext&&) noexcept = default;
+GlContext& GlContext::operator=(GlContext&&) noexcept = default;
+GlContext::~GlContext() = default;
+
+void GlContext::make_current() const {
+    if (!eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context))
+        throw Error("EGL: eglMakeCurrent failed (" + hex(eglGetError()) + ")");
+}
+const std::string& GlContext::renderer() const { return impl_->renderer; }
+const std::string& GlContext::vendor() const { return impl_->vendor; }
+const std::string& GlContext::version() const { return impl_->version; }
+const std::string& GlContext::platform() const { return impl_->platform; }
+bool GlContext::is_software() const { return impl_->software; }
+
+}  // namespace patchcull::gl

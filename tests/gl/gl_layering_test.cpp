@@ -1,0 +1,36 @@
+// DESIGN.md's layering for the renderer: src/gl uses public headers (and its own files, the shared
+// shader header), never src/import or src/eval internals; shaders are real files, not C++ strings.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+
+namespace fs = std::filesystem;
+
+TEST(GlLayering, RendererUsesOnlyPublicHeadersAndItsOwnFiles) {
+    const std::regex include_re(R"(^\s*#\s*include\s*[<"]([^>"]+)[>"])");
+    std::size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(fs::path(PATCHCULL_SOURCE_DIR) / "src/gl")) {
+        if (!entry.is_regular_file() || entry.path().extension() == ".txt") continue;
+        ++files;
+        std::ifstream in(entry.path());
+        std::string line;
+        std::smatch m;
+        while (std::getline(in, line)) {
+            if (!std::regex_search(line, m, include_re)) continue;
+            const std::string inc = m[1];
+            EXPECT_EQ(inc.find("import"), std::string::npos) << entry.path() << " includes " << inc;
+            EXPECT_EQ(inc.find("eval"), std::string::npos) << entry.path() << " includes " << inc;
+            EXPECT_EQ(inc.find("topology"), std::string::npos) << entry.path() << " includes " << inc;
+            EXPECT_EQ(inc.find("opensubdiv"), std::string::npos) << entry.path() << " includes " << inc;
+            EXPECT_EQ(inc.find("../"), std::string::npos) << entry.path() << " includes " << inc;
+        }
+        // No GLSL embedded as string literals in the sources: shaders live in shaders/*.glsl.
+        std::ifstream again(entry.path());
+        const std::string text((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
+        EXPECT_EQ(text.find("#version 4"), std::string::npos) << entry.path();
+    }
+    EXPECT_GE(files, 3u);
+}

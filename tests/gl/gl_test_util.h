@@ -1,0 +1,51 @@
+// Helpers shared by the OpenGL tests: one headless context per test process, the teapot split into
+// small patches, and id-buffer summaries.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <set>
+#include <vector>
+
+#include "patchcull/gl_renderer.h"
+#include "patchcull/mesh.h"
+#include "patchcull/patch.h"
+#include "patchcull/teapot.h"
+
+namespace patchcull::gl::test {
+
+/// The process's context (created on first use, on the calling thread). Creation failing is a
+/// test failure, not a skip: the platform guarantees Mesa's llvmpipe (../shared/PLATFORM.md).
+inline GlContext& context() {
+    static GlContext ctx = GlContext::create_headless();
+    return ctx;
+}
+
+/// The teapot's 32 patches after `levels` 1-to-4 splits (32 * 4^levels patches).
+inline std::vector<BezierPatch> split_teapot(int levels) {
+    std::vector<BezierPatch> patches = teapot_patches();
+    for (int l = 0; l < levels; ++l) {
+        std::vector<BezierPatch> next(patches.size() * 4);
+        for (std::size_t i = 0; i < patches.size(); ++i) split_patch(patches[i], &next[4 * i]);
+        patches.swap(next);
+    }
+    return patches;
+}
+
+inline Bounds control_point_bounds(const std::vector<BezierPatch>& patches) {
+    std::vector<Vec3> points;
+    for (const BezierPatch& p : patches)
+        for (const Vec4& c : p.cp) points.push_back(cartesian(c));
+    return compute_bounds(points);
+}
+
+/// Distinct non-background ids in an id buffer.
+inline std::set<std::uint32_t> ids_present(const std::vector<std::uint32_t>& ids) {
+    std::set<std::uint32_t> s;
+    for (std::uint32_t id : ids)
+        if (id != 0) s.insert(id);
+    return s;
+}
+
+}  // namespace patchcull::gl::test
