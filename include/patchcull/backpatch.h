@@ -12,7 +12,9 @@
 //   Both cone tests are made conservative for a perspective eye and a patch of finite extent:
 //   with the patch inside a sphere (c, r) and d = e - c, the directions e - p (p on the patch)
 //   lie within angle beta = asin(r/|d|) of d, so the patch is back-facing when
-//   angle(a, d) >= 90deg + alpha + beta, i.e. |d| > r and a . d/|d| <= -sin(alpha + beta).
+//   angle(a, d) >= 90deg + alpha + beta, i.e. |d| > r, alpha + beta <= 90deg and
+//   a . d/|d| <= -sin(alpha + beta). (Without the alpha + beta <= 90deg condition the last
+//   inequality also holds for facing patches: alpha = beta = 80deg, angle(a, d) = 175deg.)
 //   Cones apply to polynomial patches (all w = 1); a rational patch is never culled by them.
 // - ptp (seed 001 §3-6): the 8x8 Bezier control planes of T, from the 516 weighted cross4
 //   products of the clip-space control points, evaluated as z components only (cross4Z). With
