@@ -18,9 +18,12 @@
 //   Cones apply to polynomial patches (all w = 1); a rational patch is never culled by them.
 // - ptp (seed 001 §3-6): the 8x8 Bezier control planes of T, from the 516 weighted cross4
 //   products of the clip-space control points, evaluated as z components only (cross4Z). With
-//   the eye at (0, 0, alpha, 0) in clip space, e . t_i = alpha * t_i.z. DVis on Ncnt: culled
-//   when all 64 e . t_i < 0. ptp-pcnt: culled when no e . t_i > 0 (Pcnt = 0), which also culls
-//   degenerate patches with collapsed edges (the teapot's top). Rational patches are supported.
+//   the eye at (0, 0, alpha, 0) in clip space, e . t_i = s * alpha * t_i.z, where s = sign(det M)
+//   because cross4 of transformed points is det(M) times the transformed plane (det < 0 for
+//   every GL perspective here; the kernels fold sign(alpha) * sign(det M) into the matrix rows
+//   once per call, so mirroring model matrices work too). DVis on Ncnt: culled when all 64
+//   e . t_i < 0. ptp-pcnt: culled when no e . t_i > 0 (Pcnt = 0), which also culls degenerate
+//   patches with collapsed edges (the teapot's top). Rational patches are supported.
 //
 // Contracts: culled must hold patches.count bytes. Kernels never allocate or throw; each has a
 // scalar reference and a SIMD version that give identical decisions. Displacement is not

@@ -4,8 +4,8 @@
 // Bit-exact agreement with the SIMD kernels (tests/core/frustum_test.cpp) rests on three rules
 // that both files follow operation by operation:
 // - every multiply-add the SIMD code does with MulAdd is std::fma here (one rounding); every
-//   other product and sum is a separate, individually rounded operation (the build uses ISO C++
-//   mode, where GCC does not contract a*b+c on its own);
+//   other product and sum is a separate, individually rounded operation (the build passes
+//   -ffp-contract=off: GCC would otherwise contract a*b+c on its own, even in ISO C++ mode);
 // - min/max are written as `a < b ? a : b` / `a > b ? a : b`, which is what x86 minps/maxps
 //   (Highway Min/Max) return for every input, signed zeros included;
 // - the same order of accumulation (points 0..15, planes 0..5, corners in the same order).

@@ -1,0 +1,22 @@
+// Shared by the ptp kernels (ptp.cpp, ptp_simd.cpp); private to patchcull.
+#pragma once
+
+#include "patchcull/math.h"
+#include "patchcull/patch.h"
+
+namespace patchcull::ptp_detail {
+
+/// Rows x, y, w of s * object_to_clip with s = sign(alpha) * sign(det object_to_clip) (ptp.cpp
+/// explains why), r[row][column].
+struct PtpClipRows {
+    float r[3][4];
+};
+
+/// False when nothing may be culled (alpha or det zero or not finite).
+bool ptp_clip_rows(const Mat4& object_to_clip, float alpha, PtpClipRows& out);
+
+/// The scalar kernel's 64 clip-space control plane z components (times the sign s) of one patch,
+/// computed exactly as cull_ptp_scalar does (for tests: compared against double precision).
+void ptp_control_planes_z(const BezierPatch& patch, const PtpClipRows& rows, float t[64]);
+
+}  // namespace patchcull::ptp_detail

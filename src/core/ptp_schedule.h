@@ -1,0 +1,207 @@
+// The ptp kernels' evaluation schedule (private to patchcull; shared by ptp.cpp and ptp_simd.cpp so
+// both do the same operations in the same order), derived at compile time from the generated
+// table src/core/ptp_table.inc.
+//
+// The table: t[dest] = sum of 516 terms w * cross4Z(p_j, p_k, p_l) over clip-space control points,
+// each sorted triple (j < k < l) in exactly one destination. cross4Z(a, b, c) is the 3x3
+// determinant of the (x, y, w) columns a, b, c; expanded along its third column,
+//   cross4Z(a, b, c) = c.x * m_yw(a,b) - c.y * m_xw(a,b) + c.w * m_xy(a,b),
+//   m_xy(a,b) = a.x b.y - a.y b.x,  m_xw(a,b) = a.x b.w - a.w b.x,  m_yw(a,b) = a.y b.w - a.w b.y.
+// Shared work: each term is computed from the 2x2 minors of one of its three point pairs (the
+// third point then enters with 3 multiply-adds), and the pairs are chosen so that few distinct
+// pairs are needed: 66 pairs cover the 512 non-corner terms (greedy set cover below; every sorted
+// triple occurs in exactly one destination, and no pair twice in one destination, so grouping
+// terms by pair or by destination shares nothing more). Per patch (FLOPs: fma = 2; in brackets
+// the vector instructions):
+//   clip transform, rows x, y, w: 16 x 3 x (mul + 3 fma)              =  336  [192]
+//   minors: 66 pairs x (3 sub for b - a, 3 x (mul + fma))             =  792  [594]
+//   terms: 512 x (mul + 2 fma for cross4Z, 1 fma with the weight)     = 3584 [2048]
+//   corners: 4 x (6 sub + 3 x (mul + fma) + mul + 2 fma + fma)        =   88   [64]
+//   total                                                             = 4800 [2898] + 64 compares
+// against the seed's serial loop (516 full cross4Z: 3 minors (mul + fma) + mul + 2 fma, then the
+// weighted fma: 16 FLOPs [10 instructions] each, 8256 [5160], + transform 336 [192] = 8592 [5352]):
+// 44% fewer FLOPs, 46% fewer instructions.
+//
+// Exact zeros on collapsed edges (seed 001 §7's Pcnt rule for e.g. the teapot's lid): when a
+// patch edge collapses to one point, T vanishes along it and its 8 boundary control planes are
+// zero; they must come out as exactly 0 in floating point too, or a +tiny value blocks the Pcnt
+// cull. Every term of a boundary destination has two points on that edge (T(u,0) depends only on
+// B, B_u along v = 0), so:
+// - the minors of a pair (a, b) are computed as the minors of (a, b - a) (the same values in exact
+//   arithmetic): exactly 0 when b == a, since b - a is then the zero vector, whatever the rounding;
+// - a non-corner boundary term uses the pair on its destination's edge;
+// - the 4 corner terms (one per corner destination, e.g. 9 cross4Z(p0, p1, p4)) touch two edges:
+//   they are computed as det[a, b - a, c - a] with a the corner (the "anchor"): exactly 0 when
+//   b == a or c == a (a zero difference vector), whichever edge collapsed.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace patchcull::ptp_detail {
+
+struct TableRow {
+    int dest, j, k, l;
+    long long num, den;
+};
+
+inline constexpr TableRow kTable[] = {
+#include "core/ptp_table.inc"
+};
+inline constexpr int kTermCount = static_cast<int>(sizeof(kTable) / sizeof(kTable[0]));
+static_assert(kTermCount == 516, "seed 001: 516 weighted cross4 products");
+
+struct Pair {
+    std::uint8_t a, b;  // a < b
+};
+struct Step {           // acc += weight * cross4Z(p[pairs[pair].a], p[pairs[pair].b], p[third])
+    std::uint8_t pair, third;
+    float weight;       // table weight with the permutation sign folded in
+};
+struct Corner {         // t[dest] = weight * det[p_a, p_b - p_a, p_c - p_a]
+    std::uint8_t dest, a, b, c;
+    float weight;
+};
+
+struct Schedule {
+    int num_pairs = 0;
+    std::array<Pair, 120> pairs{};
+    std::array<Step, kTermCount> steps{};             // grouped by destination, table order within
+    std::array<std::uint16_t, 65> dest_first{};       // steps of dest d: [dest_first[d], dest_first[d+1])
+    std::array<Corner, 4> corners{};
+    std::array<std::int8_t, 64> corner_of_dest{};      // index into corners, or -1
+};
+
+namespace schedule_build {
+
+constexpr bool is_corner_dest(int d) { return (d % 8 == 0 || d % 8 == 7) && (d / 8 == 0 || d / 8 == 7); }
+
+// Whether control point a lies on the patch edge of boundary destination d (non-corner).
+constexpr bool on_dest_edge(int d, int a) {
+    const int iu = d % 8, jv = d / 8;
+    if (jv == 0) return a / 4 == 0;
+    if (jv == 7) return a / 4 == 3;
+    if (iu == 0) return a % 4 == 0;
+    if (iu == 7) return a % 4 == 3;
+    return true;  // interior destination: any pair
+}
+
+constexpr int pair_index(int a, int b) {  // a < b, dense index in 0..119
+    int idx = 0;
+    for (int x = 0; x < a; ++x) idx += 15 - x;
+    return idx + (b - a - 1);
+}
+
+// Sign of the permutation taking (j, k, l) to (x, y, z).
+constexpr int perm_sign(int j, int k, int /*l*/, int x, int y, int z) {
+    const int p[3] = {x == j ? 0 : x == k ? 1 : 2, y == j ? 0 : y == k ? 1 : 2, z == j ? 0 : z == k ? 1 : 2};
+    int inv = 0;
+    for (int s = 0; s < 3; ++s)
+        for (int t = s + 1; t < 3; ++t) inv += p[s] > p[t];
+    return inv % 2 ? -1 : 1;
+}
+
+constexpr Schedule make() {
+    Schedule s;
+    // Candidate pairs (index into {(j,k), (j,l), (k,l)}) per term; corner terms handled apart.
+    std::array<std::array<bool, 3>, kTermCount> allowed{};
+    std::array<bool, 120> chosen{};
+    for (int t = 0; t < kTermCount; ++t) {
+        const TableRow& r = kTable[t];
+        const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
+        for (int q = 0; q < 3; ++q) allowed[t][q] = on_dest_edge(r.dest, pa[q][0]) && on_dest_edge(r.dest, pa[q][1]);
+    }
+    // Greedy set cover: forced pairs first, then repeatedly the pair covering most uncovered terms
+    // (ties: lowest pair index). Deterministic.
+    std::array<bool, kTermCount> covered{};
+    for (int t = 0; t < kTermCount; ++t) {
+        if (is_corner_dest(kTable[t].dest)) {
+            covered[t] = true;
+            continue;
+        }
+        int n = 0, only = -1;
+        for (int q = 0; q < 3; ++q)
+            if (allowed[t][q]) ++n, only = q;
+        if (n == 0) throw "ptp schedule: boundary term without an edge pair";
+        if (n == 1) {
+            const TableRow& r = kTable[t];
+            const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
+            chosen[pair_index(pa[only][0], pa[only][1])] = true;
+        }
+    }
+    auto term_covered = [&](int t) {
+        const TableRow& r = kTable[t];
+        const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
+        for (int q = 0; q < 3; ++q)
+            if (allowed[t][q] && chosen[pair_index(pa[q][0], pa[q][1])]) return true;
+        return false;
+    };
+    for (;;) {
+        std::array<int, 120> count{};
+        bool any = false;
+        for (int t = 0; t < kTermCount; ++t) {
+            if (covered[t] || term_covered(t)) continue;
+            any = true;
+            const TableRow& r = kTable[t];
+            const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
+            for (int q = 0; q < 3; ++q)
+                if (allowed[t][q]) ++count[pair_index(pa[q][0], pa[q][1])];
+        }
+        if (!any) break;
+        int best = 0;
+        for (int p = 1; p < 120; ++p)
+            if (count[p] > count[best]) best = p;
+        chosen[best] = true;
+    }
+    // Dense numbering of the chosen pairs, in pair index order.
+    std::array<int, 120> slot{};
+    for (int a = 0; a < 16; ++a)
+        for (int b = a + 1; b < 16; ++b)
+            if (chosen[pair_index(a, b)]) {
+                slot[pair_index(a, b)] = s.num_pairs;
+                s.pairs[s.num_pairs++] = Pair{static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b)};
+            }
+    // Steps grouped by destination (table order within one), corners apart.
+    int n = 0, c = 0;
+    for (int d = 0; d < 64; ++d) {
+        s.dest_first[d] = static_cast<std::uint16_t>(n);
+        s.corner_of_dest[d] = -1;
+        for (int t = 0; t < kTermCount; ++t) {
+            const TableRow& r = kTable[t];
+            if (r.dest != d) continue;
+            const float w = static_cast<float>(r.num) / static_cast<float>(r.den);
+            if (is_corner_dest(d)) {
+                // Anchor: the corner point of the destination's corner (shared by both edges).
+                const int corner = (d % 8 == 0 ? 0 : 3) + 4 * (d / 8 == 0 ? 0 : 3);
+                const int other[2] = {r.j == corner ? r.k : r.j, r.l == corner ? r.k : r.l};
+                if (!(r.j == corner || r.k == corner || r.l == corner)) throw "ptp schedule: corner term without its corner";
+                const int sign = perm_sign(r.j, r.k, r.l, corner, other[0], other[1]);
+                s.corner_of_dest[d] = static_cast<std::int8_t>(c);
+                s.corners[c++] = Corner{static_cast<std::uint8_t>(d), static_cast<std::uint8_t>(corner),
+                                        static_cast<std::uint8_t>(other[0]), static_cast<std::uint8_t>(other[1]),
+                                        sign > 0 ? w : -w};
+                continue;
+            }
+            const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
+            const int third[3] = {r.l, r.k, r.j};
+            const int sign[3] = {1, -1, 1};  // det[j,k,l] = det[j,k,l] = -det[j,l,k] = det[k,l,j]
+            int q = -1;
+            for (int e = 0; e < 3 && q < 0; ++e)
+                if (allowed[t][e] && chosen[pair_index(pa[e][0], pa[e][1])]) q = e;
+            s.steps[n++] = Step{static_cast<std::uint8_t>(slot[pair_index(pa[q][0], pa[q][1])]),
+                                static_cast<std::uint8_t>(third[q]), sign[q] > 0 ? w : -w};
+        }
+    }
+    s.dest_first[64] = static_cast<std::uint16_t>(n);
+    if (c != 4 || n != kTermCount - 4) throw "ptp schedule: unexpected term split";
+    return s;
+}
+
+}  // namespace schedule_build
+
+inline constexpr Schedule kSchedule = schedule_build::make();
+inline constexpr int kPairCount = kSchedule.num_pairs;
+inline constexpr int kStepCount = kTermCount - 4;
+
+}  // namespace patchcull::ptp_detail

@@ -1,0 +1,235 @@
+// Parametric tangent plane (ptp) back-patch cull kernel, SIMD (patchcull/backpatch.h), written
+// once over Highway vectors and compiled for every x86 target Highway attains; the best one the
+// CPU supports is chosen once, at the first call (HWY_DYNAMIC_DISPATCH). Same structure as
+// frustum_simd.cpp.
+//
+// Lanes are patches: lane j holds patch i+j, loaded straight from the SoA arrays (unaligned loads,
+// so subranges at any offset work); the last partial group is copied to a stack buffer whose
+// unused lanes repeat the last patch, so no load leaves the caller's arrays and only valid
+// decisions are written.
+//
+// The operations and their order are the scalar reference's (ptp.cpp), fully unrolled at compile
+// time over the schedule of ptp_schedule.h (pair indices, third points, weights and destination
+// groups are constants, so the stack arrays of points and minors are addressed with constant
+// offsets): MulAdd <-> std::fma, NegMulAdd(a, b, c) <-> std::fma(-a, b, c), MulSub(a, b, c) <->
+// std::fma(a, b, -c), every other product and sum separately rounded, and no Mul feeding a plain
+// Add/Sub (GCC would contract that into an fma on FMA targets only; see ptp.cpp). Targets without an FMA instruction (HWY_NATIVE_FMA == 0) use
+// std::fma per lane instead, slow but exact, as frustum_simd.cpp does.
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <utility>
+
+#include "core/ptp_internal.h"
+#include "core/ptp_schedule.h"
+#include "patchcull/backpatch.h"
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "core/ptp_simd.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace patchcull {
+namespace HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+namespace ptp {
+
+using DF = hn::ScalableTag<float>;
+using VF = hn::Vec<DF>;
+using MF = hn::Mask<DF>;
+using ptp_detail::kPairCount;
+using ptp_detail::kSchedule;
+
+constexpr std::size_t kMaxLanes = HWY_LANES(float);
+constexpr int kComponents = 4 * kPatchPoints;
+
+// a * b + c with a single rounding, like std::fma.
+HWY_INLINE VF Fma(DF d, VF a, VF b, VF c) {
+#if HWY_NATIVE_FMA
+    (void)d;
+    return hn::MulAdd(a, b, c);
+#else
+    HWY_ALIGN float fa[kMaxLanes], fb[kMaxLanes], fc[kMaxLanes];
+    hn::Store(a, d, fa);
+    hn::Store(b, d, fb);
+    hn::Store(c, d, fc);
+    for (std::size_t j = 0; j < hn::Lanes(d); ++j) fa[j] = std::fma(fa[j], fb[j], fc[j]);
+    return hn::Load(d, fa);
+#endif
+}
+
+// -a * b + c with a single rounding, like std::fma(-a, b, c).
+HWY_INLINE VF NegFma(DF d, VF a, VF b, VF c) {
+#if HWY_NATIVE_FMA
+    (void)d;
+    return hn::NegMulAdd(a, b, c);
+#else
+    return Fma(d, hn::Neg(a), b, c);
+#endif
+}
+
+// a * b - c with a single rounding, like std::fma(a, b, -c).
+HWY_INLINE VF FmaSub(DF d, VF a, VF b, VF c) {
+#if HWY_NATIVE_FMA
+    (void)d;
+    return hn::MulSub(a, b, c);
+#else
+    return Fma(d, a, b, hn::Neg(c));
+#endif
+}
+
+// a*b - c*e as fma(a, b, -(c*e)), like minor2 in ptp.cpp. (A plain Sub(Mul, Mul) would not do:
+// GCC contracts it into an fma on FMA targets, but not on the others.)
+HWY_INLINE VF Minor(DF d, VF a, VF b, VF c, VF e) { return FmaSub(d, a, b, hn::Mul(c, e)); }
+
+template <class F, std::size_t... I>
+HWY_INLINE void Unroll(std::index_sequence<I...>, F&& f) {
+    (f(std::integral_constant<std::size_t, I>{}), ...);
+}
+
+// One group of Lanes(d) patches: component (k, c) of lane j is base[(4k + c) * stride + j].
+struct Group {
+    const float* base;
+    std::size_t stride;
+    HWY_INLINE VF load(DF d, int k, int c) const {
+        return hn::LoadU(d, base + static_cast<std::size_t>(4 * k + c) * stride);
+    }
+};
+
+// Writes 0/1 bytes for the first n lanes of culled.
+HWY_INLINE void StoreDecisions(DF d, MF culled, std::uint8_t* out, std::size_t n) {
+    const hn::RebindToSigned<DF> di;
+    const hn::Rebind<std::uint8_t, DF> du8;
+    const auto ones = hn::And(hn::BitCast(di, hn::VecFromMask(d, culled)), hn::Set(di, 1));
+    const auto bytes = hn::DemoteTo(du8, ones);
+    if (kMaxLanes == 1 || n == hn::Lanes(d)) {
+        hn::StoreU(bytes, du8, out);
+    } else {
+        HWY_ALIGN std::uint8_t tmp[kMaxLanes];
+        hn::Store(bytes, du8, tmp);
+        std::memcpy(out, tmp, n);
+    }
+}
+
+template <bool kPcnt>
+HWY_INLINE MF PtpGroup(DF d, const Group& g, const ptp_detail::PtpClipRows& rows) {
+    VF px[16], py[16], pw[16];
+    {
+        VF r[3][4];
+        for (int i = 0; i < 3; ++i)
+            for (int c = 0; c < 4; ++c) r[i][c] = hn::Set(d, rows.r[i][c]);
+        for (int k = 0; k < 16; ++k) {
+            const VF X = g.load(d, k, 0), Y = g.load(d, k, 1), Z = g.load(d, k, 2), W = g.load(d, k, 3);
+            VF o[3];
+            for (int i = 0; i < 3; ++i) {
+                VF v = hn::Mul(r[i][0], X);
+                v = Fma(d, r[i][1], Y, v);
+                v = Fma(d, r[i][2], Z, v);
+                o[i] = Fma(d, r[i][3], W, v);
+            }
+            px[k] = o[0], py[k] = o[1], pw[k] = o[2];
+        }
+    }
+    VF mxy[kPairCount], mxw[kPairCount], myw[kPairCount];
+    Unroll(std::make_index_sequence<kPairCount>{}, [&](auto q) {
+        constexpr int a = kSchedule.pairs[decltype(q)::value].a, b = kSchedule.pairs[decltype(q)::value].b;
+        constexpr int qi = decltype(q)::value;
+        const VF ex = hn::Sub(px[b], px[a]), ey = hn::Sub(py[b], py[a]), ew = hn::Sub(pw[b], pw[a]);
+        mxy[qi] = Minor(d, px[a], ey, py[a], ex);
+        mxw[qi] = Minor(d, px[a], ew, pw[a], ex);
+        myw[qi] = Minor(d, py[a], ew, pw[a], ey);
+    });
+    const VF zero = hn::Zero(d);
+    MF cull = hn::FirstN(d, hn::Lanes(d));
+    Unroll(std::make_index_sequence<64>{}, [&](auto dd) {
+        constexpr int dest = decltype(dd)::value;
+        VF acc = zero;
+        constexpr int ci = kSchedule.corner_of_dest[dest];
+        if constexpr (ci >= 0) {
+            constexpr ptp_detail::Corner cr = kSchedule.corners[ci];
+            const VF d1x = hn::Sub(px[cr.b], px[cr.a]), d1y = hn::Sub(py[cr.b], py[cr.a]);
+            const VF d1w = hn::Sub(pw[cr.b], pw[cr.a]);
+            const VF d2x = hn::Sub(px[cr.c], px[cr.a]), d2y = hn::Sub(py[cr.c], py[cr.a]);
+            const VF d2w = hn::Sub(pw[cr.c], pw[cr.a]);
+            const VF m_xy = Minor(d, px[cr.a], d1y, py[cr.a], d1x);
+            const VF m_xw = Minor(d, px[cr.a], d1w, pw[cr.a], d1x);
+            const VF m_yw = Minor(d, py[cr.a], d1w, pw[cr.a], d1y);
+            VF v = hn::Mul(d2x, m_yw);
+            v = NegFma(d, d2y, m_xw, v);
+            v = Fma(d, d2w, m_xy, v);
+            acc = Fma(d, hn::Set(d, cr.weight), v, acc);
+        } else {
+            constexpr int first = kSchedule.dest_first[dest];
+            constexpr int n = kSchedule.dest_first[dest + 1] - first;
+            Unroll(std::make_index_sequence<n>{}, [&](auto s) {
+                constexpr ptp_detail::Step st = kSchedule.steps[first + decltype(s)::value];
+                VF v = hn::Mul(px[st.third], myw[st.pair]);
+                v = NegFma(d, py[st.third], mxw[st.pair], v);
+                v = Fma(d, pw[st.third], mxy[st.pair], v);
+                acc = Fma(d, hn::Set(d, st.weight), v, acc);
+            });
+        }
+        cull = hn::And(cull, kPcnt ? hn::Le(acc, zero) : hn::Lt(acc, zero));
+    });
+    return cull;
+}
+
+template <bool kPcnt>
+HWY_NOINLINE void CullGroups(const PatchBatchView& patches, const ptp_detail::PtpClipRows& rows,
+                             std::uint8_t* culled) {
+    const DF d;
+    const std::size_t N = hn::Lanes(d);
+    const std::size_t count = patches.count;
+    std::size_t i = 0;
+    for (; i + N <= count; i += N) {
+        const Group g{patches.data + i, patches.stride};
+        StoreDecisions(d, PtpGroup<kPcnt>(d, g, rows), culled + i, N);
+    }
+    if (i == count) return;
+    // Tail: n < N patches, padded with copies of the last one.
+    const std::size_t n = count - i;
+    HWY_ALIGN float buf[kComponents * kMaxLanes];
+    for (int a = 0; a < kComponents; ++a) {
+        const float* src = patches.data + static_cast<std::size_t>(a) * patches.stride + i;
+        for (std::size_t j = 0; j < N; ++j) buf[a * N + j] = src[j < n ? j : n - 1];
+    }
+    const Group g{buf, N};
+    StoreDecisions(d, PtpGroup<kPcnt>(d, g, rows), culled + i, n);
+}
+
+}  // namespace ptp
+
+void CullPtp(const PatchBatchView& patches, const ptp_detail::PtpClipRows& rows, bool pcnt, std::uint8_t* culled) {
+    if (pcnt) {
+        ptp::CullGroups<true>(patches, rows, culled);
+    } else {
+        ptp::CullGroups<false>(patches, rows, culled);
+    }
+}
+
+}  // namespace HWY_NAMESPACE
+}  // namespace patchcull
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace patchcull {
+
+HWY_EXPORT(CullPtp);
+
+void cull_ptp_simd(const PatchBatchView& patches, const Mat4& object_to_clip, float alpha, PtpRule rule,
+                   std::uint8_t* culled) {
+    if (patches.count == 0) return;
+    ptp_detail::PtpClipRows rows;
+    if (!ptp_detail::ptp_clip_rows(object_to_clip, alpha, rows)) {
+        std::memset(culled, 0, patches.count);
+        return;
+    }
+    HWY_DYNAMIC_DISPATCH(CullPtp)(patches, rows, rule == PtpRule::pcnt, culled);
+}
+
+}  // namespace patchcull
+#endif  // HWY_ONCE
