@@ -13,7 +13,10 @@
 
 namespace patchcull {
 
-/// Names of the cull methods the CPU runs, in a stable order: "frustum", "frustum-disp".
+/// Names of the cull methods the CPU runs, in a stable order: "frustum", "frustum-disp" (view
+/// frustum; judged by surface samples inside the view volume), "tcone", "ncone", "ptp",
+/// "ptp-pcnt" (back-patch, seed 001; judged by sampled tangent planes facing the eye; they
+/// refuse displaced patches).
 std::vector<std::string> cull_method_names();
 bool is_cull_method(const std::string& name);
 

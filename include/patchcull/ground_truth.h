@@ -43,10 +43,19 @@ void sample_tangent_planes(const BezierPatch& patch, int grid, PlaneD* out);
 /// A culled patch with a facing sample is a false back-patch cull.
 bool any_plane_faces_eye(const PlaneD* planes, std::size_t count, Vec3 eye);
 
+/// A point in double precision.
+struct PointD {
+    double x = 0, y = 0, z = 0;
+};
+
+/// Surface points of the patch (undisplaced) at a grid x grid lattice, evaluated in double.
+void sample_patch_points(const BezierPatch& patch, int grid, PointD* out);
+
 /// True when some triangle of the uniform level-(grid-1) tessellation of the grid of surface
 /// points (row v, column u) faces the eye. Both diagonals of every cell are tried, so the result
-/// holds whatever triangulation the tessellator picks. Double precision, same tolerance rule.
-bool any_tessellation_triangle_faces_eye(const Vec3* grid_points, int grid, Vec3 eye);
+/// holds whatever triangulation the tessellator picks. Triangles without area (relative to
+/// their edges, 1e-12: collapsed patch edges) face nowhere. Same tolerance rule as above.
+bool any_tessellation_triangle_faces_eye(const PointD* grid_points, int grid, Vec3 eye);
 
 /// A sphere holding a set of points (not the smallest one; any holding sphere is exact for the
 /// test below).

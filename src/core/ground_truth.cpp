@@ -105,21 +105,43 @@ bool any_plane_faces_eye(const PlaneD* planes, std::size_t count, Vec3 eye) {
     return false;
 }
 
-bool any_tessellation_triangle_faces_eye(const Vec3* pts, int grid, Vec3 eye) {
-    auto faces = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
-        const double e1[3] = {double(b.x) - a.x, double(b.y) - a.y, double(b.z) - a.z};
-        const double e2[3] = {double(c.x) - a.x, double(c.y) - a.y, double(c.z) - a.z};
+void sample_patch_points(const BezierPatch& patch, int grid, PointD* out) {
+    for (int j = 0; j < grid; ++j)
+        for (int i = 0; i < grid; ++i) {
+            const double u = grid > 1 ? double(i) / (grid - 1) : 0.5, v = grid > 1 ? double(j) / (grid - 1) : 0.5;
+            double bu[4], du[4], bv[4], dv[4];
+            bernstein3d(u, bu, du);
+            bernstein3d(v, bv, dv);
+            V4 p{0, 0, 0, 0};
+            for (int b = 0; b < 4; ++b)
+                for (int a = 0; a < 4; ++a) {
+                    const Vec4 c = patch.cp[4 * b + a];
+                    const double w = bu[a] * bv[b];
+                    p = {p.x + w * c.x, p.y + w * c.y, p.z + w * c.z, p.w + w * c.w};
+                }
+            out[j * grid + i] = {p.x / p.w, p.y / p.w, p.z / p.w};
+        }
+}
+
+bool any_tessellation_triangle_faces_eye(const PointD* pts, int grid, Vec3 eye) {
+    auto faces = [&](const PointD& a, const PointD& b, const PointD& c) {
+        const double e1[3] = {b.x - a.x, b.y - a.y, b.z - a.z};
+        const double e2[3] = {c.x - a.x, c.y - a.y, c.z - a.z};
         const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-        const double value = n[0] * (eye.x - double(a.x)) + n[1] * (eye.y - double(a.y)) + n[2] * (eye.z - double(a.z));
+        const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        const double l1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+        const double l2 = std::sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
+        if (nn <= 1e-12 * l1 * l2) return false;  // no area: a collapsed edge
+        const double value = n[0] * (eye.x - a.x) + n[1] * (eye.y - a.y) + n[2] * (eye.z - a.z);
         const double nw = n[0] * a.x + n[1] * a.y + n[2] * a.z;
         return value > 0 && value > facing_tolerance(n[0], n[1], n[2], nw, eye);
     };
     for (int j = 0; j + 1 < grid; ++j)
         for (int i = 0; i + 1 < grid; ++i) {
-            const Vec3& p00 = pts[j * grid + i];
-            const Vec3& p10 = pts[j * grid + i + 1];
-            const Vec3& p01 = pts[(j + 1) * grid + i];
-            const Vec3& p11 = pts[(j + 1) * grid + i + 1];
+            const PointD& p00 = pts[j * grid + i];
+            const PointD& p10 = pts[j * grid + i + 1];
+            const PointD& p01 = pts[(j + 1) * grid + i];
+            const PointD& p11 = pts[(j + 1) * grid + i + 1];
             // Counter-clockwise in (u,v), so a front face has its normal along du x dv.
             if (faces(p00, p10, p11) || faces(p00, p11, p01) || faces(p00, p10, p01) || faces(p10, p11, p01))
                 return true;

@@ -3,9 +3,11 @@
 #include "patchcull/cull_eval.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <functional>
 
+#include "patchcull/backpatch.h"
 #include "patchcull/error.h"
 #include "patchcull/frustum.h"
 #include "patchcull/ground_truth.h"
@@ -21,10 +23,13 @@ constexpr std::size_t kGrain = 1024;
 struct ViewContext {
     Mat4 object_to_clip;
     FrustumPlanes planes;
+    Vec3 eye;     ///< object space
+    float alpha;  ///< clip-space eye z (backpatch.h)
 };
 
-/// Which ground truth judges a method's decisions.
-enum class Truth { frustum };
+/// Which ground truth judges a method's decisions: a sample inside the view volume (frustum
+/// methods), or a sampled tangent plane facing the eye (back-patch methods, seed 001).
+enum class Truth { frustum, backface };
 
 struct Method {
     const char* name;
@@ -41,6 +46,22 @@ const std::vector<Method>& methods() {
         {"frustum-disp", Truth::frustum,
          [](const PatchBatchView& b, const float* d, const ViewContext& v, std::uint8_t* out) {
              cull_frustum_disp_simd(b, d, v.object_to_clip, out);
+         }},
+        {"tcone", Truth::backface,
+         [](const PatchBatchView& b, const float*, const ViewContext& v, std::uint8_t* out) {
+             cull_tcone_simd(b, v.eye, out);
+         }},
+        {"ncone", Truth::backface,
+         [](const PatchBatchView& b, const float*, const ViewContext& v, std::uint8_t* out) {
+             cull_ncone_simd(b, v.eye, out);
+         }},
+        {"ptp", Truth::backface,
+         [](const PatchBatchView& b, const float*, const ViewContext& v, std::uint8_t* out) {
+             cull_ptp_simd(b, v.object_to_clip, v.alpha, PtpRule::ncnt, out);
+         }},
+        {"ptp-pcnt", Truth::backface,
+         [](const PatchBatchView& b, const float*, const ViewContext& v, std::uint8_t* out) {
+             cull_ptp_simd(b, v.object_to_clip, v.alpha, PtpRule::pcnt, out);
          }},
     };
     return table;
@@ -65,11 +86,15 @@ bool is_cull_method(const std::string& name) { return find_method(name) != nullp
 CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* displacement,
                              const CullEvalOptions& options) {
     std::vector<const Method*> selected;
+    bool needs_frustum_truth = false, needs_backface_truth = false;
     for (const std::string& name : options.methods) {
         const Method* m = find_method(name);
         if (!m) throw Error("--methods: unknown cull method '" + name + "'");
         selected.push_back(m);
+        (m->truth == Truth::frustum ? needs_frustum_truth : needs_backface_truth) = true;
     }
+    if (needs_backface_truth && displacement && !displacement->empty())
+        throw Error("--displace: back-patch methods (tcone, ncone, ptp) do not bound displaced patches (seed 001 §8)");
     const std::size_t n = frame.patches.size();
     const PatchBatch batch = make_batch(frame.patches);
     const std::vector<DisplacementRange> ranges = displacement_ranges(frame, displacement);
@@ -81,13 +106,17 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
     }
     const float* disp_ptr = largest > 0 ? max_disp.data() : nullptr;
 
-    // Ground-truth samples of every patch, computed once (the frame is static).
+    // Ground-truth samples of every patch, computed once (the frame is static): surface points
+    // for the frustum truth, tangent planes for the back-facing truth.
     const int grid = options.ground_truth_grid;
     const std::size_t per_patch = static_cast<std::size_t>(grid) * grid;
-    std::vector<Vec3> samples(n * per_patch);
-    std::vector<SampleSphere> spheres(n);
+    std::vector<Vec3> samples(needs_frustum_truth ? n * per_patch : 0);
+    std::vector<SampleSphere> spheres(needs_frustum_truth ? n : 0);
+    std::vector<PlaneD> planes(needs_backface_truth ? n * per_patch : 0);
     parallel_for_ranges(n, 64, [&](std::size_t first, std::size_t last) {
         for (std::size_t p = first; p < last; ++p) {
+            if (needs_backface_truth) sample_tangent_planes(frame.patches[p], grid, &planes[p * per_patch]);
+            if (!needs_frustum_truth) continue;
             const PatchInfo& info = frame.info[p];
             const TangentPatches* t = info.tangent_index >= 0 ? &frame.tangents[info.tangent_index] : nullptr;
             sample_displaced_patch(frame.patches[p], t, info.uv, displacement, grid, &samples[p * per_patch]);
@@ -111,6 +140,8 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
         ViewContext ctx;
         ctx.object_to_clip = camera.view_projection();
         ctx.planes = make_frustum_planes(ctx.object_to_clip);
+        ctx.eye = camera.eye;
+        ctx.alpha = clip_space_eye_alpha(camera.projection());
         for (std::size_t m = 0; m < selected.size(); ++m) {
             const auto start = std::chrono::steady_clock::now();
             parallel_for_ranges(n, kGrain, [&](std::size_t first, std::size_t last) {
@@ -118,13 +149,26 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
                                     ctx, culled.data() + first);
             });
             seconds[m] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            CullMethodResult& r = result.methods[m];
-            for (std::size_t p = 0; p < n; ++p) {
-                if (!culled[p]) continue;
-                ++r.culled;
-                if (sphere_outside_clip_volume(ctx.object_to_clip, spheres[p])) continue;  // exact shortcut
-                if (any_point_in_clip_volume(ctx.object_to_clip, &samples[p * per_patch], per_patch)) ++r.false_culls;
-            }
+            // Judge every culled patch against the ground truth, in parallel (the truth costs far
+            // more than the kernel).
+            const bool backface = selected[m]->truth == Truth::backface;
+            std::atomic<std::uint64_t> culled_count{0}, false_count{0};
+            parallel_for_ranges(n, 256, [&](std::size_t first, std::size_t last) {
+                std::uint64_t local_culled = 0, local_false = 0;
+                for (std::size_t p = first; p < last; ++p) {
+                    if (!culled[p]) continue;
+                    ++local_culled;
+                    if (backface) {
+                        local_false += any_plane_faces_eye(&planes[p * per_patch], per_patch, ctx.eye) ? 1 : 0;
+                    } else if (!sphere_outside_clip_volume(ctx.object_to_clip, spheres[p])) {  // exact shortcut
+                        local_false += any_point_in_clip_volume(ctx.object_to_clip, &samples[p * per_patch], per_patch) ? 1 : 0;
+                    }
+                }
+                culled_count += local_culled;
+                false_count += local_false;
+            });
+            result.methods[m].culled += culled_count;
+            result.methods[m].false_culls += false_count;
         }
     }
     const double pairs = static_cast<double>(n) * std::max(1, options.views);

@@ -25,9 +25,9 @@ std::vector<PlaneD> planes_of(const BezierPatch& p, int grid) {
     return planes;
 }
 
-std::vector<Vec3> points_of(const BezierPatch& p, int grid) {
-    std::vector<Vec3> pts(grid * grid);
-    sample_displaced_patch(p, nullptr, nullptr, nullptr, grid, pts.data());
+std::vector<PointD> points_of(const BezierPatch& p, int grid) {
+    std::vector<PointD> pts(grid * grid);
+    sample_patch_points(p, grid, pts.data());
     return pts;
 }
 
