@@ -160,3 +160,23 @@ TEST(Cli, UnknownFlagAndBadValues) {
     expect_one_line_error(run("cull teapot --displace procedural --displace-scale nan"), "--displace-scale");
     expect_one_line_error(run("frobnicate"), "frobnicate");
 }
+
+TEST(Cli, CullBackPatchMethodsOnTheTeapot) {
+    const CliRun r = run("cull teapot --methods tcone,ncone,ptp,ptp-pcnt --views 200 --view-mode contain --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    for (const char* m : {"tcone", "ncone", "ptp", "ptp-pcnt"}) {
+        EXPECT_EQ(j["methods"][m]["false_culls"], 0) << m;
+        EXPECT_GT(j["methods"][m]["cull_rate"].get<double>(), 0.005) << m;
+    }
+    // The teapot's 32 patches are large and curved: few are wholly back-facing, and the tighter
+    // bounds cull more (seed 001's order).
+    EXPECT_GE(j["methods"]["ptp"]["cull_rate"].get<double>(), j["methods"]["ncone"]["cull_rate"].get<double>());
+    EXPECT_GE(j["methods"]["ncone"]["cull_rate"].get<double>(), j["methods"]["tcone"]["cull_rate"].get<double>());
+    // Pcnt additionally culls the degenerate lid and bottom patches (seed 001 §7).
+    EXPECT_GE(j["methods"]["ptp-pcnt"]["cull_rate"].get<double>(), j["methods"]["ptp"]["cull_rate"].get<double>());
+}
+
+TEST(Cli, BackPatchMethodsRefuseDisplacement) {
+    expect_one_line_error(run("cull teapot --methods ptp --displace procedural --views 1 --json"), "--displace");
+}
