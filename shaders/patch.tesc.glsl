@@ -1,6 +1,15 @@
 // Patch tessellation control shader: passes the 16 control points through and sets the
-// tessellation factors. A patch whose cull flag is nonzero gets outer and inner levels 0, so the
+// tessellation factors. A patch that is not to be drawn gets outer and inner levels 0, so the
 // tessellator discards it (seed 000 §3: the decision lands where the tessellator reads it).
+// Drawn iff (flag word & u_draw_mask) == u_draw_value (gl_renderer.h): mask kCullReasonMask,
+// value 0 = "no cull reason" (render()); kStatusVisible = the first pass of the pipeline;
+// kStatusVisible | kStatusNewlyVisible = its second pass; mask 0 = every patch (the reference).
+//
+// Levels: uniform u_tess_level on every edge and the interior, or adaptive by distance (seed 000
+// §6.3, like DirectX's DetailTessellation11): edge level = clamp(u_tess_level * u_tess_reference /
+// distance(eye, midpoint of the edge's two corner points), 1, u_tess_level), inner levels the max
+// of the two opposite edges. An edge's level depends only on its two corner points (symmetric in
+// them), so two patches sharing an edge give it the same level.
 #version 450 core
 #include "shared.h"
 
@@ -10,26 +19,43 @@ layout(std430, binding = kBindingCullFlags) readonly buffer CullFlags {
     uint cull_flags[];
 };
 
-uniform float u_tess_level;     // uniform level for every edge and the interior, in [1, 64]
-uniform bool u_use_cull_flags;  // false: draw every patch (the reference render)
+uniform float u_tess_level;    // uniform level (or the adaptive maximum), in [1, 64]
+uniform uint u_draw_mask;
+uniform uint u_draw_value;
+uniform bool u_adaptive;
+uniform float u_tess_reference;  // distance at which the adaptive level is u_tess_level, > 0
+uniform vec3 u_eye;              // object-space eye position
 
 in vec4 vs_point[];
 flat in uint vs_patch[];
 out vec4 tcs_point[];
 patch out uint tcs_patch;
 
+float edge_level(vec4 a, vec4 b) {
+    const vec3 mid = 0.5 * (a.xyz / a.w + b.xyz / b.w);
+    const float d = max(distance(mid, u_eye), 1e-20);
+    return clamp(u_tess_level * u_tess_reference / d, 1.0, u_tess_level);
+}
+
 void main() {
     tcs_point[gl_InvocationID] = vs_point[gl_InvocationID];
     if (gl_InvocationID == 0) {
         const uint p = vs_patch[0];
-        const bool culled = u_use_cull_flags && cull_flags[p] != 0u;
-        const float level = culled ? 0.0 : u_tess_level;
-        gl_TessLevelOuter[0] = level;
-        gl_TessLevelOuter[1] = level;
-        gl_TessLevelOuter[2] = level;
-        gl_TessLevelOuter[3] = level;
-        gl_TessLevelInner[0] = level;
-        gl_TessLevelInner[1] = level;
+        const bool drawn = (cull_flags[p] & u_draw_mask) == u_draw_value;
+        vec4 outer = vec4(u_tess_level);
+        if (u_adaptive) {
+            // Quad domain: outer[0] is the edge u = 0, [1] v = 0, [2] u = 1, [3] v = 1; control
+            // point (i, j) (u index i) is vs_point[4j + i].
+            outer = vec4(edge_level(vs_point[0], vs_point[12]), edge_level(vs_point[0], vs_point[3]),
+                         edge_level(vs_point[3], vs_point[15]), edge_level(vs_point[12], vs_point[15]));
+        }
+        if (!drawn) outer = vec4(0.0);
+        gl_TessLevelOuter[0] = outer[0];
+        gl_TessLevelOuter[1] = outer[1];
+        gl_TessLevelOuter[2] = outer[2];
+        gl_TessLevelOuter[3] = outer[3];
+        gl_TessLevelInner[0] = max(outer[1], outer[3]);
+        gl_TessLevelInner[1] = max(outer[0], outer[2]);
         tcs_patch = p;
     }
 }

@@ -23,22 +23,55 @@ PATCHCULL_CONST uint kBindingCullFlags = 1u;      // uint flags[patch_count]: 0 
 PATCHCULL_CONST uint kBindingMaxDisplacement = 2u; // float max_disp[patch_count], >= 0 (cull margin)
 PATCHCULL_CONST uint kBindingPatchTexcoords = 3u;  // vec2 uv[4 * patch_count]: corner texcoords (patch.h order)
 PATCHCULL_CONST uint kBindingPlaneValues = 4u;     // float values[6 * patch_count]: frustum diagnostics
+PATCHCULL_CONST uint kBindingBackPatchFlags = 5u;  // uint backpatch[patch_count]: nonzero = back-facing (input of
+                                                   // cull_occlusion: the back-patch hook, see gl_renderer.h)
+PATCHCULL_CONST uint kBindingCullCounters = 6u;    // uint counters[kCounterCount]: atomics of cull_occlusion
+PATCHCULL_CONST uint kBindingOccluderVertices = 7u; // vec4 v[3 * triangle_count]: triangle list, w = 1
 
 // Texture units.
 PATCHCULL_CONST uint kTextureUnitDisplacement = 0u;  // R32F height map, GL_REPEAT, bilinear
+PATCHCULL_CONST uint kTextureUnitDepth = 1u;         // DEPTH32F depth buffer (Hi-Z level 0 input)
+PATCHCULL_CONST uint kTextureUnitHiZ = 2u;           // R32F Hi-Z pyramid, level l = hiz.h's level l
 
-// Cull flag bits. Each cull pass ORs its bit in (the frustum pass, the first, overwrites).
+// Image units.
+PATCHCULL_CONST uint kImageUnitHiZOut = 0u;          // R32F Hi-Z level being written
+
+// Per-patch flag word (kBindingCullFlags). Bits 0-7: the cull reason of the latest test (0 = not
+// culled); cull_frustum writes 0 or kCullFrustum, cull_occlusion exactly one reason (the first test
+// that culls, in the order frustum, back-patch, occlusion) or 0.
 PATCHCULL_CONST uint kCullFrustum = 1u;
-PATCHCULL_CONST uint kCullBackPatch = 2u;   // reserved for the back-patch pass
-PATCHCULL_CONST uint kCullOcclusion = 4u;   // reserved for the Hi-Z occlusion pass
+PATCHCULL_CONST uint kCullBackPatch = 2u;   // from the back-patch hook (kBindingBackPatchFlags)
+PATCHCULL_CONST uint kCullOcclusion = 4u;   // behind the Hi-Z pyramid
+PATCHCULL_CONST uint kCullReasonMask = 0xFFu;
+// Bits 8-9: temporal status of the two-pass pipeline (seed 000 §3), written by cull_occlusion:
+// kStatusVisible = passed the latest test (drawn in the next frame's first pass); with
+// kStatusNewlyVisible also set it was not tagged visible before that test (drawn in the second
+// pass). Neither bit = occluded (or culled by another test).
+PATCHCULL_CONST uint kStatusVisible = 0x100u;
+PATCHCULL_CONST uint kStatusNewlyVisible = 0x200u;
 
-// Patch-ID buffer encoding (R32UI): 0 = background, patch p writes p + 1. Ids with the top bit
-// set are reserved for triangle-mesh occluders (not drawn yet).
+// Counters written by cull_occlusion (kBindingCullCounters), cleared before each dispatch.
+PATCHCULL_CONST uint kCounterFrustum = 0u;       // patches culled by the frustum test
+PATCHCULL_CONST uint kCounterBackPatch = 1u;     // ... by the back-patch hook
+PATCHCULL_CONST uint kCounterOcclusion = 2u;     // ... by the Hi-Z test
+PATCHCULL_CONST uint kCounterWasVisible = 3u;    // tagged visible before the test (first-pass draws)
+PATCHCULL_CONST uint kCounterVisible = 4u;       // passed the test
+PATCHCULL_CONST uint kCounterNewlyVisible = 5u;  // passed the test, not tagged visible before
+PATCHCULL_CONST uint kCounterCount = 8u;
+
+// Patch fragment colour modes (u_color_mode).
+PATCHCULL_CONST uint kColorPatch = 0u;   // per-patch hue, shaded
+PATCHCULL_CONST uint kColorStatus = 1u;  // status of the flag word (gl_renderer.h's legend), shaded
+
+// Patch-ID buffer encoding (R32UI): 0 = background, patch p writes p + 1; triangle t of the
+// occluder mesh writes kIdOccluderBit | t.
 PATCHCULL_CONST uint kIdBackground = 0u;
 PATCHCULL_CONST uint kIdOccluderBit = 0x80000000u;
 
 // Compute work-group size of the per-patch cull shaders (one invocation per patch).
 PATCHCULL_CONST uint kCullGroupSize = 64u;
+// Hi-Z build work groups: kHiZGroupSize x kHiZGroupSize texels of one level.
+PATCHCULL_CONST uint kHiZGroupSize = 8u;
 
 #ifdef __cplusplus
 }  // namespace patchcull::gl::shared

@@ -1,37 +1,49 @@
 // patchcull/gl_renderer.h: the OpenGL 4.5 renderer (library patchcull_gl): a headless EGL
 // context, bicubic patches drawn through hardware tessellation (TCS/TES) into an off-screen
-// framebuffer, per-patch cull flags read by the TCS, and GPU cull passes (compute shaders) that
-// mirror the CPU kernels.
+// framebuffer, per-patch cull flags read by the TCS, GPU cull passes (compute shaders) that mirror
+// the CPU kernels, triangle-mesh occluders, a compute-built Hi-Z pyramid and seed 000 §3's
+// two-pass temporal-coherence occlusion pipeline (render_frame).
 //
-// Conventions (as math.h, frustum.h and displacement.h):
+// Conventions (as math.h, frustum.h, hiz.h and displacement.h):
 // - Patches are in object space = world space (no model matrix); render parameters give view and
 //   projection, object_to_clip = projection * view. Clip space is GL's with
 //   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE): depth z/w in [0,1], larger = farther, cleared to 1,
 //   depth test GL_LESS.
-// - Framebuffer: RGBA8 colour, R32UI patch id, DEPTH32F; all read-backs are width*height values in
-//   image order: row 0 is the TOP row (GL window row height-1), pixel (x, row) at [row*width + x].
+// - Framebuffer: RGBA8 colour, R32UI patch id, DEPTH32F; all read-backs of it are width*height
+//   values in image order: row 0 is the TOP row (GL window row height-1), pixel (x, row) at
+//   [row*width + x]. (The Hi-Z read-back, read_hiz, keeps hiz.h's order instead: row 0 = bottom.)
 // - Patch id buffer: 0 = background, patch index p (its position in the uploaded set) writes p + 1.
-//   Ids with the top bit set are reserved for triangle-mesh occluders (not implemented yet; they
-//   will be drawn by a separate call into the same framebuffer before or after the patches).
-// - Cull flags: one uint per patch, 0 = draw, nonzero = culled (bit 1 frustum, 2 back-patch,
-//   4 occlusion; shaders/shared.h). A culled patch gets tessellation levels 0 in the TCS and is
-//   discarded by the tessellator (seed 000 §3, seed 002: cull in the patch-constant phase).
+//   Triangle t of the occluder mesh (set_occluders) writes kIdOccluderBit | t.
+// - Flag word: one uint per patch, read by the TCS. Bits 0-7 = cull reason of the latest test,
+//   0 = not culled: kFlagFrustum (1), kFlagBackPatch (2), kFlagOcclusion (4) (shaders/shared.h).
+//   Bits 8-9 = temporal status of the pipeline, written by cull_occlusion/render_frame:
+//   kStatusVisible (passed the latest test) and kStatusNewlyVisible (passed it, and was not
+//   tagged visible before). A culled patch gets tessellation levels 0 in the TCS and is discarded
+//   by the tessellator (seed 000 §3, seed 002: cull in the patch-constant phase).
 // - Tessellation: uniform integer level L (equal_spacing) on every edge and the interior, L in
-//   [1, 64]; the surface is evaluated exactly (rational Bezier) at the (L+1)^2 tessellator points.
+//   [1, 64], or adaptive by distance (RenderParams::adaptive_tess, seed 000 §6.3); the surface is
+//   evaluated exactly (rational Bezier) at the tessellator points.
 // - Displacement (optional, the rendered surface): S = B + D(s,t) n as in displacement.h, D from a
 //   DisplacementMap uploaded as an R32F GL_REPEAT bilinear texture, (s,t) from per-patch corner
 //   texcoords. Points where du x dv = 0 (degenerate patch corners) are not displaced. The cull
 //   margin (per-patch max |D|) is given separately, so tests can check that it bounds the surface.
+//   The Hi-Z test is applied only to patches whose margin is 0 (a displaced patch needs the
+//   camera-aligned frustum of seed 000 §4.2, not implemented here): displaced patches are culled
+//   by the frustum (with their margin) and back-patch tests only. While a displacement map is set
+//   and drawn without margins, no patch is Hi-Z tested (nothing says which ones are flat).
 //
 // Workarounds for Mesa llvmpipe (../shared/PLATFORM.md), applied ALWAYS (they cost nothing
 // measurable on a GPU and keep one code path):
 // 1. gl_PrimitiveID restarts every 4096 input vertices on llvmpipe: the patch index is derived as
-//    gl_VertexID / 16 in the vertex shader and passed on; gl_PrimitiveID is never used.
+//    gl_VertexID / 16 in the vertex shader and passed on; gl_PrimitiveID is never used (occluder
+//    triangle ids likewise come from gl_VertexID / 3).
 // 2. llvmpipe emits garbage when one 4096-vertex chunk yields more than 65536 tessellated vertices:
 //    every draw is split with glMultiDrawArrays into sub-draws of at most
-//    max(1, 65536 / (L+1)^2) patches (809 at L = 8, 226 at L = 16, 15 at L = 64).
-// On llvmpipe GL timer queries measure only part of the work: time with a wall clock around
-// finish(). On a real GPU use timer queries.
+//    max(1, 65536 / (L+1)^2) patches (809 at L = 8, 226 at L = 16, 15 at L = 64), L the uniform
+//    level or the adaptive maximum.
+// Timing: on llvmpipe GL timer queries measure only part of the work (the vertex/tessellation
+// stage, not rasterization), so render_frame times passes with a wall clock around glFinish()
+// there; on a real GPU it uses GL_TIMESTAMP queries (FrameStats::timing says which).
 //
 // Threads and lifetime: a GlContext is current on the thread that created it; every other object
 // here must be created, used and destroyed on that thread while the context lives (destroy
@@ -40,10 +52,10 @@
 // Linking: patchcull_gl links libepoxy, which loads libEGL.so.1 and libOpenGL.so.0 (or libGL.so.1)
 // at run time; binaries start without them and create_headless() reports their absence.
 //
-// Planned, not implemented yet (the API leaves room for them): triangle-mesh occluders
-// (set_occluders(positions, triangles): drawn by render() before the patches, ids
-// kIdOccluderBit | mesh index), the back-patch and Hi-Z occlusion passes (more cull_* calls ORing
-// their bits into the same flags), and a GLFW window context beside create_headless().
+// Back-patch culling (seed 001) plugs in through a hook: per-patch decisions from the CPU
+// (FrameParams::backpatch_culled) or a GL buffer written by a GPU pass (FrameParams::backpatch_buffer).
+// Planned, not implemented yet: the camera-aligned frustum for displaced patches (seed 000 §4.2),
+// and a GLFW window context beside create_headless().
 //
 // Errors: factories and calls that can fail throw patchcull::Error with a one-line message
 // ("EGL: no display ...", "GL: shader patch.tesc.glsl: <first log line>", "GL: error 0x0502 after
@@ -60,10 +72,35 @@
 #include "patchcull/displacement.h"
 #include "patchcull/error.h"
 #include "patchcull/frustum.h"
+#include "patchcull/hiz.h"
 #include "patchcull/math.h"
 #include "patchcull/patch.h"
 
 namespace patchcull::gl {
+
+// Flag word bits and id encoding (equal to shaders/shared.h's; static_asserts in the renderer).
+inline constexpr std::uint32_t kFlagFrustum = 1u;        ///< culled by the view frustum
+inline constexpr std::uint32_t kFlagBackPatch = 2u;      ///< culled as back-facing (the hook)
+inline constexpr std::uint32_t kFlagOcclusion = 4u;      ///< culled behind the Hi-Z pyramid
+inline constexpr std::uint32_t kFlagReasonMask = 0xFFu;  ///< bits of the cull reason
+inline constexpr std::uint32_t kStatusVisible = 0x100u;  ///< passed the latest test
+inline constexpr std::uint32_t kStatusNewlyVisible = 0x200u;  ///< ... and was not tagged visible
+inline constexpr std::uint32_t kIdOccluderBit = 0x80000000u;  ///< id of occluder triangle t: bit | t
+
+/// Which tests a cull pass runs; the values are the flag bits a culled patch gets.
+/// backpatch uses the decisions handed to the hook (FrameParams::backpatch_culled); without
+/// them it culls nothing.
+enum class CullMode : std::uint32_t {
+    none = 0,
+    frustum = kFlagFrustum,
+    backpatch = kFlagBackPatch,
+    occlusion = kFlagOcclusion,
+    all = kFlagFrustum | kFlagBackPatch | kFlagOcclusion,
+};
+/// "none", "frustum", "backpatch", "occlusion", "all".
+const char* cull_mode_name(CullMode mode);
+/// Parses cull_mode_name's names; returns false (mode unchanged) otherwise.
+bool parse_cull_mode(const char* text, CullMode& mode);
 
 /// An OpenGL 4.5 core context without a window.
 class GlContext {
@@ -117,9 +154,65 @@ struct RenderParams {
     Mat4 projection;  ///< view -> clip (perspective, depth [0,1])
     int width = 256;
     int height = 256;
-    int tess_level = 8;           ///< uniform tessellation level, clamped to [1, 64]
+    int tess_level = 8;           ///< uniform tessellation level (adaptive: the maximum), clamped to [1, 64]
     bool use_cull_flags = true;   ///< false: ignore the flags and draw every patch (the reference)
     bool displace = true;         ///< displace the surface when a displacement map is set
+    /// Adaptive tessellation by distance (seed 000 §6.3): each edge gets
+    /// clamp(tess_level * tess_reference_distance / d, 1, tess_level), d = distance from the eye to
+    /// the midpoint of the edge's two corner points; interior levels the max of opposite edges.
+    /// Shared edges get equal levels (no T-junction cracks). false: tess_level everywhere.
+    bool adaptive_tess = false;
+    float tess_reference_distance = 1.0f;  ///< > 0, object-space units
+};
+
+/// How render_frame times its passes.
+enum class TimingMethod {
+    automatic,    ///< wall_clock on a software rasterizer, timer_query on a GPU
+    wall_clock,   ///< steady_clock around glFinish() after each pass (serializes the passes)
+    timer_query,  ///< GL_TIMESTAMP queries between passes (no stall; results read at frame end)
+    off,          ///< no timing (every *_ms is 0)
+};
+const char* timing_method_name(TimingMethod method);  ///< "automatic", "wall-clock", "timer-query", "off"
+
+/// Parameters of one frame of the culling pipeline.
+struct FrameParams {
+    RenderParams render;         ///< camera, size, tessellation (use_cull_flags is ignored)
+    CullMode cull = CullMode::all;
+    /// Seed 000 §3.1: skip the second pass (newly visible patches appear one frame late). NOT
+    /// conservative for the current frame: its image can miss patches that became visible; the
+    /// status update still fixes the next frame (identical again after one static frame).
+    bool aggressive = false;
+    TimingMethod timing = TimingMethod::automatic;
+    /// Back-patch hook, CPU side: null, or patch_count() bytes, nonzero = the patch faces away
+    /// (e.g. from a CPU back-patch kernel). Uploaded each frame; a patch flagged here (and inside
+    /// the frustum) gets kFlagBackPatch when the mode includes backpatch.
+    const std::uint8_t* backpatch_culled = nullptr;
+    /// Back-patch hook, GPU side (used instead of backpatch_culled when nonzero): the name of a GL
+    /// buffer object of this context holding patch_count() uints, nonzero = back-facing, written
+    /// before render_frame (e.g. by a back-patch compute pass; the cull pass reads it at binding
+    /// kBindingBackPatchFlags after a GL_SHADER_STORAGE_BARRIER_BIT barrier). No read-back.
+    std::uint32_t backpatch_buffer = 0;
+};
+
+/// What one render_frame did. Counts are patches; each patch has exactly one of: frustum_culled,
+/// backpatch_culled, occlusion_culled, or it passed (visible = tagged visible for the next frame).
+struct FrameStats {
+    std::size_t patches = 0;
+    bool two_pass = false;           ///< the mode includes occlusion (seed 000 §3's pipeline)
+    // Every pass issues all patches to the TCS (seed 000 §6.3's RT_0 cost per pass); "drawn" =
+    // tessellated (levels > 0), the others get levels 0 there.
+    std::size_t pass1_drawn = 0;     ///< patches drawn (tessellated) in the first pass
+    std::size_t pass2_drawn = 0;     ///< ... in the second pass (newly visible; 0 when aggressive)
+    std::size_t frustum_culled = 0;
+    std::size_t backpatch_culled = 0;
+    std::size_t occlusion_culled = 0;
+    std::size_t visible = 0;         ///< passed every test of the mode
+    std::size_t newly_visible = 0;   ///< passed, and were not tagged visible before (not drawn in pass 1)
+    /// Per-pass times in milliseconds. Two-pass: pass1 (clear, occluders, patches tagged visible),
+    /// hiz (build), cull (frustum + back-patch + occlusion test), pass2 (newly visible). One pass
+    /// (no occlusion): cull first, then pass1 draws the patches that passed; hiz = pass2 = 0.
+    double pass1_ms = 0, hiz_ms = 0, cull_ms = 0, pass2_ms = 0, total_ms = 0;
+    TimingMethod timing = TimingMethod::off;  ///< the method used (never automatic)
 };
 
 /// Draws one uploaded set of patches with hardware tessellation into its own framebuffer.
@@ -141,6 +234,12 @@ public:
     void set_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes = {});
     /// Same from a structure-of-arrays batch (patches.count patches).
     void set_patches(const PatchBatchView& patches, const PatchAttributes& attributes = {});
+    /// Animation: replaces the control points (and attributes) of the uploaded set by those of
+    /// the same patches in a new pose, KEEPING the flag words, so the pipeline's temporal status
+    /// carries over to the next render_frame (seed 000 §3 with animated patches). Throws
+    /// patchcull::Error when patches.size() != patch_count() or an attribute vector has the
+    /// wrong size.
+    void update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes = {});
     std::size_t patch_count() const;
 
     /// True when the cull passes compute once-rounded multiply-adds in double precision
@@ -153,17 +252,18 @@ public:
     void set_displacement_map(const DisplacementMap& map);
 
     // ---- cull flags --------------------------------------------------------------------------
-    /// Sets every flag to 0 (draw every patch).
+    /// Sets every flag word to 0 (draw every patch; no status).
     void clear_cull_flags();
-    /// Uploads flags from a CPU kernel: culled[p] nonzero sets flag kCullFrustum (1) on patch p,
-    /// zero sets 0; culled holds patch_count() bytes.
+    /// Uploads flags from a CPU kernel: culled[p] nonzero sets the word of patch p to kFlagFrustum
+    /// (1), zero sets 0; culled holds patch_count() bytes.
     void set_cull_flags(const std::uint8_t* culled);
-    /// Reads the flags back (patch_count() values; 0 = draw). Waits for the GPU.
+    /// Reads the flag words back (patch_count() values; bits 0-7 = cull reason, 0 = drawn by
+    /// render(); bits 8-9 = status). Waits for the GPU.
     std::vector<std::uint32_t> read_cull_flags() const;
 
     /// The GPU frustum pass (shaders/cull_frustum.comp.glsl, one invocation per patch): writes
     /// flag kCullFrustum (1) or 0 for every patch, overwriting the flags, from the control points,
-    /// the max_displacement margins and planes. Makes the same decisions as cull_frustum_scalar on
+    /// the max_displacement margins and planes (the whole word: status bits cleared). Makes the same decisions as cull_frustum_scalar on
     /// the same inputs (same operations, a once-rounded multiply-add where the CPU uses std::fma;
     /// on llvmpipe, which flushes subnormals to zero, values below 1.2e-38 in magnitude may differ).
     /// When plane_values is non-null it also receives, per patch, the six maxima over the control
@@ -172,12 +272,83 @@ public:
     /// At most 65535 * 64 patches (one dispatch), else throws patchcull::Error.
     void cull_frustum(const FrustumPlanes& planes, std::vector<float>* plane_values = nullptr);
 
+    // ---- occluders ---------------------------------------------------------------------------
+    /// Sets the triangle-mesh occluders (seed 000 §3), replacing the previous ones: triangle t has
+    /// corners vertices[indices[3t + i]] (object space). They are drawn by render() and by the
+    /// first pass of render_frame() before any patch, with ids kIdOccluderBit | t, so they occlude
+    /// patches through the depth buffer and the Hi-Z pyramid. Empty vectors remove them. Throws
+    /// patchcull::Error when indices.size() is not a multiple of 3, an index is out of range, or
+    /// there are 2^31 triangles or more.
+    void set_occluders(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& indices);
+    std::size_t occluder_triangle_count() const;
+
     // ---- drawing -----------------------------------------------------------------------------
-    /// Clears the framebuffer (colour dark grey, id 0, depth 1) and draws every patch whose flag is
-    /// 0 (every patch when !use_cull_flags), resizing the framebuffer to width x height when it
-    /// changed (each in [1, 8192], else throws). Does not wait for the GPU. Throws
-    /// patchcull::Error("GL: error 0x.... after render") when GL reports an error.
+    /// Clears the framebuffer (colour dark grey, id 0, depth 1), draws the occluders, then every
+    /// patch whose cull reason (flag bits 0-7) is 0 (every patch when !use_cull_flags), resizing
+    /// the framebuffer to width x height when it changed (each in [1, 8192], else throws). Does not
+    /// wait for the GPU. Throws patchcull::Error("GL: error 0x.... after render") when GL reports
+    /// an error.
     void render(const RenderParams& params);
+
+    /// One frame of the culling pipeline into the framebuffer (read back with read_ids() etc.).
+    /// With occlusion in the mode (seed 000 §3, Fig. 2):
+    ///   1. clear, draw the occluders and the patches tagged visible (kStatusVisible);
+    ///   2. build the Hi-Z pyramid from that depth buffer (build_hiz);
+    ///   3. test every patch (cull_occlusion: frustum, back-patch hook, Hi-Z, as the mode says) and
+    ///      update its status;
+    ///   4. draw the newly visible patches into the same framebuffer (skipped when aggressive).
+    /// Without occlusion: test every patch, then clear, draw the occluders and the patches that
+    /// passed (one pass). The first frame after set_patches(), set_cull_flags(), clear_cull_flags(),
+    /// cull_frustum() or reset_visibility() tags the even-indexed patches visible (seed 000 §3:
+    /// half of them). Conservative (except aggressive): the final id buffer equals render()'s with
+    /// use_cull_flags = false, up to exact depth ties between patches (draw order differs).
+    /// Returns the counts and per-pass times (FrameStats). Reads the counters back, so it waits for
+    /// the GPU at its end. Throws patchcull::Error like render() and cull_occlusion().
+    FrameStats render_frame(const FrameParams& params);
+
+    /// Makes the next render_frame a first frame (even-indexed patches tagged visible).
+    void reset_visibility();
+
+    // ---- Hi-Z (seed 000 §4.1; the pyramid of hiz.h) -----------------------------------------
+    /// Builds the Hi-Z pyramid from the depth buffer of the last render (compute shader
+    /// hiz_build.comp.glsl, one dispatch per level). The texels equal HiZPyramid::build's on the
+    /// same depth buffer (read_depth() with its rows flipped) bit for bit. Does not wait.
+    void build_hiz();
+    /// HiZPyramid::level_count(width(), height()).
+    int hiz_levels() const;
+    /// The pyramid last built, in HiZPyramid::data()'s layout (level l at HiZPyramid's
+    /// level(l).offset, W_l x H_l row-major, row 0 = BOTTOM). Waits for the GPU.
+    std::vector<float> read_hiz() const;
+
+    /// The combined cull pass (shaders/cull_occlusion.comp.glsl, one invocation per patch) against
+    /// the pyramid last built: per patch the frustum test (as cull_frustum, with the margins), the
+    /// back-patch hook (backpatch_culled / backpatch_buffer as in FrameParams), and
+    /// the Hi-Z test of hiz.h (steps 2-9, patches with a zero margin only), as mode enables them;
+    /// writes the flag word (reason of the first test that culls, else kStatusVisible, plus
+    /// kStatusNewlyVisible when the old word lacked kStatusVisible). The screen is the framebuffer
+    /// (width() x height(), the pyramid's size). Without displacement margins the decisions equal
+    /// cull_occlusion_scalar's (kHiZFrustumCulled <-> kFlagFrustum, kHiZOccluded <-> kFlagOcclusion)
+    /// on the same matrix and pyramid. Does not wait. At most 65535 * 64 patches.
+    /// Throws patchcull::Error when occlusion is tested without a pyramid of the framebuffer's size,
+    /// or when backpatch_buffer is not a buffer of at least patch_count() uints.
+    void cull_occlusion(const Mat4& object_to_clip, CullMode mode = CullMode::all,
+                        const std::uint8_t* backpatch_culled = nullptr, std::uint32_t backpatch_buffer = 0);
+
+    /// Visualisation (seed 000 Fig. 2's statuses): renders every patch, ignoring the flags, with a
+    /// colour from its flag word, and the occluders in grey, seen through `view` (its camera, size
+    /// and tessellation; use_cull_flags ignored), into a separate image (the framebuffer keeps the
+    /// last frame). Legend:
+    ///   green   visible (passed the latest test, was tagged visible: drawn in pass 1)
+    ///   yellow  newly visible (passed, was not tagged visible: drawn in pass 2)
+    ///   blue    frustum-culled
+    ///   magenta back-patch-culled
+    ///   red     occlusion-culled
+    ///   grey    no status yet (before any test); occluders a darker neutral grey
+    /// With the frame's own camera no red or magenta patch may show in front (that would be a false
+    /// cull); another camera shows the culled patches. Returns RGBA8, row 0 = top. Waits.
+    std::vector<std::uint8_t> render_status_image(const RenderParams& view);
+    /// render_status_image written as a PNG. Throws patchcull::Error("PATH: cannot write PNG").
+    void write_status_png(const std::string& path, const RenderParams& view);
 
     /// Waits until every command issued so far has completed (glFinish): the end point of a
     /// wall-clock measurement.
@@ -199,6 +370,25 @@ private:
     bool native_fma_rounds_once();
     std::unique_ptr<Impl> impl_;
 };
+
+/// A culled frame against the unculled render of the same camera, resolution and tessellation
+/// (DESIGN.md's GPU ground truth), e.g. for a --verify option.
+struct FrameComparison {
+    std::size_t differing_pixels = 0;  ///< pixels whose id differs
+    /// Of those, pixels where both ids are patches and the depths are equal: two patches with
+    /// fragments at exactly the same depth, drawn in another order (GL_LESS keeps the first). With
+    /// no false cull these are the only possible differences (culling is per patch).
+    std::size_t depth_ties = 0;
+    std::vector<std::uint32_t> false_culled;  ///< patch indices present unculled, absent culled (ascending)
+    bool identical() const { return differing_pixels == 0; }
+    /// No false cull and nothing but depth ties differs.
+    bool conservative() const { return false_culled.empty() && differing_pixels == depth_ties; }
+};
+/// Compares id and depth buffers as read_ids()/read_depth() return them. Throws patchcull::Error
+/// when the four sizes differ.
+FrameComparison compare_frames(const std::vector<std::uint32_t>& unculled_ids,
+                               const std::vector<float>& unculled_depth,
+                               const std::vector<std::uint32_t>& culled_ids, const std::vector<float>& culled_depth);
 
 /// Writes an id buffer (as read_ids returns it) as a PNG with one distinct colour per id, black
 /// for the background: for looking at false culls. Throws patchcull::Error on failure.

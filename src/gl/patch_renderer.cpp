@@ -1,221 +1,26 @@
 // PatchRenderer (patchcull/gl_renderer.h): buffers, programs, the tessellated draw into an
-// off-screen framebuffer, the GPU frustum pass and read-backs. GL 4.5 direct state access.
+// off-screen framebuffer, triangle occluders, the GPU frustum pass and read-backs. GL 4.5 direct
+// state access. The Hi-Z build, the combined cull pass and the frame pipeline are in
+// occlusion_pipeline.cpp; the shared internals in renderer_internal.h.
 #include <epoxy/gl.h>
 #include <stb_image_write.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
 
 #include "patchcull/error.h"
 #include "patchcull/gl_renderer.h"
-#include "shader_sources.h"
-#include "shared.h"
+#include "renderer_internal.h"
 
 namespace patchcull::gl {
 
-namespace {
-
-namespace sh = shared;
-
-std::string hex(unsigned value) {
-    char buf[16];
-    std::snprintf(buf, sizeof buf, "0x%04X", value);
-    return buf;
-}
-
-void check_gl(const char* where) {
-    const GLenum e = glGetError();
-    if (e == GL_NO_ERROR) return;
-    while (glGetError() != GL_NO_ERROR) {
-    }
-    throw Error("GL: error " + hex(e) + " after " + where);
-}
-
-std::string first_line(std::string log) {
-    while (!log.empty() && (log.back() == '\n' || log.back() == '\r' || log.back() == ' ')) log.pop_back();
-    const std::size_t nl = log.find('\n');
-    if (nl != std::string::npos) log = log.substr(0, nl) + " (...)";
-    return log;
-}
-
-// Compiles embedded shader name with `defines` (lines "#define X 1\n") inserted after #version.
-GLuint compile_shader(const char* name, GLenum stage, const std::string& defines) {
-    const char* embedded = detail::find_shader_source(name);
-    if (!embedded) throw Error(std::string("GL: shader ") + name + " is not embedded");
-    std::string text = embedded;
-    const std::size_t version = text.find("#version");
-    if (version == std::string::npos) throw Error(std::string("GL: shader ") + name + " has no #version line");
-    const std::size_t line_end = text.find('\n', version);
-    text.insert(line_end == std::string::npos ? text.size() : line_end + 1, defines);
-    const char* source = text.c_str();
-    const GLuint s = glCreateShader(stage);
-    glShaderSource(s, 1, &source, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        GLint len = 0;
-        glGetShaderiv(s, GL_INFO_LOG_LENGTH, &len);
-        std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
-        glGetShaderInfoLog(s, len, nullptr, log.data());
-        glDeleteShader(s);
-        throw Error(std::string("GL: shader ") + name + ": " + first_line(log.c_str()));
-    }
-    return s;
-}
-
-GLuint link_program(const std::vector<std::pair<const char*, GLenum>>& stages, const char* label,
-                    const std::string& defines = {}) {
-    const GLuint program = glCreateProgram();
-    std::vector<GLuint> shaders;
-    try {
-        for (const auto& [name, stage] : stages) shaders.push_back(compile_shader(name, stage, defines));
-    } catch (...) {
-        for (GLuint s : shaders) glDeleteShader(s);
-        glDeleteProgram(program);
-        throw;
-    }
-    for (GLuint s : shaders) glAttachShader(program, s);
-    glLinkProgram(program);
-    for (GLuint s : shaders) {
-        glDetachShader(program, s);
-        glDeleteShader(s);
-    }
-    GLint ok = 0;
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        GLint len = 0;
-        glGetProgramiv(program, GL_INFO_LOG_LENGTH, &len);
-        std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
-        glGetProgramInfoLog(program, len, nullptr, log.data());
-        glDeleteProgram(program);
-        throw Error(std::string("GL: program ") + label + ": " + first_line(log.c_str()));
-    }
-    return program;
-}
-
-// (Re)allocates buffer with size bytes (at least 16: a zero-sized store cannot be bound).
-void upload(GLuint buffer, std::size_t size, const void* data) {
-    glNamedBufferData(buffer, static_cast<GLsizeiptr>(std::max<std::size_t>(size, 16)), nullptr, GL_DYNAMIC_DRAW);
-    if (size && data) glNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(size), data);
-}
-
-template <class T>
-std::vector<T> flip_rows(const std::vector<T>& in, int width, int height, int per_pixel) {
-    std::vector<T> out(in.size());
-    const std::size_t row = static_cast<std::size_t>(width) * per_pixel;
-    for (int y = 0; y < height; ++y)
-        std::copy_n(in.begin() + static_cast<std::ptrdiff_t>(row * (height - 1 - y)), row,
-                    out.begin() + static_cast<std::ptrdiff_t>(row * y));
-    return out;
-}
-
-}  // namespace
-
-struct PatchRenderer::Impl {
-    GLuint vao = 0;
-    GLuint draw_program = 0, frustum_program = 0;
-    GLuint control_points = 0, cull_flags = 0, max_displacement = 0, texcoords = 0, plane_values = 0;
-    GLuint displacement_texture = 0;
-    float displacement_scale = 0, displacement_midlevel = 0.5f;
-    bool has_displacement_map = false;
-    bool has_max_displacement = false;
-    bool fma_via_double = false;
-    GLuint fbo = 0, color = 0, ids = 0, depth = 0;
-    int width = 0, height = 0;
-    std::size_t count = 0;
-
-    struct {
-        GLint tess_level, use_cull_flags, object_to_clip, displace, displacement_scale, displacement_midlevel, eye;
-    } draw_loc{};
-    struct {
-        GLint rows, normal_length, patch_count, has_displacement, write_plane_values;
-    } frustum_loc{};
-
-    ~Impl() {
-        glDeleteProgram(draw_program);
-        glDeleteProgram(frustum_program);
-        const GLuint buffers[] = {control_points, cull_flags, max_displacement, texcoords, plane_values};
-        glDeleteBuffers(5, buffers);
-        const GLuint textures[] = {displacement_texture, color, ids, depth};
-        glDeleteTextures(4, textures);
-        glDeleteFramebuffers(1, &fbo);
-        glDeleteVertexArrays(1, &vao);
-    }
-
-    void link_cull_programs() {
-        glDeleteProgram(frustum_program);
-        const std::string defines = fma_via_double ? "#define PATCHCULL_FMA_VIA_DOUBLE 1\n" : "";
-        frustum_program = link_program({{"cull_frustum.comp.glsl", GL_COMPUTE_SHADER}}, "cull_frustum", defines);
-        const GLuint fp = frustum_program;
-        frustum_loc = {glGetUniformLocation(fp, "u_plane_rows"), glGetUniformLocation(fp, "u_plane_normal_length"),
-                       glGetUniformLocation(fp, "u_patch_count"), glGetUniformLocation(fp, "u_has_displacement"),
-                       glGetUniformLocation(fp, "u_write_plane_values")};
-    }
-
-    void resize(int w, int h) {
-        if (w == width && h == height) return;
-        if (w < 1 || h < 1 || w > 8192 || h > 8192)
-            throw Error("GL: framebuffer size " + std::to_string(w) + "x" + std::to_string(h) + " outside [1, 8192]");
-        const GLuint textures[] = {color, ids, depth};
-        glDeleteTextures(3, textures);
-        glCreateTextures(GL_TEXTURE_2D, 1, &color);
-        glCreateTextures(GL_TEXTURE_2D, 1, &ids);
-        glCreateTextures(GL_TEXTURE_2D, 1, &depth);
-        glTextureStorage2D(color, 1, GL_RGBA8, w, h);
-        glTextureStorage2D(ids, 1, GL_R32UI, w, h);
-        glTextureStorage2D(depth, 1, GL_DEPTH_COMPONENT32F, w, h);
-        for (GLuint t : {color, ids, depth}) {
-            glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-            glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        }
-        glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
-        glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT1, ids, 0);
-        glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, depth, 0);
-        const GLenum draw_buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-        glNamedFramebufferDrawBuffers(fbo, 2, draw_buffers);
-        const GLenum status = glCheckNamedFramebufferStatus(fbo, GL_DRAW_FRAMEBUFFER);
-        if (status != GL_FRAMEBUFFER_COMPLETE) throw Error("GL: framebuffer incomplete (" + hex(status) + ")");
-        width = w;
-        height = h;
-        check_gl("framebuffer resize");
-    }
-
-    void bind_buffers() const {
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, control_points);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullFlags, cull_flags);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingMaxDisplacement, max_displacement);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchTexcoords, texcoords);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPlaneValues, plane_values);
-    }
-
-    void set_patches(const float* aos_points, std::size_t n, const PatchAttributes& a) {
-        if (!a.max_displacement.empty() && a.max_displacement.size() != n)
-            throw Error("GL: set_patches: max_displacement has " + std::to_string(a.max_displacement.size()) +
-                        " entries for " + std::to_string(n) + " patches");
-        if (!a.texcoords.empty() && a.texcoords.size() != n)
-            throw Error("GL: set_patches: texcoords has " + std::to_string(a.texcoords.size()) + " entries for " +
-                        std::to_string(n) + " patches");
-        if (n > 0x7FFFFFFFu / kPatchPoints) throw Error("GL: set_patches: too many patches for one draw (" + std::to_string(n) + ")");
-        count = n;
-        upload(control_points, n * kPatchPoints * 4 * sizeof(float), aos_points);
-        upload(cull_flags, n * sizeof(std::uint32_t), nullptr);
-        glClearNamedBufferData(cull_flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-        has_max_displacement = !a.max_displacement.empty();
-        upload(max_displacement, has_max_displacement ? n * sizeof(float) : 0, a.max_displacement.data());
-        std::vector<Vec2> uv(4 * n);
-        for (std::size_t p = 0; p < n; ++p)
-            for (int c = 0; c < 4; ++c)
-                uv[4 * p + c] = a.texcoords.empty() ? Vec2{float(c & 1), float(c >> 1)} : a.texcoords[p][c];
-        upload(texcoords, uv.size() * sizeof(Vec2), uv.data());
-        upload(plane_values, 0, nullptr);
-        check_gl("set_patches");
-    }
-};
+static_assert(kFlagFrustum == sh::kCullFrustum && kFlagBackPatch == sh::kCullBackPatch &&
+              kFlagOcclusion == sh::kCullOcclusion && kFlagReasonMask == sh::kCullReasonMask);
+static_assert(kStatusVisible == sh::kStatusVisible && kStatusNewlyVisible == sh::kStatusNewlyVisible);
+static_assert(kIdOccluderBit == sh::kIdOccluderBit);
 
 PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl>()) {
     ctx.make_current();
@@ -230,22 +35,39 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
     // in double precision (shaders/exact_fma.h) so that decisions equal the CPU kernels'. On other
     // drivers native fma() is checked once below.
     m.fma_via_double = ctx.is_software();
+    m.is_software = ctx.is_software();
     m.link_cull_programs();
     const GLuint dp = m.draw_program;
-    m.draw_loc = {glGetUniformLocation(dp, "u_tess_level"),         glGetUniformLocation(dp, "u_use_cull_flags"),
-                  glGetUniformLocation(dp, "u_object_to_clip"),     glGetUniformLocation(dp, "u_displace"),
-                  glGetUniformLocation(dp, "u_displacement_scale"), glGetUniformLocation(dp, "u_displacement_midlevel"),
-                  glGetUniformLocation(dp, "u_eye")};
+    m.draw_loc = {glGetUniformLocation(dp, "u_tess_level"),         glGetUniformLocation(dp, "u_draw_mask"),
+                  glGetUniformLocation(dp, "u_draw_value"),         glGetUniformLocation(dp, "u_adaptive"),
+                  glGetUniformLocation(dp, "u_tess_reference"),     glGetUniformLocation(dp, "u_object_to_clip"),
+                  glGetUniformLocation(dp, "u_displace"),           glGetUniformLocation(dp, "u_displacement_scale"),
+                  glGetUniformLocation(dp, "u_displacement_midlevel"), glGetUniformLocation(dp, "u_eye"),
+                  glGetUniformLocation(dp, "u_color_mode")};
+    m.hiz_program = link_program({{"hiz_build.comp.glsl", GL_COMPUTE_SHADER}}, "hiz_build");
+    const GLuint hp = m.hiz_program;
+    m.hiz_loc = {glGetUniformLocation(hp, "u_from_depth"), glGetUniformLocation(hp, "u_source_level"),
+                 glGetUniformLocation(hp, "u_source_size"), glGetUniformLocation(hp, "u_out_size")};
+    m.occluder_program =
+        link_program({{"occluder.vert.glsl", GL_VERTEX_SHADER}, {"occluder.frag.glsl", GL_FRAGMENT_SHADER}}, "occluder");
+    m.occluder_loc = {glGetUniformLocation(m.occluder_program, "u_object_to_clip"),
+                      glGetUniformLocation(m.occluder_program, "u_eye")};
 
     glCreateVertexArrays(1, &m.vao);
-    GLuint buffers[5];
-    glCreateBuffers(5, buffers);
+    GLuint buffers[8];
+    glCreateBuffers(8, buffers);
     m.control_points = buffers[0];
     m.cull_flags = buffers[1];
     m.max_displacement = buffers[2];
     m.texcoords = buffers[3];
     m.plane_values = buffers[4];
+    m.backpatch_flags = buffers[5];
+    m.counters = buffers[6];
+    m.occluder_vertices = buffers[7];
+    upload(m.counters, sh::kCounterCount * sizeof(std::uint32_t), nullptr);
+    upload(m.occluder_vertices, 0, nullptr);
     glCreateFramebuffers(1, &m.fbo);
+    glCreateFramebuffers(1, &m.vis_fbo);
     m.set_patches(nullptr, 0, {});
     set_displacement_map(DisplacementMap{});
     m.resize(256, 256);
@@ -301,6 +123,10 @@ void PatchRenderer::set_patches(const PatchBatchView& patches, const PatchAttrib
     impl_->set_patches(aos.data(), patches.count, attributes);
 }
 
+void PatchRenderer::update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes) {
+    impl_->set_patches(patches.empty() ? nullptr : &patches[0].cp[0].x, patches.size(), attributes, true);
+}
+
 std::size_t PatchRenderer::patch_count() const { return impl_->count; }
 bool PatchRenderer::fma_via_double() const { return impl_->fma_via_double; }
 
@@ -328,12 +154,14 @@ void PatchRenderer::set_displacement_map(const DisplacementMap& map) {
 
 void PatchRenderer::clear_cull_flags() {
     glClearNamedBufferData(impl_->cull_flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    impl_->primed = false;
     check_gl("clear_cull_flags");
 }
 
 void PatchRenderer::set_cull_flags(const std::uint8_t* culled) {
     std::vector<std::uint32_t> flags(impl_->count);
     for (std::size_t p = 0; p < flags.size(); ++p) flags[p] = culled[p] ? sh::kCullFrustum : 0u;
+    impl_->primed = false;
     if (!flags.empty())
         glNamedBufferSubData(impl_->cull_flags, 0, static_cast<GLsizeiptr>(flags.size() * sizeof(std::uint32_t)),
                              flags.data());
@@ -370,6 +198,7 @@ void PatchRenderer::cull_frustum(const FrustumPlanes& planes, std::vector<float>
     glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glUseProgram(0);
+    m.primed = false;
     if (plane_values) {
         plane_values->resize(6 * m.count);
         glGetNamedBufferSubData(m.plane_values, 0, static_cast<GLsizeiptr>(plane_values->size() * sizeof(float)),
@@ -382,57 +211,38 @@ void PatchRenderer::cull_frustum(const FrustumPlanes& planes, std::vector<float>
 void PatchRenderer::render(const RenderParams& params) {
     Impl& m = *impl_;
     m.resize(params.width, params.height);
-    const int level = std::clamp(params.tess_level, 1, 64);
     const Mat4 object_to_clip = params.projection * params.view;
-    Mat4 view_inverse;
-    Vec3 eye{0, 0, 0};
-    if (invert(params.view, view_inverse)) eye = {view_inverse.at(0, 3), view_inverse.at(1, 3), view_inverse.at(2, 3)};
-
-    const GLuint dp = m.draw_program;
-    glProgramUniform1f(dp, m.draw_loc.tess_level, static_cast<float>(level));
-    glProgramUniform1i(dp, m.draw_loc.use_cull_flags, params.use_cull_flags ? 1 : 0);
-    glProgramUniformMatrix4fv(dp, m.draw_loc.object_to_clip, 1, GL_FALSE, object_to_clip.m);
-    glProgramUniform1i(dp, m.draw_loc.displace, params.displace && m.has_displacement_map ? 1 : 0);
-    glProgramUniform1f(dp, m.draw_loc.displacement_scale, m.displacement_scale);
-    glProgramUniform1f(dp, m.draw_loc.displacement_midlevel, m.displacement_midlevel);
-    glProgramUniform3f(dp, m.draw_loc.eye, eye.x, eye.y, eye.z);
-
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m.fbo);
-    glViewport(0, 0, m.width, m.height);
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);
-    glDisable(GL_BLEND);
-    const float background[4] = {0.12f, 0.12f, 0.14f, 1.0f};
-    const GLuint no_id[4] = {sh::kIdBackground, 0, 0, 0};
-    const float far_depth = 1.0f;
-    glClearNamedFramebufferfv(m.fbo, GL_COLOR, 0, background);
-    glClearNamedFramebufferuiv(m.fbo, GL_COLOR, 1, no_id);
-    glClearNamedFramebufferfv(m.fbo, GL_DEPTH, 0, &far_depth);
-
-    if (m.count > 0) {
-        glUseProgram(dp);
-        glBindVertexArray(m.vao);
-        m.bind_buffers();
-        glBindTextureUnit(sh::kTextureUnitDisplacement, m.displacement_texture);
-        glPatchParameteri(GL_PATCH_VERTICES, kPatchPoints);
-        // llvmpipe workaround 2 (header): at most 65536 / (L+1)^2 patches per sub-draw.
-        const std::size_t per_draw = std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((level + 1) * (level + 1)));
-        std::vector<GLint> firsts;
-        std::vector<GLsizei> counts;
-        for (std::size_t first = 0; first < m.count; first += per_draw) {
-            firsts.push_back(static_cast<GLint>(first * kPatchPoints));
-            counts.push_back(static_cast<GLsizei>(std::min(per_draw, m.count - first) * kPatchPoints));
-        }
-        glMultiDrawArrays(GL_PATCHES, firsts.data(), counts.data(), static_cast<GLsizei>(firsts.size()));
-        glBindVertexArray(0);
-        glUseProgram(0);
-    }
+    const int level = m.set_draw_uniforms(params, object_to_clip, sh::kColorPatch);
+    m.begin_target(m.fbo, m.width, m.height);
+    m.draw_occluders();
+    m.draw_patches(level, params.use_cull_flags ? sh::kCullReasonMask : 0u, 0u);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     check_gl("render");
 }
+
+// ---- occluders ---------------------------------------------------------------------------------
+
+void PatchRenderer::set_occluders(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& indices) {
+    if (indices.size() % 3 != 0)
+        throw Error("GL: set_occluders: " + std::to_string(indices.size()) + " indices is not a multiple of 3");
+    if (indices.size() / 3 >= 0x80000000u) throw Error("GL: set_occluders: 2^31 triangles or more");
+    std::vector<float> expanded(indices.size() * 4);
+    for (std::size_t i = 0; i < indices.size(); ++i) {
+        if (indices[i] >= vertices.size())
+            throw Error("GL: set_occluders: index " + std::to_string(indices[i]) + " out of range (" +
+                        std::to_string(vertices.size()) + " vertices)");
+        const Vec3 v = vertices[indices[i]];
+        expanded[4 * i] = v.x;
+        expanded[4 * i + 1] = v.y;
+        expanded[4 * i + 2] = v.z;
+        expanded[4 * i + 3] = 1.0f;
+    }
+    upload(impl_->occluder_vertices, expanded.size() * sizeof(float), expanded.data());
+    impl_->occluder_triangles = indices.size() / 3;
+    check_gl("set_occluders");
+}
+
+std::size_t PatchRenderer::occluder_triangle_count() const { return impl_->occluder_triangles; }
 
 void PatchRenderer::finish() const { glFinish(); }
 

@@ -26,6 +26,11 @@ TEST(GlLayering, RendererUsesOnlyPublicHeadersAndItsOwnFiles) {
             EXPECT_EQ(inc.find("topology"), std::string::npos) << entry.path() << " includes " << inc;
             EXPECT_EQ(inc.find("opensubdiv"), std::string::npos) << entry.path() << " includes " << inc;
             EXPECT_EQ(inc.find("../"), std::string::npos) << entry.path() << " includes " << inc;
+            // The import layer (model loading, animation) stays out of the renderer: the caller hands
+            // it patches.
+            EXPECT_EQ(inc.find("scene.h"), std::string::npos) << entry.path() << " includes " << inc;
+            EXPECT_EQ(inc.find("animation.h"), std::string::npos) << entry.path() << " includes " << inc;
+            EXPECT_EQ(inc.find("subdivision.h"), std::string::npos) << entry.path() << " includes " << inc;
         }
         // No GLSL embedded as string literals in the sources: shaders live in shaders/*.glsl.
         std::ifstream again(entry.path());
@@ -33,4 +38,18 @@ TEST(GlLayering, RendererUsesOnlyPublicHeadersAndItsOwnFiles) {
         EXPECT_EQ(text.find("#version 4"), std::string::npos) << entry.path();
     }
     EXPECT_GE(files, 3u);
+}
+
+TEST(GlLayering, PublicRendererHeaderUsesOnlyCoreHeaders) {
+    const std::regex include_re(R"(^\s*#\s*include\s*[<"]([^>"]+)[>"])");
+    std::ifstream in(fs::path(PATCHCULL_SOURCE_DIR) / "include/patchcull/gl_renderer.h");
+    ASSERT_TRUE(in.good());
+    std::string line;
+    std::smatch m;
+    while (std::getline(in, line)) {
+        if (!std::regex_search(line, m, include_re)) continue;
+        const std::string inc = m[1];
+        for (const char* banned : {"scene.h", "animation.h", "subdivision.h", "obj.h", "epoxy", "GL/", "EGL/"})
+            EXPECT_EQ(inc.find(banned), std::string::npos) << "gl_renderer.h includes " << inc;
+    }
 }

@@ -1,0 +1,164 @@
+// frustum + back-patch + Hi-Z occlusion cull pass (seed 000 §4.1.1), one invocation per patch: the
+// GPU twin of cull_occlusion_scalar (include/patchcull/hiz.h, src/core/hiz.cpp), steps numbered
+// as in hiz.h. Operation by operation the same arithmetic, so the decisions are identical:
+// products and std::fma <-> `precise` products and pc_fma (exact_fma.h), `a < b ? a : b` min/max,
+// floor, integer shifts; the divisions of step 4 are correctly rounded (pc_div below).
+//
+// Tests, cheapest first, each enabled by its bit in u_tests; the first that culls sets its reason:
+//   kCullFrustum:   frustum_test.h (= cull_frustum.comp.glsl, with the displacement margin);
+//   kCullBackPatch: the hook: backpatch_flags[p] != 0 (written by the caller or a later pass);
+//   kCullOcclusion: steps 2-9 against the Hi-Z pyramid (u_hiz), only for patches whose margin is 0
+//                   (displaced patches need the camera-aligned frustum of seed 000 §4.2: not here).
+// Then the flag word gets its reason and the temporal status (shared.h):
+//   passed: kStatusVisible, plus kStatusNewlyVisible when the old word lacked kStatusVisible;
+//   culled: the reason bit alone.
+#version 450 core
+#include "shared.h"
+#include "exact_fma.h"
+
+layout(local_size_x = kCullGroupSize) in;
+
+layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
+    vec4 control_points[];
+};
+layout(std430, binding = kBindingCullFlags) buffer CullFlags {
+    uint cull_flags[];  // read (old status) and written by the same invocation only
+};
+layout(std430, binding = kBindingMaxDisplacement) readonly buffer MaxDisplacement {
+    float max_displacement[];
+};
+layout(std430, binding = kBindingBackPatchFlags) readonly buffer BackPatchFlags {
+    uint backpatch_flags[];
+};
+layout(std430, binding = kBindingCullCounters) buffer CullCounters {
+    uint counters[];
+};
+
+uniform vec4 u_plane_rows[6];            // FrustumPlanes::rows of u_object_to_clip
+uniform float u_plane_normal_length[6];  // FrustumPlanes::normal_length
+uniform uint u_patch_count;
+uniform bool u_has_displacement;
+uniform bool u_has_backpatch;
+uniform uint u_tests;                    // kCullFrustum | kCullBackPatch | kCullOcclusion
+uniform mat4 u_object_to_clip;           // column-major: u_object_to_clip[c][r] = M(r, c)
+uniform ivec2 u_screen;                  // W, H: the depth buffer of the pyramid (viewport 0,0,W,H)
+uniform int u_hiz_levels;                // HiZPyramid::level_count(W, H)
+layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
+
+#include "frustum_test.h"
+
+float pc_min(float a, float b) { return a < b ? a : b; }
+float pc_max(float a, float b) { return a > b ? a : b; }
+
+// a / b correctly rounded (IEEE), as the CPU's float division. GLSL allows 2.5 ulp for float
+// division, so it is computed in double and rounded once to float: for float a, b the exact
+// quotient lies at least 2^-49 (relative) from every midpoint between two floats (a/b = midpoint
+// m would need m*b, with m's odd 25-bit significand, to fit a 24-bit significand), farther than
+// the error of any double division within 16 double ulps (2^-48 relative); so the float nearest
+// to the double quotient is the float nearest to a/b.
+float pc_div(float a, float b) {
+    precise double q = double(a) / double(b);
+    return float(q);
+}
+
+// 2^-20: step 3's safety factor (hiz.cpp kWSafety).
+const float kWSafety = 9.5367431640625e-07;
+
+// Steps 2-9 for patch p: true when the patch lies behind the pyramid.
+bool hiz_occluded(uint p) {
+    precise float nxmin = 0.0, nxmax = 0.0, nymin = 0.0, nymax = 0.0, zmin = 0.0;
+    for (uint k = 0u; k < 16u; ++k) {
+        const vec4 P = control_points[16u * p + k];
+        // Step 2: clip-space point, c_r = fma(M(r,3), W, fma(M(r,2), Z, fma(M(r,1), Y, M(r,0) * X))).
+        precise float c[4];
+        for (int r = 0; r < 4; ++r) {
+            precise float t = u_object_to_clip[0][r] * P.x;
+            t = pc_fma(u_object_to_clip[1][r], P.y, t);
+            t = pc_fma(u_object_to_clip[2][r], P.z, t);
+            c[r] = pc_fma(u_object_to_clip[3][r], P.w, t);
+        }
+        // Step 3: projectable (provably w > 0), else the patch is not screen-tested.
+        precise float s = abs(u_object_to_clip[0][3]) * abs(P.x);
+        s = pc_fma(abs(u_object_to_clip[1][3]), abs(P.y), s);
+        s = pc_fma(abs(u_object_to_clip[2][3]), abs(P.z), s);
+        s = pc_fma(abs(u_object_to_clip[3][3]), abs(P.w), s);
+        precise float bound = kWSafety * s;
+        if (!(c[3] > bound)) return false;
+        // Step 4: NDC box and front plane.
+        const float nx = pc_div(c[0], c[3]);
+        const float ny = pc_div(c[1], c[3]);
+        const float nz = pc_div(c[2], c[3]);
+        if (k == 0u) {
+            nxmin = nx;
+            nxmax = nx;
+            nymin = ny;
+            nymax = ny;
+            zmin = nz;
+        } else {
+            nxmin = pc_min(nxmin, nx);
+            nxmax = pc_max(nxmax, nx);
+            nymin = pc_min(nymin, ny);
+            nymax = pc_max(nymax, ny);
+            zmin = pc_min(zmin, nz);
+        }
+    }
+    // Step 5: window box.
+    const float half_w = 0.5 * float(u_screen.x), half_h = 0.5 * float(u_screen.y);
+    precise float xlo = pc_fma(nxmin, half_w, half_w);
+    precise float xhi = pc_fma(nxmax, half_w, half_w);
+    precise float ylo = pc_fma(nymin, half_h, half_h);
+    precise float yhi = pc_fma(nymax, half_h, half_h);
+    // Step 6: pixel rectangle, clamped in float (hiz_rect_from_window_box).
+    const float wmax = float(u_screen.x - 1), hmax = float(u_screen.y - 1);
+    const int x0 = int(pc_min(pc_max(floor(xlo), 0.0), wmax));
+    const int x1 = int(pc_min(pc_max(floor(xhi), 0.0), wmax));
+    const int y0 = int(pc_min(pc_max(floor(ylo), 0.0), hmax));
+    const int y1 = int(pc_min(pc_max(floor(yhi), 0.0), hmax));
+    // Step 7: level (hiz_select_level): Lc = bit_width(span - 1) - 1 = findMSB(span - 1).
+    const int span = max(x1 - x0, y1 - y0);
+    int level = span <= 2 ? 0 : findMSB(uint(span - 1));
+    if (level > 0) {
+        const int sh = level;  // shift of level - 1
+        if ((x1 >> sh) - (x0 >> sh) <= 1 && (y1 >> sh) - (y0 >> sh) <= 1) --level;
+    }
+    level = min(level, u_hiz_levels - 1);
+    // Step 8: max of the (at most) 2x2 texels, in hiz_rect_max's order.
+    const int sh = level + 1;
+    const int tx0 = x0 >> sh, tx1 = x1 >> sh, ty0 = y0 >> sh, ty1 = y1 >> sh;
+    const float t00 = texelFetch(u_hiz, ivec2(tx0, ty0), level).r;
+    const float t10 = texelFetch(u_hiz, ivec2(tx1, ty0), level).r;
+    const float t01 = texelFetch(u_hiz, ivec2(tx0, ty1), level).r;
+    const float t11 = texelFetch(u_hiz, ivec2(tx1, ty1), level).r;
+    const float h = pc_max(pc_max(t00, t10), pc_max(t01, t11));
+    // Step 9: strictly nearer everywhere.
+    return h < zmin;
+}
+
+void main() {
+    const uint p = gl_GlobalInvocationID.x;
+    if (p >= u_patch_count) return;
+    const uint old_word = cull_flags[p];
+    const float d = u_has_displacement ? max_displacement[p] : 0.0;
+    uint reason = 0u;
+    if ((u_tests & kCullFrustum) != 0u) {
+        float mx[6];
+        if (pc_frustum_culled(p, d, mx)) reason = kCullFrustum;
+    }
+    if (reason == 0u && (u_tests & kCullBackPatch) != 0u && u_has_backpatch && backpatch_flags[p] != 0u)
+        reason = kCullBackPatch;
+    if (reason == 0u && (u_tests & kCullOcclusion) != 0u && d == 0.0 && hiz_occluded(p)) reason = kCullOcclusion;
+
+    const bool was_visible = (old_word & kStatusVisible) != 0u;
+    uint word = reason;
+    if (reason == 0u) word = kStatusVisible | (was_visible ? 0u : kStatusNewlyVisible);
+    cull_flags[p] = word;
+
+    if (was_visible) atomicAdd(counters[kCounterWasVisible], 1u);
+    if (reason == kCullFrustum) atomicAdd(counters[kCounterFrustum], 1u);
+    if (reason == kCullBackPatch) atomicAdd(counters[kCounterBackPatch], 1u);
+    if (reason == kCullOcclusion) atomicAdd(counters[kCounterOcclusion], 1u);
+    if (reason == 0u) {
+        atomicAdd(counters[kCounterVisible], 1u);
+        if (!was_visible) atomicAdd(counters[kCounterNewlyVisible], 1u);
+    }
+}

@@ -1,0 +1,164 @@
+// ptp back-patch cull pass (seed 001 §3-6): the GPU twin of cull_ptp_scalar
+// (include/patchcull/backpatch.h, src/core/ptp.cpp) with seed 001 §6's parallel scheme:
+// kPtpLanes = 16 invocations per patch, kPtpPatchesPerGroup = 8 patches per work group.
+//
+// Per patch (lane = gl_LocalInvocationID.x, the patch's slot in the group = .y):
+// 1. lane k transforms control point k to clip space (rows x, y, w of s * object_to_clip, given
+//    by the host exactly as ptp_clip_rows computes them) into shared memory;
+// 2. the lanes share the schedule's 2x2 minors (kPtpPairCount pairs, round robin) in shared
+//    memory;
+// 3. lane tau = 4 (jv % 4) + (iu % 4) computes the 4 destinations {iu, iu + 4} x {jv, jv + 4} of
+//    its 4x4 block (seed §6's load balance: 31 to 33 terms per lane), each summed in the CPU
+//    schedule's order (ptp_schedule.h: table order within a destination, the same pair minors,
+//    the corner formula for the 4 corner destinations), so every t is bit-identical to the CPU's
+//    (pc_fma = std::fma; the other operations are single IEEE operations marked precise). A lane
+//    owns its destinations alone: no write hazards, no atomics;
+// 4. the 64 t go to shared memory and are counted by a parallel reduction: lane i counts how many
+//    of t[4i .. 4i+3] satisfy the rule (ncnt: t < 0, pcnt: t <= 0; NaN satisfies neither), then a
+//    tree sum over the 16 lanes; culled when all 64 do (as the CPU's "every t < 0" / "no t > 0").
+// Writes kCullBackPatch or 0 to the back-patch flag word; the 64 t to kBindingPtpPlanes on
+// request (tests). The host skips the dispatch (and clears the flags) when ptp_clip_rows would
+// return false (alpha or det(object_to_clip) zero or not finite).
+#version 450 core
+#include "shared.h"
+#include "backpatch_shared.h"
+#include "exact_fma.h"
+#include "ptp_schedule.h"
+
+layout(local_size_x = kPtpLanes, local_size_y = kPtpPatchesPerGroup) in;
+
+layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
+    vec4 control_points[];  // patch p's point k at 16p + k (patch.h order)
+};
+layout(std430, binding = kBindingBackPatchFlags) writeonly buffer BackPatchFlags {
+    uint backpatch_flags[];
+};
+layout(std430, binding = kBindingPtpPlanes) writeonly buffer PtpPlanes {
+    float ptp_planes[];  // 64 per patch, written only when u_write_planes
+};
+
+uniform vec4 u_rows[3];  // rows x, y, w of s * object_to_clip (ptp.cpp: s = sign(alpha) sign(det))
+uniform uint u_patch_count;
+uniform uint u_first_patch;  // dispatches cover patches from here (large sets take several)
+uniform bool u_pcnt;     // PtpRule::pcnt (else ncnt)
+uniform bool u_write_planes;
+// Always 0.0 (the host sets it): the accumulators start from this run-time zero, not from a
+// literal, because Mesa folds `x + 0.0` into x even in precise code, which turns the CPU's
+// fma(w, v, +0) = +0 for v = -0 into -0 (measured on llvmpipe: the sign of zero t differed).
+uniform float u_zero;
+
+shared float s_x[kPtpPatchesPerGroup][16];
+shared float s_y[kPtpPatchesPerGroup][16];
+shared float s_w[kPtpPatchesPerGroup][16];
+shared float s_mxy[kPtpPatchesPerGroup][kPtpPairCount];
+shared float s_mxw[kPtpPatchesPerGroup][kPtpPairCount];
+shared float s_myw[kPtpPatchesPerGroup][kPtpPairCount];
+shared float s_t[kPtpPatchesPerGroup][64];
+shared uint s_count[kPtpPatchesPerGroup][kPtpLanes];
+
+// a*b - c*d as fma(a, b, -(c*d)) (ptp.cpp's minor2).
+float pc_minor2(float a, float b, float c, float d) {
+    precise float q = c * d;
+    precise float r = pc_fma(a, b, -q);
+    return r;
+}
+
+void sync_shared() {
+    memoryBarrierShared();
+    barrier();
+}
+
+void main() {
+    const uint lane = gl_LocalInvocationID.x, slot = gl_LocalInvocationID.y;
+    const uint p = u_first_patch + gl_WorkGroupID.x * kPtpPatchesPerGroup + slot;
+    const bool in_range = p < u_patch_count;  // inactive slots still take part in every barrier
+
+    // 1. Clip transform of control point `lane`: v = r.x X; v = fma(r.y, Y, v); ... (ptp.cpp step 1).
+    {
+        const vec4 P = in_range ? control_points[16u * p + lane] : vec4(0.0);
+        precise float o[3];
+        for (int r = 0; r < 3; ++r) {
+            const vec4 row = u_rows[r];
+            precise float v = row.x * P.x;
+            v = pc_fma(row.y, P.y, v);
+            v = pc_fma(row.z, P.z, v);
+            o[r] = pc_fma(row.w, P.w, v);
+        }
+        s_x[slot][lane] = o[0];
+        s_y[slot][lane] = o[1];
+        s_w[slot][lane] = o[2];
+    }
+    sync_shared();
+
+    // 2. Minors of the schedule's pairs (a, b), as the minors of (a, b - a) (ptp.cpp step 2).
+    for (uint q = lane; q < kPtpPairCount; q += kPtpLanes) {
+        const uint pair = kPtpPairs[q];
+        const uint a = pair & 0xFFu, b = pair >> 8;
+        const float ax = s_x[slot][a], ay = s_y[slot][a], aw = s_w[slot][a];
+        precise float ex = s_x[slot][b] - ax;
+        precise float ey = s_y[slot][b] - ay;
+        precise float ew = s_w[slot][b] - aw;
+        s_mxy[slot][q] = pc_minor2(ax, ey, ay, ex);
+        s_mxw[slot][q] = pc_minor2(ax, ew, aw, ex);
+        s_myw[slot][q] = pc_minor2(ay, ew, aw, ey);
+    }
+    sync_shared();
+
+    // 3. The 4 destinations of this lane's 4x4 block, each in the CPU schedule's order (step 3).
+    const uint iu0 = lane & 3u, jv0 = lane >> 2;
+    for (uint s = 0u; s < 4u; ++s) {
+        const uint d = (iu0 + 4u * (s & 1u)) + 8u * (jv0 + 4u * (s >> 1));
+        precise float acc = u_zero;
+        const int ci = kPtpCornerOfDest[d];
+        if (ci >= 0) {
+            // t[d] = weight * det[p_a, p_b - p_a, p_c - p_a] (ptp_schedule.h's corners).
+            const uint cr = kPtpCorners[ci];
+            const uint a = (cr >> 8) & 0xFFu, b = (cr >> 16) & 0xFFu, c = cr >> 24;
+            const float ax = s_x[slot][a], ay = s_y[slot][a], aw = s_w[slot][a];
+            precise float d1x = s_x[slot][b] - ax;
+            precise float d1y = s_y[slot][b] - ay;
+            precise float d1w = s_w[slot][b] - aw;
+            precise float d2x = s_x[slot][c] - ax;
+            precise float d2y = s_y[slot][c] - ay;
+            precise float d2w = s_w[slot][c] - aw;
+            const float m_xy = pc_minor2(ax, d1y, ay, d1x);
+            const float m_xw = pc_minor2(ax, d1w, aw, d1x);
+            const float m_yw = pc_minor2(ay, d1w, aw, d1y);
+            precise float v = d2x * m_yw;
+            v = pc_fma(-d2y, m_xw, v);
+            v = pc_fma(d2w, m_xy, v);
+            acc = pc_fma(uintBitsToFloat(kPtpCornerWeights[ci]), v, acc);
+        } else {
+            const uint first = kPtpDestFirst[d], last = kPtpDestFirst[d + 1u];
+            for (uint st = first; st < last; ++st) {
+                const uint step = kPtpSteps[st];
+                const uint q = step & 0xFFu, third = step >> 8;
+                const float cx = s_x[slot][third], cy = s_y[slot][third], cw = s_w[slot][third];
+                precise float v = cx * s_myw[slot][q];
+                v = pc_fma(-cy, s_mxw[slot][q], v);
+                v = pc_fma(cw, s_mxy[slot][q], v);
+                acc = pc_fma(uintBitsToFloat(kPtpStepWeights[st]), v, acc);
+            }
+        }
+        s_t[slot][d] = acc;
+    }
+    sync_shared();
+
+    // 4. Sign count by parallel reduction (step 4): how many t satisfy the rule.
+    uint ok = 0u;
+    for (uint i = 0u; i < 4u; ++i) {
+        const float t = s_t[slot][4u * lane + i];
+        const bool pass = u_pcnt ? (t <= 0.0) : (t < 0.0);  // NaN: false (kept)
+        ok += pass ? 1u : 0u;
+    }
+    s_count[slot][lane] = ok;
+    sync_shared();
+    for (uint stride = kPtpLanes / 2u; stride > 0u; stride >>= 1) {
+        if (lane < stride) s_count[slot][lane] += s_count[slot][lane + stride];
+        sync_shared();
+    }
+    if (!in_range) return;
+    if (lane == 0u) backpatch_flags[p] = s_count[slot][0] == 64u ? kCullBackPatch : 0u;
+    if (u_write_planes)
+        for (uint i = 0u; i < 4u; ++i) ptp_planes[64u * p + 4u * lane + i] = s_t[slot][4u * lane + i];
+}

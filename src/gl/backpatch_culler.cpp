@@ -1,0 +1,405 @@
+// BackpatchCuller (patchcull/gl_backpatch.h): the GPU back-patch cull passes tcone, ncone and ptp.
+// Self-contained (its own programs and buffers; shares only the buffer layouts and bindings of
+// shaders/shared.h with the renderer). GL 4.5 direct state access.
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "backpatch_shared.h"
+#include "patchcull/error.h"
+#include "patchcull/gl_backpatch.h"
+#include "shader_sources.h"
+#include "shared.h"
+
+namespace patchcull::gl {
+
+namespace {
+
+namespace sh = shared;
+namespace bs = backpatch_shared;
+
+static_assert(kFlagBackPatch == sh::kCullBackPatch);
+
+std::string hex_code(unsigned value) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "0x%04X", value);
+    return buf;
+}
+
+void check_gl_error(const char* where) {
+    const GLenum e = glGetError();
+    if (e == GL_NO_ERROR) return;
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    throw Error("GL: error " + hex_code(e) + " after " + where);
+}
+
+std::string first_log_line(std::string log) {
+    while (!log.empty() && (log.back() == '\n' || log.back() == '\r' || log.back() == ' ' || log.back() == '\0'))
+        log.pop_back();
+    const std::size_t nl = log.find('\n');
+    if (nl != std::string::npos) log = log.substr(0, nl) + " (...)";
+    return log;
+}
+
+// Compiles and links the embedded compute shader `name` with `defines` inserted after #version.
+GLuint compute_program(const char* name, const std::string& defines) {
+    const char* embedded = detail::find_shader_source(name);
+    if (!embedded) throw Error(std::string("GL: shader ") + name + " is not embedded");
+    std::string text = embedded;
+    const std::size_t version = text.find("#version");
+    if (version == std::string::npos) throw Error(std::string("GL: shader ") + name + " has no #version line");
+    const std::size_t line_end = text.find('\n', version);
+    text.insert(line_end == std::string::npos ? text.size() : line_end + 1, defines);
+    const char* source = text.c_str();
+    const GLuint s = glCreateShader(GL_COMPUTE_SHADER);
+    glShaderSource(s, 1, &source, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        GLint len = 0;
+        glGetShaderiv(s, GL_INFO_LOG_LENGTH, &len);
+        std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
+        glGetShaderInfoLog(s, len, nullptr, log.data());
+        glDeleteShader(s);
+        throw Error(std::string("GL: shader ") + name + ": " + first_log_line(log));
+    }
+    const GLuint program = glCreateProgram();
+    glAttachShader(program, s);
+    glLinkProgram(program);
+    glDetachShader(program, s);
+    glDeleteShader(s);
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        GLint len = 0;
+        glGetProgramiv(program, GL_INFO_LOG_LENGTH, &len);
+        std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
+        glGetProgramInfoLog(program, len, nullptr, log.data());
+        glDeleteProgram(program);
+        throw Error(std::string("GL: program ") + name + ": " + first_log_line(log));
+    }
+    return program;
+}
+
+// (Re)allocates buffer with size bytes (at least 16: a zero-sized store cannot be bound).
+void allocate(GLuint buffer, std::size_t size, const void* data) {
+    glNamedBufferData(buffer, static_cast<GLsizeiptr>(std::max<std::size_t>(size, 16)), nullptr, GL_DYNAMIC_DRAW);
+    if (size && data) glNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(size), data);
+}
+
+// Rows x, y, w of s * object_to_clip with s = sign(alpha) * sign(det object_to_clip): the same
+// computation as ptp_detail::ptp_clip_rows (src/core/ptp.cpp; src/gl may not include core
+// internals, tests/gl/backpatch_gpu_test.cpp compares the two). False: nothing may be culled.
+bool ptp_rows(const Mat4& object_to_clip, float alpha, float rows[3][4]) {
+    double m[4][4];
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) m[r][c] = object_to_clip.at(r, c);
+    const double s0 = m[0][0] * m[1][1] - m[1][0] * m[0][1], s1 = m[0][0] * m[1][2] - m[1][0] * m[0][2];
+    const double s2 = m[0][0] * m[1][3] - m[1][0] * m[0][3], s3 = m[0][1] * m[1][2] - m[1][1] * m[0][2];
+    const double s4 = m[0][1] * m[1][3] - m[1][1] * m[0][3], s5 = m[0][2] * m[1][3] - m[1][2] * m[0][3];
+    const double c5 = m[2][2] * m[3][3] - m[3][2] * m[2][3], c4 = m[2][1] * m[3][3] - m[3][1] * m[2][3];
+    const double c3 = m[2][1] * m[3][2] - m[3][1] * m[2][2], c2 = m[2][0] * m[3][3] - m[3][0] * m[2][3];
+    const double c1 = m[2][0] * m[3][2] - m[3][0] * m[2][2], c0 = m[2][0] * m[3][1] - m[3][0] * m[2][1];
+    const double det = s0 * c5 - s1 * c4 + s2 * c3 + s3 * c2 - s4 * c1 + s5 * c0;
+    if (!std::isfinite(det) || det == 0.0 || !std::isfinite(alpha) || alpha == 0.0f) return false;
+    const float s = ((det > 0) == (alpha > 0)) ? 1.0f : -1.0f;
+    const int src_row[3] = {0, 1, 3};  // x, y, w
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) rows[r][c] = s * object_to_clip.at(src_row[r], c);
+    return true;
+}
+
+// Patches per dispatch: at most 65535 work groups (the GL minimum of the x count).
+constexpr std::size_t kMaxGroups = 65535;
+
+}  // namespace
+
+const char* backpatch_method_name(BackpatchMethod method) {
+    switch (method) {
+        case BackpatchMethod::tcone: return "tcone";
+        case BackpatchMethod::ncone: return "ncone";
+        case BackpatchMethod::ptp: return "ptp";
+    }
+    return "?";
+}
+
+struct BackpatchCuller::Impl {
+    GLuint tcone = 0, ncone = 0, ptp = 0, probe = 0;
+    GLuint own_points = 0, flags = 0, planes = 0, probe_in = 0, probe_out = 0, cone_values = 0;
+    GLuint points = 0;  // own_points or the caller's buffer
+    std::size_t count = 0;
+    bool fma_via_double = false;
+
+    ~Impl() {
+        for (GLuint p : {tcone, ncone, ptp, probe}) glDeleteProgram(p);
+        const GLuint buffers[] = {own_points, flags, planes, probe_in, probe_out, cone_values};
+        glDeleteBuffers(6, buffers);
+    }
+
+    // Programs are compiled on first use (llvmpipe takes seconds for ncone); link() drops them
+    // all (after the fma mode changed).
+    void link() {
+        for (GLuint* p : {&tcone, &ncone, &ptp, &probe}) {
+            glDeleteProgram(*p);
+            *p = 0;
+        }
+    }
+
+    GLuint program(GLuint& slot, const char* name) {
+        if (!slot) slot = compute_program(name, fma_via_double ? "#define PATCHCULL_FMA_VIA_DOUBLE 1\n" : "");
+        return slot;
+    }
+    GLuint tcone_program() { return program(tcone, "cull_tcone.comp.glsl"); }
+    GLuint ncone_program() { return program(ncone, "cull_ncone.comp.glsl"); }
+    GLuint ptp_program() { return program(ptp, "cull_ptp.comp.glsl"); }
+    GLuint probe_program() { return program(probe, "backpatch_probe.comp.glsl"); }
+
+    void resize_flags(std::size_t n) {
+        count = n;
+        allocate(flags, n * sizeof(std::uint32_t), nullptr);
+        glClearNamedBufferData(flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    }
+
+    void read_flags(std::vector<std::uint8_t>& out) const {
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        std::vector<std::uint32_t> words(count);
+        if (count)
+            glGetNamedBufferSubData(flags, 0, static_cast<GLsizeiptr>(count * sizeof(std::uint32_t)), words.data());
+        out.resize(count);
+        for (std::size_t p = 0; p < count; ++p) out[p] = words[p] != 0 ? 1 : 0;
+        check_gl_error("back-patch flag read-back");
+    }
+
+    void cull_cone(GLuint program, Vec3 eye, std::vector<std::uint8_t>* culled, std::vector<float>* cones) {
+        if (cones) allocate(cone_values, count * bs::kConeValues * sizeof(float), nullptr);
+        glUseProgram(program);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, points);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingBackPatchFlags, flags);
+        glUniform1ui(glGetUniformLocation(program, "u_patch_count"), static_cast<GLuint>(count));
+        glUniform3f(glGetUniformLocation(program, "u_eye"), eye.x, eye.y, eye.z);
+        glUniform1f(glGetUniformLocation(program, "u_zero"), 0.0f);
+        glUniform1i(glGetUniformLocation(program, "u_write_cones"), cones ? 1 : 0);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bs::kBindingConeValues, cone_values);
+        const GLint first_loc = glGetUniformLocation(program, "u_first_patch");
+        const std::size_t per_dispatch = kMaxGroups * bs::kConeGroupSize;
+        for (std::size_t first = 0; first < count; first += per_dispatch) {
+            const std::size_t n = std::min(per_dispatch, count - first);
+            glUniform1ui(first_loc, static_cast<GLuint>(first));
+            glDispatchCompute(static_cast<GLuint>((n + bs::kConeGroupSize - 1) / bs::kConeGroupSize), 1, 1);
+        }
+        glUseProgram(0);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        check_gl_error("back-patch cone pass");
+        if (culled) read_flags(*culled);
+        if (cones) {
+            glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+            cones->assign(count * bs::kConeValues, 0.0f);
+            if (count)
+                glGetNamedBufferSubData(cone_values, 0, static_cast<GLsizeiptr>(cones->size() * sizeof(float)),
+                                        cones->data());
+            check_gl_error("back-patch cone values read-back");
+        }
+    }
+};
+
+BackpatchCuller::BackpatchCuller(const GlContext& ctx) : impl_(std::make_unique<Impl>()) {
+    ctx.make_current();
+    if (epoxy_gl_version() < 45)
+        throw Error("GL: BackpatchCuller needs OpenGL 4.5 (context has " + ctx.version() + ")");
+    Impl& m = *impl_;
+    m.fma_via_double = ctx.is_software();
+    m.link();
+    GLuint buffers[6];
+    glCreateBuffers(6, buffers);
+    m.own_points = buffers[0];
+    m.flags = buffers[1];
+    m.planes = buffers[2];
+    m.probe_in = buffers[3];
+    m.probe_out = buffers[4];
+    m.cone_values = buffers[5];
+    allocate(m.cone_values, 0, nullptr);
+    m.points = m.own_points;
+    allocate(m.own_points, 0, nullptr);
+    allocate(m.planes, 0, nullptr);
+    m.resize_flags(0);
+    check_gl_error("BackpatchCuller setup");
+    if (!m.fma_via_double) {
+        // GLSL fma() on a GPU: cases where a*b + c lies just off a midpoint between two floats, so
+        // any second rounding gives the other neighbour (as PatchRenderer's check).
+        const float a = std::ldexp(1.0f + std::ldexp(1.0f, -23), -24);
+        const float b = 1.0f - std::ldexp(1.0f, -23);
+        const float c = 1.0f + std::ldexp(1.0f, -23);
+        const float a_values[6] = {a, -a, 2 * a, a / 2, -2 * a, 0.75f};
+        const float bc[4][2] = {{b, c}, {b, -c}, {-b, -c}, {std::ldexp(b, 9), std::ldexp(c, 9)}};
+        std::vector<Vec3> cases;
+        for (const float av : a_values)
+            for (const auto& pair : bc) cases.push_back({av, pair[0], pair[1]});
+        const std::vector<float> got = probe(BackpatchProbe::fma, cases);
+        bool once = true;
+        for (std::size_t i = 0; i < cases.size(); ++i)
+            once = once && got[i] == std::fma(cases[i].x, cases[i].y, cases[i].z);
+        if (!once) {
+            m.fma_via_double = true;
+            m.link();
+        }
+    }
+}
+
+BackpatchCuller::BackpatchCuller(BackpatchCuller&&) noexcept = default;
+BackpatchCuller& BackpatchCuller::operator=(BackpatchCuller&&) noexcept = default;
+BackpatchCuller::~BackpatchCuller() = default;
+
+void BackpatchCuller::set_patches(const std::vector<BezierPatch>& patches) {
+    static_assert(sizeof(BezierPatch) == kPatchPoints * 4 * sizeof(float), "BezierPatch must be 16 packed float4");
+    Impl& m = *impl_;
+    allocate(m.own_points, patches.size() * sizeof(BezierPatch), patches.empty() ? nullptr : &patches[0].cp[0].x);
+    m.points = m.own_points;
+    m.resize_flags(patches.size());
+    check_gl_error("BackpatchCuller::set_patches");
+}
+
+void BackpatchCuller::set_patches(const PatchBatchView& patches) {
+    std::vector<float> aos(patches.count * kPatchPoints * 4);
+    for (std::size_t p = 0; p < patches.count; ++p)
+        for (int k = 0; k < kPatchPoints; ++k)
+            for (int c = 0; c < 4; ++c) aos[(p * kPatchPoints + k) * 4 + c] = patches.component(k, c)[p];
+    Impl& m = *impl_;
+    allocate(m.own_points, aos.size() * sizeof(float), aos.data());
+    m.points = m.own_points;
+    m.resize_flags(patches.count);
+    check_gl_error("BackpatchCuller::set_patches");
+}
+
+void BackpatchCuller::use_patch_buffer(std::uint32_t buffer, std::size_t count) {
+    Impl& m = *impl_;
+    if (!glIsBuffer(buffer)) throw Error("GL: use_patch_buffer: " + std::to_string(buffer) + " is not a buffer");
+    GLint64 size = 0;
+    glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &size);
+    if (static_cast<std::uint64_t>(size) < count * sizeof(BezierPatch))
+        throw Error("GL: use_patch_buffer: buffer of " + std::to_string(size) + " bytes for " + std::to_string(count) +
+                    " patches");
+    m.points = buffer;
+    m.resize_flags(count);
+    check_gl_error("BackpatchCuller::use_patch_buffer");
+}
+
+std::size_t BackpatchCuller::patch_count() const { return impl_->count; }
+std::uint32_t BackpatchCuller::patch_buffer() const { return impl_->points; }
+
+void BackpatchCuller::cull_tcone(Vec3 eye, std::vector<std::uint8_t>* culled, std::vector<float>* cones) {
+    impl_->cull_cone(impl_->tcone_program(), eye, culled, cones);
+}
+void BackpatchCuller::cull_ncone(Vec3 eye, std::vector<std::uint8_t>* culled, std::vector<float>* cones) {
+    impl_->cull_cone(impl_->ncone_program(), eye, culled, cones);
+}
+
+void BackpatchCuller::cull_ptp(const Mat4& object_to_clip, float alpha, PtpRule rule, std::vector<std::uint8_t>* culled,
+                               std::vector<float>* planes) {
+    Impl& m = *impl_;
+    float rows[3][4];
+    if (!ptp_rows(object_to_clip, alpha, rows)) {
+        glClearNamedBufferData(m.flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+        check_gl_error("back-patch ptp pass (nothing culled)");
+        if (culled) m.read_flags(*culled);
+        if (planes) planes->clear();
+        return;
+    }
+    const GLuint program = m.ptp_program();
+    if (planes) allocate(m.planes, m.count * 64 * sizeof(float), nullptr);
+    glUseProgram(program);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, m.points);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingBackPatchFlags, m.flags);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bs::kBindingPtpPlanes, m.planes);
+    glUniform4fv(glGetUniformLocation(program, "u_rows"), 3, &rows[0][0]);
+    glUniform1ui(glGetUniformLocation(program, "u_patch_count"), static_cast<GLuint>(m.count));
+    glUniform1i(glGetUniformLocation(program, "u_pcnt"), rule == PtpRule::pcnt ? 1 : 0);
+    glUniform1i(glGetUniformLocation(program, "u_write_planes"), planes ? 1 : 0);
+    glUniform1f(glGetUniformLocation(program, "u_zero"), 0.0f);
+    const GLint first_loc = glGetUniformLocation(program, "u_first_patch");
+    const std::size_t per_dispatch = kMaxGroups * bs::kPtpPatchesPerGroup;
+    for (std::size_t first = 0; first < m.count; first += per_dispatch) {
+        const std::size_t n = std::min(per_dispatch, m.count - first);
+        glUniform1ui(first_loc, static_cast<GLuint>(first));
+        glDispatchCompute(static_cast<GLuint>((n + bs::kPtpPatchesPerGroup - 1) / bs::kPtpPatchesPerGroup), 1, 1);
+    }
+    glUseProgram(0);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    check_gl_error("back-patch ptp pass");
+    if (culled) m.read_flags(*culled);
+    if (planes) {
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        planes->assign(m.count * 64, 0.0f);
+        if (m.count)
+            glGetNamedBufferSubData(m.planes, 0, static_cast<GLsizeiptr>(planes->size() * sizeof(float)), planes->data());
+        check_gl_error("back-patch ptp planes read-back");
+    }
+}
+
+void BackpatchCuller::cull(BackpatchMethod method, const Mat4& object_to_clip, Vec3 eye, float alpha, PtpRule rule,
+                           std::vector<std::uint8_t>* culled) {
+    switch (method) {
+        case BackpatchMethod::tcone: cull_tcone(eye, culled); return;
+        case BackpatchMethod::ncone: cull_ncone(eye, culled); return;
+        case BackpatchMethod::ptp: cull_ptp(object_to_clip, alpha, rule, culled); return;
+    }
+}
+
+std::uint32_t BackpatchCuller::flag_buffer() const { return impl_->flags; }
+
+std::vector<std::uint32_t> BackpatchCuller::read_flag_words() const {
+    const Impl& m = *impl_;
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<std::uint32_t> words(m.count);
+    if (m.count)
+        glGetNamedBufferSubData(m.flags, 0, static_cast<GLsizeiptr>(m.count * sizeof(std::uint32_t)), words.data());
+    check_gl_error("back-patch flag read-back");
+    return words;
+}
+
+bool BackpatchCuller::fma_via_double() const { return impl_->fma_via_double; }
+
+std::vector<float> BackpatchCuller::probe(BackpatchProbe op, const std::vector<Vec3>& abc) {
+    Impl& m = *impl_;
+    std::vector<float> in(abc.size() * 4);
+    for (std::size_t i = 0; i < abc.size(); ++i) {
+        in[4 * i] = abc[i].x;
+        in[4 * i + 1] = abc[i].y;
+        in[4 * i + 2] = abc[i].z;
+        in[4 * i + 3] = 0.0f;
+    }
+    allocate(m.probe_in, in.size() * sizeof(float), in.data());
+    allocate(m.probe_out, abc.size() * sizeof(float), nullptr);
+    const GLuint program = m.probe_program();
+    glUseProgram(program);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bs::kBindingProbeIn, m.probe_in);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bs::kBindingProbeOut, m.probe_out);
+    glUniform1ui(glGetUniformLocation(program, "u_count"), static_cast<GLuint>(abc.size()));
+    GLuint mode = bs::kProbeFma;
+    switch (op) {
+        case BackpatchProbe::fma: mode = bs::kProbeFma; break;
+        case BackpatchProbe::div: mode = bs::kProbeDiv; break;
+        case BackpatchProbe::sqrt: mode = bs::kProbeSqrt; break;
+        case BackpatchProbe::div_from: mode = bs::kProbeDivFrom; break;
+        case BackpatchProbe::sqrt_from: mode = bs::kProbeSqrtFrom; break;
+    }
+    glUniform1ui(glGetUniformLocation(program, "u_mode"), mode);
+    if (!abc.empty()) {
+        if (abc.size() > kMaxGroups * bs::kProbeGroupSize) throw Error("GL: probe: too many inputs");
+        glDispatchCompute(static_cast<GLuint>((abc.size() + bs::kProbeGroupSize - 1) / bs::kProbeGroupSize), 1, 1);
+    }
+    glUseProgram(0);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<float> out(abc.size());
+    if (!out.empty())
+        glGetNamedBufferSubData(m.probe_out, 0, static_cast<GLsizeiptr>(out.size() * sizeof(float)), out.data());
+    check_gl_error("back-patch probe");
+    return out;
+}
+
+}  // namespace patchcull::gl

@@ -1,0 +1,357 @@
+// Internals of PatchRenderer (patchcull/gl_renderer.h) shared by the renderer's sources:
+// patch_renderer.cpp (buffers, programs, drawing, the frustum pass, read-backs) and
+// occlusion_pipeline.cpp (Hi-Z build, the combined cull pass, render_frame, the status image).
+// Not a public header.
+#pragma once
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "patchcull/error.h"
+#include "patchcull/gl_renderer.h"
+#include "patchcull/hiz.h"
+#include "shader_sources.h"
+#include "shared.h"
+
+namespace patchcull::gl {
+
+namespace sh = shared;
+
+namespace detail {
+
+inline std::string hex(unsigned value) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "0x%04X", value);
+    return buf;
+}
+
+inline void check_gl(const char* where) {
+    const GLenum e = glGetError();
+    if (e == GL_NO_ERROR) return;
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    throw Error("GL: error " + hex(e) + " after " + where);
+}
+
+inline std::string first_line(std::string log) {
+    while (!log.empty() && (log.back() == '\n' || log.back() == '\r' || log.back() == ' ')) log.pop_back();
+    const std::size_t nl = log.find('\n');
+    if (nl != std::string::npos) log = log.substr(0, nl) + " (...)";
+    return log;
+}
+
+// Compiles embedded shader name with `defines` (lines "#define X 1\n") inserted after #version.
+inline GLuint compile_shader(const char* name, GLenum stage, const std::string& defines) {
+    const char* embedded = detail::find_shader_source(name);
+    if (!embedded) throw Error(std::string("GL: shader ") + name + " is not embedded");
+    std::string text = embedded;
+    const std::size_t version = text.find("#version");
+    if (version == std::string::npos) throw Error(std::string("GL: shader ") + name + " has no #version line");
+    const std::size_t line_end = text.find('\n', version);
+    text.insert(line_end == std::string::npos ? text.size() : line_end + 1, defines);
+    const char* source = text.c_str();
+    const GLuint s = glCreateShader(stage);
+    glShaderSource(s, 1, &source, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        GLint len = 0;
+        glGetShaderiv(s, GL_INFO_LOG_LENGTH, &len);
+        std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
+        glGetShaderInfoLog(s, len, nullptr, log.data());
+        glDeleteShader(s);
+        throw Error(std::string("GL: shader ") + name + ": " + first_line(log.c_str()));
+    }
+    return s;
+}
+
+inline GLuint link_program(const std::vector<std::pair<const char*, GLenum>>& stages, const char* label,
+                    const std::string& defines = {}) {
+    const GLuint program = glCreateProgram();
+    std::vector<GLuint> shaders;
+    try {
+        for (const auto& [name, stage] : stages) shaders.push_back(compile_shader(name, stage, defines));
+    } catch (...) {
+        for (GLuint s : shaders) glDeleteShader(s);
+        glDeleteProgram(program);
+        throw;
+    }
+    for (GLuint s : shaders) glAttachShader(program, s);
+    glLinkProgram(program);
+    for (GLuint s : shaders) {
+        glDetachShader(program, s);
+        glDeleteShader(s);
+    }
+    GLint ok = 0;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        GLint len = 0;
+        glGetProgramiv(program, GL_INFO_LOG_LENGTH, &len);
+        std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
+        glGetProgramInfoLog(program, len, nullptr, log.data());
+        glDeleteProgram(program);
+        throw Error(std::string("GL: program ") + label + ": " + first_line(log.c_str()));
+    }
+    return program;
+}
+
+// (Re)allocates buffer with size bytes (at least 16: a zero-sized store cannot be bound).
+inline void upload(GLuint buffer, std::size_t size, const void* data) {
+    glNamedBufferData(buffer, static_cast<GLsizeiptr>(std::max<std::size_t>(size, 16)), nullptr, GL_DYNAMIC_DRAW);
+    if (size && data) glNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(size), data);
+}
+
+template <class T>
+std::vector<T> flip_rows(const std::vector<T>& in, int width, int height, int per_pixel) {
+    std::vector<T> out(in.size());
+    const std::size_t row = static_cast<std::size_t>(width) * per_pixel;
+    for (int y = 0; y < height; ++y)
+        std::copy_n(in.begin() + static_cast<std::ptrdiff_t>(row * (height - 1 - y)), row,
+                    out.begin() + static_cast<std::ptrdiff_t>(row * y));
+    return out;
+}
+
+}  // namespace detail
+
+using namespace detail;
+
+struct PatchRenderer::Impl {
+    GLuint vao = 0;
+    GLuint draw_program = 0, frustum_program = 0, occlusion_program = 0, hiz_program = 0, occluder_program = 0;
+    GLuint control_points = 0, cull_flags = 0, max_displacement = 0, texcoords = 0, plane_values = 0;
+    GLuint backpatch_flags = 0, counters = 0, occluder_vertices = 0;
+    GLuint displacement_texture = 0;
+    float displacement_scale = 0, displacement_midlevel = 0.5f;
+    bool has_displacement_map = false;
+    bool has_max_displacement = false;
+    bool fma_via_double = false;
+    bool is_software = false;
+    GLuint fbo = 0, color = 0, ids = 0, depth = 0;
+    int width = 0, height = 0;
+    std::size_t count = 0;
+    std::size_t occluder_triangles = 0;
+    // Hi-Z pyramid: a POT R32F mipmapped texture (level l allocated >= W_l x H_l, hiz.h's sizes
+    // used), built for hiz_width x hiz_height; the layout of hiz.h in hiz_layout.
+    GLuint hiz = 0;
+    int hiz_width = 0, hiz_height = 0;
+    std::vector<HiZLevel> hiz_layout;
+    // Status visualisation: its own colour + depth framebuffer.
+    GLuint vis_fbo = 0, vis_color = 0, vis_depth = 0;
+    int vis_width = 0, vis_height = 0;
+    GLuint timer_queries[5] = {};
+    bool primed = false;  // statuses valid for the pipeline (else the next frame tags even patches)
+
+    struct {
+        GLint tess_level, draw_mask, draw_value, adaptive, tess_reference, object_to_clip, displace,
+            displacement_scale, displacement_midlevel, eye, color_mode;
+    } draw_loc{};
+    struct {
+        GLint rows, normal_length, patch_count, has_displacement, write_plane_values;
+    } frustum_loc{};
+    struct {
+        GLint rows, normal_length, patch_count, has_displacement, has_backpatch, tests, object_to_clip, screen,
+            hiz_levels;
+    } occlusion_loc{};
+    struct {
+        GLint from_depth, source_level, source_size, out_size;
+    } hiz_loc{};
+    struct {
+        GLint object_to_clip, eye;
+    } occluder_loc{};
+
+    ~Impl() {
+        for (GLuint p : {draw_program, frustum_program, occlusion_program, hiz_program, occluder_program})
+            glDeleteProgram(p);
+        const GLuint buffers[] = {control_points, cull_flags, max_displacement, texcoords, plane_values,
+                                  backpatch_flags, counters, occluder_vertices};
+        glDeleteBuffers(8, buffers);
+        const GLuint textures[] = {displacement_texture, color, ids, depth, hiz, vis_color, vis_depth};
+        glDeleteTextures(7, textures);
+        glDeleteFramebuffers(1, &fbo);
+        glDeleteFramebuffers(1, &vis_fbo);
+        glDeleteVertexArrays(1, &vao);
+        if (timer_queries[0]) glDeleteQueries(5, timer_queries);
+    }
+
+    void link_cull_programs() {
+        glDeleteProgram(frustum_program);
+        glDeleteProgram(occlusion_program);
+        const std::string defines = fma_via_double ? "#define PATCHCULL_FMA_VIA_DOUBLE 1\n" : "";
+        frustum_program = link_program({{"cull_frustum.comp.glsl", GL_COMPUTE_SHADER}}, "cull_frustum", defines);
+        const GLuint fp = frustum_program;
+        frustum_loc = {glGetUniformLocation(fp, "u_plane_rows"), glGetUniformLocation(fp, "u_plane_normal_length"),
+                       glGetUniformLocation(fp, "u_patch_count"), glGetUniformLocation(fp, "u_has_displacement"),
+                       glGetUniformLocation(fp, "u_write_plane_values")};
+        occlusion_program =
+            link_program({{"cull_occlusion.comp.glsl", GL_COMPUTE_SHADER}}, "cull_occlusion", defines);
+        const GLuint op = occlusion_program;
+        occlusion_loc = {glGetUniformLocation(op, "u_plane_rows"),     glGetUniformLocation(op, "u_plane_normal_length"),
+                         glGetUniformLocation(op, "u_patch_count"),    glGetUniformLocation(op, "u_has_displacement"),
+                         glGetUniformLocation(op, "u_has_backpatch"),  glGetUniformLocation(op, "u_tests"),
+                         glGetUniformLocation(op, "u_object_to_clip"), glGetUniformLocation(op, "u_screen"),
+                         glGetUniformLocation(op, "u_hiz_levels")};
+    }
+
+    void resize(int w, int h) {
+        if (w == width && h == height) return;
+        if (w < 1 || h < 1 || w > 8192 || h > 8192)
+            throw Error("GL: framebuffer size " + std::to_string(w) + "x" + std::to_string(h) + " outside [1, 8192]");
+        const GLuint textures[] = {color, ids, depth};
+        glDeleteTextures(3, textures);
+        glCreateTextures(GL_TEXTURE_2D, 1, &color);
+        glCreateTextures(GL_TEXTURE_2D, 1, &ids);
+        glCreateTextures(GL_TEXTURE_2D, 1, &depth);
+        glTextureStorage2D(color, 1, GL_RGBA8, w, h);
+        glTextureStorage2D(ids, 1, GL_R32UI, w, h);
+        glTextureStorage2D(depth, 1, GL_DEPTH_COMPONENT32F, w, h);
+        for (GLuint t : {color, ids, depth}) {
+            glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        }
+        glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
+        glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT1, ids, 0);
+        glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, depth, 0);
+        const GLenum draw_buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+        glNamedFramebufferDrawBuffers(fbo, 2, draw_buffers);
+        const GLenum status = glCheckNamedFramebufferStatus(fbo, GL_DRAW_FRAMEBUFFER);
+        if (status != GL_FRAMEBUFFER_COMPLETE) throw Error("GL: framebuffer incomplete (" + hex(status) + ")");
+        width = w;
+        height = h;
+        check_gl("framebuffer resize");
+    }
+
+    void bind_buffers() const {
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, control_points);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullFlags, cull_flags);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingMaxDisplacement, max_displacement);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchTexcoords, texcoords);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPlaneValues, plane_values);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingBackPatchFlags, backpatch_flags);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullCounters, counters);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingOccluderVertices, occluder_vertices);
+    }
+
+    void set_patches(const float* aos_points, std::size_t n, const PatchAttributes& a, bool keep_flags = false) {
+        if (!a.max_displacement.empty() && a.max_displacement.size() != n)
+            throw Error("GL: set_patches: max_displacement has " + std::to_string(a.max_displacement.size()) +
+                        " entries for " + std::to_string(n) + " patches");
+        if (!a.texcoords.empty() && a.texcoords.size() != n)
+            throw Error("GL: set_patches: texcoords has " + std::to_string(a.texcoords.size()) + " entries for " +
+                        std::to_string(n) + " patches");
+        if (n > 0x7FFFFFFFu / kPatchPoints) throw Error("GL: set_patches: too many patches for one draw (" + std::to_string(n) + ")");
+        if (keep_flags && n != count)
+            throw Error("GL: update_patches: " + std::to_string(n) + " patches for a set of " + std::to_string(count));
+        count = n;
+        upload(control_points, n * kPatchPoints * 4 * sizeof(float), aos_points);
+        if (!keep_flags) {
+            upload(cull_flags, n * sizeof(std::uint32_t), nullptr);
+            glClearNamedBufferData(cull_flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+        }
+        has_max_displacement = !a.max_displacement.empty();
+        upload(max_displacement, has_max_displacement ? n * sizeof(float) : 0, a.max_displacement.data());
+        std::vector<Vec2> uv(4 * n);
+        for (std::size_t p = 0; p < n; ++p)
+            for (int c = 0; c < 4; ++c)
+                uv[4 * p + c] = a.texcoords.empty() ? Vec2{float(c & 1), float(c >> 1)} : a.texcoords[p][c];
+        upload(texcoords, uv.size() * sizeof(Vec2), uv.data());
+        upload(plane_values, 0, nullptr);
+        if (!keep_flags) {
+            upload(backpatch_flags, n * sizeof(std::uint32_t), nullptr);
+            primed = false;
+        }
+        check_gl("set_patches");
+    }
+
+    // Hi-Z, statuses and the combined cull pass (occlusion_pipeline.cpp).
+    void ensure_hiz();
+    void build_hiz();
+    void prime_statuses();
+    // displaced: the drawn surface is displaced (a map is set and drawing displaces); then, without
+    // per-patch margins, the Hi-Z test is skipped (the margins tell which patches are flat).
+    void cull_occlusion(const Mat4& object_to_clip, std::uint32_t tests, const std::uint8_t* backpatch,
+                        GLuint backpatch_buffer, bool displaced);
+
+    // Sets the draw program's uniforms for params; returns the effective tessellation level.
+    int set_draw_uniforms(const RenderParams& params, const Mat4& object_to_clip, GLuint color_mode) {
+        const int level = std::clamp(params.tess_level, 1, 64);
+        Mat4 view_inverse;
+        Vec3 eye{0, 0, 0};
+        if (invert(params.view, view_inverse)) eye = {view_inverse.at(0, 3), view_inverse.at(1, 3), view_inverse.at(2, 3)};
+        const GLuint dp = draw_program;
+        glProgramUniform1f(dp, draw_loc.tess_level, static_cast<float>(level));
+        glProgramUniform1i(dp, draw_loc.adaptive, params.adaptive_tess ? 1 : 0);
+        glProgramUniform1f(dp, draw_loc.tess_reference,
+                           params.tess_reference_distance > 0 ? params.tess_reference_distance : 1.0f);
+        glProgramUniformMatrix4fv(dp, draw_loc.object_to_clip, 1, GL_FALSE, object_to_clip.m);
+        glProgramUniform1i(dp, draw_loc.displace, params.displace && has_displacement_map ? 1 : 0);
+        glProgramUniform1f(dp, draw_loc.displacement_scale, displacement_scale);
+        glProgramUniform1f(dp, draw_loc.displacement_midlevel, displacement_midlevel);
+        glProgramUniform3f(dp, draw_loc.eye, eye.x, eye.y, eye.z);
+        glProgramUniform1ui(dp, draw_loc.color_mode, color_mode);
+        glProgramUniformMatrix4fv(occluder_program, occluder_loc.object_to_clip, 1, GL_FALSE, object_to_clip.m);
+        glProgramUniform3f(occluder_program, occluder_loc.eye, eye.x, eye.y, eye.z);
+        return level;
+    }
+
+    // Binds target (fbo, or vis_fbo) with the fixed-function state of every draw and clears it.
+    void begin_target(GLuint target, int w, int h) {
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target);
+        glViewport(0, 0, w, h);
+        glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glDisable(GL_CULL_FACE);
+        glDisable(GL_BLEND);
+        const float background[4] = {0.12f, 0.12f, 0.14f, 1.0f};
+        const GLuint no_id[4] = {sh::kIdBackground, 0, 0, 0};
+        const float far_depth = 1.0f;
+        glClearNamedFramebufferfv(target, GL_COLOR, 0, background);
+        if (target == fbo) glClearNamedFramebufferuiv(target, GL_COLOR, 1, no_id);
+        glClearNamedFramebufferfv(target, GL_DEPTH, 0, &far_depth);
+    }
+
+    void draw_occluders() {
+        if (occluder_triangles == 0) return;
+        glUseProgram(occluder_program);
+        glBindVertexArray(vao);
+        bind_buffers();
+        glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(3 * occluder_triangles));
+        glBindVertexArray(0);
+        glUseProgram(0);
+    }
+
+    // Draws the patches whose flag word w has (w & mask) == value (into the bound framebuffer).
+    void draw_patches(int level, GLuint mask, GLuint value) {
+        if (count == 0) return;
+        const GLuint dp = draw_program;
+        glProgramUniform1ui(dp, draw_loc.draw_mask, mask);
+        glProgramUniform1ui(dp, draw_loc.draw_value, value);
+        glUseProgram(dp);
+        glBindVertexArray(vao);
+        bind_buffers();
+        glBindTextureUnit(sh::kTextureUnitDisplacement, displacement_texture);
+        glPatchParameteri(GL_PATCH_VERTICES, kPatchPoints);
+        // llvmpipe workaround 2 (header): at most 65536 / (L+1)^2 patches per sub-draw.
+        const std::size_t per_draw = std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((level + 1) * (level + 1)));
+        std::vector<GLint> firsts;
+        std::vector<GLsizei> counts;
+        for (std::size_t first = 0; first < count; first += per_draw) {
+            firsts.push_back(static_cast<GLint>(first * kPatchPoints));
+            counts.push_back(static_cast<GLsizei>(std::min(per_draw, count - first) * kPatchPoints));
+        }
+        glMultiDrawArrays(GL_PATCHES, firsts.data(), counts.data(), static_cast<GLsizei>(firsts.size()));
+        glBindVertexArray(0);
+        glUseProgram(0);
+    }
+};
+
+}  // namespace patchcull::gl

@@ -1,0 +1,257 @@
+// The GPU Hi-Z pipeline against its CPU mirror (include/patchcull/hiz.h): on the same depth buffer
+// (rendered by GL, read back) the compute-built pyramid (shaders/hiz_build.comp.glsl) is
+// bit-identical to HiZPyramid::build, and the combined cull pass (shaders/cull_occlusion.comp.glsl)
+// makes the same decisions as cull_occlusion_scalar, patch by patch, on the same matrix: the teapot
+// with triangle occluders from several cameras, random (rational, eye-straddling) patches, and
+// NPOT / odd framebuffer sizes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "gl_test_util.h"
+#include "patchcull/camera.h"
+#include "patchcull/hiz.h"
+
+using namespace patchcull;
+using namespace patchcull::gl;
+
+namespace {
+
+// Depth as hiz.h wants it (row 0 = bottom) from read_depth (row 0 = top).
+std::vector<float> depth_bottom_up(const PatchRenderer& r) {
+    const std::vector<float> top_down = r.read_depth();
+    std::vector<float> out(top_down.size());
+    const int w = r.width(), h = r.height();
+    for (int y = 0; y < h; ++y)
+        std::memcpy(&out[static_cast<std::size_t>(y) * w], &top_down[static_cast<std::size_t>(h - 1 - y) * w],
+                    static_cast<std::size_t>(w) * sizeof(float));
+    return out;
+}
+
+Camera teapot_camera(const Bounds& b, Vec3 direction, float distance, float aspect = 1.0f) {
+    Camera cam;
+    cam.target = b.center();
+    cam.eye = b.center() + normalize(direction) * (distance * b.radius());
+    cam.up = {0, 0, 1};
+    cam.aspect = aspect;
+    cam.z_near = 0.05f * b.radius();
+    cam.z_far = 12.0f * b.radius();
+    return cam;
+}
+
+RenderParams params_for(const Camera& cam, int width, int height, int level = 6) {
+    RenderParams p;
+    p.view = cam.view();
+    p.projection = cam.projection();
+    p.width = width;
+    p.height = height;
+    p.tess_level = level;
+    return p;
+}
+
+// A vertical wall quad through point `at`, facing direction `normal` (horizontal), half-extents
+// half_w (horizontal) and from z0 to z1.
+void add_wall(std::vector<Vec3>& v, std::vector<std::uint32_t>& idx, Vec3 at, Vec3 normal, float half_w, float z0,
+              float z1) {
+    const Vec3 side = normalize(cross(Vec3{0, 0, 1}, normal)) * half_w;
+    const auto base = static_cast<std::uint32_t>(v.size());
+    v.push_back(Vec3{at.x, at.y, z0} - side);
+    v.push_back(Vec3{at.x, at.y, z0} + side);
+    v.push_back(Vec3{at.x, at.y, z1} + side);
+    v.push_back(Vec3{at.x, at.y, z1} - side);
+    for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) idx.push_back(base + i);
+}
+
+// Compares the GPU pyramid with the CPU one built from the read-back depth; returns the CPU one.
+HiZPyramid check_pyramid(PatchRenderer& r, const char* what) {
+    const std::vector<float> depth = depth_bottom_up(r);
+    HiZPyramid cpu;
+    cpu.build(depth.data(), r.width(), r.height());
+    r.build_hiz();
+    const std::vector<float> gpu = r.read_hiz();
+    EXPECT_EQ(r.hiz_levels(), cpu.levels()) << what;
+    EXPECT_EQ(gpu.size(), cpu.size()) << what;
+    if (gpu.size() == cpu.size()) {
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < gpu.size(); ++i) {
+            std::uint32_t a, b;
+            std::memcpy(&a, &gpu[i], 4);
+            std::memcpy(&b, &cpu.data()[i], 4);
+            differ += a != b;
+        }
+        EXPECT_EQ(differ, 0u) << what << ": texels differing from HiZPyramid::build";
+    }
+    return cpu;
+}
+
+struct DecisionCounts {
+    std::size_t frustum = 0, occluded = 0, visible = 0, mismatched = 0;
+};
+
+// GPU cull_occlusion vs cull_occlusion_scalar on the same pyramid and matrix.
+DecisionCounts compare_decisions(PatchRenderer& r, const std::vector<BezierPatch>& patches, const Mat4& m,
+                                 const HiZPyramid& cpu_hiz, const char* what) {
+    const PatchBatch batch = make_batch(patches);
+    std::vector<std::uint8_t> cpu(patches.size(), 0xEE);
+    cull_occlusion_scalar(batch.view(), m, cpu_hiz, cpu.data());
+    r.cull_occlusion(m, CullMode::all);
+    const std::vector<std::uint32_t> words = r.read_cull_flags();
+    DecisionCounts n;
+    for (std::size_t p = 0; p < patches.size(); ++p) {
+        const std::uint32_t reason = words[p] & kFlagReasonMask;
+        std::uint8_t gpu = 0xFF;
+        if (reason == 0) gpu = kHiZVisible;
+        if (reason == kFlagFrustum) gpu = kHiZFrustumCulled;
+        if (reason == kFlagOcclusion) gpu = kHiZOccluded;
+        if (gpu != cpu[p]) {
+            if (++n.mismatched <= 5)
+                ADD_FAILURE() << what << ": patch " << p << " GPU " << int(gpu) << " CPU " << int(cpu[p]);
+        }
+        EXPECT_EQ((words[p] & kStatusVisible) != 0, reason == 0) << what << " patch " << p;
+        n.frustum += cpu[p] == kHiZFrustumCulled;
+        n.occluded += cpu[p] == kHiZOccluded;
+        n.visible += cpu[p] == kHiZVisible;
+    }
+    return n;
+}
+
+}  // namespace
+
+TEST(GpuHiZ, PyramidBitIdenticalToCpuAtPotAndNpotSizes) {
+    const std::vector<BezierPatch> patches = test::split_teapot(1);
+    const Bounds b = test::control_point_bounds(patches);
+    PatchRenderer r(test::context());
+    r.set_patches(patches);
+    std::vector<Vec3> v;
+    std::vector<std::uint32_t> idx;
+    add_wall(v, idx, b.center() + Vec3{0.6f * b.radius(), -0.5f * b.radius(), 0}, {0.3f, -1, 0}, 0.4f * b.radius(),
+             b.min.z - 1, b.center().z + 0.2f * b.radius());
+    r.set_occluders(v, idx);
+    const int sizes[][2] = {{256, 256}, {200, 120}, {257, 130}, {97, 255}, {33, 1}, {1, 1}, {5, 3}};
+    for (const auto& s : sizes) {
+        const Camera cam = teapot_camera(b, {0.4f, -1, 0.45f}, 2.2f, float(s[0]) / float(s[1]));
+        r.render(params_for(cam, s[0], s[1], 4));
+        const std::string what = std::to_string(s[0]) + "x" + std::to_string(s[1]);
+        check_pyramid(r, what.c_str());
+    }
+}
+
+TEST(GpuHiZ, DecisionsEqualCpuOnTeapotWithOccluders) {
+    const std::vector<BezierPatch> patches = test::split_teapot(2);
+    const Bounds b = test::control_point_bounds(patches);
+    PatchRenderer r(test::context());
+    r.set_patches(patches);
+    std::vector<Vec3> v;
+    std::vector<std::uint32_t> idx;
+    add_wall(v, idx, b.center() + Vec3{0, -1.1f * b.radius(), 0}, {0, -1, 0}, 0.35f * b.radius(), b.min.z - 1,
+             b.max.z + 0.2f);
+    r.set_occluders(v, idx);
+    const Vec3 dirs[] = {{0.3f, -1, 0.4f}, {1, 0.2f, 0.1f}, {0, 0.1f, 1}, {-0.7f, 0.5f, -0.3f}, {0.1f, -1, 0.05f}};
+    const float dists[] = {2.0f, 1.6f, 2.5f, 0.9f, 3.0f};
+    DecisionCounts total;
+    for (int c = 0; c < 5; ++c) {
+        const Camera cam = teapot_camera(b, dirs[c], dists[c]);
+        RenderParams params = params_for(cam, 256, 256);
+        // Depth of the even-indexed patches only (like a first pass), so that many patches are
+        // tested against a partial buffer; then every patch.
+        for (int partial = 1; partial >= 0; --partial) {
+            std::vector<std::uint8_t> culled(patches.size(), 0);
+            if (partial)
+                for (std::size_t p = 1; p < patches.size(); p += 2) culled[p] = 1;
+            r.set_cull_flags(culled.data());
+            r.render(params);
+            const std::string what = "camera " + std::to_string(c) + (partial ? " partial" : " full");
+            const HiZPyramid cpu = check_pyramid(r, what.c_str());
+            const DecisionCounts n = compare_decisions(r, patches, cam.view_projection(), cpu, what.c_str());
+            EXPECT_EQ(n.mismatched, 0u) << what;
+            total.frustum += n.frustum;
+            total.occluded += n.occluded;
+            total.visible += n.visible;
+        }
+    }
+    // The cameras exercise every outcome.
+    EXPECT_GT(total.frustum, 50u);
+    EXPECT_GT(total.occluded, 500u);
+    EXPECT_GT(total.visible, 500u);
+}
+
+TEST(GpuHiZ, DecisionsEqualCpuOnRandomPatches) {
+    // Random (a third rational) patches of random sizes around random cameras, some straddling the
+    // eye plane (w <= 0: never screen-tested), some beyond the far plane; the depth buffer is that
+    // of a random half of them. Odd framebuffer sizes.
+    std::mt19937 rng(20240611);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    auto range = [&](float lo, float hi) { return lo + (hi - lo) * u01(rng); };
+    PatchRenderer r(test::context());
+    DecisionCounts total;
+    const int sizes[][2] = {{256, 256}, {203, 150}, {120, 250}};
+    for (int round = 0; round < 6; ++round) {
+        Camera cam;
+        cam.eye = {range(-2, 2), range(-2, 2), range(-2, 2)};
+        cam.target = {range(-0.5f, 0.5f), range(-0.5f, 0.5f), range(-0.5f, 0.5f)};
+        cam.up = normalize(Vec3{range(-1, 1), range(-1, 1), range(-1, 1)});
+        cam.fovy_radians = range(0.5f, 1.6f);
+        cam.z_near = range(0.02f, 0.3f);
+        cam.z_far = cam.z_near + range(3.0f, 12.0f);
+        const int w = sizes[round % 3][0], h = sizes[round % 3][1];
+        cam.aspect = float(w) / float(h);
+        const Vec3 forward = normalize(cam.target - cam.eye);
+        std::vector<BezierPatch> patches;
+        for (int p = 0; p < 600; ++p) {
+            // Mostly in front of the camera, some around and behind it.
+            const float along = p % 10 == 0 ? range(-1.0f, 0.5f) : range(0.2f, 8.0f);
+            const Vec3 centre = cam.eye + forward * along +
+                                Vec3{range(-1, 1), range(-1, 1), range(-1, 1)} * (0.2f + 0.6f * std::fabs(along));
+            const float size = std::pow(10.0f, range(-2.0f, -0.2f));
+            const bool rational = p % 3 == 0;
+            // A bumpy sheet (a real surface, so that it writes depth) with random orientation.
+            const Vec3 a = normalize(Vec3{range(-1, 1), range(-1, 1), range(-1, 1)});
+            const Vec3 bdir = normalize(cross(a, Vec3{range(-1, 1), range(-1, 1), range(-1, 1)}));
+            const Vec3 n = cross(a, bdir);
+            BezierPatch patch;
+            for (int j = 0; j < 4; ++j)
+                for (int i = 0; i < 4; ++i) {
+                    const Vec3 x = centre + a * (size * (i / 1.5f - 1)) + bdir * (size * (j / 1.5f - 1)) +
+                                   n * (size * range(-0.3f, 0.3f));
+                    patch.cp[4 * j + i] = homogeneous(x, rational ? std::pow(2.0f, range(-1.5f, 1.5f)) : 1.0f);
+                }
+            patches.push_back(patch);
+        }
+        r.set_patches(patches);
+        std::vector<std::uint8_t> culled(patches.size(), 0);
+        for (auto& c : culled) c = u01(rng) < 0.5f;
+        r.set_cull_flags(culled.data());
+        RenderParams params = params_for(cam, w, h, 5);
+        r.render(params);
+        const std::string what = "round " + std::to_string(round);
+        const HiZPyramid cpu = check_pyramid(r, what.c_str());
+        const DecisionCounts n = compare_decisions(r, patches, cam.view_projection(), cpu, what.c_str());
+        EXPECT_EQ(n.mismatched, 0u) << what;
+        total.frustum += n.frustum;
+        total.occluded += n.occluded;
+        total.visible += n.visible;
+    }
+    EXPECT_GT(total.frustum, 100u);
+    EXPECT_GT(total.occluded, 100u);
+    EXPECT_GT(total.visible, 100u);
+}
+
+TEST(GpuHiZ, CullOcclusionNeedsAPyramidOfTheFramebufferSize) {
+    PatchRenderer r(test::context());
+    r.set_patches(teapot_patches());
+    RenderParams p = params_for(teapot_camera(test::control_point_bounds(teapot_patches()), {0, -1, 0.3f}, 2.5f), 64, 64);
+    r.render(p);
+    EXPECT_THROW(r.cull_occlusion(p.projection * p.view, CullMode::occlusion), patchcull::Error);
+    EXPECT_THROW(r.read_hiz(), patchcull::Error);
+    r.build_hiz();
+    EXPECT_NO_THROW(r.cull_occlusion(p.projection * p.view, CullMode::occlusion));
+    EXPECT_EQ(r.read_hiz().size(), HiZPyramid(64, 64).size());
+    p.width = 80;
+    r.render(p);  // resized: the pyramid is stale
+    EXPECT_THROW(r.cull_occlusion(p.projection * p.view, CullMode::all), patchcull::Error);
+    EXPECT_NO_THROW(r.cull_occlusion(p.projection * p.view, CullMode::frustum));
+}
