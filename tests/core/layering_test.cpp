@@ -43,7 +43,9 @@ bool is_ours(const std::string& inc, std::string& header) {
 TEST(Layering, CoreDependsOnNothingAboveIt) {
     for (const auto& [file, inc] : includes_under("src/core")) {
         std::string h;
-        if (is_ours(inc, h)) EXPECT_TRUE(kCoreHeaders.count(h)) << file << " includes " << inc;
+        if (is_ours(inc, h)) {
+            EXPECT_TRUE(kCoreHeaders.count(h)) << file << " includes " << inc;
+        }
         EXPECT_EQ(inc.find("opensubdiv"), std::string::npos) << file;
         EXPECT_EQ(inc.find("stb"), std::string::npos) << file;
         EXPECT_EQ(inc.find("GL"), std::string::npos) << file;
@@ -52,14 +54,18 @@ TEST(Layering, CoreDependsOnNothingAboveIt) {
         for (const auto& [file, inc] : includes_under("include/patchcull")) {
             if (fs::path(file).filename() != header) continue;
             std::string h;
-            if (is_ours(inc, h)) EXPECT_TRUE(kCoreHeaders.count(h)) << file << " includes " << inc;
+            if (is_ours(inc, h)) {
+                EXPECT_TRUE(kCoreHeaders.count(h)) << file << " includes " << inc;
+            }
         }
 }
 
 TEST(Layering, ImportDependsOnlyOnCore) {
     for (const auto& [file, inc] : includes_under("src/import")) {
         std::string h;
-        if (is_ours(inc, h)) EXPECT_TRUE(kCoreHeaders.count(h) || kImportHeaders.count(h)) << file << " includes " << inc;
+        if (is_ours(inc, h)) {
+            EXPECT_TRUE(kCoreHeaders.count(h) || kImportHeaders.count(h)) << file << " includes " << inc;
+        }
     }
 }
 
