@@ -13,6 +13,7 @@
 #include "backpatch_shared.h"
 #include "patchcull/error.h"
 #include "patchcull/gl_backpatch.h"
+#include "renderer_internal.h"
 #include "shader_sources.h"
 #include "shared.h"
 
@@ -20,77 +21,16 @@ namespace patchcull::gl {
 
 namespace {
 
-namespace sh = shared;
 namespace bs = backpatch_shared;
 
 static_assert(kFlagBackPatch == sh::kCullBackPatch);
 
-std::string hex_code(unsigned value) {
-    char buf[16];
-    std::snprintf(buf, sizeof buf, "0x%04X", value);
-    return buf;
-}
+// Shader compilation, GL error checks and buffer uploads are the renderer's (renderer_internal.h).
+using detail::check_gl;
+using detail::upload;
 
-void check_gl_error(const char* where) {
-    const GLenum e = glGetError();
-    if (e == GL_NO_ERROR) return;
-    while (glGetError() != GL_NO_ERROR) {
-    }
-    throw Error("GL: error " + hex_code(e) + " after " + where);
-}
-
-std::string first_log_line(std::string log) {
-    while (!log.empty() && (log.back() == '\n' || log.back() == '\r' || log.back() == ' ' || log.back() == '\0'))
-        log.pop_back();
-    const std::size_t nl = log.find('\n');
-    if (nl != std::string::npos) log = log.substr(0, nl) + " (...)";
-    return log;
-}
-
-// Compiles and links the embedded compute shader `name` with `defines` inserted after #version.
 GLuint compute_program(const char* name, const std::string& defines) {
-    const char* embedded = detail::find_shader_source(name);
-    if (!embedded) throw Error(std::string("GL: shader ") + name + " is not embedded");
-    std::string text = embedded;
-    const std::size_t version = text.find("#version");
-    if (version == std::string::npos) throw Error(std::string("GL: shader ") + name + " has no #version line");
-    const std::size_t line_end = text.find('\n', version);
-    text.insert(line_end == std::string::npos ? text.size() : line_end + 1, defines);
-    const char* source = text.c_str();
-    const GLuint s = glCreateShader(GL_COMPUTE_SHADER);
-    glShaderSource(s, 1, &source, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        GLint len = 0;
-        glGetShaderiv(s, GL_INFO_LOG_LENGTH, &len);
-        std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
-        glGetShaderInfoLog(s, len, nullptr, log.data());
-        glDeleteShader(s);
-        throw Error(std::string("GL: shader ") + name + ": " + first_log_line(log));
-    }
-    const GLuint program = glCreateProgram();
-    glAttachShader(program, s);
-    glLinkProgram(program);
-    glDetachShader(program, s);
-    glDeleteShader(s);
-    glGetProgramiv(program, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        GLint len = 0;
-        glGetProgramiv(program, GL_INFO_LOG_LENGTH, &len);
-        std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
-        glGetProgramInfoLog(program, len, nullptr, log.data());
-        glDeleteProgram(program);
-        throw Error(std::string("GL: program ") + name + ": " + first_log_line(log));
-    }
-    return program;
-}
-
-// (Re)allocates buffer with size bytes (at least 16: a zero-sized store cannot be bound).
-void allocate(GLuint buffer, std::size_t size, const void* data) {
-    glNamedBufferData(buffer, static_cast<GLsizeiptr>(std::max<std::size_t>(size, 16)), nullptr, GL_DYNAMIC_DRAW);
-    if (size && data) glNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(size), data);
+    return detail::link_program({{name, GL_COMPUTE_SHADER}}, name, defines);
 }
 
 // Rows x, y, w of s * object_to_clip with s = sign(alpha) * sign(det object_to_clip): the same
@@ -162,7 +102,7 @@ struct BackpatchCuller::Impl {
 
     void resize_flags(std::size_t n) {
         count = n;
-        allocate(flags, n * sizeof(std::uint32_t), nullptr);
+        upload(flags, n * sizeof(std::uint32_t), nullptr);
         glClearNamedBufferData(flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
     }
 
@@ -173,11 +113,11 @@ struct BackpatchCuller::Impl {
             glGetNamedBufferSubData(flags, 0, static_cast<GLsizeiptr>(count * sizeof(std::uint32_t)), words.data());
         out.resize(count);
         for (std::size_t p = 0; p < count; ++p) out[p] = words[p] != 0 ? 1 : 0;
-        check_gl_error("back-patch flag read-back");
+        check_gl("back-patch flag read-back");
     }
 
     void cull_cone(GLuint program, Vec3 eye, std::vector<std::uint8_t>* culled, std::vector<float>* cones) {
-        if (cones) allocate(cone_values, count * bs::kConeValues * sizeof(float), nullptr);
+        if (cones) upload(cone_values, count * bs::kConeValues * sizeof(float), nullptr);
         glUseProgram(program);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, points);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingBackPatchFlags, flags);
@@ -195,7 +135,7 @@ struct BackpatchCuller::Impl {
         }
         glUseProgram(0);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        check_gl_error("back-patch cone pass");
+        check_gl("back-patch cone pass");
         if (culled) read_flags(*culled);
         if (cones) {
             glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -203,7 +143,7 @@ struct BackpatchCuller::Impl {
             if (count)
                 glGetNamedBufferSubData(cone_values, 0, static_cast<GLsizeiptr>(cones->size() * sizeof(float)),
                                         cones->data());
-            check_gl_error("back-patch cone values read-back");
+            check_gl("back-patch cone values read-back");
         }
     }
 };
@@ -223,12 +163,12 @@ BackpatchCuller::BackpatchCuller(const GlContext& ctx) : impl_(std::make_unique<
     m.probe_in = buffers[3];
     m.probe_out = buffers[4];
     m.cone_values = buffers[5];
-    allocate(m.cone_values, 0, nullptr);
+    upload(m.cone_values, 0, nullptr);
     m.points = m.own_points;
-    allocate(m.own_points, 0, nullptr);
-    allocate(m.planes, 0, nullptr);
+    upload(m.own_points, 0, nullptr);
+    upload(m.planes, 0, nullptr);
     m.resize_flags(0);
-    check_gl_error("BackpatchCuller setup");
+    check_gl("BackpatchCuller setup");
     if (!m.fma_via_double) {
         // GLSL fma() on a GPU: cases where a*b + c lies just off a midpoint between two floats, so
         // any second rounding gives the other neighbour (as PatchRenderer's check).
@@ -258,10 +198,10 @@ BackpatchCuller::~BackpatchCuller() = default;
 void BackpatchCuller::set_patches(const std::vector<BezierPatch>& patches) {
     static_assert(sizeof(BezierPatch) == kPatchPoints * 4 * sizeof(float), "BezierPatch must be 16 packed float4");
     Impl& m = *impl_;
-    allocate(m.own_points, patches.size() * sizeof(BezierPatch), patches.empty() ? nullptr : &patches[0].cp[0].x);
+    upload(m.own_points, patches.size() * sizeof(BezierPatch), patches.empty() ? nullptr : &patches[0].cp[0].x);
     m.points = m.own_points;
     m.resize_flags(patches.size());
-    check_gl_error("BackpatchCuller::set_patches");
+    check_gl("BackpatchCuller::set_patches");
 }
 
 void BackpatchCuller::set_patches(const PatchBatchView& patches) {
@@ -270,10 +210,10 @@ void BackpatchCuller::set_patches(const PatchBatchView& patches) {
         for (int k = 0; k < kPatchPoints; ++k)
             for (int c = 0; c < 4; ++c) aos[(p * kPatchPoints + k) * 4 + c] = patches.component(k, c)[p];
     Impl& m = *impl_;
-    allocate(m.own_points, aos.size() * sizeof(float), aos.data());
+    upload(m.own_points, aos.size() * sizeof(float), aos.data());
     m.points = m.own_points;
     m.resize_flags(patches.count);
-    check_gl_error("BackpatchCuller::set_patches");
+    check_gl("BackpatchCuller::set_patches");
 }
 
 void BackpatchCuller::use_patch_buffer(std::uint32_t buffer, std::size_t count) {
@@ -286,7 +226,7 @@ void BackpatchCuller::use_patch_buffer(std::uint32_t buffer, std::size_t count) 
                     " patches");
     m.points = buffer;
     m.resize_flags(count);
-    check_gl_error("BackpatchCuller::use_patch_buffer");
+    check_gl("BackpatchCuller::use_patch_buffer");
 }
 
 std::size_t BackpatchCuller::patch_count() const { return impl_->count; }
@@ -305,13 +245,13 @@ void BackpatchCuller::cull_ptp(const Mat4& object_to_clip, float alpha, PtpRule 
     float rows[3][4];
     if (!ptp_rows(object_to_clip, alpha, rows)) {
         glClearNamedBufferData(m.flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-        check_gl_error("back-patch ptp pass (nothing culled)");
+        check_gl("back-patch ptp pass (nothing culled)");
         if (culled) m.read_flags(*culled);
         if (planes) planes->clear();
         return;
     }
     const GLuint program = m.ptp_program();
-    if (planes) allocate(m.planes, m.count * 64 * sizeof(float), nullptr);
+    if (planes) upload(m.planes, m.count * 64 * sizeof(float), nullptr);
     glUseProgram(program);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, m.points);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingBackPatchFlags, m.flags);
@@ -330,14 +270,14 @@ void BackpatchCuller::cull_ptp(const Mat4& object_to_clip, float alpha, PtpRule 
     }
     glUseProgram(0);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    check_gl_error("back-patch ptp pass");
+    check_gl("back-patch ptp pass");
     if (culled) m.read_flags(*culled);
     if (planes) {
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         planes->assign(m.count * 64, 0.0f);
         if (m.count)
             glGetNamedBufferSubData(m.planes, 0, static_cast<GLsizeiptr>(planes->size() * sizeof(float)), planes->data());
-        check_gl_error("back-patch ptp planes read-back");
+        check_gl("back-patch ptp planes read-back");
     }
 }
 
@@ -358,7 +298,7 @@ std::vector<std::uint32_t> BackpatchCuller::read_flag_words() const {
     std::vector<std::uint32_t> words(m.count);
     if (m.count)
         glGetNamedBufferSubData(m.flags, 0, static_cast<GLsizeiptr>(m.count * sizeof(std::uint32_t)), words.data());
-    check_gl_error("back-patch flag read-back");
+    check_gl("back-patch flag read-back");
     return words;
 }
 
@@ -373,8 +313,8 @@ std::vector<float> BackpatchCuller::probe(BackpatchProbe op, const std::vector<V
         in[4 * i + 2] = abc[i].z;
         in[4 * i + 3] = 0.0f;
     }
-    allocate(m.probe_in, in.size() * sizeof(float), in.data());
-    allocate(m.probe_out, abc.size() * sizeof(float), nullptr);
+    upload(m.probe_in, in.size() * sizeof(float), in.data());
+    upload(m.probe_out, abc.size() * sizeof(float), nullptr);
     const GLuint program = m.probe_program();
     glUseProgram(program);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bs::kBindingProbeIn, m.probe_in);
@@ -398,7 +338,7 @@ std::vector<float> BackpatchCuller::probe(BackpatchProbe op, const std::vector<V
     std::vector<float> out(abc.size());
     if (!out.empty())
         glGetNamedBufferSubData(m.probe_out, 0, static_cast<GLsizeiptr>(out.size() * sizeof(float)), out.data());
-    check_gl_error("back-patch probe");
+    check_gl("back-patch probe");
     return out;
 }
 
