@@ -1,57 +1,13 @@
 // tcone back-patch cull pass, one invocation per patch: the GPU twin of cull_tcone_scalar
-// (include/patchcull/backpatch.h, src/core/backpatch_cones.cpp): TCONE (the Sederberg & Meyers
-// cone of the tangent and bitangent control vectors), the control-point sphere and the
-// perspective back-facing test, all from backpatch_cones.h (the operation-by-operation mirror of
-// src/core/cones_internal.h). Rational patches (any w != 1) are never culled. Writes
-// kCullBackPatch or 0 to the patch's back-patch flag word (kBindingBackPatchFlags, the input of
-// cull_occlusion's back-patch hook).
+// (include/patchcull/backpatch.h, src/core/backpatch_cones.cpp): TCONE, the Sederberg & Meyers
+// cone of the tangent and bitangent control vectors. The pass itself is cone_pass.h; the cone
+// and the test are backpatch_cones.h (the operation-by-operation mirror of
+// src/core/cones_internal.h).
 #version 450 core
 #include "shared.h"
 #include "backpatch_shared.h"
 #include "exact_fma.h"
 #include "backpatch_exact.h"
 #include "backpatch_cones.h"
-
-layout(local_size_x = kConeGroupSize) in;
-
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];  // patch p's point k at 16p + k (patch.h order)
-};
-layout(std430, binding = kBindingBackPatchFlags) writeonly buffer BackPatchFlags {
-    uint backpatch_flags[];
-};
-
-layout(std430, binding = kBindingConeValues) writeonly buffer ConeValues {
-    float cone_values[];  // kConeValues per patch, written only when u_write_cones
-};
-
-uniform uint u_patch_count;
-uniform uint u_first_patch;  // dispatches cover patches from here (large sets take several)
-uniform vec3 u_eye;  // object space
-uniform bool u_write_cones;
-
-void main() {
-    const uint p = u_first_patch + gl_GlobalInvocationID.x;
-    if (p >= u_patch_count) return;
-    vec4 P[16];
-    for (int k = 0; k < 16; ++k) P[k] = control_points[16u * p + uint(k)];
-    const PcCone cone = pc_tangent_cone(P);
-    const PcSphere sphere = pc_sphere_of_points(P);
-    const bool culled = pc_is_polynomial(P) && pc_back_facing(cone, sphere, u_eye);
-    backpatch_flags[p] = culled ? kCullBackPatch : 0u;
-    if (u_write_cones) {
-        const uint o = kConeValues * p;
-        cone_values[o] = cone.axis.x;
-        cone_values[o + 1u] = cone.axis.y;
-        cone_values[o + 2u] = cone.axis.z;
-        cone_values[o + 3u] = cone.cos_angle;
-        cone_values[o + 4u] = cone.sin_angle;
-        cone_values[o + 5u] = cone.valid ? 1.0 : 0.0;
-        cone_values[o + 6u] = sphere.center.x;
-        cone_values[o + 7u] = sphere.center.y;
-        cone_values[o + 8u] = sphere.center.z;
-        cone_values[o + 9u] = sphere.radius;
-        cone_values[o + 10u] = 0.0;
-        cone_values[o + 11u] = 0.0;
-    }
-}
+#define PC_PASS_CONE pc_tangent_cone
+#include "cone_pass.h"
