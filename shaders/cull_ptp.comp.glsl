@@ -13,11 +13,14 @@
 //    the corner formula for the 4 corner destinations), so every t is bit-identical to the CPU's
 //    (pc_fma = std::fma; the other operations are single IEEE operations marked precise). A lane
 //    owns its destinations alone: no write hazards, no atomics;
-// 4. the 64 t go to shared memory and are counted by a parallel reduction: lane i counts how many
-//    of t[4i .. 4i+3] satisfy the rule (ncnt: t < 0, pcnt: t <= 0; NaN satisfies neither), then a
-//    tree sum over the 16 lanes; culled when all 64 do (as the CPU's "every t < 0" / "no t > 0").
-// Writes kCullBackPatch or 0 to the back-patch flag word; the 64 t to kBindingPtpPlanes on
-// request (tests). The host skips the dispatch (and clears the flags) when ptp_clip_rows would
+//    Each lane also computes the patch's rounding-error margin scales (ptp_schedule.h, "Rounding-
+//    error margin": R, E, g1, g2 and the collapsed edges, from shared memory, in the CPU's order)
+//    and the margins thr of its 4 destinations;
+// 4. the 64 t and thr go to shared memory and are counted by a parallel reduction: lane i counts
+//    how many of t[4i .. 4i+3] satisfy the rule (ncnt: t < -thr, pcnt: t <= -thr; NaN satisfies
+//    neither), then a tree sum over the 16 lanes; culled when all 64 do (as the CPU).
+// Writes kCullBackPatch or 0 to the back-patch flag word; the 64 t and then the 64 thr to
+// kBindingPtpPlanes (128 floats per patch) on request (tests). The host skips the dispatch (and clears the flags) when ptp_clip_rows would
 // return false (alpha or det(object_to_clip) zero or not finite).
 #version 450 core
 #include "shared.h"
@@ -34,7 +37,7 @@ layout(std430, binding = kBindingBackPatchFlags) writeonly buffer BackPatchFlags
     uint backpatch_flags[];
 };
 layout(std430, binding = kBindingPtpPlanes) writeonly buffer PtpPlanes {
-    float ptp_planes[];  // 64 per patch, written only when u_write_planes
+    float ptp_planes[];  // 128 per patch (t[64], thr[64]), written only when u_write_planes
 };
 
 uniform vec4 u_rows[3];  // rows x, y, w of s * object_to_clip (ptp.cpp: s = sign(alpha) sign(det))
@@ -47,6 +50,7 @@ uniform bool u_write_planes;
 // fma(w, v, +0) = +0 for v = -0 into -0 (measured on llvmpipe: the sign of zero t differed).
 uniform float u_zero;
 
+shared vec4 s_object[kPtpPatchesPerGroup][16];
 shared float s_x[kPtpPatchesPerGroup][16];
 shared float s_y[kPtpPatchesPerGroup][16];
 shared float s_w[kPtpPatchesPerGroup][16];
@@ -54,6 +58,7 @@ shared float s_mxy[kPtpPatchesPerGroup][kPtpPairCount];
 shared float s_mxw[kPtpPatchesPerGroup][kPtpPairCount];
 shared float s_myw[kPtpPatchesPerGroup][kPtpPairCount];
 shared float s_t[kPtpPatchesPerGroup][64];
+shared float s_thr[kPtpPatchesPerGroup][64];
 shared uint s_count[kPtpPatchesPerGroup][kPtpLanes];
 
 // a*b - c*d as fma(a, b, -(c*d)) (ptp.cpp's minor2).
@@ -84,6 +89,7 @@ void main() {
             v = pc_fma(row.z, P.z, v);
             o[r] = pc_fma(row.w, P.w, v);
         }
+        s_object[slot][lane] = P;
         s_x[slot][lane] = o[0];
         s_y[slot][lane] = o[1];
         s_w[slot][lane] = o[2];
@@ -103,6 +109,50 @@ void main() {
         s_myw[slot][q] = pc_minor2(ay, ew, aw, ey);
     }
     sync_shared();
+
+    // Margin scales of the patch (ptp.cpp's rounding_margins), computed by every lane alike.
+    bool finite;
+    precise float g1, g2;
+    uint collapsed = 0u;
+    {
+        precise vec4 mag = vec4(0.0);
+        for (uint k = 0u; k < 16u; ++k) mag = max(mag, abs(s_object[slot][k]));
+        precise float magnitude_sum = (mag.x + mag.y) + (mag.z + mag.w);
+        finite = magnitude_sum <= uintBitsToFloat(0x7F7FFFFFu);  // FLT_MAX
+        precise float row_bound[3];
+        for (int r = 0; r < 3; ++r) {
+            const vec4 row = abs(u_rows[r]);
+            precise float v = row.x * mag.x;
+            v = pc_fma(row.y, mag.y, v);
+            v = pc_fma(row.z, mag.z, v);
+            row_bound[r] = pc_fma(row.w, mag.w, v);
+        }
+        const float R = max(max(row_bound[0], row_bound[1]), row_bound[2]);
+        vec3 lo = vec3(s_x[slot][0], s_y[slot][0], s_w[slot][0]), hi = lo;
+        for (uint k = 1u; k < 16u; ++k) {
+            const vec3 P = vec3(s_x[slot][k], s_y[slot][k], s_w[slot][k]);
+            lo = min(lo, P);
+            hi = max(hi, P);
+        }
+        precise vec3 extent = hi - lo;
+        const float E = max(max(extent.x, extent.y), extent.z);
+        precise float RR = R * R;
+        precise float RRE = RR * E;
+        precise float RRR = RR * R;
+        precise float RE = R * E;
+        precise float REE = RE * E;
+        const float uf = uintBitsToFloat(kPtpMarginUnderflow);
+        g1 = pc_fma(uf, RR, uf);
+        g1 = pc_fma(uintBitsToFloat(kPtpMarginC3), RRR, g1);
+        g1 = pc_fma(uintBitsToFloat(kPtpMarginC1), RRE, g1);
+        g2 = uintBitsToFloat(kPtpMarginC2) * REE;
+        for (uint e = 0u; e < 4u; ++e) {
+            const vec4 a = s_object[slot][kPtpEdgePoints[4u * e]];
+            bool same = true;
+            for (uint i = 1u; i < 4u; ++i) same = same && all(equal(s_object[slot][kPtpEdgePoints[4u * e + i]], a));
+            if (same) collapsed |= 1u << e;
+        }
+    }
 
     // 3. The 4 destinations of this lane's 4x4 block, each in the CPU schedule's order (step 3).
     const uint iu0 = lane & 3u, jv0 = lane >> 2;
@@ -141,14 +191,20 @@ void main() {
             }
         }
         s_t[slot][d] = acc;
+        // thr = fma(W_d (K_d + 12), g2, W_d g1), 0 where one of the destination's edges collapsed.
+        precise float scaled = uintBitsToFloat(kPtpMarginWeights[d]) * g1;
+        precise float thr = pc_fma(uintBitsToFloat(kPtpMarginWeightTerms[d]), g2, scaled);
+        const uint iu = d & 7u, jv = d >> 3;
+        const uint edges = (jv == 0u ? 1u : 0u) | (iu == 7u ? 2u : 0u) | (jv == 7u ? 4u : 0u) | (iu == 0u ? 8u : 0u);
+        s_thr[slot][d] = (edges & collapsed) != 0u ? 0.0 : thr;
     }
     sync_shared();
 
     // 4. Sign count by parallel reduction (step 4): how many t satisfy the rule.
     uint ok = 0u;
     for (uint i = 0u; i < 4u; ++i) {
-        const float t = s_t[slot][4u * lane + i];
-        const bool pass = u_pcnt ? (t <= 0.0) : (t < 0.0);  // NaN: false (kept)
+        const float t = s_t[slot][4u * lane + i], neg_thr = -s_thr[slot][4u * lane + i];
+        const bool pass = finite && (u_pcnt ? (t <= neg_thr) : (t < neg_thr));  // NaN: false (kept)
         ok += pass ? 1u : 0u;
     }
     s_count[slot][lane] = ok;
@@ -160,5 +216,8 @@ void main() {
     if (!in_range) return;
     if (lane == 0u) backpatch_flags[p] = s_count[slot][0] == 64u ? kCullBackPatch : 0u;
     if (u_write_planes)
-        for (uint i = 0u; i < 4u; ++i) ptp_planes[64u * p + 4u * lane + i] = s_t[slot][4u * lane + i];
+        for (uint i = 0u; i < 4u; ++i) {
+            ptp_planes[128u * p + 4u * lane + i] = s_t[slot][4u * lane + i];
+            ptp_planes[128u * p + 64u + 4u * lane + i] = s_thr[slot][4u * lane + i];
+        }
 }

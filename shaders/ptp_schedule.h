@@ -8,7 +8,10 @@
 //   permutation sign folded in): acc = fma(weight, cross4Z from the pair's minors and point third, acc);
 //   the steps of destination d are [kPtpDestFirst[d], kPtpDestFirst[d + 1]), in table order;
 // - kPtpCornerOfDest[d]: index into kPtpCorners (dest | a << 8 | b << 16 | c << 24) and
-//   kPtpCornerWeights, or -1: t[d] = weight * det[p_a, p_b - p_a, p_c - p_a].
+//   kPtpCornerWeights, or -1: t[d] = weight * det[p_a, p_b - p_a, p_c - p_a];
+// - the rounding-error margin's constants (float bits): kPtpMarginC1, C2, C3, Underflow,
+//   kPtpMarginWeights[d] = W_d, kPtpMarginWeightTerms[d] = W_d (K_d + 12), and the edges'
+//   control points kPtpEdgePoints[4 e + i] (ptp_schedule.h's kEdgePoints).
 const uint kPtpPairCount = 66u;
 const uint kPtpPairs[66] = uint[66](
     256u, 512u, 768u, 1024u, 1792u, 2048u, 2304u, 2560u,
@@ -187,3 +190,33 @@ const uint kPtpCorners[4] = uint[4](
     0x04010000u, 0x07020307u, 0x0D080C38u, 0x0E0B0F3Fu);
 const uint kPtpCornerWeights[4] = uint[4](
     0x41100000u, 0xC1100000u, 0x41100000u, 0xC1100000u);
+const uint kPtpMarginC1 = 0x37000000u;
+const uint kPtpMarginC2 = 0x35000000u;
+const uint kPtpMarginC3 = 0x2C800000u;
+const uint kPtpMarginUnderflow = 0x0D800000u;
+const uint kPtpMarginWeights[64] = uint[64](
+    0x41100009u, 0x40CDB6E8u, 0x40B24930u, 0x40ACCCD8u, 0x40ACCCD8u, 0x40B24930u,
+    0x40CDB6E8u, 0x41100009u, 0x40CDB6E8u, 0x4092F05Du, 0x407EB1B2u, 0x4076DB7Du,
+    0x4076DB7Du, 0x407EB1B2u, 0x4092F05Du, 0x40CDB6E8u, 0x40B24930u, 0x407EB1B2u,
+    0x402DB6E6u, 0x404C89FAu, 0x404C89FAu, 0x402DB6E6u, 0x407EB1B2u, 0x40B24930u,
+    0x40ACCCD8u, 0x4076DB7Du, 0x404C89FAu, 0x404C89FAu, 0x404C89FAu, 0x404C89FAu,
+    0x4076DB7Du, 0x40ACCCD8u, 0x40ACCCD8u, 0x4076DB7Du, 0x404C89FAu, 0x404C89FAu,
+    0x404C89FAu, 0x404C89FAu, 0x4076DB7Du, 0x40ACCCD8u, 0x40B24930u, 0x407EB1B2u,
+    0x402DB6E6u, 0x404C89FAu, 0x404C89FAu, 0x402DB6E6u, 0x407EB1B2u, 0x40B24930u,
+    0x40CDB6E8u, 0x4092F05Du, 0x407EB1B2u, 0x4076DB7Du, 0x4076DB7Du, 0x407EB1B2u,
+    0x4092F05Du, 0x40CDB6E8u, 0x41100009u, 0x40CDB6E8u, 0x40B24930u, 0x40ACCCD8u,
+    0x40ACCCD8u, 0x40B24930u, 0x40CDB6E8u, 0x41100009u);
+const uint kPtpMarginWeightTerms[64] = uint[64](
+    0x42EA000Fu, 0x42B4000Bu, 0x42B24930u, 0x42B799A5u, 0x42B799A5u, 0x42B24930u,
+    0x42B4000Bu, 0x42EA000Fu, 0x42B4000Bu, 0x4292F05Du, 0x429F2F0Fu, 0x42A9B6E6u,
+    0x42A9B6E6u, 0x429F2F0Fu, 0x4292F05Du, 0x42B4000Bu, 0x42B24930u, 0x429F2F0Fu,
+    0x4279B6EBu, 0x42B95D0Bu, 0x42B95D0Bu, 0x4279B6EBu, 0x429F2F0Fu, 0x42B24930u,
+    0x42B799A5u, 0x42A9B6E6u, 0x42B95D0Bu, 0x42D2EE4Au, 0x42D2EE4Au, 0x42B95D0Bu,
+    0x42A9B6E6u, 0x42B799A5u, 0x42B799A5u, 0x42A9B6E6u, 0x42B95D0Bu, 0x42D2EE4Au,
+    0x42D2EE4Au, 0x42B95D0Bu, 0x42A9B6E6u, 0x42B799A5u, 0x42B24930u, 0x429F2F0Fu,
+    0x4279B6EBu, 0x42B95D0Bu, 0x42B95D0Bu, 0x4279B6EBu, 0x429F2F0Fu, 0x42B24930u,
+    0x42B4000Bu, 0x4292F05Du, 0x429F2F0Fu, 0x42A9B6E6u, 0x42A9B6E6u, 0x429F2F0Fu,
+    0x4292F05Du, 0x42B4000Bu, 0x42EA000Fu, 0x42B4000Bu, 0x42B24930u, 0x42B799A5u,
+    0x42B799A5u, 0x42B24930u, 0x42B4000Bu, 0x42EA000Fu);
+const uint kPtpEdgePoints[16] = uint[16](
+    0u, 1u, 2u, 3u, 3u, 7u, 11u, 15u, 12u, 13u, 14u, 15u, 0u, 4u, 8u, 12u);

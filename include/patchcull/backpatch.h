@@ -24,6 +24,12 @@
 //   once per call, so mirroring model matrices work too). DVis on Ncnt: culled when all 64
 //   e . t_i < 0. ptp-pcnt: culled when no e . t_i > 0 (Pcnt = 0), which also culls degenerate
 //   patches with collapsed edges (the teapot's top). Rational patches are supported.
+//   Float rounding: each computed t_i must be below -thr_i, thr_i a rigorous bound on its
+//   rounding error (per patch, from the control points' magnitude and clip-space extent; 0 on
+//   collapsed edges, whose planes are exact zeros), so a plane that faces the eye by less than
+//   float precision keeps the patch (src/core/ptp_schedule.h derives the bound; without it,
+//   distant edge-on patches were falsely culled about once per million culls). A non-finite
+//   control point keeps the patch.
 //
 // Contracts: culled must hold patches.count bytes. Kernels never allocate or throw; each has a
 // scalar reference and a SIMD version that give identical decisions. Displacement is not

@@ -16,9 +16,10 @@
 //   every cull call: kFlagBackPatch (2, gl_renderer.h) = back-facing (culled), 0 = kept. This is
 //   the layout cull_occlusion reads as its back-patch hook ("nonzero = back-facing"), so the
 //   buffer can be bound there as is.
-// - ptp diagnostics, backpatch_shared.h's kBindingPtpPlanes (12): float t[64 * patch_count], the
-//   64 clip-space control plane z values per patch (t[64p + 8 jv + iu]), written only when
-//   cull_ptp is asked for them.
+// - ptp diagnostics, backpatch_shared.h's kBindingPtpPlanes (12): float [128 * patch_count], per
+//   patch the 64 clip-space control plane z values (at 128p + 8 jv + iu) and then their 64
+//   rounding-error margins thr (at 128p + 64 + 8 jv + iu), written only when cull_ptp is asked
+//   for them.
 // - cone diagnostics, kBindingConeValues (15): float c[12 * patch_count], per patch (axis.xyz,
 //   cos, sin, valid 1/0, sphere center.xyz, radius, 0, 0), written only when cull_tcone /
 //   cull_ncone are asked for them.
@@ -117,10 +118,12 @@ public:
     /// cull_ptp_scalar on the GPU (object_to_clip = projection * view (* model), alpha =
     /// clip_space_eye_alpha(projection)). planes (optional): the 64 control plane z values per
     /// patch as ptp_control_planes_z computes them (times the orientation sign s of ptp.cpp),
-    /// t[64p + d]; nothing is written to it when nothing may be culled (alpha or det zero or not
-    /// finite: all flags 0, as the CPU).
+    /// t[64p + d]; margins (optional): their rounding-error margins thr[64p + d] as the CPU's
+    /// ptp_rounding_margins computes them (a patch with a non-finite coordinate: unspecified);
+    /// neither is written when nothing may be culled (alpha or det zero or not finite: all flags
+    /// 0, as the CPU).
     void cull_ptp(const Mat4& object_to_clip, float alpha, PtpRule rule, std::vector<std::uint8_t>* culled = nullptr,
-                  std::vector<float>* planes = nullptr);
+                  std::vector<float>* planes = nullptr, std::vector<float>* margins = nullptr);
     /// One of the above: tcone/ncone use eye, ptp uses object_to_clip, alpha and rule.
     void cull(BackpatchMethod method, const Mat4& object_to_clip, Vec3 eye, float alpha, PtpRule rule,
               std::vector<std::uint8_t>* culled = nullptr);

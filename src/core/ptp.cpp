@@ -10,8 +10,10 @@
 // 3. For each destination d in 0..63: acc = 0; for each of its terms (table order)
 //      c = p.x * m_yw;  c = fma(-p.y, m_xw, c);  c = fma(p.w, m_xy, c);  acc = fma(weight, c, acc)
 //    (corner destinations: the same with the anchor's difference vectors, ptp_schedule.h).
-// 4. ncnt: culled when every acc < 0; pcnt: culled when no acc > 0 (every acc <= 0). A NaN
-//    anywhere fails the comparisons, so the patch is kept.
+// 4. ncnt: culled when every acc < -thr; pcnt: culled when every acc <= -thr, thr >= 0 the
+//    per-destination bound on acc's rounding error (ptp_schedule.h, "Rounding-error margin"; 0 on
+//    a collapsed edge, whose planes are exact zeros, so Pcnt still culls degenerate patches). A
+//    NaN anywhere fails the comparisons, so the patch is kept.
 //
 // Orientation. With object-space control points b and clip points M b, cross4 transforms as
 // cross4(Ma, Mb, Mc) = det(M) M^-T cross4(a, b, c), so for the clip-space eye f = M e = (0,0,alpha,0)
@@ -30,8 +32,10 @@
 // default for C++ is -ffp-contract=fast even with -std=c++20 (it does turn a*b - c*d into an fma,
 // scalar and intrinsics alike, checked with g++ 12), so every product here feeds an explicit fma
 // or is a lone multiply whose only use is an fma operand, which GCC never fuses.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "core/ptp_internal.h"
 #include "core/ptp_schedule.h"
@@ -86,12 +90,9 @@ inline float minor2(float a, float b, float c, float d) {
     return std::fma(a, b, -q);
 }
 
-// The 64 clip-space control plane z components of one patch (steps 1-3 above), with
-// point k's components at X[k], Y[k], Z[k], W[k].
-inline __attribute__((always_inline)) void control_planes_z(const float* X, const float* Y, const float* Z,
-                                                            const float* W, const ptp_detail::PtpClipRows& rows,
-                                                            float t[64]) {
-    Pt P[16];
+// Step 1: the clip-space points (rows x, y, w) of the patch whose point k is X[k], Y[k], Z[k], W[k].
+inline __attribute__((always_inline)) void clip_points(const float* X, const float* Y, const float* Z, const float* W,
+                                                       const ptp_detail::PtpClipRows& rows, Pt P[16]) {
     for (int k = 0; k < 16; ++k) {
         float o[3];
         for (int r = 0; r < 3; ++r) {
@@ -102,6 +103,10 @@ inline __attribute__((always_inline)) void control_planes_z(const float* X, cons
         }
         P[k] = {o[0], o[1], o[2]};
     }
+}
+
+// Steps 2-3: the 64 clip-space control plane z components.
+inline __attribute__((always_inline)) void control_planes_z(const Pt P[16], float t[64]) {
     float mxy[kPairCount], mxw[kPairCount], myw[kPairCount];
     for (int q = 0; q < kPairCount; ++q) {
         // Minors of (a, b - a): equal to those of (a, b), and exactly 0 when b == a.
@@ -139,6 +144,73 @@ inline __attribute__((always_inline)) void control_planes_z(const float* X, cons
     }
 }
 
+// Step 4's rounding-error margins thr[64] (ptp_schedule.h, "Rounding-error margin"); false when
+// the patch has a non-finite coordinate (then it is kept).
+inline __attribute__((always_inline)) bool rounding_margins(const float* X, const float* Y, const float* Z,
+                                                            const float* W, const Pt P[16],
+                                                            const ptp_detail::PtpClipRows& rows, float thr[64]) {
+    using namespace ptp_detail;
+    float mx = 0.0f, my = 0.0f, mz = 0.0f, mw = 0.0f;
+    for (int k = 0; k < 16; ++k) {
+        mx = std::max(mx, std::fabs(X[k]));
+        my = std::max(my, std::fabs(Y[k]));
+        mz = std::max(mz, std::fabs(Z[k]));
+        mw = std::max(mw, std::fabs(W[k]));
+    }
+    const float magnitude_sum = (mx + my) + (mz + mw);
+    if (!(magnitude_sum <= std::numeric_limits<float>::max())) return false;
+    float row_bound[3];
+    for (int r = 0; r < 3; ++r) {
+        float v = std::fabs(rows.r[r][0]) * mx;
+        v = std::fma(std::fabs(rows.r[r][1]), my, v);
+        v = std::fma(std::fabs(rows.r[r][2]), mz, v);
+        row_bound[r] = std::fma(std::fabs(rows.r[r][3]), mw, v);
+    }
+    const float R = std::max(std::max(row_bound[0], row_bound[1]), row_bound[2]);
+    Pt lo = P[0], hi = P[0];
+    for (int k = 1; k < 16; ++k) {
+        lo = {std::min(lo.x, P[k].x), std::min(lo.y, P[k].y), std::min(lo.w, P[k].w)};
+        hi = {std::max(hi.x, P[k].x), std::max(hi.y, P[k].y), std::max(hi.w, P[k].w)};
+    }
+    const float E = std::max(std::max(hi.x - lo.x, hi.y - lo.y), hi.w - lo.w);
+    const float RR = R * R;
+    const float RRE = RR * E, RRR = RR * R, RE = R * E;
+    const float REE = RE * E;
+    float g1 = std::fma(kMarginUnderflow, RR, kMarginUnderflow);
+    g1 = std::fma(kMarginC3, RRR, g1);
+    g1 = std::fma(kMarginC1, RRE, g1);
+    const float g2 = kMarginC2 * REE;
+    unsigned collapsed = 0;
+    for (int e = 0; e < 4; ++e) {
+        const int a = kEdgePoints[e][0];
+        bool same = true;
+        for (int i = 1; i < 4; ++i) {
+            const int b = kEdgePoints[e][i];
+            same = same && X[b] == X[a] && Y[b] == Y[a] && Z[b] == Z[a] && W[b] == W[a];
+        }
+        collapsed |= same ? 1u << e : 0u;
+    }
+    for (int d = 0; d < 64; ++d) {
+        const float scaled = kMarginWeights.weight[d] * g1;
+        const float margin = std::fma(kMarginWeights.weight_terms[d], g2, scaled);
+        thr[d] = (dest_edges(d) & collapsed) ? 0.0f : margin;
+    }
+    return true;
+}
+
+// The decision of step 4 for one patch.
+inline __attribute__((always_inline)) bool decide(const float* X, const float* Y, const float* Z, const float* W,
+                                                  const ptp_detail::PtpClipRows& rows, bool pcnt) {
+    Pt P[16];
+    float t[64], thr[64];
+    clip_points(X, Y, Z, W, rows, P);
+    control_planes_z(P, t);
+    if (!rounding_margins(X, Y, Z, W, P, rows, thr)) return false;
+    bool cull = true;
+    for (int d = 0; d < 64; ++d) cull = cull && (pcnt ? t[d] <= -thr[d] : t[d] < -thr[d]);
+    return cull;
+}
+
 }  // namespace
 
 namespace ptp_detail {
@@ -147,7 +219,18 @@ PATCHCULL_SCALAR_CLONES
 void ptp_control_planes_z(const BezierPatch& patch, const PtpClipRows& rows, float t[64]) {
     float X[16], Y[16], Z[16], W[16];
     for (int k = 0; k < 16; ++k) X[k] = patch.cp[k].x, Y[k] = patch.cp[k].y, Z[k] = patch.cp[k].z, W[k] = patch.cp[k].w;
-    control_planes_z(X, Y, Z, W, rows, t);
+    Pt P[16];
+    clip_points(X, Y, Z, W, rows, P);
+    control_planes_z(P, t);
+}
+
+PATCHCULL_SCALAR_CLONES
+bool ptp_rounding_margins(const BezierPatch& patch, const PtpClipRows& rows, float thr[64]) {
+    float X[16], Y[16], Z[16], W[16];
+    for (int k = 0; k < 16; ++k) X[k] = patch.cp[k].x, Y[k] = patch.cp[k].y, Z[k] = patch.cp[k].z, W[k] = patch.cp[k].w;
+    Pt P[16];
+    clip_points(X, Y, Z, W, rows, P);
+    return rounding_margins(X, Y, Z, W, P, rows, thr);
 }
 
 }  // namespace ptp_detail
@@ -162,15 +245,12 @@ void cull_ptp_scalar(const PatchBatchView& patches, const Mat4& object_to_clip, 
     }
     const bool pcnt = rule == PtpRule::pcnt;
     for (std::size_t p = 0; p < patches.count; ++p) {
-        float X[16], Y[16], Z[16], W[16], t[64];
+        float X[16], Y[16], Z[16], W[16];
         for (int k = 0; k < 16; ++k) {
             X[k] = patches.component(k, 0)[p], Y[k] = patches.component(k, 1)[p];
             Z[k] = patches.component(k, 2)[p], W[k] = patches.component(k, 3)[p];
         }
-        control_planes_z(X, Y, Z, W, rows, t);
-        bool cull = true;
-        for (int d = 0; d < 64; ++d) cull = cull && (pcnt ? t[d] <= 0.0f : t[d] < 0.0f);
-        culled[p] = cull ? 1 : 0;
+        culled[p] = decide(X, Y, Z, W, rows, pcnt) ? 1 : 0;
     }
 }
 

@@ -19,4 +19,8 @@ bool ptp_clip_rows(const Mat4& object_to_clip, float alpha, PtpClipRows& out);
 /// computed exactly as cull_ptp_scalar does (for tests: compared against double precision).
 void ptp_control_planes_z(const BezierPatch& patch, const PtpClipRows& rows, float t[64]);
 
+/// The scalar kernel's rounding-error margins thr[64] >= |t - exact t| of one patch (ptp_schedule.h,
+/// "Rounding-error margin"); false (thr unspecified) when a coordinate is not finite (kept).
+bool ptp_rounding_margins(const BezierPatch& patch, const PtpClipRows& rows, float thr[64]);
+
 }  // namespace patchcull::ptp_detail

@@ -204,4 +204,78 @@ inline constexpr Schedule kSchedule = schedule_build::make();
 inline constexpr int kPairCount = kSchedule.num_pairs;
 inline constexpr int kStepCount = kTermCount - 4;
 
+// ---- Rounding-error margin ----------------------------------------------------------------------
+// The kernels cull only when every t[d] < -thr[d] (Ncnt) or <= -thr[d] (Pcnt), where thr[d]
+// bounds |t[d] - t*[d]|, t*[d] being the exact value for the exact clip points M X of the patch's
+// float control points X (M the float rows of s * object_to_clip) and the exact rational weights.
+// Without it, distant nearly edge-on patches were culled with a tangent plane facing the eye by
+// ~1e-5 rad (docs/RESULTS.md, Finding 1). Per patch (the same operations, in this order, in
+// ptp.cpp, ptp_simd.cpp and cull_ptp.comp.glsl, so all three agree bit for bit):
+//   Mc = max_k |X_k.c| (c = x, y, z, w), finite = (Mx + My) + (Mz + Mw) <= FLT_MAX
+//   R  = max over rows i of fma chain |r_i0| Mx + |r_i1| My + |r_i2| Mz + |r_i3| Mw
+//        (>= sum_c |r_ic| |X_k.c| for every point k: R bounds |P| and P's rounding scale)
+//   E  = max over x, y, w of (max_k P - min_k P) (every clip-space difference is <= E)
+//   RR = R R;  g1 = fma(kC1, RR E, fma(kC3, RR R, fma(kUf, RR, kUf)));  g2 = kC2 ((R E) E)
+//   thr[d] = fma(margin_weight_terms[d], g2, margin_weight[d] g1), or 0 on a collapsed edge.
+// Why it bounds the error (u = 2^-24; |det[x,y,z]| <= 6 |x| |y| |z| in the max norm over x, y, w):
+// - P = M X by mul + 3 fma: |P - P*| <= eta R, eta = gamma_4 ~ 4u. With det[a,b,c] =
+//   det[a, b - a, c - a] and |b - a| <= E, one term's sensitivity to these errors is
+//   <= 24 eta R^2 E + 6 eta R E^2 + 24 eta^2 R^3;
+// - the schedule's arithmetic on the computed P: a pair minor of (a, e = b - a) has error
+//   <= 5u R E (e's rounding included) and magnitude <= 2 R E; cross4Z = c . m then errs by
+//   <= 3 R 5u R E + u (2 + 4 + 6) R^2 E = 27u R^2 E (a corner, det[a, d1, d2] with |d2| <= E,
+//   by <= 33u R E^2);
+// - the weighted sum: |v| <= 6 R E^2 per term, so the K_d fma roundings and the float weight
+//   add <= 6u (K_d + 1) W_d R E^2, W_d = sum of the destination's |weights|.
+// Sum: W_d ((24 eta + 27u) R^2 E + 24 eta^2 R^3) + 6u W_d (K_d + 5) R E^2 (corners: 6u (K_d + 10)),
+// covered by kC1 = 128u >= 123u, kC3 = 2^-38 >= 384 u^2, kC2 = 8u with margin_weight_terms =
+// W_d (K_d + 12), all rounded up, leaving slack for the roundings of R, E and thr themselves.
+// kUf covers underflow: each of the < 3000 operations may lose up to 2^-126 (flush to zero on
+// GPUs included), amplified into t by < 54 W_d max(1, R^2). Non-finite inputs keep the patch
+// (NaN or inf in t, thr, or `finite` false).
+// Collapsed edges: when an edge's 4 control points are equal (object space, every component), its
+// 8 destinations are computed as exact zeros (see above) and are exactly zero, so their thr is 0
+// and Pcnt can still cull such patches. Edges: 0 = v0 (points 0-3, destinations jv = 0),
+// 1 = u1 (3, 7, 11, 15; iu = 7), 2 = v1 (12-15; jv = 7), 3 = u0 (0, 4, 8, 12; iu = 0).
+// The bound is about 100 times the largest error observed (tests/core/ptp_test.cpp: worst-case
+// roundings against ones that partly cancel); its cost in culls is in docs/RESULTS.md.
+inline constexpr float kMarginC1 = 0x1p-17f;   // 128 u
+inline constexpr float kMarginC2 = 0x1p-21f;   // 8 u
+inline constexpr float kMarginC3 = 0x1p-38f;   // >= 384 u^2
+inline constexpr float kMarginUnderflow = 0x1p-100f;
+inline constexpr int kEdgePoints[4][4] = {{0, 1, 2, 3}, {3, 7, 11, 15}, {12, 13, 14, 15}, {0, 4, 8, 12}};
+
+/// Bit e set: destination d lies on edge e (kEdgePoints), 0 for interior destinations.
+constexpr unsigned dest_edges(int d) {
+    const int iu = d % 8, jv = d / 8;
+    return (jv == 0 ? 1u : 0u) | (iu == 7 ? 2u : 0u) | (jv == 7 ? 4u : 0u) | (iu == 0 ? 8u : 0u);
+}
+
+struct MarginWeights {
+    std::array<float, 64> weight{};        // W_d, rounded up
+    std::array<float, 64> weight_terms{};  // W_d (K_d + 12), rounded up
+};
+
+namespace schedule_build {
+
+// x rounded up to a float (conversion rounds to nearest; the factor lifts it above x).
+constexpr float round_up(double x) { return static_cast<float>(x * (1.0 + 0x1p-20)); }
+
+constexpr MarginWeights make_margin_weights() {
+    MarginWeights m;
+    for (int d = 0; d < 64; ++d) {
+        double w = 0;
+        int k = 0;
+        for (const TableRow& r : kTable)
+            if (r.dest == d) w += static_cast<double>(r.num < 0 ? -r.num : r.num) / static_cast<double>(r.den), ++k;
+        m.weight[d] = round_up(w);
+        m.weight_terms[d] = round_up(w * (k + 12));
+    }
+    return m;
+}
+
+}  // namespace schedule_build
+
+inline constexpr MarginWeights kMarginWeights = schedule_build::make_margin_weights();
+
 }  // namespace patchcull::ptp_detail

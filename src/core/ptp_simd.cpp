@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 #include "core/ptp_internal.h"
@@ -115,6 +116,57 @@ HWY_INLINE void StoreDecisions(DF d, MF culled, std::uint8_t* out, std::size_t n
     }
 }
 
+// The rounding-error margins' per-patch scales (ptp.cpp's rounding_margins, same operations in
+// the same order): g1, g2, the collapsed-edge masks and whether every coordinate is finite.
+struct MarginScales {
+    VF g1, g2;
+    MF collapsed[4];
+    MF finite;
+};
+
+HWY_INLINE MarginScales PatchMarginScales(DF d, const Group& g, const ptp_detail::PtpClipRows& rows, const VF* px,
+                                          const VF* py, const VF* pw) {
+    using namespace ptp_detail;
+    MarginScales m;
+    VF mag[4] = {hn::Zero(d), hn::Zero(d), hn::Zero(d), hn::Zero(d)};
+    for (int k = 0; k < 16; ++k)
+        for (int c = 0; c < 4; ++c) mag[c] = hn::Max(mag[c], hn::Abs(g.load(d, k, c)));
+    const VF magnitude_sum = hn::Add(hn::Add(mag[0], mag[1]), hn::Add(mag[2], mag[3]));
+    m.finite = hn::Le(magnitude_sum, hn::Set(d, std::numeric_limits<float>::max()));
+    VF row_bound[3];
+    for (int r = 0; r < 3; ++r) {
+        VF v = hn::Mul(hn::Set(d, std::fabs(rows.r[r][0])), mag[0]);
+        v = Fma(d, hn::Set(d, std::fabs(rows.r[r][1])), mag[1], v);
+        v = Fma(d, hn::Set(d, std::fabs(rows.r[r][2])), mag[2], v);
+        row_bound[r] = Fma(d, hn::Set(d, std::fabs(rows.r[r][3])), mag[3], v);
+    }
+    const VF R = hn::Max(hn::Max(row_bound[0], row_bound[1]), row_bound[2]);
+    VF lox = px[0], loy = py[0], low = pw[0], hix = px[0], hiy = py[0], hiw = pw[0];
+    for (int k = 1; k < 16; ++k) {
+        lox = hn::Min(lox, px[k]), loy = hn::Min(loy, py[k]), low = hn::Min(low, pw[k]);
+        hix = hn::Max(hix, px[k]), hiy = hn::Max(hiy, py[k]), hiw = hn::Max(hiw, pw[k]);
+    }
+    const VF E = hn::Max(hn::Max(hn::Sub(hix, lox), hn::Sub(hiy, loy)), hn::Sub(hiw, low));
+    const VF RR = hn::Mul(R, R);
+    const VF RRE = hn::Mul(RR, E), RRR = hn::Mul(RR, R), RE = hn::Mul(R, E);
+    const VF REE = hn::Mul(RE, E);
+    const VF uf = hn::Set(d, kMarginUnderflow);
+    VF g1 = Fma(d, uf, RR, uf);
+    g1 = Fma(d, hn::Set(d, kMarginC3), RRR, g1);
+    m.g1 = Fma(d, hn::Set(d, kMarginC1), RRE, g1);
+    m.g2 = hn::Mul(hn::Set(d, kMarginC2), REE);
+    for (int e = 0; e < 4; ++e) {
+        const int a = kEdgePoints[e][0];
+        MF same = hn::FirstN(d, hn::Lanes(d));
+        for (int i = 1; i < 4; ++i) {
+            const int b = kEdgePoints[e][i];
+            for (int c = 0; c < 4; ++c) same = hn::And(same, hn::Eq(g.load(d, b, c), g.load(d, a, c)));
+        }
+        m.collapsed[e] = same;
+    }
+    return m;
+}
+
 template <bool kPcnt>
 HWY_INLINE MF PtpGroup(DF d, const Group& g, const ptp_detail::PtpClipRows& rows) {
     VF px[16], py[16], pw[16];
@@ -134,6 +186,7 @@ HWY_INLINE MF PtpGroup(DF d, const Group& g, const ptp_detail::PtpClipRows& rows
             px[k] = o[0], py[k] = o[1], pw[k] = o[2];
         }
     }
+    const MarginScales margin = PatchMarginScales(d, g, rows, px, py, pw);
     VF mxy[kPairCount], mxw[kPairCount], myw[kPairCount];
     Unroll(std::make_index_sequence<kPairCount>{}, [&](auto q) {
         constexpr int a = kSchedule.pairs[decltype(q)::value].a, b = kSchedule.pairs[decltype(q)::value].b;
@@ -144,7 +197,7 @@ HWY_INLINE MF PtpGroup(DF d, const Group& g, const ptp_detail::PtpClipRows& rows
         myw[qi] = Minor(d, py[a], ew, pw[a], ey);
     });
     const VF zero = hn::Zero(d);
-    MF cull = hn::FirstN(d, hn::Lanes(d));
+    MF cull = margin.finite;
     Unroll(std::make_index_sequence<64>{}, [&](auto dd) {
         constexpr int dest = decltype(dd)::value;
         VF acc = zero;
@@ -173,7 +226,14 @@ HWY_INLINE MF PtpGroup(DF d, const Group& g, const ptp_detail::PtpClipRows& rows
                 acc = Fma(d, hn::Set(d, st.weight), v, acc);
             });
         }
-        cull = hn::And(cull, kPcnt ? hn::Le(acc, zero) : hn::Lt(acc, zero));
+        // thr = fma(W_d (K_d + 12), g2, W_d g1), 0 where one of the destination's edges collapsed.
+        const VF scaled = hn::Mul(hn::Set(d, ptp_detail::kMarginWeights.weight[dest]), margin.g1);
+        VF thr = Fma(d, hn::Set(d, ptp_detail::kMarginWeights.weight_terms[dest]), margin.g2, scaled);
+        constexpr unsigned edges = ptp_detail::dest_edges(dest);
+        for (int e = 0; e < 4; ++e)
+            if (edges & (1u << e)) thr = hn::IfThenZeroElse(margin.collapsed[e], thr);
+        const VF neg_thr = hn::Neg(thr);
+        cull = hn::And(cull, kPcnt ? hn::Le(acc, neg_thr) : hn::Lt(acc, neg_thr));
     });
     return cull;
 }

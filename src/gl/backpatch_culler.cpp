@@ -240,7 +240,7 @@ void BackpatchCuller::cull_ncone(Vec3 eye, std::vector<std::uint8_t>* culled, st
 }
 
 void BackpatchCuller::cull_ptp(const Mat4& object_to_clip, float alpha, PtpRule rule, std::vector<std::uint8_t>* culled,
-                               std::vector<float>* planes) {
+                               std::vector<float>* planes, std::vector<float>* margins) {
     Impl& m = *impl_;
     float rows[3][4];
     if (!ptp_rows(object_to_clip, alpha, rows)) {
@@ -248,10 +248,12 @@ void BackpatchCuller::cull_ptp(const Mat4& object_to_clip, float alpha, PtpRule 
         check_gl("back-patch ptp pass (nothing culled)");
         if (culled) m.read_flags(*culled);
         if (planes) planes->clear();
+        if (margins) margins->clear();
         return;
     }
     const GLuint program = m.ptp_program();
-    if (planes) upload(m.planes, m.count * 64 * sizeof(float), nullptr);
+    const bool diagnostics = planes || margins;
+    if (diagnostics) upload(m.planes, m.count * 128 * sizeof(float), nullptr);
     glUseProgram(program);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, m.points);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingBackPatchFlags, m.flags);
@@ -259,7 +261,7 @@ void BackpatchCuller::cull_ptp(const Mat4& object_to_clip, float alpha, PtpRule 
     glUniform4fv(glGetUniformLocation(program, "u_rows"), 3, &rows[0][0]);
     glUniform1ui(glGetUniformLocation(program, "u_patch_count"), static_cast<GLuint>(m.count));
     glUniform1i(glGetUniformLocation(program, "u_pcnt"), rule == PtpRule::pcnt ? 1 : 0);
-    glUniform1i(glGetUniformLocation(program, "u_write_planes"), planes ? 1 : 0);
+    glUniform1i(glGetUniformLocation(program, "u_write_planes"), diagnostics ? 1 : 0);
     glUniform1f(glGetUniformLocation(program, "u_zero"), 0.0f);
     const GLint first_loc = glGetUniformLocation(program, "u_first_patch");
     const std::size_t per_dispatch = kMaxGroups * bs::kPtpPatchesPerGroup;
@@ -272,12 +274,21 @@ void BackpatchCuller::cull_ptp(const Mat4& object_to_clip, float alpha, PtpRule 
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     check_gl("back-patch ptp pass");
     if (culled) m.read_flags(*culled);
-    if (planes) {
+    if (diagnostics) {
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-        planes->assign(m.count * 64, 0.0f);
+        std::vector<float> both(m.count * 128, 0.0f);
         if (m.count)
-            glGetNamedBufferSubData(m.planes, 0, static_cast<GLsizeiptr>(planes->size() * sizeof(float)), planes->data());
+            glGetNamedBufferSubData(m.planes, 0, static_cast<GLsizeiptr>(both.size() * sizeof(float)), both.data());
         check_gl("back-patch ptp planes read-back");
+        // Per patch: t[64] then thr[64].
+        for (std::vector<float>* out : {planes, margins}) {
+            if (!out) continue;
+            const std::size_t offset = out == planes ? 0 : 64;
+            out->resize(m.count * 64);
+            for (std::size_t p = 0; p < m.count; ++p)
+                std::copy_n(both.begin() + static_cast<std::ptrdiff_t>(128 * p + offset), 64,
+                            out->begin() + static_cast<std::ptrdiff_t>(64 * p));
+        }
     }
 }
 

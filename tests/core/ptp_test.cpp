@@ -15,8 +15,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -462,6 +464,96 @@ TEST(PtpKernel, ControlPlanesMatchDoublePrecision) {
             }
     }
     RecordProperty("worst_relative_error", std::to_string(worst));
+}
+
+// The rounding-error margin (ptp_schedule.h) bounds the float kernel's error against the exact
+// control planes of the same float inputs, where it matters most: small patches far from the eye
+// (clip-space extent E down to 1e-5 of the magnitude R), nearly flat or curved, polynomial or
+// rational, with model matrices (mirroring ones included) and collapsed edges (margin 0 there,
+// exact zeros). The reference is the table in double, on clip points computed in double from the
+// same float rows and control points (cancellation there costs ~2^-50 R^3, far below the margin).
+// The largest error / margin ratio is recorded (about 1/100: the margin is a worst-case bound,
+// the observed errors add up like a random walk) and must be above 1/1000: a margin a thousand
+// times smaller would be violated, so the check has teeth.
+TEST(PtpKernel, RoundingMarginBoundsTheError) {
+    std::mt19937 rng(15);
+    std::uniform_real_distribution<float> u(-1, 1), unit(0, 1);
+    const std::vector<TableTerm> table = compiled_table();
+    double worst_ratio = 0;
+    int zero_margins = 0;
+    for (int n = 0; n < (kSlowBuild ? 600 : 6000); ++n) {
+        const float distance = std::pow(10.0f, 3.0f * unit(rng));
+        const float size = distance * std::pow(10.0f, -5.0f + 5.0f * unit(rng));
+        const float bump = n % 3 == 0 ? 0.0f : std::pow(10.0f, -4.0f + 3.0f * unit(rng));
+        const Vec3 dir = normalize(Vec3{u(rng), u(rng), u(rng)});
+        BezierPatch p = sheet(rng, dir * distance, size, bump, n % 5 == 0 ? 0.5f : 1.0f, n % 5 == 0 ? 2.0f : 1.0f);
+        if (n % 7 == 0) p = collapse_edge(p, n % 4);
+        const Vec3 eye = Vec3{u(rng), u(rng), u(rng)} * (0.1f * distance);
+        const View view = make_view(eye, dir * distance, n % 2 ? model_matrix(rng, n % 4 == 1) : Mat4{});
+        ptp_detail::PtpClipRows rows;
+        ASSERT_TRUE(ptp_detail::ptp_clip_rows(view.object_to_clip, view.alpha, rows));
+        float t[64], thr[64];
+        ptp_detail::ptp_control_planes_z(p, rows, t);
+        ASSERT_TRUE(ptp_detail::ptp_rounding_margins(p, rows, thr));
+        double q[16][3];
+        for (int k = 0; k < 16; ++k)
+            for (int r = 0; r < 3; ++r)
+                q[k][r] = rows.r[r][0] * double(p.cp[k].x) + rows.r[r][1] * double(p.cp[k].y) +
+                          rows.r[r][2] * double(p.cp[k].z) + rows.r[r][3] * double(p.cp[k].w);
+        double ref[64] = {};
+        for (const TableTerm& r : table) {
+            const double* a = q[r.j];
+            const double* b = q[r.k];
+            const double* c = q[r.l];
+            ref[r.dest] += r.weight * det3(a[0], b[0], c[0], a[1], b[1], c[1], a[2], b[2], c[2]);
+        }
+        for (int d = 0; d < 64; ++d) {
+            const double err = std::fabs(double(t[d]) - ref[d]);
+            ASSERT_GE(thr[d], 0.0f);
+            if (thr[d] == 0) {
+                ++zero_margins;
+                ASSERT_EQ(t[d], 0.0f) << "patch " << n << " dest " << d << ": margin 0 off a collapsed edge";
+                continue;
+            }
+            ASSERT_LE(err, thr[d]) << "patch " << n << " dest " << d << ": |" << t[d] << " - " << ref[d]
+                                   << "| exceeds the margin " << thr[d];
+            worst_ratio = std::max(worst_ratio, err / thr[d]);
+        }
+    }
+    RecordProperty("worst_error_to_margin", std::to_string(worst_ratio));
+    std::printf("[ ptp margin ] worst error / margin = %.3g, %d zero margins\n", worst_ratio, zero_margins);
+    EXPECT_GT(worst_ratio, 0.001);
+    EXPECT_GT(zero_margins, 0);
+}
+
+// Non-finite coordinates: the kernels keep the patch.
+TEST(PtpKernel, NonFiniteControlPointsAreKept) {
+    BezierPatch p;
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) p.cp[4 * j + i] = homogeneous({i / 3.0f - 0.5f, j / 3.0f - 0.5f, 0.0f});
+    const View below = make_view({0.1f, 0.2f, -2.0f}, {0, 0, 0});
+    ptp_detail::PtpClipRows rows;
+    ASSERT_TRUE(ptp_detail::ptp_clip_rows(below.object_to_clip, below.alpha, rows));
+    std::vector<BezierPatch> patches = {p};
+    for (float bad : {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                      std::numeric_limits<float>::quiet_NaN()})
+        for (int k : {0, 5, 15}) {
+            BezierPatch q = p;
+            q.cp[k].z = bad;
+            patches.push_back(q);
+            float thr[64];
+            // An infinite coordinate has no margin; a NaN one gives NaN planes (no rule holds).
+            if (std::isinf(bad)) {
+                EXPECT_FALSE(ptp_detail::ptp_rounding_margins(q, rows, thr)) << "point " << k;
+            }
+        }
+    const PatchBatch batch = make_batch(patches);
+    for (Impl impl : {Impl::kScalar, Impl::kSimd})
+        for (PtpRule rule : {PtpRule::ncnt, PtpRule::pcnt}) {
+            const std::vector<std::uint8_t> c = run_ptp(impl, batch.view(), below, rule);
+            EXPECT_EQ(c[0], 1);  // the finite one is back-facing from below
+            for (std::size_t i = 1; i < c.size(); ++i) EXPECT_EQ(c[i], 0) << "non-finite patch " << i << " culled";
+        }
 }
 
 // ---- (c) decisions are conservative ------------------------------------------------------------

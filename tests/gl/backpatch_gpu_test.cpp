@@ -81,7 +81,10 @@ std::string ptp_schedule_glsl() {
          "//   permutation sign folded in): acc = fma(weight, cross4Z from the pair's minors and point third, acc);\n"
          "//   the steps of destination d are [kPtpDestFirst[d], kPtpDestFirst[d + 1]), in table order;\n"
          "// - kPtpCornerOfDest[d]: index into kPtpCorners (dest | a << 8 | b << 16 | c << 24) and\n"
-         "//   kPtpCornerWeights, or -1: t[d] = weight * det[p_a, p_b - p_a, p_c - p_a].\n";
+         "//   kPtpCornerWeights, or -1: t[d] = weight * det[p_a, p_b - p_a, p_c - p_a];\n"
+         "// - the rounding-error margin's constants (float bits): kPtpMarginC1, C2, C3, Underflow,\n"
+         "//   kPtpMarginWeights[d] = W_d, kPtpMarginWeightTerms[d] = W_d (K_d + 12), and the edges'\n"
+         "//   control points kPtpEdgePoints[4 e + i] (ptp_schedule.h's kEdgePoints).\n";
     o << "const uint kPtpPairCount = " << ptp_detail::kPairCount << "u;\n";
     emit_array<std::uint32_t>(o, "uint", "kPtpPairs", ptp_detail::kPairCount, 8, [&](std::size_t i) {
         return std::to_string(kSchedule.pairs[i].a | (kSchedule.pairs[i].b << 8)) + "u";
@@ -102,6 +105,20 @@ std::string ptp_schedule_glsl() {
     });
     emit_array<std::uint32_t>(o, "uint", "kPtpCornerWeights", 4, 4,
                               [&](std::size_t i) { return hex32(std::bit_cast<std::uint32_t>(kSchedule.corners[i].weight)); });
+    o << "const uint kPtpMarginC1 = " << hex32(std::bit_cast<std::uint32_t>(ptp_detail::kMarginC1)) << ";\n";
+    o << "const uint kPtpMarginC2 = " << hex32(std::bit_cast<std::uint32_t>(ptp_detail::kMarginC2)) << ";\n";
+    o << "const uint kPtpMarginC3 = " << hex32(std::bit_cast<std::uint32_t>(ptp_detail::kMarginC3)) << ";\n";
+    o << "const uint kPtpMarginUnderflow = " << hex32(std::bit_cast<std::uint32_t>(ptp_detail::kMarginUnderflow))
+      << ";\n";
+    emit_array<std::uint32_t>(o, "uint", "kPtpMarginWeights", 64, 6, [&](std::size_t i) {
+        return hex32(std::bit_cast<std::uint32_t>(ptp_detail::kMarginWeights.weight[i]));
+    });
+    emit_array<std::uint32_t>(o, "uint", "kPtpMarginWeightTerms", 64, 6, [&](std::size_t i) {
+        return hex32(std::bit_cast<std::uint32_t>(ptp_detail::kMarginWeights.weight_terms[i]));
+    });
+    emit_array<std::uint32_t>(o, "uint", "kPtpEdgePoints", 16, 16, [&](std::size_t i) {
+        return std::to_string(ptp_detail::kEdgePoints[i / 4][i % 4]) + "u";
+    });
     return o.str();
 }
 
@@ -359,9 +376,11 @@ TEST(BackpatchGpu, PtpDecisionsAndPlanesEqualCpu) {
         ASSERT_TRUE(ptp_detail::ptp_clip_rows(view.object_to_clip, view.alpha, rows));
         for (const PtpRule rule : {PtpRule::ncnt, PtpRule::pcnt}) {
             std::vector<std::uint8_t> cpu(patches.size()), gpu;
-            std::vector<float> planes;
+            std::vector<float> planes, margins;
             cull_ptp_scalar(batch.view(), view.object_to_clip, view.alpha, rule, cpu.data());
-            c.cull_ptp(view.object_to_clip, view.alpha, rule, &gpu, rule == PtpRule::ncnt ? &planes : nullptr);
+            const bool diagnostics = rule == PtpRule::ncnt;
+            c.cull_ptp(view.object_to_clip, view.alpha, rule, &gpu, diagnostics ? &planes : nullptr,
+                       diagnostics ? &margins : nullptr);
             ASSERT_EQ(gpu.size(), patches.size());
             const Comparison r = compare(cpu, gpu);
             const char* rn = rule == PtpRule::ncnt ? "ncnt" : "pcnt";
@@ -371,22 +390,27 @@ TEST(BackpatchGpu, PtpDecisionsAndPlanesEqualCpu) {
             all.gpu_only += r.gpu_only, all.cpu_only += r.cpu_only;
             if (rule != PtpRule::ncnt) continue;
             ASSERT_EQ(planes.size(), patches.size() * 64);
+            ASSERT_EQ(margins.size(), patches.size() * 64);
             for (std::size_t p = 0; p < patches.size(); ++p) {
-                float t[64];
+                float t[64], thr[64];
                 ptp_detail::ptp_control_planes_z(patches[p], rows, t);
+                ASSERT_TRUE(ptp_detail::ptp_rounding_margins(patches[p], rows, thr));
                 for (int d = 0; d < 64; ++d) {
-                    ++planes_total;
-                    if (std::bit_cast<std::uint32_t>(t[d]) != std::bit_cast<std::uint32_t>(planes[64 * p + d])) {
+                    planes_total += 2;
+                    const bool t_equal = std::bit_cast<std::uint32_t>(t[d]) == std::bit_cast<std::uint32_t>(planes[64 * p + d]);
+                    const bool thr_equal =
+                        std::bit_cast<std::uint32_t>(thr[d]) == std::bit_cast<std::uint32_t>(margins[64 * p + d]);
+                    if (!t_equal || !thr_equal) {
                         if (plane_mismatch < 5)
-                            ADD_FAILURE() << "view " << v << " patch " << p << " t[" << d << "]: CPU " << t[d] << " GPU "
-                                          << planes[64 * p + d];
-                        ++plane_mismatch;
+                            ADD_FAILURE() << "view " << v << " patch " << p << " d " << d << ": CPU t " << t[d] << " thr "
+                                          << thr[d] << ", GPU t " << planes[64 * p + d] << " thr " << margins[64 * p + d];
+                        plane_mismatch += !t_equal + !thr_equal;
                     }
                 }
             }
         }
     }
-    std::printf("[ ptp ] %zu decisions, CPU culled %zu, GPU culled %zu, GPU-only %zu, CPU-only %zu; planes %zu of %zu differ\n",
+    std::printf("[ ptp ] %zu decisions, CPU culled %zu, GPU culled %zu, GPU-only %zu, CPU-only %zu; planes and margins %zu of %zu differ\n",
                 all.total, all.cpu_culled, all.gpu_culled, all.gpu_only, all.cpu_only, plane_mismatch, planes_total);
     EXPECT_EQ(plane_mismatch, 0u);
     EXPECT_GT(all.cpu_culled, all.total / 10);

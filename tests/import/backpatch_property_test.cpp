@@ -168,14 +168,12 @@ TEST(BackpatchProperty, GroundTruthCatchesACentreNormalKernel) {
     EXPECT_GT(false_culls, 100u);
 }
 
-// KNOWN BUG (issue 3, blocks its resolution): ptp decides on float clip-space control planes
-// with no rounding margin. For a nearly edge-on silhouette patch seen from far away, a corner
-// tangent plane that faces the eye by ~1.5e-5 rad (eye 0.0026 units in front of it, 171 units
-// away) computes as back-facing. `patchcull cull monsterfrog.obj --split 1 --methods ptp
-// --views 10000 --view-mode contain` reports 26 such false culls in ~22 M culls. This reproducer
-// is disabled until the kernels (scalar, SIMD, GLSL) carry a rounding-error margin; enable it
-// with --gtest_also_run_disabled_tests to see it fail.
-TEST(BackpatchProperty, DISABLED_PtpFloatRoundingFalseCullOnDistantSilhouette) {
+// Regression (docs/RESULTS.md, Finding 1): before the kernels carried a rounding-error margin
+// (ptp_schedule.h), ptp culled this nearly edge-on silhouette patch seen from far away: a corner
+// tangent plane facing the eye by ~1.5e-5 rad (eye 0.0026 units in front of it, 171 units away)
+// computed as back-facing. `patchcull cull monsterfrog.obj --split 1 --methods ptp --views 10000
+// --view-mode contain` reported 26 such false culls in ~22 M culls; with the margin it reports 0.
+TEST(BackpatchProperty, PtpFloatRoundingFalseCullOnDistantSilhouette) {
     const LoadedModel m = load_model(shipped_model_path("monsterfrog.obj"), Scheme::acc, 1);
     ViewGenerator views(patch_bounds(m.rest), ViewMode::contain, 1);
     Camera camera;
@@ -187,5 +185,6 @@ TEST(BackpatchProperty, DISABLED_PtpFloatRoundingFalseCullOnDistantSilhouette) {
     std::vector<PlaneD> planes(289);
     sample_tangent_planes(m.rest.patches[1316], 17, planes.data());
     const bool faces = any_plane_faces_eye(planes.data(), 289, camera.eye);
-    EXPECT_FALSE(culled[1316] && faces) << "patch 1316 culled although a tangent plane faces the eye";
+    ASSERT_TRUE(faces) << "the reproducer's patch no longer faces the eye: the test would check nothing";
+    EXPECT_FALSE(culled[1316]) << "patch 1316 culled although a tangent plane faces the eye";
 }
