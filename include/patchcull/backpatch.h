@@ -54,6 +54,11 @@ void cull_ncone_scalar(const PatchBatchView& patches, Vec3 eye, std::uint8_t* cu
 void cull_ncone_simd(const PatchBatchView& patches, Vec3 eye, std::uint8_t* culled);
 
 enum class PtpRule { ncnt, pcnt };
+
+/// The orientation sign s = sign(alpha) * sign(det object_to_clip) that the ptp kernels fold into
+/// the rows of object_to_clip (see ptp above; det in double), or 0 when nothing may be culled
+/// (alpha or det zero or not finite). For GPU twins of the ptp kernels.
+int ptp_orientation_sign(const Mat4& object_to_clip, float alpha);
 /// object_to_clip = projection * view (* model); alpha = clip_space_eye_alpha(projection).
 void cull_ptp_scalar(const PatchBatchView& patches, const Mat4& object_to_clip, float alpha, PtpRule rule,
                      std::uint8_t* culled);

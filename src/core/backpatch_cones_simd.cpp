@@ -2,17 +2,15 @@
 // Highway vectors and compiled for every x86 target Highway attains; the best one the CPU supports
 // is chosen once, at the first call (HWY_DYNAMIC_DISPATCH), as in frustum_simd.cpp.
 //
-// Lanes are patches: lane j holds patch i+j, loaded straight from the SoA arrays (unaligned loads,
-// so subranges at any offset work). The last partial group is copied to a stack buffer whose unused
-// lanes repeat the last patch, so no load leaves the caller's arrays and only valid decisions are
-// written. Branch-free: every lane runs the whole cone construction; masks replace the scalar
-// code's conditionals (x ? y : 0 -> IfThenElseZero, x ? y : z -> IfThenElse).
+// Lanes are patches, groups and partial-group padding as in simd_groups-inl.h. Branch-free: every
+// lane runs the whole cone construction; masks replace the scalar code's conditionals
+// (x ? y : 0 -> IfThenElseZero, x ? y : z -> IfThenElse).
 //
 // Every operation mirrors the scalar reference in cones_internal.h, operation by operation:
-// MulAdd <-> std::fma, Min/Max <-> `a < b ? a : b` / `a > b ? a : b`, Sqrt and Div (correctly
-// rounded) <-> std::sqrt and /, the same accumulation order; so the decisions are identical
-// (tests/core/backpatch_cones_test.cpp checks every compiled target). Targets without an FMA
-// instruction (HWY_NATIVE_FMA == 0) use std::fma per lane instead of a twice-rounded MulAdd.
+// Fma <-> std::fma (exact on every target, simd_groups-inl.h), Min/Max <-> `a < b ? a : b` /
+// `a > b ? a : b`, Sqrt and Div (correctly rounded) <-> std::sqrt and /, the same accumulation
+// order; so the decisions are identical (tests/core/backpatch_cones_test.cpp checks every compiled
+// target).
 
 #include <cmath>
 #include <cstddef>
@@ -28,6 +26,8 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
+#include "core/simd_groups-inl.h"
+
 HWY_BEFORE_NAMESPACE();
 namespace patchcull {
 namespace cones_simd {
@@ -35,27 +35,12 @@ namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 namespace cd = patchcull::cones_detail;
 
-using DF = hn::ScalableTag<float>;
-using VF = hn::Vec<DF>;
-using MF = hn::Mask<DF>;
-
-constexpr std::size_t kMaxLanes = HWY_LANES(float);
-constexpr int kComponents = 4 * kPatchPoints;
-
-// a * b + c with a single rounding, like std::fma.
-HWY_INLINE VF Fma(DF d, VF a, VF b, VF c) {
-#if HWY_NATIVE_FMA
-    (void)d;
-    return hn::MulAdd(a, b, c);
-#else
-    HWY_ALIGN float fa[kMaxLanes], fb[kMaxLanes], fc[kMaxLanes];
-    hn::Store(a, d, fa);
-    hn::Store(b, d, fb);
-    hn::Store(c, d, fc);
-    for (std::size_t j = 0; j < hn::Lanes(d); ++j) fa[j] = std::fma(fa[j], fb[j], fc[j]);
-    return hn::Load(d, fa);
-#endif
-}
+using patchcull::HWY_NAMESPACE::simd_groups::DF;
+using patchcull::HWY_NAMESPACE::simd_groups::Fma;
+using patchcull::HWY_NAMESPACE::simd_groups::ForEachGroup;
+using patchcull::HWY_NAMESPACE::simd_groups::Group;
+using patchcull::HWY_NAMESPACE::simd_groups::MF;
+using patchcull::HWY_NAMESPACE::simd_groups::VF;
 
 struct V3 {
     VF x, y, z;
@@ -78,19 +63,12 @@ struct ConeV {
     MF valid;
 };
 
-// One group of Lanes(d) patches: component (k, c) of lane j is base[(4k + c) * stride + j].
-struct Group {
-    const float* base;
-    std::size_t stride;
-    HWY_INLINE VF load(DF d, int k, int c) const {
-        return hn::LoadU(d, base + static_cast<std::size_t>(4 * k + c) * stride);
-    }
-    HWY_INLINE V3 point(DF d, int k) const { return {load(d, k, 0), load(d, k, 1), load(d, k, 2)}; }
-    HWY_INLINE V3 diff(DF d, int k1, int k0) const {
-        return {hn::Sub(load(d, k1, 0), load(d, k0, 0)), hn::Sub(load(d, k1, 1), load(d, k0, 1)),
-                hn::Sub(load(d, k1, 2), load(d, k0, 2))};
-    }
-};
+// Control point k of every lane, and the difference of points k1 - k0.
+HWY_INLINE V3 Point(DF d, const Group& g, int k) { return {g.load(d, k, 0), g.load(d, k, 1), g.load(d, k, 2)}; }
+HWY_INLINE V3 Diff(DF d, const Group& g, int k1, int k0) {
+    return {hn::Sub(g.load(d, k1, 0), g.load(d, k0, 0)), hn::Sub(g.load(d, k1, 1), g.load(d, k0, 1)),
+            hn::Sub(g.load(d, k1, 2), g.load(d, k0, 2))};
+}
 
 // cd::is_polynomial.
 HWY_INLINE MF Polynomial(DF d, const Group& g) {
@@ -150,9 +128,9 @@ HWY_INLINE ConeV ConeOfVectors(DF d, const V3* v, const VF* widen) {
 // cd::tangent_vectors.
 HWY_INLINE void TangentVectors(DF d, const Group& g, V3 U[12], V3 V[12]) {
     for (int b = 0; b < 4; ++b)
-        for (int a = 0; a < 3; ++a) U[3 * b + a] = g.diff(d, 4 * b + a + 1, 4 * b + a);
+        for (int a = 0; a < 3; ++a) U[3 * b + a] = Diff(d, g, 4 * b + a + 1, 4 * b + a);
     for (int dd = 0; dd < 3; ++dd)
-        for (int c = 0; c < 4; ++c) V[4 * dd + c] = g.diff(d, 4 * dd + 4 + c, 4 * dd + c);
+        for (int c = 0; c < 4; ++c) V[4 * dd + c] = Diff(d, g, 4 * dd + 4 + c, 4 * dd + c);
 }
 
 // cd::combine_cones.
@@ -228,9 +206,9 @@ HWY_INLINE ConeV NormalPatchCone(DF d, const Group& g) {
 
 // cd::sphere_of_points<false> and cd::back_facing, and the polynomial test.
 HWY_INLINE MF BackFacing(DF d, const Group& g, const ConeV& cone, const V3& eye) {
-    V3 lo = g.point(d, 0), hi = lo;
+    V3 lo = Point(d, g, 0), hi = lo;
     for (int k = 1; k < kPatchPoints; ++k) {
-        const V3 q = g.point(d, k);
+        const V3 q = Point(d, g, k);
         lo = {hn::Min(lo.x, q.x), hn::Min(lo.y, q.y), hn::Min(lo.z, q.z)};
         hi = {hn::Max(hi.x, q.x), hn::Max(hi.y, q.y), hn::Max(hi.z, q.z)};
     }
@@ -239,7 +217,7 @@ HWY_INLINE MF BackFacing(DF d, const Group& g, const ConeV& cone, const V3& eye)
                hn::Mul(hn::Add(lo.z, hi.z), half)};
     VF r2 = zero;
     for (int k = 0; k < kPatchPoints; ++k) {
-        const V3 q = g.point(d, k);
+        const V3 q = Point(d, g, k);
         const V3 dq{hn::Sub(q.x, c.x), hn::Sub(q.y, c.y), hn::Sub(q.z, c.z)};
         r2 = hn::Max(r2, Dot3(d, dq, dq));
     }
@@ -259,52 +237,15 @@ HWY_INLINE MF BackFacing(DF d, const Group& g, const ConeV& cone, const V3& eye)
     return hn::And(out, Polynomial(d, g));
 }
 
-// Writes 0/1 bytes for the first n lanes of culled.
-HWY_INLINE void StoreDecisions(DF d, MF culled, std::uint8_t* out, std::size_t n) {
-    const hn::RebindToSigned<DF> di;
-    const hn::Rebind<std::uint8_t, DF> du8;
-    const auto ones = hn::And(hn::BitCast(di, hn::VecFromMask(d, culled)), hn::Set(di, 1));
-    const auto bytes = hn::DemoteTo(du8, ones);
-    if (kMaxLanes == 1 || n == hn::Lanes(d)) {
-        hn::StoreU(bytes, du8, out);
-    } else {
-        HWY_ALIGN std::uint8_t tmp[kMaxLanes];
-        hn::Store(bytes, du8, tmp);
-        std::memcpy(out, tmp, n);
-    }
-}
-
-// Runs group_fn over full groups in place and over the last partial group from a stack copy.
-template <class GroupFn>
-HWY_INLINE void ForEachGroup(const PatchBatchView& patches, std::uint8_t* culled, const GroupFn& group_fn) {
-    const DF d;
-    const std::size_t N = hn::Lanes(d);
-    const std::size_t count = patches.count;
-    std::size_t i = 0;
-    for (; i + N <= count; i += N) {
-        const Group g{patches.data + i, patches.stride};
-        StoreDecisions(d, group_fn(d, g), culled + i, N);
-    }
-    if (i == count) return;
-    const std::size_t n = count - i;
-    HWY_ALIGN float buf[kComponents * kMaxLanes];
-    for (int a = 0; a < kComponents; ++a) {
-        const float* src = patches.data + static_cast<std::size_t>(a) * patches.stride + i;
-        for (std::size_t j = 0; j < N; ++j) buf[a * N + j] = src[j < n ? j : n - 1];
-    }
-    const Group g{buf, N};
-    StoreDecisions(d, group_fn(d, g), culled + i, n);
-}
-
 void CullTcone(const PatchBatchView& patches, Vec3 eye, std::uint8_t* culled) {
-    ForEachGroup(patches, culled, [&eye](DF d, const Group& g) {
+    ForEachGroup(patches, culled, [&eye](DF d, const Group& g, std::size_t, std::size_t) {
         const V3 e{hn::Set(d, eye.x), hn::Set(d, eye.y), hn::Set(d, eye.z)};
         return BackFacing(d, g, TangentCone(d, g), e);
     });
 }
 
 void CullNcone(const PatchBatchView& patches, Vec3 eye, std::uint8_t* culled) {
-    ForEachGroup(patches, culled, [&eye](DF d, const Group& g) {
+    ForEachGroup(patches, culled, [&eye](DF d, const Group& g, std::size_t, std::size_t) {
         const V3 e{hn::Set(d, eye.x), hn::Set(d, eye.y), hn::Set(d, eye.z)};
         return BackFacing(d, g, NormalPatchCone(d, g), e);
     });

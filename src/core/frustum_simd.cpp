@@ -2,16 +2,11 @@
 // compiled for every x86 target Highway attains (SSSE3, SSE4, AVX2, AVX3 + the baseline); the best
 // one the CPU supports is chosen once, at the first call (HWY_DYNAMIC_DISPATCH).
 //
-// Lanes are patches: lane j of a vector holds patch i+j, loaded straight from the SoA arrays
-// (unaligned loads, so subranges at any offset work). The last partial group of a call is copied
-// to a stack buffer whose unused lanes repeat the last patch, so no load ever leaves the caller's
-// arrays (a subrange's padding may belong to other patches or lie past the allocation) and only
-// valid decisions are written.
+// Lanes are patches, groups and partial-group padding as in simd_groups-inl.h.
 //
 // Every operation mirrors the scalar reference in frustum.cpp, operation by operation (see the
-// comment there): MulAdd <-> std::fma, Min/Max <-> `a < b ? a : b` / `a > b ? a : b`. Targets
-// without an FMA instruction (HWY_NATIVE_FMA == 0: SSSE3, SSE4, emulated/scalar, i.e. pre-2013
-// CPUs) would round MulAdd twice; there the kernel uses std::fma per lane instead, slow but exact.
+// comment there): Fma <-> std::fma (exact on every target, simd_groups-inl.h), Min/Max <->
+// `a < b ? a : b` / `a > b ? a : b`.
 
 #include <cmath>
 #include <cstddef>
@@ -26,56 +21,20 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
+#include "core/simd_groups-inl.h"
+
 HWY_BEFORE_NAMESPACE();
 namespace patchcull {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-using DF = hn::ScalableTag<float>;
-using VF = hn::Vec<DF>;
-using MF = hn::Mask<DF>;
-
-constexpr std::size_t kMaxLanes = HWY_LANES(float);
-constexpr int kComponents = 4 * kPatchPoints;  // 64 float arrays per batch
-
-// a * b + c with a single rounding, like std::fma.
-HWY_INLINE VF Fma(DF d, VF a, VF b, VF c) {
-#if HWY_NATIVE_FMA
-    (void)d;
-    return hn::MulAdd(a, b, c);
-#else
-    HWY_ALIGN float fa[kMaxLanes], fb[kMaxLanes], fc[kMaxLanes];
-    hn::Store(a, d, fa);
-    hn::Store(b, d, fb);
-    hn::Store(c, d, fc);
-    for (std::size_t j = 0; j < hn::Lanes(d); ++j) fa[j] = std::fma(fa[j], fb[j], fc[j]);
-    return hn::Load(d, fa);
-#endif
-}
-
-// One group of Lanes(d) patches: component (k, c) of lane j is base[(4k + c) * stride + j].
-struct Group {
-    const float* base;
-    std::size_t stride;
-    HWY_INLINE VF load(DF d, int k, int c) const {
-        return hn::LoadU(d, base + static_cast<std::size_t>(4 * k + c) * stride);
-    }
-};
-
-// Writes 0/1 bytes for the first n lanes of culled.
-HWY_INLINE void StoreDecisions(DF d, MF culled, std::uint8_t* out, std::size_t n) {
-    const hn::RebindToSigned<DF> di;
-    const hn::Rebind<std::uint8_t, DF> du8;
-    const auto ones = hn::And(hn::BitCast(di, hn::VecFromMask(d, culled)), hn::Set(di, 1));
-    const auto bytes = hn::DemoteTo(du8, ones);
-    if (kMaxLanes == 1 || n == hn::Lanes(d)) {
-        hn::StoreU(bytes, du8, out);
-    } else {
-        HWY_ALIGN std::uint8_t tmp[kMaxLanes];
-        hn::Store(bytes, du8, tmp);
-        std::memcpy(out, tmp, n);
-    }
-}
+using simd_groups::DF;
+using simd_groups::Fma;
+using simd_groups::ForEachGroup;
+using simd_groups::Group;
+using simd_groups::LoadPadded;
+using simd_groups::MF;
+using simd_groups::VF;
 
 // frustum (see frustum.cpp for the operation order).
 HWY_INLINE MF FrustumGroup(DF d, const Group& g, VF disp, const FrustumPlanes& planes) {
@@ -174,37 +133,16 @@ HWY_INLINE MF FrustumDispGroup(DF d, const Group& g, VF disp, const ClipMatrix& 
     return out;
 }
 
-// Runs group_fn over full groups in place and over the last partial group from a stack copy.
-template <class GroupFn>
-HWY_INLINE void ForEachGroup(const PatchBatchView& patches, const float* max_displacement,
-                             std::uint8_t* culled, const GroupFn& group_fn) {
-    const DF d;
-    const std::size_t N = hn::Lanes(d);
-    const std::size_t count = patches.count;
-    std::size_t i = 0;
-    for (; i + N <= count; i += N) {
-        const Group g{patches.data + i, patches.stride};
-        const VF disp = max_displacement ? hn::LoadU(d, max_displacement + i) : hn::Zero(d);
-        StoreDecisions(d, group_fn(d, g, disp), culled + i, N);
-    }
-    if (i == count) return;
-    // Tail: n < N patches, padded with copies of the last one (finite, positive weights).
-    const std::size_t n = count - i;
-    HWY_ALIGN float buf[kComponents * kMaxLanes];
-    HWY_ALIGN float dbuf[kMaxLanes];
-    for (int a = 0; a < kComponents; ++a) {
-        const float* src = patches.data + static_cast<std::size_t>(a) * patches.stride + i;
-        for (std::size_t j = 0; j < N; ++j) buf[a * N + j] = src[j < n ? j : n - 1];
-    }
-    for (std::size_t j = 0; j < N; ++j) dbuf[j] = max_displacement ? max_displacement[i + (j < n ? j : n - 1)] : 0.0f;
-    const Group g{buf, N};
-    StoreDecisions(d, group_fn(d, g, hn::Load(d, dbuf)), culled + i, n);
+// A group's per-patch displacement margins (zero without them).
+HWY_INLINE VF GroupDisplacement(DF d, const float* max_displacement, std::size_t first, std::size_t valid) {
+    return max_displacement ? LoadPadded(d, max_displacement + first, valid) : hn::Zero(d);
 }
 
 void CullFrustum(const PatchBatchView& patches, const float* max_displacement,
                  const FrustumPlanes& planes, std::uint8_t* culled) {
-    ForEachGroup(patches, max_displacement, culled,
-                 [&planes](DF d, const Group& g, VF disp) { return FrustumGroup(d, g, disp, planes); });
+    ForEachGroup(patches, culled, [&](DF d, const Group& g, std::size_t first, std::size_t valid) {
+        return FrustumGroup(d, g, GroupDisplacement(d, max_displacement, first, valid), planes);
+    });
 }
 
 void CullFrustumDisp(const PatchBatchView& patches, const float* max_displacement,
@@ -212,8 +150,9 @@ void CullFrustumDisp(const PatchBatchView& patches, const float* max_displacemen
     ClipMatrix cm;
     for (int r = 0; r < 4; ++r)
         for (int c = 0; c < 4; ++c) cm.m[r][c] = object_to_clip.at(r, c);
-    ForEachGroup(patches, max_displacement, culled,
-                 [&cm](DF d, const Group& g, VF disp) { return FrustumDispGroup(d, g, disp, cm); });
+    ForEachGroup(patches, culled, [&](DF d, const Group& g, std::size_t first, std::size_t valid) {
+        return FrustumDispGroup(d, g, GroupDisplacement(d, max_displacement, first, valid), cm);
+    });
 }
 
 const char* TargetName() { return hwy::TargetName(HWY_TARGET); }

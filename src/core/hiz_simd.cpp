@@ -4,8 +4,8 @@
 // loads, compare) per patch with the scalar code of hiz.cpp: the level is data dependent and the
 // loads are an irregular gather, which vectors do not speed up.
 //
-// Every operation mirrors patch_bounds() in hiz.cpp: MulAdd <-> std::fma (targets without an FMA
-// instruction use std::fma per lane, like frustum_simd.cpp), Min/Max <-> `a < b ? a : b` /
+// Every operation mirrors patch_bounds() in hiz.cpp: Fma <-> std::fma (exact on every target,
+// simd_groups-inl.h), Min/Max <-> `a < b ? a : b` /
 // `a > b ? a : b`, Div <-> IEEE division, Floor <-> std::floor, ConvertTo of the clamped integral
 // value <-> static_cast<int>. Lanes whose patch is not projectable (or frustum-culled) may hold
 // garbage (divisions by w <= 0); they are never read.
@@ -23,33 +23,23 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
+#include "core/simd_groups-inl.h"
+
 HWY_BEFORE_NAMESPACE();
 namespace patchcull {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-using DF = hn::ScalableTag<float>;
+using simd_groups::CopyPartialGroup;
+using simd_groups::DF;
+using simd_groups::Fma;
+using simd_groups::Group;
+using simd_groups::kComponents;
+using simd_groups::kMaxLanes;
+using simd_groups::MF;
+using simd_groups::VF;
 using DI = hn::RebindToSigned<DF>;
-using VF = hn::Vec<DF>;
-using MF = hn::Mask<DF>;
-
-constexpr std::size_t kMaxLanesHiZ = HWY_LANES(float);
-constexpr int kComponentsHiZ = 4 * kPatchPoints;
 constexpr std::size_t kChunkHiZ = 256;  // patches per frustum pass; multiple of every lane count
-
-HWY_INLINE VF FmaHiZ(DF d, VF a, VF b, VF c) {
-#if HWY_NATIVE_FMA
-    (void)d;
-    return hn::MulAdd(a, b, c);
-#else
-    HWY_ALIGN float fa[kMaxLanesHiZ], fb[kMaxLanesHiZ], fc[kMaxLanesHiZ];
-    hn::Store(a, d, fa);
-    hn::Store(b, d, fb);
-    hn::Store(c, d, fc);
-    for (std::size_t j = 0; j < hn::Lanes(d); ++j) fa[j] = std::fma(fa[j], fb[j], fc[j]);
-    return hn::Load(d, fa);
-#endif
-}
 
 struct Consts {
     float m[4][4];
@@ -64,32 +54,29 @@ struct ChunkBounds {
     HWY_ALIGN std::int32_t ok[kChunkHiZ];  // nonzero: projectable
 };
 
-// Steps 2-6 for Lanes(d) patches: component (k, c) of lane j is base[(4k + c) * stride + j];
-// results to b at index at.
-HWY_INLINE void BoundsGroup(DF d, const float* base, std::size_t stride, const Consts& k_, ChunkBounds& b,
-                            std::size_t at) {
+// Steps 2-6 for a group of Lanes(d) patches; results to b at index at.
+HWY_INLINE void BoundsGroup(DF d, const Group& g, const Consts& k_, ChunkBounds& b, std::size_t at) {
     const DI di;
     VF m[4][4], aw[4];
     for (int r = 0; r < 4; ++r)
         for (int c = 0; c < 4; ++c) m[r][c] = hn::Set(d, k_.m[r][c]);
     for (int c = 0; c < 4; ++c) aw[c] = hn::Set(d, k_.abs_w[c]);
     const VF safety = hn::Set(d, 0x1p-20f);
-    auto load = [&](int k, int c) { return hn::LoadU(d, base + static_cast<std::size_t>(4 * k + c) * stride); };
     MF ok = hn::FirstN(d, hn::Lanes(d));
     VF nxmin = hn::Zero(d), nxmax = nxmin, nymin = nxmin, nymax = nxmin, zmin = nxmin;
     for (int k = 0; k < kPatchPoints; ++k) {
-        const VF X = load(k, 0), Y = load(k, 1), Z = load(k, 2), W = load(k, 3);
+        const VF X = g.load(d, k, 0), Y = g.load(d, k, 1), Z = g.load(d, k, 2), W = g.load(d, k, 3);
         VF c[4];
         for (int r = 0; r < 4; ++r) {
             VF t = hn::Mul(m[r][0], X);
-            t = FmaHiZ(d, m[r][1], Y, t);
-            t = FmaHiZ(d, m[r][2], Z, t);
-            c[r] = FmaHiZ(d, m[r][3], W, t);
+            t = Fma(d, m[r][1], Y, t);
+            t = Fma(d, m[r][2], Z, t);
+            c[r] = Fma(d, m[r][3], W, t);
         }
         VF s = hn::Mul(aw[0], hn::Abs(X));
-        s = FmaHiZ(d, aw[1], hn::Abs(Y), s);
-        s = FmaHiZ(d, aw[2], hn::Abs(Z), s);
-        s = FmaHiZ(d, aw[3], hn::Abs(W), s);
+        s = Fma(d, aw[1], hn::Abs(Y), s);
+        s = Fma(d, aw[2], hn::Abs(Z), s);
+        s = Fma(d, aw[3], hn::Abs(W), s);
         ok = hn::And(ok, hn::Gt(c[3], hn::Mul(safety, s)));
         const VF nx = hn::Div(c[0], c[3]), ny = hn::Div(c[1], c[3]), nz = hn::Div(c[2], c[3]);
         if (k == 0) {
@@ -107,7 +94,7 @@ HWY_INLINE void BoundsGroup(DF d, const float* base, std::size_t stride, const C
     const VF hw = hn::Set(d, k_.half_w), hh = hn::Set(d, k_.half_h);
     const VF zero = hn::Zero(d), wmax = hn::Set(d, k_.wmax), hmax = hn::Set(d, k_.hmax);
     auto pixel = [&](VF v, VF half, VF vmax) {
-        const VF win = FmaHiZ(d, v, half, half);
+        const VF win = Fma(d, v, half, half);
         return hn::ConvertTo(di, hn::Min(hn::Max(hn::Floor(win), zero), vmax));
     };
     hn::Store(pixel(nxmin, hw, wmax), di, b.x0 + at);
@@ -132,23 +119,14 @@ void CullOcclusion(const PatchBatchView& patches, const Mat4& object_to_clip, co
     k_.half_h = 0.5f * static_cast<float>(height);
     k_.wmax = static_cast<float>(width - 1);
     k_.hmax = static_cast<float>(height - 1);
-    HWY_ALIGN float buf[kComponentsHiZ * kMaxLanesHiZ];
+    HWY_ALIGN float buf[kComponents * kMaxLanes];
     ChunkBounds b;
     for (std::size_t first = 0; first < patches.count; first += kChunkHiZ) {
         const std::size_t n = std::min(kChunkHiZ, patches.count - first);
         cull_frustum_simd(patches.subrange(first, n), nullptr, planes, decision + first);  // step 1
         std::size_t j = 0;
-        for (; j + N <= n; j += N) BoundsGroup(d, patches.data + first + j, patches.stride, k_, b, j);
-        if (j < n) {
-            // Tail: copy to a stack buffer whose unused lanes repeat the last patch, so no load leaves
-            // the caller's arrays.
-            const std::size_t m = n - j;
-            for (int a = 0; a < kComponentsHiZ; ++a) {
-                const float* src = patches.data + static_cast<std::size_t>(a) * patches.stride + first + j;
-                for (std::size_t l = 0; l < N; ++l) buf[a * N + l] = src[l < m ? l : m - 1];
-            }
-            BoundsGroup(d, buf, N, k_, b, j);
-        }
+        for (; j + N <= n; j += N) BoundsGroup(d, Group{patches.data + first + j, patches.stride}, k_, b, j);
+        if (j < n) BoundsGroup(d, CopyPartialGroup(d, patches, first + j, n - j, buf), k_, b, j);
         for (std::size_t i = 0; i < n; ++i) {  // steps 7-9, scalar
             if (decision[first + i] != kHiZVisible || b.ok[i] == 0) continue;
             const PixelRect rect{b.x0[i], b.y0[i], b.x1[i], b.y1[i]};

@@ -49,9 +49,8 @@
 #endif
 
 namespace patchcull {
-namespace ptp_detail {
 
-bool ptp_clip_rows(const Mat4& object_to_clip, float alpha, PtpClipRows& out) {
+int ptp_orientation_sign(const Mat4& object_to_clip, float alpha) {
     // det in double: the entries are floats, so this is far more accurate than its sign needs.
     double m[4][4];
     for (int r = 0; r < 4; ++r)
@@ -63,8 +62,16 @@ bool ptp_clip_rows(const Mat4& object_to_clip, float alpha, PtpClipRows& out) {
     const double c3 = m[2][1] * m[3][2] - m[3][1] * m[2][2], c2 = m[2][0] * m[3][3] - m[3][0] * m[2][3];
     const double c1 = m[2][0] * m[3][2] - m[3][0] * m[2][2], c0 = m[2][0] * m[3][1] - m[3][0] * m[2][1];
     const double det = s0 * c5 - s1 * c4 + s2 * c3 + s3 * c2 - s4 * c1 + s5 * c0;
-    if (!std::isfinite(det) || det == 0.0 || !std::isfinite(alpha) || alpha == 0.0f) return false;
-    const float s = ((det > 0) == (alpha > 0)) ? 1.0f : -1.0f;
+    if (!std::isfinite(det) || det == 0.0 || !std::isfinite(alpha) || alpha == 0.0f) return 0;
+    return (det > 0) == (alpha > 0) ? 1 : -1;
+}
+
+namespace ptp_detail {
+
+bool ptp_clip_rows(const Mat4& object_to_clip, float alpha, PtpClipRows& out) {
+    const int sign = ptp_orientation_sign(object_to_clip, alpha);
+    if (sign == 0) return false;
+    const float s = static_cast<float>(sign);
     const int src_row[3] = {0, 1, 3};  // x, y, w
     for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 4; ++c) out.r[r][c] = s * object_to_clip.at(src_row[r], c);

@@ -3,18 +3,15 @@
 // CPU supports is chosen once, at the first call (HWY_DYNAMIC_DISPATCH). Same structure as
 // frustum_simd.cpp.
 //
-// Lanes are patches: lane j holds patch i+j, loaded straight from the SoA arrays (unaligned loads,
-// so subranges at any offset work); the last partial group is copied to a stack buffer whose
-// unused lanes repeat the last patch, so no load leaves the caller's arrays and only valid
-// decisions are written.
+// Lanes are patches, groups and partial-group padding as in simd_groups-inl.h.
 //
 // The operations and their order are the scalar reference's (ptp.cpp), fully unrolled at compile
 // time over the schedule of ptp_schedule.h (pair indices, third points, weights and destination
 // groups are constants, so the stack arrays of points and minors are addressed with constant
 // offsets): MulAdd <-> std::fma, NegMulAdd(a, b, c) <-> std::fma(-a, b, c), MulSub(a, b, c) <->
-// std::fma(a, b, -c), every other product and sum separately rounded, and no Mul feeding a plain
-// Add/Sub (GCC would contract that into an fma on FMA targets only; see ptp.cpp). Targets without an FMA instruction (HWY_NATIVE_FMA == 0) use
-// std::fma per lane instead, slow but exact, as frustum_simd.cpp does.
+// std::fma(a, b, -c) (exact on every target, simd_groups-inl.h), every other product and sum
+// separately rounded, and no Mul feeding a plain Add/Sub (GCC would contract that into an fma on
+// FMA targets only; see ptp.cpp).
 
 #include <cmath>
 #include <cstddef>
@@ -32,6 +29,8 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
+#include "core/simd_groups-inl.h"
+
 HWY_BEFORE_NAMESPACE();
 namespace patchcull {
 namespace HWY_NAMESPACE {
@@ -39,49 +38,16 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 namespace ptp {
 
-using DF = hn::ScalableTag<float>;
-using VF = hn::Vec<DF>;
-using MF = hn::Mask<DF>;
+using simd_groups::DF;
+using simd_groups::Fma;
+using simd_groups::FmaSub;
+using simd_groups::ForEachGroup;
+using simd_groups::Group;
+using simd_groups::MF;
+using simd_groups::NegFma;
+using simd_groups::VF;
 using ptp_detail::kPairCount;
 using ptp_detail::kSchedule;
-
-constexpr std::size_t kMaxLanes = HWY_LANES(float);
-constexpr int kComponents = 4 * kPatchPoints;
-
-// a * b + c with a single rounding, like std::fma.
-HWY_INLINE VF Fma(DF d, VF a, VF b, VF c) {
-#if HWY_NATIVE_FMA
-    (void)d;
-    return hn::MulAdd(a, b, c);
-#else
-    HWY_ALIGN float fa[kMaxLanes], fb[kMaxLanes], fc[kMaxLanes];
-    hn::Store(a, d, fa);
-    hn::Store(b, d, fb);
-    hn::Store(c, d, fc);
-    for (std::size_t j = 0; j < hn::Lanes(d); ++j) fa[j] = std::fma(fa[j], fb[j], fc[j]);
-    return hn::Load(d, fa);
-#endif
-}
-
-// -a * b + c with a single rounding, like std::fma(-a, b, c).
-HWY_INLINE VF NegFma(DF d, VF a, VF b, VF c) {
-#if HWY_NATIVE_FMA
-    (void)d;
-    return hn::NegMulAdd(a, b, c);
-#else
-    return Fma(d, hn::Neg(a), b, c);
-#endif
-}
-
-// a * b - c with a single rounding, like std::fma(a, b, -c).
-HWY_INLINE VF FmaSub(DF d, VF a, VF b, VF c) {
-#if HWY_NATIVE_FMA
-    (void)d;
-    return hn::MulSub(a, b, c);
-#else
-    return Fma(d, a, b, hn::Neg(c));
-#endif
-}
 
 // a*b - c*e as fma(a, b, -(c*e)), like minor2 in ptp.cpp. (A plain Sub(Mul, Mul) would not do:
 // GCC contracts it into an fma on FMA targets, but not on the others.)
@@ -90,30 +56,6 @@ HWY_INLINE VF Minor(DF d, VF a, VF b, VF c, VF e) { return FmaSub(d, a, b, hn::M
 template <class F, std::size_t... I>
 HWY_INLINE void Unroll(std::index_sequence<I...>, F&& f) {
     (f(std::integral_constant<std::size_t, I>{}), ...);
-}
-
-// One group of Lanes(d) patches: component (k, c) of lane j is base[(4k + c) * stride + j].
-struct Group {
-    const float* base;
-    std::size_t stride;
-    HWY_INLINE VF load(DF d, int k, int c) const {
-        return hn::LoadU(d, base + static_cast<std::size_t>(4 * k + c) * stride);
-    }
-};
-
-// Writes 0/1 bytes for the first n lanes of culled.
-HWY_INLINE void StoreDecisions(DF d, MF culled, std::uint8_t* out, std::size_t n) {
-    const hn::RebindToSigned<DF> di;
-    const hn::Rebind<std::uint8_t, DF> du8;
-    const auto ones = hn::And(hn::BitCast(di, hn::VecFromMask(d, culled)), hn::Set(di, 1));
-    const auto bytes = hn::DemoteTo(du8, ones);
-    if (kMaxLanes == 1 || n == hn::Lanes(d)) {
-        hn::StoreU(bytes, du8, out);
-    } else {
-        HWY_ALIGN std::uint8_t tmp[kMaxLanes];
-        hn::Store(bytes, du8, tmp);
-        std::memcpy(out, tmp, n);
-    }
 }
 
 // The rounding-error margins' per-patch scales (ptp.cpp's rounding_margins, same operations in
@@ -241,24 +183,9 @@ HWY_INLINE MF PtpGroup(DF d, const Group& g, const ptp_detail::PtpClipRows& rows
 template <bool kPcnt>
 HWY_NOINLINE void CullGroups(const PatchBatchView& patches, const ptp_detail::PtpClipRows& rows,
                              std::uint8_t* culled) {
-    const DF d;
-    const std::size_t N = hn::Lanes(d);
-    const std::size_t count = patches.count;
-    std::size_t i = 0;
-    for (; i + N <= count; i += N) {
-        const Group g{patches.data + i, patches.stride};
-        StoreDecisions(d, PtpGroup<kPcnt>(d, g, rows), culled + i, N);
-    }
-    if (i == count) return;
-    // Tail: n < N patches, padded with copies of the last one.
-    const std::size_t n = count - i;
-    HWY_ALIGN float buf[kComponents * kMaxLanes];
-    for (int a = 0; a < kComponents; ++a) {
-        const float* src = patches.data + static_cast<std::size_t>(a) * patches.stride + i;
-        for (std::size_t j = 0; j < N; ++j) buf[a * N + j] = src[j < n ? j : n - 1];
-    }
-    const Group g{buf, N};
-    StoreDecisions(d, PtpGroup<kPcnt>(d, g, rows), culled + i, n);
+    ForEachGroup(patches, culled, [&rows](DF d, const Group& g, std::size_t, std::size_t) {
+        return PtpGroup<kPcnt>(d, g, rows);
+    });
 }
 
 }  // namespace ptp

@@ -33,22 +33,12 @@ GLuint compute_program(const char* name, const std::string& defines) {
     return detail::link_program({{name, GL_COMPUTE_SHADER}}, name, defines);
 }
 
-// Rows x, y, w of s * object_to_clip with s = sign(alpha) * sign(det object_to_clip): the same
-// computation as ptp_detail::ptp_clip_rows (src/core/ptp.cpp; src/gl may not include core
-// internals, tests/gl/backpatch_gpu_test.cpp compares the two). False: nothing may be culled.
+// Rows x, y, w of s * object_to_clip, s = ptp_orientation_sign (backpatch.h), as the CPU kernels'
+// ptp_clip_rows (tests/gl/backpatch_gpu_test.cpp compares the two). False: nothing may be culled.
 bool ptp_rows(const Mat4& object_to_clip, float alpha, float rows[3][4]) {
-    double m[4][4];
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c) m[r][c] = object_to_clip.at(r, c);
-    const double s0 = m[0][0] * m[1][1] - m[1][0] * m[0][1], s1 = m[0][0] * m[1][2] - m[1][0] * m[0][2];
-    const double s2 = m[0][0] * m[1][3] - m[1][0] * m[0][3], s3 = m[0][1] * m[1][2] - m[1][1] * m[0][2];
-    const double s4 = m[0][1] * m[1][3] - m[1][1] * m[0][3], s5 = m[0][2] * m[1][3] - m[1][2] * m[0][3];
-    const double c5 = m[2][2] * m[3][3] - m[3][2] * m[2][3], c4 = m[2][1] * m[3][3] - m[3][1] * m[2][3];
-    const double c3 = m[2][1] * m[3][2] - m[3][1] * m[2][2], c2 = m[2][0] * m[3][3] - m[3][0] * m[2][3];
-    const double c1 = m[2][0] * m[3][2] - m[3][0] * m[2][2], c0 = m[2][0] * m[3][1] - m[3][0] * m[2][1];
-    const double det = s0 * c5 - s1 * c4 + s2 * c3 + s3 * c2 - s4 * c1 + s5 * c0;
-    if (!std::isfinite(det) || det == 0.0 || !std::isfinite(alpha) || alpha == 0.0f) return false;
-    const float s = ((det > 0) == (alpha > 0)) ? 1.0f : -1.0f;
+    const int sign = ptp_orientation_sign(object_to_clip, alpha);
+    if (sign == 0) return false;
+    const float s = static_cast<float>(sign);
     const int src_row[3] = {0, 1, 3};  // x, y, w
     for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 4; ++c) rows[r][c] = s * object_to_clip.at(src_row[r], c);
