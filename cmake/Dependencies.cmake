@@ -32,3 +32,5 @@ find_package(OpenGL REQUIRED COMPONENTS OpenGL EGL)
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
 add_library(PatchcullDeps::epoxy ALIAS PkgConfig::EPOXY)
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
+# The window context (GlContext::create_window): GLFW 3 (libglfw3-dev), CMake target `glfw`.
+find_package(glfw3 3.3 REQUIRED)

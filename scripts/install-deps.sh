@@ -9,6 +9,7 @@ PACKAGES=(
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev glslang-tools
   libosd-dev libstb-dev libtbb-dev libhwy-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
+  libglfw3-dev xvfb xauth  # the window context; its test runs under xvfb-run
   assimp-testmodels  # third-party OBJ files for the unseen-models test
 )
 missing=()

@@ -1,96 +1,166 @@
-// The main job (`patchcull` with no arguments, or `patchcull demo`): the built-in default scene.
-// Until the GL pipeline is wired into the CLI (issue 4) it runs the CPU cull pipeline on the default scene:
-// BigGuy and MonsterFrog (ACC patches, procedural displacement), animated over a few frames,
-// each frame seen from random cameras, every decision checked against the dense-sample ground
-// truth. It prints the culling summary.
+// The main job (`patchcull` with no arguments, or `patchcull demo`): renders the built-in default
+// scene (patchcull/default_scene.h; seed 000 Fig. 1 (c): animated characters among triangle
+// occluders) headless with the GPU pipeline (seed 000 §3, seed 001's back-patch tests), along the
+// scene's camera path, once without culling (the reference) and once per cull method. Every culled
+// frame is compared with the unculled one (compare_frames; a false cull fails the job, exit 1).
+// Writes OUT/frame.png (colour, last frame, cull mode all) and OUT/cull.png (the patch statuses of
+// that frame seen from another camera, turned 90 degrees and above, so that culled patches show) and
+// prints, per method, cull rates and pass times.
 #include <chrono>
 #include <cstdio>
-#include <iostream>
-#include <map>
+#include <filesystem>
 #include <memory>
 
 #include "commands.h"
-#include "patchcull/animation.h"
-#include "patchcull/cull_eval.h"
-#include "patchcull/frustum.h"
-#include "patchcull/parallel.h"
+#include "patchcull/default_scene.h"
+#include "patchcull/error.h"
+#include "render_support.h"
 
 namespace patchcull::cli {
-
 namespace {
 
-struct Pass {
-    const char* label;
-    ViewMode mode;
-    bool displaced;
-    std::vector<std::string> methods;
+struct DemoOptions {
+    std::string size = "640x360";
+    int frames = 6;
+    int tess = 8;
+    std::string out_dir = "out";
 };
 
-}  // namespace
+struct Method {
+    const char* label;
+    gl::CullMode cull;
+    gl::BackpatchMethod backpatch;
+};
 
-int run_demo() {
-    constexpr int kFrames = 6;
-    constexpr int kViewsPerFrame = 40;
-    // View-frustum culling of the displaced surface from free-roaming cameras; back-patch culling
-    // (which does not bound displacement, seed 001 §8) of the undisplaced surface from cameras
-    // that see the whole character.
-    const Pass passes[] = {
-        {"free views, displaced", ViewMode::free, true, {"frustum", "frustum-disp"}},
-        {"contain views", ViewMode::contain, false, {"tcone", "ncone", "ptp", "ptp-pcnt"}},
-    };
+struct Sums {
+    double frustum = 0, backpatch = 0, occlusion = 0, drawn = 0;
+    double pass1 = 0, hiz = 0, cull = 0, pass2 = 0, total = 0;
+    std::size_t false_culls = 0;
+    int frames = 0;
+};
+
+int run_demo(const DemoOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    std::printf("patchcull default scene: BigGuy + MonsterFrog, ACC patches, procedural displacement,\n"
-                "%d animated frames x %d random views per pass; CPU kernels (%s, %d threads).\n\n",
-                kFrames, kViewsPerFrame, simd_target_name(), hardware_threads());
-    std::printf("%-16s %-22s %-12s %8s %10s %12s %10s\n", "model", "pass", "method", "patches", "cull rate",
-                "false culls", "ns/patch");
-    std::uint64_t total_false = 0;
-    for (const char* file : {"bigguy.obj", "monsterfrog.obj"}) {
-        const LoadedModel model = load_model(shipped_model_path(file), Scheme::acc, 0);
-        const Bounds rest_bounds = patch_bounds(model.rest);
-        const DisplacementMap displacement =
-            make_procedural_displacement(512, 0.02f * length(rest_bounds.max - rest_bounds.min));
-        std::vector<Vec3> positions;
-        PatchFrame frame;
-        for (const Pass& pass : passes) {
-            std::map<std::string, CullMethodResult> sums;
-            for (int f = 0; f < kFrames; ++f) {
-                animate(model.subdiv->mesh.positions, f / 24.0f * 4.0f, AnimationParams{}, positions);
-                evaluate_frame(model, positions, frame);
-                CullEvalOptions options;
-                options.views = kViewsPerFrame;
-                options.seed = 1000 + f;
-                options.mode = pass.mode;
-                options.methods = pass.methods;
-                const CullEvalResult r = evaluate_cull(frame, pass.displaced ? &displacement : nullptr, options);
-                for (const CullMethodResult& m : r.methods) {
-                    CullMethodResult& s = sums[m.name];
-                    s.culled += m.culled;
-                    s.false_culls += m.false_culls;
-                    s.ns_per_patch += m.ns_per_patch / kFrames;
-                }
-            }
-            const double pairs = double(model.rest.patches.size()) * kFrames * kViewsPerFrame;
-            for (const std::string& name : pass.methods) {
-                const CullMethodResult& s = sums[name];
-                total_false += s.false_culls;
-                std::printf("%-16s %-22s %-12s %8zu %9.1f%% %12llu %10.2f\n", file, pass.label, name.c_str(),
-                            model.rest.patches.size(), 100.0 * s.culled / pairs,
-                            static_cast<unsigned long long>(s.false_culls), s.ns_per_patch);
-            }
+    int width = 0, height = 0;
+    parse_size("--size", options.size, width, height);
+    const Scene scene = make_default_scene();
+    gl::GlContext context = gl::GlContext::create_headless();
+    gl::CullPipeline pipeline(context);
+    gl::PatchRenderer& renderer = pipeline.renderer();
+
+    // Poses and cameras of every frame, computed once and replayed for every method.
+    ScenePoser poser(scene);
+    std::vector<std::vector<BezierPatch>> poses;
+    for (int f = 0; f < options.frames; ++f) poses.push_back(poser.pose(f * kSecondsPerFrame));
+    const std::vector<Camera> cameras = scene.camera_path(options.frames, float(width) / float(height));
+    auto params_of = [&](int f) { return render_params(cameras[static_cast<std::size_t>(f)], width, height, options.tess); };
+    const std::size_t patches = scene.patch_count();
+
+    pipeline.set_patches(poses[0]);
+    renderer.set_occluders(scene.occluder_vertices, scene.occluder_indices);
+    std::printf("patchcull default scene: 3 BigGuy + 3 MonsterFrog (ACC, animated), %zu patches, %zu occluder "
+                "triangles;\n%d frames along the camera path, %dx%d, tessellation level %d; %s (%s).\n",
+                patches, renderer.occluder_triangle_count(), options.frames, width, height, options.tess,
+                context.renderer().c_str(), context.is_software() ? "software: wall-clock pass times" : "GPU timer queries");
+
+    // Compiles every back-patch program before anything is timed (llvmpipe takes seconds for ncone).
+    for (gl::BackpatchMethod m : {gl::BackpatchMethod::tcone, gl::BackpatchMethod::ncone, gl::BackpatchMethod::ptp}) {
+        const gl::RenderParams p = params_of(0);
+        pipeline.culler().cull(m, p.projection * p.view, gl::eye_of_view(p.view), clip_space_eye_alpha(p.projection),
+                               PtpRule::ncnt);
+    }
+    std::vector<ReferenceFrame> references;
+    double reference_ms = 0;
+    for (int f = 0; f < options.frames; ++f) {
+        pipeline.update_patches(poses[static_cast<std::size_t>(f)]);
+        references.push_back(render_reference(renderer, params_of(f)));
+        if (f > 0 || options.frames == 1) reference_ms += references.back().ms;
+    }
+    const int timed_frames = options.frames > 1 ? options.frames - 1 : 1;
+    reference_ms /= timed_frames;
+
+    const Method methods[] = {
+        {"frustum", gl::CullMode::frustum, gl::BackpatchMethod::tcone},
+        {"backpatch tcone", gl::CullMode::backpatch, gl::BackpatchMethod::tcone},
+        {"backpatch ncone", gl::CullMode::backpatch, gl::BackpatchMethod::ncone},
+        {"backpatch ptp", gl::CullMode::backpatch, gl::BackpatchMethod::ptp},
+        {"occlusion", gl::CullMode::occlusion, gl::BackpatchMethod::tcone},
+        {"all (tcone)", gl::CullMode::all, gl::BackpatchMethod::tcone},
+    };
+    std::printf("\nPer method, averaged over frames 1..%d (frame 0 starts with half the patches tagged visible, "
+                "seed 000 §3);\ncull rates are fractions of the %zu patches; times in ms; 'x ref' = total / unculled "
+                "render.\n\n",
+                options.frames - 1, patches);
+    std::printf("%-17s %7s %7s %7s %7s %7s %7s %7s %7s %7s %8s %6s %6s\n", "method", "culled", "frustum", "back",
+                "occl", "drawn", "pass1", "hiz", "cull", "pass2", "total", "x ref", "false");
+    std::printf("%-17s %7s %7s %7s %7s %6.1f%% %7s %7s %7s %7s %8.1f %6.2f %6s\n", "none (reference)", "0.0%", "-", "-",
+                "-", 100.0, "-", "-", "-", "-", reference_ms, 1.0, "-");
+    std::size_t total_false = 0;
+    const std::filesystem::path out_dir(options.out_dir);
+    for (const Method& method : methods) {
+        pipeline.set_patches(poses[0]);  // fresh statuses: a first frame
+        Sums sums;
+        for (int f = 0; f < options.frames; ++f) {
+            if (f > 0) pipeline.update_patches(poses[static_cast<std::size_t>(f)]);
+            gl::PipelineParams params;
+            params.frame.render = params_of(f);
+            params.frame.cull = method.cull;
+            params.backpatch = method.backpatch;
+            const gl::FrameStats s = pipeline.render_frame(params);
+            const gl::FrameComparison cmp = compare_with_reference(renderer, references[static_cast<std::size_t>(f)]);
+            sums.false_culls += cmp.false_culled.size();
+            if (f == 0 && options.frames > 1) continue;
+            ++sums.frames;
+            sums.frustum += s.frustum_culled;
+            sums.backpatch += s.backpatch_culled;
+            sums.occlusion += s.occlusion_culled;
+            sums.drawn += s.pass1_drawn + s.pass2_drawn;
+            sums.pass1 += s.pass1_ms;
+            sums.hiz += s.hiz_ms;
+            sums.cull += s.cull_ms;
+            sums.pass2 += s.pass2_ms;
+            sums.total += s.total_ms;
+        }
+        const double n = sums.frames, pct = 100.0 / (n * double(patches));
+        std::printf("%-17s %6.1f%% %6.1f%% %6.1f%% %6.1f%% %6.1f%% %7.1f %7.1f %7.1f %7.1f %8.1f %6.2f %6zu\n",
+                    method.label, (sums.frustum + sums.backpatch + sums.occlusion) * pct, sums.frustum * pct,
+                    sums.backpatch * pct, sums.occlusion * pct, sums.drawn * pct, sums.pass1 / n, sums.hiz / n,
+                    sums.cull / n, sums.pass2 / n, sums.total / n, sums.total / n / reference_ms, sums.false_culls);
+        total_false += sums.false_culls;
+        if (method.cull == gl::CullMode::all) {
+            std::filesystem::create_directories(out_dir);
+            renderer.write_color_png((out_dir / "frame.png").string());
+            // The last camera's view turned 90 degrees about the target, farther out and above:
+            // the sides facing away from the path's camera (back-patch and occlusion culled) show.
+            Camera overview = cameras.back();
+            const Vec3 d = overview.eye - overview.target;
+            overview.eye = overview.target + Vec3{-d.z, 0, d.x} * 1.4f + Vec3{0, 1.8f, 0};
+            overview.fovy_radians = 1.0471976f;
+            overview.z_far *= 2;
+            renderer.write_status_png((out_dir / "cull.png").string(), render_params(overview, width, height, options.tess));
         }
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("\nfalse culls in total: %llu (must be 0); %.1f s\n", static_cast<unsigned long long>(total_false),
-                seconds);
-    std::printf("The OpenGL pipeline (library patchcull_gl, tests/gl) is not yet wired into this job: rendering\n"
-                "out/frame.png and out/cull.png is still to come (issue 4).\n");
+    std::printf("\nWrote %s (colour, cull mode all) and %s (statuses, seen from the side and above: green "
+                "visible,\nyellow newly visible, blue frustum-culled, magenta back-patch-culled, red occlusion-culled, "
+                "grey occluders).\nFalse culls (patches in the unculled image but culled) in total: %zu (must be 0); "
+                "%.1f s.\n",
+                (out_dir / "frame.png").string().c_str(), (out_dir / "cull.png").string().c_str(), total_false, seconds);
     return total_false == 0 ? 0 : 1;
 }
 
+}  // namespace
+
 Runner add_demo_command(CLI::App& app) {
-    app.add_subcommand("demo", "Run the main job on the built-in default scene (the default command)");
-    return run_demo;
+    auto options = std::make_shared<DemoOptions>();
+    CLI::App* command =
+        app.add_subcommand("demo", "Render the built-in default scene (the main job; the default command)");
+    command->add_option("--size", options->size, "framebuffer size WxH (default 640x360)");
+    command->add_option("--frames", options->frames, "frames along the camera path (2..100, default 6)")
+        ->check(CLI::Range(2, 100));
+    command->add_option("--tess", options->tess, "uniform tessellation level (1..64, default 8)")->check(CLI::Range(1, 64));
+    command->add_option("--out-dir", options->out_dir, "directory of frame.png and cull.png (default out)");
+    return [options]() { return run_demo(*options); };
 }
 
 }  // namespace patchcull::cli

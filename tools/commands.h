@@ -16,9 +16,18 @@ using Runner = std::function<int()>;
 
 Runner add_info_command(CLI::App& app);
 Runner add_cull_command(CLI::App& app);
-/// The main job: runs on the built-in default scene (also `patchcull demo`).
+/// `render`: the GPU pipeline over an animated camera path (tools/cmd_render.cpp).
+Runner add_render_command(CLI::App& app);
+/// `view`: the render pipeline shown in a window (GLFW), optionally saving a screenshot.
+Runner add_view_command(CLI::App& app);
+/// `eval occlusion` (and later `eval displaced`): seed 000 §6.2's figures (tools/cmd_eval.cpp).
+Runner add_eval_command(CLI::App& app);
+/// The main job: renders the built-in default scene (also `patchcull demo`). The runner returned
+/// here runs with the options given to `demo`, or with the defaults when there is no subcommand.
 Runner add_demo_command(CLI::App& app);
-int run_demo();
+
+/// Parses "WxH" (each in [1, 8192]) for the option named flag; throws patchcull::Error naming it.
+void parse_size(const std::string& flag, const std::string& text, int& width, int& height);
 
 /// Options shared by the commands that load a model.
 struct ModelOptions {

@@ -1,5 +1,6 @@
 // patchcull: command-line entry point. With no arguments it runs the main job on the built-in
-// default scene. Every error is one line on stderr and exit status 2.
+// default scene (tools/cmd_demo.cpp). Every error is one line on stderr and exit status 2 (a
+// missing OpenGL driver included: GlContext::create_headless throws patchcull::Error).
 #include <iostream>
 
 #include "commands.h"
@@ -11,12 +12,18 @@ int main(int argc, char** argv) {
     app.require_subcommand(0, 1);
     const Runner info = add_info_command(app);
     const Runner cull = add_cull_command(app);
+    const Runner render = add_render_command(app);
+    const Runner view = add_view_command(app);
+    const Runner eval = add_eval_command(app);
     const Runner demo = add_demo_command(app);
     try {
         app.parse(argc, argv);
         if (app.got_subcommand("info")) return info();
         if (app.got_subcommand("cull")) return cull();
-        return demo();
+        if (app.got_subcommand("render")) return render();
+        if (app.got_subcommand("view")) return view();
+        if (app.got_subcommand("eval")) return eval();
+        return demo();  // `demo`, or no subcommand: the main job with its default options
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {

@@ -53,9 +53,11 @@
 // at run time; binaries start without them and create_headless() reports their absence.
 //
 // Back-patch culling (seed 001) plugs in through a hook: per-patch decisions from the CPU
-// (FrameParams::backpatch_culled) or a GL buffer written by a GPU pass (FrameParams::backpatch_buffer).
-// Planned, not implemented yet: the camera-aligned frustum for displaced patches (seed 000 §4.2),
-// and a GLFW window context beside create_headless().
+// (FrameParams::backpatch_culled) or a GL buffer written by a GPU pass (FrameParams::backpatch_buffer);
+// gl_pipeline.h's CullPipeline runs the GPU tcone/ncone/ptp pass (gl_backpatch.h) into that buffer.
+// Planned, not implemented yet: the camera-aligned frustum for displaced patches (seed 000 §4.2)
+// in render_frame. Contexts: headless EGL (create_headless) or a GLFW window (create_window); the
+// renderer is the same code in both.
 //
 // Errors: factories and calls that can fail throw patchcull::Error with a one-line message
 // ("EGL: no display ...", "GL: shader patch.tesc.glsl: <first log line>", "GL: error 0x0502 after
@@ -102,7 +104,7 @@ const char* cull_mode_name(CullMode mode);
 /// Parses cull_mode_name's names; returns false (mode unchanged) otherwise.
 bool parse_cull_mode(const char* text, CullMode& mode);
 
-/// An OpenGL 4.5 core context without a window.
+/// An OpenGL 4.5 core context: headless (EGL) or in a window (GLFW).
 class GlContext {
 public:
     /// Creates a headless context and makes it current on the calling thread. Tries, in order:
@@ -118,14 +120,33 @@ public:
     GlContext& operator=(const GlContext&) = delete;
     ~GlContext();
 
+    /// Opens a window of width x height pixels with an OpenGL 4.5 core context, current on the
+    /// calling thread: the same renderer and cull pipeline as create_headless, shown on screen
+    /// (PatchRenderer::blit_color_to_window, swap_buffers). GLFW 3 on X11; without a screen, run
+    /// under a virtual X server (`xvfb-run -a -s "-screen 0 1280x1024x24" ...`, llvmpipe). At most
+    /// one window context at a time. Throws patchcull::Error with one line ("GLFW: ...") when
+    /// there is no X display or no 4.5 core context.
+    static GlContext create_window(int width, int height, const std::string& title);
+
     /// Makes this context current on the calling thread (needed only after another context was).
     void make_current() const;
+
+    /// True for a create_window context.
+    bool has_window() const;
+    /// Window: processes pending events; false once the user has closed the window (or Escape).
+    /// Headless: always true.
+    bool window_open() const;
+    /// Window: shows the back buffer. Headless: nothing.
+    void swap_buffers() const;
+    /// Window: writes the back buffer (what the next swap_buffers shows) as an RGBA PNG, top row
+    /// first (a screenshot). Throws patchcull::Error for a headless context or an unwritable path.
+    void write_window_png(const std::string& path) const;
 
     /// GL_RENDERER, GL_VENDOR and GL_VERSION strings.
     const std::string& renderer() const;
     const std::string& vendor() const;
     const std::string& version() const;
-    /// How the display was obtained: "device" (GPU), "surfaceless" or "software-device".
+    /// How the display was obtained: "device" (GPU), "surfaceless", "software-device" or "window".
     const std::string& platform() const;
     /// True for a software rasterizer (llvmpipe, softpipe, swrast).
     bool is_software() const;
@@ -212,6 +233,9 @@ struct FrameStats {
     /// hiz (build), cull (frustum + back-patch + occlusion test), pass2 (newly visible). One pass
     /// (no occlusion): cull first, then pass1 draws the patches that passed; hiz = pass2 = 0.
     double pass1_ms = 0, hiz_ms = 0, cull_ms = 0, pass2_ms = 0, total_ms = 0;
+    /// Time of a GPU back-patch pass run before the frame (CullPipeline::render_frame,
+    /// gl_pipeline.h); already included in cull_ms and total_ms. 0 from render_frame alone.
+    double backpatch_ms = 0;
     TimingMethod timing = TimingMethod::off;  ///< the method used (never automatic)
 };
 
@@ -241,6 +265,11 @@ public:
     /// wrong size.
     void update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes = {});
     std::size_t patch_count() const;
+    /// The GL buffer holding the uploaded control points (vec4 cp[16 * patch_count()], patch p's
+    /// point k at 16p + k), e.g. for BackpatchCuller::use_patch_buffer so that a GPU back-patch
+    /// pass reads the renderer's patches without a second upload. Its name stays the same for the
+    /// renderer's lifetime (set_patches/update_patches re-specify its storage, not its name).
+    std::uint32_t patch_buffer() const;
 
     /// True when the cull passes compute once-rounded multiply-adds in double precision
     /// (shaders/exact_fma.h): on software rasterizers (llvmpipe rounds GLSL fma() twice), and on a
@@ -363,6 +392,10 @@ public:
     /// Writes the colour image of the last render as a PNG. Throws patchcull::Error("PATH: cannot
     /// write PNG") on failure.
     void write_color_png(const std::string& path) const;
+    /// Copies the colour image of the last frame to the current context's window (the default
+    /// framebuffer's back buffer) of window_width x window_height pixels, scaled to fill it
+    /// (nearest texel). For GlContext::create_window contexts; then swap_buffers shows it.
+    void blit_color_to_window(int window_width, int window_height) const;
 
     struct Impl;
 

@@ -35,6 +35,12 @@ struct ControlMesh {
     std::uint32_t face_size(std::size_t f) const { return face_offsets[f + 1] - face_offsets[f]; }
     bool has_texcoords() const { return !face_texcoords.empty(); }
     bool all_quads() const;
+    /// True when every edge is shared by exactly two faces, used once in each direction (a closed,
+    /// consistently oriented surface, and at least one face). Only on such a surface are
+    /// back-facing patches always hidden by front-facing ones when both sides are drawn: through
+    /// the boundary of an open one (the teapot's lid gap) the inside of a patch facing away can
+    /// show, so back-patch culling (seed 001) is not conservative there.
+    bool is_closed() const;
 };
 
 /// Axis-aligned bounds of a point set.

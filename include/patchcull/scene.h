@@ -16,6 +16,9 @@ struct LoadedModel {
     int split_levels = 0;
     PatchFrame rest;                         ///< patches at rest, after split_levels splits
     std::vector<std::string> warnings;
+    /// A closed surface (ControlMesh::is_closed): back-patch culling is conservative for it even
+    /// when both sides are drawn. False for the teapot (its lid sits loose in the rim).
+    bool closed = false;
 };
 
 /// Loads spec ("teapot" or an OBJ path), builds patches with scheme (ignored for the teapot) and

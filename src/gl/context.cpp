@@ -1,4 +1,4 @@
-// Headless EGL context (patchcull/gl_renderer.h: GlContext).
+// OpenGL contexts (patchcull/gl_renderer.h: GlContext): headless EGL, or a GLFW window.
 //
 // libepoxy dispatches EGL and GL; it loads libEGL.so.1 and libOpenGL.so.0 / libGL.so.1 at run
 // time, and aborts the process when they are missing, so create_headless() dlopen()s them first
@@ -8,7 +8,12 @@
 #include <dlfcn.h>
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
+#define GLFW_INCLUDE_NONE  // GL declarations come from libepoxy
+#include <GLFW/glfw3.h>
+#include <stb_image_write.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <mutex>
@@ -23,6 +28,7 @@ namespace patchcull::gl {
 struct GlContext::Impl {
     EGLDisplay display = EGL_NO_DISPLAY;
     EGLContext context = EGL_NO_CONTEXT;
+    GLFWwindow* window = nullptr;  // a window context instead of EGL
     std::string renderer, vendor, version, platform;
     bool software = false;
     ~Impl();
@@ -126,7 +132,19 @@ std::string try_candidate(const Candidate& c, PFNEGLGETPLATFORMDISPLAYEXTPROC ge
 
 }  // namespace
 
+// The last GLFW error, for one-line messages (GLFW reports through a callback).
+std::string g_glfw_error;
+
+void remember_glfw_error(int code, const char* description) {
+    g_glfw_error = description ? description : "error " + std::to_string(code);
+}
+
 GlContext::Impl::~Impl() {
+    if (window) {
+        glfwDestroyWindow(window);
+        glfwTerminate();  // one window context at a time (create_window)
+        return;
+    }
     if (context != EGL_NO_CONTEXT) {
         if (eglGetCurrentContext() == context) eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(display, context);
@@ -181,14 +199,86 @@ GlContext GlContext::create_headless() {
     throw Error("EGL: no OpenGL 4.5 core context: " + reasons);
 }
 
+GlContext GlContext::create_window(int width, int height, const std::string& title) {
+    if (width < 1 || height < 1) throw Error("GLFW: window size must be positive");
+    glfwSetErrorCallback(remember_glfw_error);
+    g_glfw_error.clear();
+    if (!glfwInit()) throw Error("GLFW: cannot start: " + g_glfw_error + " (no X display? run under xvfb-run)");
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);  // the renderer's framebuffer has a fixed size
+    GLFWwindow* window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+    if (!window) {
+        const std::string why = g_glfw_error;
+        glfwTerminate();
+        throw Error("GLFW: no OpenGL 4.5 core window: " + why);
+    }
+    glfwMakeContextCurrent(window);
+    glfwSwapInterval(0);  // measure frames, not the display's refresh
+    auto impl = std::make_unique<Impl>();
+    impl->window = window;
+    if (epoxy_gl_version() < 45) throw Error("GLFW: the window's context is not OpenGL 4.5");
+    auto str = [](GLenum e) {
+        const GLubyte* v = glGetString(e);
+        return v ? std::string(reinterpret_cast<const char*>(v)) : std::string();
+    };
+    impl->renderer = str(GL_RENDERER);
+    impl->vendor = str(GL_VENDOR);
+    impl->version = str(GL_VERSION);
+    impl->platform = "window";
+    impl->software = impl->renderer.find("llvmpipe") != std::string::npos ||
+                     impl->renderer.find("softpipe") != std::string::npos ||
+                     impl->renderer.find("swrast") != std::string::npos;
+    return GlContext(std::move(impl));
+}
+
 GlContext::GlContext(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 GlContext::GlContext(GlContext&&) noexcept = default;
 GlContext& GlContext::operator=(GlContext&&) noexcept = default;
 GlContext::~GlContext() = default;
 
 void GlContext::make_current() const {
+    if (impl_->window) {
+        glfwMakeContextCurrent(impl_->window);
+        return;
+    }
     if (!eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context))
         throw Error("EGL: eglMakeCurrent failed (" + hex(eglGetError()) + ")");
+}
+
+bool GlContext::has_window() const { return impl_->window != nullptr; }
+
+bool GlContext::window_open() const {
+    if (!impl_->window) return true;
+    glfwPollEvents();
+    if (glfwGetKey(impl_->window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(impl_->window, GLFW_TRUE);
+    return !glfwWindowShouldClose(impl_->window);
+}
+
+void GlContext::swap_buffers() const {
+    if (impl_->window) glfwSwapBuffers(impl_->window);
+}
+
+void GlContext::write_window_png(const std::string& path) const {
+    if (!impl_->window) throw Error(path + ": cannot write a window screenshot: the context has no window");
+    int width = 0, height = 0;
+    glfwGetFramebufferSize(impl_->window, &width, &height);
+    std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) * height * 4);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    glReadBuffer(GL_BACK);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    if (const GLenum e = glGetError(); e != GL_NO_ERROR) throw Error("GL: error " + hex(e) + " reading the window");
+    // GL rows start at the bottom; PNG rows at the top.
+    const std::size_t row = static_cast<std::size_t>(width) * 4;
+    for (int y = 0; y < height / 2; ++y)
+        std::swap_ranges(rgba.begin() + static_cast<std::ptrdiff_t>(y * row),
+                         rgba.begin() + static_cast<std::ptrdiff_t>((y + 1) * row),
+                         rgba.begin() + static_cast<std::ptrdiff_t>((height - 1 - y) * row));
+    if (!stbi_write_png(path.c_str(), width, height, 4, rgba.data(), static_cast<int>(row)))
+        throw Error(path + ": cannot write PNG");
 }
 const std::string& GlContext::renderer() const { return impl_->renderer; }
 const std::string& GlContext::vendor() const { return impl_->vendor; }

@@ -128,6 +128,7 @@ void PatchRenderer::update_patches(const std::vector<BezierPatch>& patches, cons
 }
 
 std::size_t PatchRenderer::patch_count() const { return impl_->count; }
+std::uint32_t PatchRenderer::patch_buffer() const { return impl_->control_points; }
 bool PatchRenderer::fma_via_double() const { return impl_->fma_via_double; }
 
 void PatchRenderer::set_displacement_map(const DisplacementMap& map) {
@@ -274,6 +275,14 @@ std::vector<std::uint8_t> PatchRenderer::read_color() const {
     glGetTextureImage(m.color, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(rgba.size()), rgba.data());
     check_gl("read_color");
     return flip_rows(rgba, m.width, m.height, 4);
+}
+
+void PatchRenderer::blit_color_to_window(int window_width, int window_height) const {
+    const Impl& m = *impl_;
+    glNamedFramebufferReadBuffer(m.fbo, GL_COLOR_ATTACHMENT0);
+    glBlitNamedFramebuffer(m.fbo, 0, 0, 0, m.width, m.height, 0, 0, window_width, window_height, GL_COLOR_BUFFER_BIT,
+                           GL_NEAREST);
+    check_gl("blit to window");
 }
 
 void PatchRenderer::write_color_png(const std::string& path) const {

@@ -48,6 +48,7 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
     for (const std::string& w : model.subdiv->mesh.warnings)
         if (std::find(model.warnings.begin(), model.warnings.end(), w) == model.warnings.end()) model.warnings.push_back(w);
     evaluate_patches(*model.subdiv, model.subdiv->mesh.positions, split_levels, model.rest);
+    model.closed = model.subdiv->mesh.is_closed();
     return model;
 }
 

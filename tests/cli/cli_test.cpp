@@ -1,67 +1,12 @@
 // The CLI contract (issue 2): `info` and `cull` JSON shapes and counts, and one-line errors with
 // exit status 2 for every kind of bad input.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-
-#include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
-namespace {
+#include "cli_test_util.h"
 
-struct CliRun {
-    int status = -1;
-    std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-const std::string& scratch_dir() {
-    static const std::string dir = [] {
-        std::string d = (std::filesystem::temp_directory_path() / ("patchcull_cli_" + std::to_string(getpid()))).string();
-        std::filesystem::create_directories(d);
-        return d;
-    }();
-    return dir;
-}
-
-CliRun run(const std::string& args) {
-    const std::string out = scratch_dir() + "/stdout", err = scratch_dir() + "/stderr";
-    const std::string cmd = std::string(PATCHCULL_CLI) + " " + args + " >" + out + " 2>" + err + " </dev/null";
-    const int raw = std::system(cmd.c_str());
-    CliRun r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
-
-std::string model(const char* name) { return std::string(PATCHCULL_SOURCE_DIR) + "/data/models/" + name; }
-
-std::string write_file(const std::string& name, const std::string& content) {
-    const std::string path = scratch_dir() + "/" + name;
-    std::ofstream(path, std::ios::binary) << content;
-    return path;
-}
-
-// The error must be exactly one line, name the culprit, and exit with status 2.
-void expect_one_line_error(const CliRun& r, const std::string& must_contain) {
-    EXPECT_EQ(r.status, 2) << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
-    ASSERT_FALSE(r.err.empty());
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
-    EXPECT_NE(r.err.find(must_contain), std::string::npos) << r.err;
-}
-
-}  // namespace
+using namespace patchcull::cli_test;
 
 TEST(Cli, InfoBigGuyAcc) {
     const CliRun r = run("info " + model("bigguy.obj") + " --json");

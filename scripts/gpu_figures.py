@@ -1,0 +1,77 @@
+#!/usr/bin/env python3
+"""GPU-pipeline figures of docs/PERFORMANCE.md, measured with `patchcull render --json`.
+
+Usage: python3 scripts/gpu_figures.py [BUILD_DIR]   (default: build)
+
+1. Default scene: frame time with culling (cull all, tcone) against without (cull none), per
+   tessellation level, as a ratio (seed 000 Fig. 9's payoff).
+2. Hi-Z build time against resolution (default scene, cull occlusion).
+3. Cull-pass time against patch count (the teapot split 0..4 times and BigGuy split 0..2; cull
+   occlusion alone, and all with each back-patch method; seed 000 Fig. 7).
+Every figure is the mean over frames 1..N-1 (frame 0 compiles and primes the statuses). On
+llvmpipe the times are wall clock around glFinish (gl_renderer.h); on a GPU, timer queries.
+"""
+import json
+import os
+import subprocess
+import sys
+
+BUILD = sys.argv[1] if len(sys.argv) > 1 else "build"
+CLI = os.path.join(BUILD, "patchcull")
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BIGGUY = os.path.join(ROOT, "data", "models", "bigguy.obj")
+
+
+def render(*args):
+    cmd = [CLI, "render", *map(str, args), "--json"]
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    return json.loads(out)
+
+
+def mean_ms(result, key):
+    frames = result["frames"][1:] or result["frames"]
+    return sum(f["ms"][key] for f in frames) / len(frames)
+
+
+def mean_count(result, key):
+    frames = result["frames"][1:] or result["frames"]
+    return sum(f[key] for f in frames) / len(frames)
+
+
+def main():
+    first = render("teapot", "--frames", 1, "--size", "8x8")
+    print(f"renderer: {first['renderer']}\n")
+
+    print("1. Default scene (8226 patches), 640x360, 5 frames: frame time (ms) without / with culling")
+    print(f"{'tess':>5} {'none':>9} {'all':>9} {'ratio':>7} {'culled':>7}")
+    for tess in (1, 2, 4, 8, 16):
+        none = render("default", "--frames", 5, "--tess", tess, "--cull", "none")
+        cull = render("default", "--frames", 5, "--tess", tess, "--cull", "all", "--backpatch", "tcone")
+        culled = sum(mean_count(cull, k) for k in ("frustum_culled", "backpatch_culled", "occlusion_culled"))
+        t0, t1 = mean_ms(none, "total"), mean_ms(cull, "total")
+        print(f"{tess:>5} {t0:>9.1f} {t1:>9.1f} {t1 / t0:>7.2f} {100 * culled / cull['patches']:>6.1f}%")
+
+    print("\n2. Hi-Z build time (ms) against resolution (default scene, cull occlusion, level 1, 4 frames)")
+    print(f"{'size':>10} {'levels':>6} {'hiz ms':>8}")
+    for w, h in ((256, 144), (640, 360), (1280, 720), (1920, 1080), (3840, 2160)):
+        r = render("default", "--frames", 4, "--tess", 1, "--cull", "occlusion", "--size", f"{w}x{h}")
+        levels = max(w, h).bit_length()
+        print(f"{w}x{h:<5} {levels:>6} {mean_ms(r, 'hiz'):>8.2f}")
+
+    print("\n3. Cull-pass time (ms) against patch count (256x256, level 1, 4 frames)")
+    print(f"{'model':>14} {'patches':>8} {'occlusion':>10} {'+tcone':>8} {'+ncone':>8} {'+ptp':>8}")
+    models = [("teapot", s) for s in range(5)] + [(BIGGUY, s) for s in range(3)]
+    for model, split in models:
+        row = []
+        base = ["--split", split, "--frames", 4, "--tess", 1, "--size", "256x256"]
+        occ = render(model, *base, "--cull", "occlusion")
+        row.append(mean_ms(occ, "cull"))
+        for method in ("tcone", "ncone", "ptp"):
+            row.append(mean_ms(render(model, *base, "--cull", "all", "--backpatch", method), "cull"))
+        name = "teapot" if model == "teapot" else "bigguy"
+        print(f"{name + ' /' + str(split):>14} {occ['patches']:>8} {row[0]:>10.2f} "
+              + " ".join(f"{v:>8.2f}" for v in row[1:]))
+
+
+if __name__ == "__main__":
+    main()

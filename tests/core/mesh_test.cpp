@@ -1,0 +1,46 @@
+// ControlMesh::is_closed (patchcull/mesh.h): closed, consistently oriented meshes only.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "patchcull/mesh.h"
+
+using namespace patchcull;
+
+namespace {
+
+// A unit cube of 6 quads, counter-clockwise from outside.
+ControlMesh cube() {
+    ControlMesh m;
+    m.name = "cube";
+    m.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    const std::vector<std::vector<std::uint32_t>> faces = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                                           {2, 3, 7, 6}, {1, 2, 6, 5}, {0, 4, 7, 3}};
+    for (const auto& f : faces) {
+        m.face_vertices.insert(m.face_vertices.end(), f.begin(), f.end());
+        m.face_offsets.push_back(static_cast<std::uint32_t>(m.face_vertices.size()));
+    }
+    return m;
+}
+
+ControlMesh without_last_face(ControlMesh m) {
+    m.face_vertices.resize(m.face_offsets[m.face_count() - 1]);
+    m.face_offsets.pop_back();
+    return m;
+}
+
+}  // namespace
+
+TEST(ControlMesh, CubeIsClosed) { EXPECT_TRUE(cube().is_closed()); }
+
+TEST(ControlMesh, OpenFlippedDuplicatedAndEmptyMeshesAreNotClosed) {
+    EXPECT_FALSE(without_last_face(cube()).is_closed());  // a boundary loop
+    ControlMesh flipped = cube();
+    std::swap(flipped.face_vertices[1], flipped.face_vertices[3]);  // face 0 now clockwise
+    EXPECT_FALSE(flipped.is_closed());
+    ControlMesh doubled = cube();  // face 0 twice: its edges have three faces
+    doubled.face_vertices.insert(doubled.face_vertices.end(), {0, 3, 2, 1});
+    doubled.face_offsets.push_back(static_cast<std::uint32_t>(doubled.face_vertices.size()));
+    EXPECT_FALSE(doubled.is_closed());
+    EXPECT_FALSE(ControlMesh{}.is_closed());
+}

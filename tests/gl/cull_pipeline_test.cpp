@@ -1,0 +1,139 @@
+// CullPipeline (patchcull/gl_pipeline.h): the GPU back-patch pass wired into seed 000 §3's frame
+// through the back-patch hook. For tcone, ncone and ptp: the frame culls exactly the patches the
+// CPU scalar kernel culls (every patch is inside the frustum), the final id buffer equals the
+// unculled render's (no false cull), and after update_patches the pass reads the new pose.
+// Small: BigGuy (1450 patches; a closed surface, as back-patch culling requires), 64x64, level 2.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "gl_test_util.h"
+#include "patchcull/backpatch.h"
+#include "patchcull/camera.h"
+#include "patchcull/gl_pipeline.h"
+#include "patchcull/scene.h"
+
+using namespace patchcull;
+using namespace patchcull::gl;
+
+namespace {
+
+constexpr int kSize = 64;
+
+CullPipeline& pipeline() {
+    static CullPipeline p(test::context());
+    return p;
+}
+
+RenderParams params_for(const Camera& camera) {
+    RenderParams rp;
+    rp.view = camera.view();
+    rp.projection = camera.projection();
+    rp.width = rp.height = kSize;
+    rp.tess_level = 2;
+    return rp;
+}
+
+std::size_t cpu_culled(BackpatchMethod method, const std::vector<BezierPatch>& patches, const RenderParams& rp) {
+    const PatchBatch batch = make_batch(patches);
+    std::vector<std::uint8_t> culled(patches.size());
+    const Mat4 object_to_clip = rp.projection * rp.view;
+    switch (method) {
+        case BackpatchMethod::tcone: cull_tcone_scalar(batch.view(), eye_of_view(rp.view), culled.data()); break;
+        case BackpatchMethod::ncone: cull_ncone_scalar(batch.view(), eye_of_view(rp.view), culled.data()); break;
+        case BackpatchMethod::ptp:
+            cull_ptp_scalar(batch.view(), object_to_clip, clip_space_eye_alpha(rp.projection), PtpRule::ncnt,
+                            culled.data());
+            break;
+    }
+    std::size_t n = 0;
+    for (std::uint8_t c : culled) n += c ? 1 : 0;
+    return n;
+}
+
+// Rotates every control point by 90 degrees about the z axis through c (w kept).
+std::vector<BezierPatch> turned(std::vector<BezierPatch> patches, Vec3 c) {
+    for (BezierPatch& p : patches)
+        for (Vec4& q : p.cp) {
+            const Vec3 d = cartesian(q) - c;
+            q = homogeneous(c + Vec3{-d.y, d.x, d.z}, q.w);
+        }
+    return patches;
+}
+
+const std::vector<BezierPatch>& bigguy() {
+    static const std::vector<BezierPatch> patches =
+        load_model(shipped_model_path("bigguy.obj"), Scheme::acc, 0).rest.patches;
+    return patches;
+}
+
+}  // namespace
+
+TEST(CullPipeline, EyeOfViewIsTheCameraPosition) {
+    Camera camera;
+    camera.eye = {1.5f, -2.0f, 3.25f};
+    camera.target = {0.1f, 0.2f, 0.3f};
+    const Vec3 eye = eye_of_view(camera.view());
+    EXPECT_NEAR(eye.x, camera.eye.x, 1e-5f);
+    EXPECT_NEAR(eye.y, camera.eye.y, 1e-5f);
+    EXPECT_NEAR(eye.z, camera.eye.z, 1e-5f);
+    Mat4 singular;
+    singular.at(1, 1) = 0;
+    EXPECT_THROW(eye_of_view(singular), Error);
+}
+
+TEST(CullPipeline, BackPatchPassFeedsTheFrameForEveryMethod) {
+    const std::vector<BezierPatch>& rest = bigguy();
+    const std::vector<Camera> cameras = orbit_sequence(test::control_point_bounds(rest), 1, 0.0f);
+    const RenderParams rp = params_for(cameras[0]);
+    for (const BackpatchMethod method : {BackpatchMethod::tcone, BackpatchMethod::ncone, BackpatchMethod::ptp}) {
+        for (const bool turn : {false, true}) {
+            CullPipeline& p = pipeline();
+            const std::vector<BezierPatch> pose = turn ? turned(rest, test::control_point_bounds(rest).center()) : rest;
+            if (turn) {
+                p.update_patches(pose);  // a new pose of the same patches: the pass must read it
+            } else {
+                p.set_patches(pose);
+            }
+            PipelineParams params;
+            params.frame.render = rp;
+            params.frame.cull = CullMode::backpatch;
+            params.frame.timing = TimingMethod::wall_clock;
+            params.backpatch = method;
+            const FrameStats s = p.render_frame(params);
+            const char* name = backpatch_method_name(method);
+            EXPECT_EQ(s.frustum_culled, 0u) << name;  // the whole teapot is in view
+            EXPECT_EQ(s.backpatch_culled, cpu_culled(method, pose, rp)) << name << (turn ? " turned" : "");
+            EXPECT_GT(s.backpatch_culled, 0u) << name;
+            EXPECT_EQ(s.backpatch_culled + s.visible, pose.size()) << name;
+            EXPECT_GT(s.backpatch_ms, 0.0) << name;
+            EXPECT_GE(s.cull_ms, s.backpatch_ms) << name;
+
+            const std::vector<std::uint32_t> ids = p.renderer().read_ids();
+            const std::vector<float> depth = p.renderer().read_depth();
+            RenderParams unculled = rp;
+            unculled.use_cull_flags = false;
+            p.renderer().render(unculled);
+            const FrameComparison cmp = compare_frames(p.renderer().read_ids(), p.renderer().read_depth(), ids, depth);
+            EXPECT_TRUE(cmp.false_culled.empty()) << name << ": " << cmp.false_culled.size() << " false culls";
+            EXPECT_TRUE(cmp.conservative()) << name;
+        }
+    }
+}
+
+TEST(CullPipeline, ModesWithoutBackPatchRunNoPass) {
+    const std::vector<BezierPatch>& rest = bigguy();
+    CullPipeline& p = pipeline();
+    p.set_patches(rest);
+    PipelineParams params;
+    params.frame.render = params_for(orbit_sequence(test::control_point_bounds(rest), 1, 0.0f)[0]);
+    params.frame.timing = TimingMethod::wall_clock;
+    params.backpatch = BackpatchMethod::ncone;
+    for (const CullMode mode : {CullMode::none, CullMode::frustum, CullMode::occlusion}) {
+        params.frame.cull = mode;
+        const FrameStats s = p.render_frame(params);
+        EXPECT_EQ(s.backpatch_culled, 0u) << cull_mode_name(mode);
+        EXPECT_EQ(s.backpatch_ms, 0.0) << cull_mode_name(mode);
+    }
+}

@@ -1,0 +1,167 @@
+// `patchcull eval ...`: the papers' evaluations, a subcommand group (`eval displaced` can join it).
+//
+// `eval occlusion MODEL [--split N] [--views N] --json` reproduces seed 000 §6.2 for non-displaced
+// models (culling within one object): views that contain the whole object (camera.h, contain
+// mode); on each view the pipeline (seed 000 §3, cull mode occlusion) runs on the static model from
+// a first frame until its visible set is stable (two consecutive frames tag the same patches
+// visible; at most --max-frames frames), and the occluded fraction of that frame is recorded. Every
+// final frame is compared with the unculled render (false culls). For comparison with seed 000's
+// back-patch figures it also reports the GPU tcone/ncone back-patch cull fractions of each view.
+// Output (--json): {"model","scheme","split","patches","views","size","tess","seed",
+//   "occluded_fraction" (mean over views),"occluded_fraction_min","occluded_fraction_max",
+//   "frustum_fraction","backpatch_fraction":{"tcone","ncone"},"frames_mean","unstable_views",
+//   "false_culls"}
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "patchcull/error.h"
+#include "render_support.h"
+
+namespace patchcull::cli {
+namespace {
+
+struct OcclusionOptions {
+    std::string model;
+    std::string scheme = "acc";
+    int split = 0;
+    int views = 20;
+    std::uint64_t seed = 1;
+    std::string size = "512x512";
+    int tess = 8;
+    int max_frames = 8;
+    bool json = false;
+};
+
+std::vector<bool> visible_set(const std::vector<std::uint32_t>& flags) {
+    std::vector<bool> visible(flags.size());
+    for (std::size_t p = 0; p < flags.size(); ++p) visible[p] = (flags[p] & gl::kStatusVisible) != 0;
+    return visible;
+}
+
+double fraction_culled(const std::vector<std::uint8_t>& culled) {
+    if (culled.empty()) return 0;
+    return double(std::count_if(culled.begin(), culled.end(), [](std::uint8_t c) { return c != 0; })) / double(culled.size());
+}
+
+int run_occlusion(const OcclusionOptions& o) {
+    int width = 0, height = 0;
+    parse_size("--size", o.size, width, height);
+    Scheme scheme = Scheme::acc;
+    if (!parse_scheme(o.scheme, scheme)) throw Error("--scheme: unknown scheme '" + o.scheme + "'");
+    const LoadedModel model = load_model(o.model, scheme, o.split);
+    for (const std::string& w : model.warnings) std::cerr << "patchcull: warning: " << w << "\n";
+    const std::size_t patches = model.rest.patches.size();
+
+    gl::GlContext context = gl::GlContext::create_headless();
+    gl::CullPipeline pipeline(context);
+    pipeline.set_patches(model.rest.patches);
+    ViewGenerator views(patch_bounds(model.rest), ViewMode::contain, o.seed, float(width) / float(height));
+
+    double occluded_sum = 0, occluded_min = 1, occluded_max = 0, frustum_sum = 0, tcone_sum = 0, ncone_sum = 0;
+    double frames_sum = 0;
+    std::size_t false_culls = 0, unstable = 0;
+    std::vector<std::uint8_t> culled;
+    for (int v = 0; v < o.views; ++v) {
+        const Camera camera = views.next();
+        gl::PipelineParams params;
+        params.frame.render = render_params(camera, width, height, o.tess);
+        params.frame.cull = gl::CullMode::occlusion;
+        params.frame.timing = gl::TimingMethod::off;
+        pipeline.renderer().reset_visibility();
+        gl::FrameStats stats;
+        std::vector<bool> previous;
+        bool stable = false;
+        int frames = 0;
+        while (frames < o.max_frames && !stable) {
+            stats = pipeline.render_frame(params);
+            ++frames;
+            std::vector<bool> visible = visible_set(pipeline.renderer().read_cull_flags());
+            stable = visible == previous;
+            previous = std::move(visible);
+        }
+        if (!stable) ++unstable;
+        frames_sum += frames;
+        const double occluded = double(stats.occlusion_culled) / double(std::max<std::size_t>(patches, 1));
+        occluded_sum += occluded;
+        occluded_min = std::min(occluded_min, occluded);
+        occluded_max = std::max(occluded_max, occluded);
+        frustum_sum += double(stats.frustum_culled) / double(std::max<std::size_t>(patches, 1));
+        const std::vector<std::uint32_t> ids = pipeline.renderer().read_ids();
+        const std::vector<float> depth = pipeline.renderer().read_depth();
+        const ReferenceFrame reference = render_reference(pipeline.renderer(), params.frame.render);
+        false_culls += gl::compare_frames(reference.ids, reference.depth, ids, depth).false_culled.size();
+
+        const gl::RenderParams& rp = params.frame.render;
+        const Vec3 eye = gl::eye_of_view(rp.view);
+        pipeline.culler().cull(gl::BackpatchMethod::tcone, rp.projection * rp.view, eye, 0, PtpRule::ncnt, &culled);
+        tcone_sum += fraction_culled(culled);
+        pipeline.culler().cull(gl::BackpatchMethod::ncone, rp.projection * rp.view, eye, 0, PtpRule::ncnt, &culled);
+        ncone_sum += fraction_culled(culled);
+    }
+    const double n = std::max(o.views, 1);
+    nlohmann::json out;
+    out["model"] = model.name;
+    out["scheme"] = model.subdiv ? scheme_name(model.subdiv->scheme) : "bezier";
+    out["split"] = o.split;
+    out["patches"] = patches;
+    out["views"] = o.views;
+    out["size"] = {width, height};
+    out["tess"] = o.tess;
+    out["seed"] = o.seed;
+    out["occluded_fraction"] = occluded_sum / n;
+    out["occluded_fraction_min"] = o.views ? occluded_min : 0.0;
+    out["occluded_fraction_max"] = occluded_max;
+    out["frustum_fraction"] = frustum_sum / n;
+    out["backpatch_fraction"] = {{"tcone", tcone_sum / n}, {"ncone", ncone_sum / n}};
+    out["frames_mean"] = frames_sum / n;
+    out["unstable_views"] = unstable;
+    out["false_culls"] = false_culls;
+    if (o.json) {
+        std::cout << out.dump() << "\n";
+    } else {
+        std::printf("%s: %zu patches, %d whole-object views at %dx%d, level %d\n", model.name.c_str(), patches, o.views,
+                    width, height, o.tess);
+        std::printf("  occluded (seed 000 §6.2): %.2f%% (min %.2f%%, max %.2f%%), %.1f frames to a stable visible set, "
+                    "%zu views unstable\n",
+                    100 * occluded_sum / n, 100 * (o.views ? occluded_min : 0.0), 100 * occluded_max, frames_sum / n,
+                    unstable);
+        std::printf("  back-patch (GPU, same views): tcone %.2f%%, ncone %.2f%%; false culls %zu\n", 100 * tcone_sum / n,
+                    100 * ncone_sum / n, false_culls);
+    }
+    return 0;
+}
+
+}  // namespace
+
+Runner add_eval_command(CLI::App& app) {
+    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion)");
+    // At most one; none is reported by the runner ("eval: expected a subcommand ..."), which names
+    // the command, unlike CLI11's own message.
+    eval->require_subcommand(0, 1);
+    auto occlusion = std::make_shared<OcclusionOptions>();
+    CLI::App* command = eval->add_subcommand(
+        "occlusion", "Seed 000 §6.2: occluded fraction of a non-displaced model over whole-object views");
+    command->add_option("MODEL", occlusion->model, "OBJ control mesh, or 'teapot'")->required();
+    command->add_option("--scheme", occlusion->scheme, "Catmull-Clark to Bezier scheme: acc or osd")
+        ->check(CLI::IsMember({"acc", "osd"}));
+    command->add_option("--split", occlusion->split, "uniform 1-to-4 patch splits (0..4)")->check(CLI::Range(0, 4));
+    command->add_option("--views", occlusion->views, "number of whole-object views (1..100000)")
+        ->check(CLI::Range(1, 100000));
+    command->add_option("--seed", occlusion->seed, "view generator seed");
+    command->add_option("--size", occlusion->size, "framebuffer size WxH (default 512x512)");
+    command->add_option("--tess", occlusion->tess, "uniform tessellation level (1..64)")->check(CLI::Range(1, 64));
+    command->add_option("--max-frames", occlusion->max_frames, "frames per view at most (2..100)")
+        ->check(CLI::Range(2, 100));
+    command->add_flag("--json", occlusion->json, "print one JSON object");
+    return [command, occlusion]() {
+        if (command->parsed()) return run_occlusion(*occlusion);
+        throw Error("eval: expected a subcommand: occlusion (e.g. patchcull eval occlusion MODEL --json)");
+    };
+}
+
+}  // namespace patchcull::cli

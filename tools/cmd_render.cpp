@@ -1,0 +1,148 @@
+// `patchcull render [MODEL|default] ... --json`: seed 000 §3's GPU pipeline (with seed 001's GPU
+// back-patch pass) over an animated scene and a moving camera, optionally verified frame by frame
+// against the unculled render (compare_frames: a patch visible unculled but culled is a false
+// cull). Output (--json), one object:
+//   {"model","patches","size":[w,h],"tess","cull","backpatch","aggressive","verified",
+//    "frames":[{"frame","pass1_drawn","pass2_drawn","frustum_culled","backpatch_culled",
+//               "occlusion_culled","visible","newly_visible","ms":{"pass1","hiz","cull","pass2",
+//               "total"[,"reference"]},"false_culls"[,"false_culled_patches":[indices]]}],
+//    "false_culls"}
+// Without --verify nothing is compared: every false_culls is 0 and "verified" is false. Patch
+// indices are positions in the scene's pose (instances in order, each in its model's order).
+// "backpatch" is "off" when no back-patch test ran (--cull none/frustum/occlusion, or `all` on a
+// scene with an open surface, see applicable_cull_mode).
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "patchcull/default_scene.h"
+#include "patchcull/error.h"
+#include "render_support.h"
+
+namespace patchcull::cli {
+
+Runner add_render_command(CLI::App& app) {
+    struct State {
+        std::string model = "default";
+        std::string scheme = "acc";
+        int split = 0;
+        int frames = 6;
+        std::string cull = "all";
+        std::string backpatch = "tcone";
+        int tess = 8;
+        std::string size = "640x360";
+        bool aggressive = false;
+        bool verify = false;
+        std::string out;
+        bool json = false;
+    };
+    auto state = std::make_shared<State>();
+    CLI::App* command = app.add_subcommand("render", "Render an animated camera path with the GPU cull pipeline");
+    command->add_option("MODEL", state->model, "OBJ control mesh, 'teapot', or 'default' (the default scene)");
+    command->add_option("--scheme", state->scheme, "Catmull-Clark to Bezier scheme: acc or osd")
+        ->check(CLI::IsMember({"acc", "osd"}));
+    command->add_option("--split", state->split, "uniform 1-to-4 patch splits of MODEL (0..4)")
+        ->check(CLI::Range(0, 4));
+    command->add_option("--frames", state->frames, "number of frames (1..1000)")->check(CLI::Range(1, 1000));
+    command->add_option("--cull", state->cull, "none, frustum, backpatch, occlusion or all")
+        ->check(CLI::IsMember({"none", "frustum", "backpatch", "occlusion", "all"}));
+    command->add_option("--backpatch", state->backpatch, "back-patch test of backpatch/all: tcone, ncone or ptp")
+        ->check(CLI::IsMember({"tcone", "ncone", "ptp"}));
+    command->add_option("--tess", state->tess, "uniform tessellation level (1..64)")->check(CLI::Range(1, 64));
+    command->add_option("--size", state->size, "framebuffer size WxH");
+    command->add_flag("--aggressive", state->aggressive, "skip the second pass (seed 000 §3.1; not conservative)");
+    command->add_flag("--verify", state->verify, "render the unculled reference of every frame and count false culls");
+    command->add_option("--out", state->out, "write the colour image of the last frame as a PNG");
+    command->add_flag("--json", state->json, "print one JSON object");
+    return [state]() {
+        int width = 0, height = 0;
+        parse_size("--size", state->size, width, height);
+        const gl::CullMode cull = parse_cull_mode_option("--cull", state->cull);
+        const gl::BackpatchMethod backpatch = parse_backpatch_method("--backpatch", state->backpatch);
+        const Scene scene = load_scene(state->model, state->scheme, state->split);
+        // Back-patch culling is conservative only on closed surfaces (both sides are drawn, and
+        // through an opening the inside of a patch that faces away shows): `all` leaves it out
+        // for a scene with an open model; an explicit `backpatch` keeps it, with a warning, so
+        // that --verify can show what it would remove.
+        const gl::CullMode applied = applicable_cull_mode(scene, cull, "render");
+        const bool backpatch_applied = (static_cast<std::uint32_t>(applied) & gl::kFlagBackPatch) != 0;
+
+        gl::GlContext context = gl::GlContext::create_headless();
+        gl::CullPipeline pipeline(context);
+        ScenePoser poser(scene);
+        pipeline.set_patches(poser.pose(0));
+        pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
+        const std::vector<Camera> cameras = scene.camera_path(state->frames, float(width) / float(height));
+
+        nlohmann::json frames = nlohmann::json::array();
+        std::size_t total_false = 0;
+        for (int f = 0; f < state->frames; ++f) {
+            if (f > 0) pipeline.update_patches(poser.pose(f * kSecondsPerFrame));
+            gl::PipelineParams params;
+            params.frame.render = render_params(cameras[static_cast<std::size_t>(f)], width, height, state->tess);
+            params.frame.cull = applied;
+            params.frame.aggressive = state->aggressive;
+            params.backpatch = backpatch;
+            const gl::FrameStats stats = pipeline.render_frame(params);
+            const bool last = f + 1 == state->frames;
+            if (last && !state->out.empty()) pipeline.renderer().write_color_png(state->out);
+            nlohmann::json ms = {{"pass1", stats.pass1_ms}, {"hiz", stats.hiz_ms}, {"cull", stats.cull_ms},
+                                 {"pass2", stats.pass2_ms}, {"total", stats.total_ms}};
+            std::size_t false_culls = 0;
+            std::vector<std::uint32_t> false_culled;  // patch indices, ascending
+            if (state->verify) {
+                const std::vector<std::uint32_t> ids = pipeline.renderer().read_ids();
+                const std::vector<float> depth = pipeline.renderer().read_depth();
+                const ReferenceFrame reference = render_reference(pipeline.renderer(), params.frame.render);
+                const gl::FrameComparison cmp = gl::compare_frames(reference.ids, reference.depth, ids, depth);
+                false_culls = cmp.false_culled.size();
+                false_culled = cmp.false_culled;
+                ms["reference"] = reference.ms;
+            }
+            total_false += false_culls;
+            frames.push_back({{"frame", f},
+                              {"pass1_drawn", stats.pass1_drawn},
+                              {"pass2_drawn", stats.pass2_drawn},
+                              {"frustum_culled", stats.frustum_culled},
+                              {"backpatch_culled", stats.backpatch_culled},
+                              {"occlusion_culled", stats.occlusion_culled},
+                              {"visible", stats.visible},
+                              {"newly_visible", stats.newly_visible},
+                              {"ms", ms},
+                              {"false_culls", false_culls}});
+            if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
+            if (!state->json) {
+                std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu; "
+                            "ms pass1 %.1f hiz %.1f cull %.1f pass2 %.1f",
+                            f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
+                            stats.backpatch_culled, stats.occlusion_culled, stats.pass1_ms, stats.hiz_ms,
+                            stats.cull_ms, stats.pass2_ms);
+                if (state->verify) std::printf("; false culls %zu", false_culls);
+                std::printf("\n");
+            }
+        }
+        if (state->json) {
+            nlohmann::json out;
+            out["model"] = scene.name;
+            out["patches"] = scene.patch_count();
+            out["size"] = {width, height};
+            out["tess"] = state->tess;
+            out["cull"] = gl::cull_mode_name(cull);
+            out["backpatch"] = backpatch_applied ? gl::backpatch_method_name(backpatch) : "off";
+            out["aggressive"] = state->aggressive;
+            out["verified"] = state->verify;
+            out["renderer"] = context.renderer();
+            out["frames"] = frames;
+            out["false_culls"] = total_false;
+            std::cout << out.dump() << "\n";
+        } else if (state->verify) {
+            std::printf("false culls in total: %zu\n", total_false);
+        }
+        return 0;
+    };
+}
+
+}  // namespace patchcull::cli

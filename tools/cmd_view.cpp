@@ -1,0 +1,82 @@
+// `patchcull view [MODEL|default] ...`: the `render` pipeline (seed 000 §3 with seed 001's GPU
+// back-patch pass) shown in a window: the same scene, camera path, PatchRenderer and CullPipeline
+// as `render`, in a GlContext::create_window context instead of a headless one. Each frame's
+// colour image is blitted to the window and swapped in; the camera path loops until the window
+// is closed (or Escape), or stops after --frames frames. --screenshot writes the window's content
+// after the last frame (tests run it under xvfb-run and compare it with `render --out`).
+#include <cstdio>
+#include <memory>
+
+#include "commands.h"
+#include "patchcull/default_scene.h"
+#include "patchcull/error.h"
+#include "render_support.h"
+
+namespace patchcull::cli {
+
+Runner add_view_command(CLI::App& app) {
+    struct State {
+        std::string model = "default";
+        std::string scheme = "acc";
+        int split = 0;
+        int frames = 0;
+        std::string cull = "all";
+        std::string backpatch = "tcone";
+        int tess = 8;
+        std::string size = "960x540";
+        std::string screenshot;
+    };
+    auto state = std::make_shared<State>();
+    CLI::App* command = app.add_subcommand("view", "Show the GPU cull pipeline in a window (GLFW)");
+    command->add_option("MODEL", state->model, "OBJ control mesh, 'teapot', or 'default' (the default scene)");
+    command->add_option("--scheme", state->scheme, "Catmull-Clark to Bezier scheme: acc or osd")
+        ->check(CLI::IsMember({"acc", "osd"}));
+    command->add_option("--split", state->split, "uniform 1-to-4 patch splits of MODEL (0..4)")->check(CLI::Range(0, 4));
+    command->add_option("--frames", state->frames, "stop after N frames (0: loop until the window is closed)")
+        ->check(CLI::Range(0, 1000000));
+    command->add_option("--cull", state->cull, "none, frustum, backpatch, occlusion or all")
+        ->check(CLI::IsMember({"none", "frustum", "backpatch", "occlusion", "all"}));
+    command->add_option("--backpatch", state->backpatch, "back-patch test of backpatch/all: tcone, ncone or ptp")
+        ->check(CLI::IsMember({"tcone", "ncone", "ptp"}));
+    command->add_option("--tess", state->tess, "uniform tessellation level (1..64)")->check(CLI::Range(1, 64));
+    command->add_option("--size", state->size, "window size WxH");
+    command->add_option("--screenshot", state->screenshot, "after the last frame, write the window's content as a PNG");
+    return [state]() {
+        int width = 0, height = 0;
+        parse_size("--size", state->size, width, height);
+        const gl::CullMode cull = parse_cull_mode_option("--cull", state->cull);
+        const gl::BackpatchMethod backpatch = parse_backpatch_method("--backpatch", state->backpatch);
+        if (!state->screenshot.empty() && state->frames == 0)
+            throw Error("--screenshot: needs --frames N (the last frame is the one saved)");
+        const Scene scene = load_scene(state->model, state->scheme, state->split);
+        const gl::CullMode applied = applicable_cull_mode(scene, cull, "view");
+
+        gl::GlContext context = gl::GlContext::create_window(width, height, "patchcull view: " + scene.name);
+        gl::CullPipeline pipeline(context);
+        ScenePoser poser(scene);
+        pipeline.set_patches(poser.pose(0));
+        pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
+        // One lap of the camera path, repeated (the same cameras as `render --frames lap`).
+        const int lap = state->frames > 0 ? state->frames : 72;
+        const std::vector<Camera> cameras = scene.camera_path(lap, float(width) / float(height));
+        for (int f = 0; state->frames == 0 || f < state->frames; ++f) {
+            if (!context.window_open()) break;
+            if (f > 0) pipeline.update_patches(poser.pose(f * kSecondsPerFrame));
+            gl::PipelineParams params;
+            params.frame.render = render_params(cameras[static_cast<std::size_t>(f % lap)], width, height, state->tess);
+            params.frame.cull = applied;
+            params.backpatch = backpatch;
+            const gl::FrameStats stats = pipeline.render_frame(params);
+            pipeline.renderer().blit_color_to_window(width, height);
+            const bool last = state->frames > 0 && f + 1 == state->frames;
+            if (last && !state->screenshot.empty()) context.write_window_png(state->screenshot);
+            context.swap_buffers();
+            std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu; %.1f ms\n", f,
+                        stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
+                        stats.backpatch_culled, stats.occlusion_culled, stats.total_ms);
+        }
+        return 0;
+    };
+}
+
+}  // namespace patchcull::cli

@@ -1,0 +1,89 @@
+// Helpers shared by the CLI's GPU commands (render_support.h).
+#include "render_support.h"
+
+#include <chrono>
+#include <iostream>
+
+#include "commands.h"
+#include "patchcull/error.h"
+
+namespace patchcull::cli {
+
+gl::RenderParams render_params(const Camera& camera, int width, int height, int tess_level) {
+    gl::RenderParams params;
+    params.view = camera.view();
+    params.projection = camera.projection();
+    params.width = width;
+    params.height = height;
+    params.tess_level = tess_level;
+    return params;
+}
+
+ReferenceFrame render_reference(gl::PatchRenderer& renderer, const gl::RenderParams& params) {
+    gl::RenderParams unculled = params;
+    unculled.use_cull_flags = false;
+    renderer.finish();
+    const auto start = std::chrono::steady_clock::now();
+    renderer.render(unculled);
+    renderer.finish();
+    ReferenceFrame reference;
+    reference.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    reference.ids = renderer.read_ids();
+    reference.depth = renderer.read_depth();
+    return reference;
+}
+
+gl::FrameComparison compare_with_reference(const gl::PatchRenderer& renderer, const ReferenceFrame& reference) {
+    return gl::compare_frames(reference.ids, reference.depth, renderer.read_ids(), renderer.read_depth());
+}
+
+Scene load_scene(const std::string& model, const std::string& scheme_text, int split) {
+    Scheme scheme = Scheme::acc;
+    if (!parse_scheme(scheme_text, scheme)) throw Error("--scheme: unknown scheme '" + scheme_text + "'");
+    if (model == "default" && split != 0)
+        throw Error("--split: not available for the default scene (its models are not split)");
+    const Scene scene = model == "default" ? make_default_scene(scheme) : make_model_scene(load_model(model, scheme, split));
+    for (const LoadedModel& m : scene.models)
+        for (const std::string& w : m.warnings) std::cerr << "patchcull: warning: " << w << "\n";
+    return scene;
+}
+
+gl::CullMode applicable_cull_mode(const Scene& scene, gl::CullMode requested, const std::string& command) {
+    const std::uint32_t bits = static_cast<std::uint32_t>(requested);
+    if ((bits & gl::kFlagBackPatch) == 0) return requested;
+    for (const LoadedModel& model : scene.models) {
+        if (model.closed) continue;
+        // Silently: `all` is the default, and the JSON says "backpatch": "off".
+        if (requested == gl::CullMode::all) return static_cast<gl::CullMode>(bits & ~gl::kFlagBackPatch);
+        std::cerr << "patchcull: warning: " << command << ": " << model.name
+                  << " is not a closed surface: back-patch culling may remove patches seen through its openings\n";
+        return requested;
+    }
+    return requested;
+}
+
+gl::BackpatchMethod parse_backpatch_method(const std::string& flag, const std::string& text) {
+    for (gl::BackpatchMethod m : {gl::BackpatchMethod::tcone, gl::BackpatchMethod::ncone, gl::BackpatchMethod::ptp})
+        if (text == gl::backpatch_method_name(m)) return m;
+    throw Error(flag + ": unknown back-patch method '" + text + "' (tcone, ncone or ptp)");
+}
+
+gl::CullMode parse_cull_mode_option(const std::string& flag, const std::string& text) {
+    gl::CullMode mode = gl::CullMode::none;
+    if (!gl::parse_cull_mode(text.c_str(), mode))
+        throw Error(flag + ": unknown cull mode '" + text + "' (none, frustum, backpatch, occlusion or all)");
+    return mode;
+}
+
+void parse_size(const std::string& flag, const std::string& text, int& width, int& height) {
+    const std::size_t x = text.find('x');
+    auto number = [&](const std::string& part, int& out) {
+        if (part.empty() || part.size() > 5 || part.find_first_not_of("0123456789") != std::string::npos) return false;
+        out = std::stoi(part);
+        return out >= 1 && out <= 8192;
+    };
+    if (x == std::string::npos || !number(text.substr(0, x), width) || !number(text.substr(x + 1), height))
+        throw Error(flag + ": expected WIDTHxHEIGHT with each in 1..8192, got '" + text + "'");
+}
+
+}  // namespace patchcull::cli

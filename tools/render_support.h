@@ -1,0 +1,50 @@
+// Helpers shared by the CLI's GPU commands (render, eval, the main job): render parameters from a
+// camera, the unculled reference frame and its comparison with a culled one (compare_frames), and
+// name parsing for cull modes and back-patch methods.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "patchcull/camera.h"
+#include "patchcull/default_scene.h"
+#include "patchcull/gl_pipeline.h"
+
+namespace patchcull::cli {
+
+/// Seconds of animation between two frames of a sequence (frames are 1/12 s apart: a visible
+/// motion per frame, as a character at 12 poses per second).
+inline constexpr float kSecondsPerFrame = 1.0f / 12.0f;
+
+gl::RenderParams render_params(const Camera& camera, int width, int height, int tess_level);
+
+/// The unculled render of the current patches (every patch drawn, flags ignored, statuses kept)
+/// and its wall-clock time (glFinish before and after).
+struct ReferenceFrame {
+    std::vector<std::uint32_t> ids;
+    std::vector<float> depth;
+    double ms = 0;
+};
+ReferenceFrame render_reference(gl::PatchRenderer& renderer, const gl::RenderParams& params);
+
+/// Compares the renderer's current framebuffer (a culled frame) with a reference.
+gl::FrameComparison compare_with_reference(const gl::PatchRenderer& renderer, const ReferenceFrame& reference);
+
+/// The scene of a MODEL argument: "default" (the default scene; split must be 0) or a model
+/// (OBJ path or "teapot") as make_model_scene places it. Prints the models' loader warnings.
+/// Throws patchcull::Error naming the flag or file.
+Scene load_scene(const std::string& model, const std::string& scheme_text, int split);
+
+/// The tests of `requested` that are conservative on scene: back-patch culling only when every
+/// model is a closed surface (LoadedModel::closed). For a scene with an open model, `all` drops
+/// the back-patch test, and an explicit `backpatch` keeps it with a one-line warning on stderr
+/// (prefixed with command).
+gl::CullMode applicable_cull_mode(const Scene& scene, gl::CullMode requested, const std::string& command);
+
+/// "tcone", "ncone", "ptp" -> method; throws patchcull::Error naming flag otherwise.
+gl::BackpatchMethod parse_backpatch_method(const std::string& flag, const std::string& text);
+/// cull_mode_name's names -> mode; throws patchcull::Error naming flag otherwise.
+gl::CullMode parse_cull_mode_option(const std::string& flag, const std::string& text);
+
+}  // namespace patchcull::cli
