@@ -1,4 +1,5 @@
-// `patchcull eval ...`: the papers' evaluations, a subcommand group (`eval displaced` can join it).
+// `patchcull eval ...`: the papers' evaluations, a subcommand group: `eval occlusion` (here) and
+// `eval displaced` (tools/eval_displaced.cpp).
 //
 // `eval occlusion MODEL [--split N] [--views N] --json` reproduces seed 000 §6.2 for non-displaced
 // models (culling within one object): views that contain the whole object (camera.h, contain
@@ -19,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "eval_displaced.h"
 #include "patchcull/error.h"
 #include "render_support.h"
 
@@ -139,7 +141,7 @@ int run_occlusion(const OcclusionOptions& o) {
 }  // namespace
 
 Runner add_eval_command(CLI::App& app) {
-    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion)");
+    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion, eval displaced)");
     // At most one; none is reported by the runner ("eval: expected a subcommand ..."), which names
     // the command, unlike CLI11's own message.
     eval->require_subcommand(0, 1);
@@ -158,9 +160,29 @@ Runner add_eval_command(CLI::App& app) {
     command->add_option("--max-frames", occlusion->max_frames, "frames per view at most (2..100)")
         ->check(CLI::Range(2, 100));
     command->add_flag("--json", occlusion->json, "print one JSON object");
-    return [command, occlusion]() {
+
+    auto displaced = std::make_shared<DisplacedEvalOptions>();
+    CLI::App* displaced_command = eval->add_subcommand(
+        "displaced", "Seed 000 Table 1: cull rates of the six displaced-patch bounds over whole-object views");
+    displaced_command->add_option("MODEL", displaced->model, "OBJ control mesh, or 'teapot'")->required();
+    displaced_command->add_option("--scheme", displaced->scheme, "Catmull-Clark to Bezier scheme: acc or osd")
+        ->check(CLI::IsMember({"acc", "osd"}));
+    displaced_command->add_option("--split", displaced->split, "uniform 1-to-4 patch splits (0..4)")
+        ->check(CLI::Range(0, 4));
+    displaced_command->add_option("--views", displaced->views, "number of whole-object views (1..100000)")
+        ->check(CLI::Range(1, 100000));
+    displaced_command->add_option("--seed", displaced->seed, "view generator seed");
+    displaced_command->add_option("--displace", displaced->displace, "height map: a PNG file or 'procedural' (default)");
+    displaced_command->add_option("--displace-scale", displaced->displace_scale,
+                                  "displacement of height 1 in object units (default 2% of the model's diagonal)");
+    displaced_command->add_option("--size", displaced->size, "framebuffer size WxH (default 512x512)");
+    displaced_command->add_option("--tess", displaced->tess, "uniform tessellation level (1..64)")
+        ->check(CLI::Range(1, 64));
+    displaced_command->add_flag("--json", displaced->json, "print one JSON object");
+    return [command, occlusion, displaced_command, displaced]() {
         if (command->parsed()) return run_occlusion(*occlusion);
-        throw Error("eval: expected a subcommand: occlusion (e.g. patchcull eval occlusion MODEL --json)");
+        if (displaced_command->parsed()) return run_displaced_eval(*displaced);
+        throw Error("eval: expected a subcommand: occlusion or displaced (e.g. patchcull eval occlusion MODEL --json)");
     };
 }
 

@@ -2,12 +2,13 @@
 // finding no false culls in any cull mode (strict: compare_frames against the unculled render of
 // every frame) and catching the ones back-patch culling makes on an open surface, one-line errors
 // with exit status 2 (bad flags, missing OpenGL), the main job writing both PNGs, and
-// `eval occlusion --json`. In the gl suite because it needs OpenGL (the cli suite also runs under
+// `eval occlusion --json`, `eval displaced --json`. In the gl suite because it needs OpenGL (the cli suite also runs under
 // ASan with leak detection, which would report Mesa's own allocations). Everything runs on Mesa
 // llvmpipe at tiny sizes (64x64; the teapot, BigGuy at tessellation level 2).
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -179,6 +180,36 @@ TEST(GpuCli, BadRenderFlagsAreOneLineErrors) {
     expect_one_line_error(run("eval occlusion teapot --views 0"), "--views");
     expect_one_line_error(run("eval sideways teapot"), "sideways");
     expect_one_line_error(run("eval occlusion /nonexistent/model.obj"), "/nonexistent/model.obj");
+}
+
+// eval displaced (seed 000 Table 1): six rows with the contract's keys, no false culls against
+// the unculled displaced render, and the nesting that is a theorem: a CAF with a cone lies inside
+// the CAF without one (DisplacedBounds.CafWithAConeLiesInsideTheFullCaf), so per view it culls
+// at least as much (a smaller rectangle reads a finer Hi-Z level, whose max is not larger).
+TEST(GpuCli, EvalDisplacedGivesSixRowsWithoutFalseCulls) {
+    const CliRun r = run("eval displaced " + model("monsterfrog.obj") + " --views 4 --size 96x96 --tess 2 --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j["rows"].size(), 6u);
+    std::map<std::string, double> rate;
+    for (const auto& row : j["rows"]) {
+        for (const char* key : {"bound", "cone", "cull_rate", "false_culls"}) ASSERT_TRUE(row.contains(key)) << row.dump();
+        EXPECT_EQ(row["false_culls"], 0) << row.dump();
+        const double c = row["cull_rate"];
+        EXPECT_GE(c, 0.0);
+        EXPECT_LE(c, 1.0);
+        rate[row["bound"].get<std::string>() + "/" + row["cone"].get<std::string>()] = c;
+    }
+    ASSERT_EQ(rate.size(), 6u);
+    EXPECT_GT(rate["caf/full"], 0.0) << "nothing culled: the comparison below would be vacuous";
+    EXPECT_GE(rate["caf/acon"], rate["caf/full"]);
+    EXPECT_GE(rate["caf/con"], rate["caf/full"]);
+}
+
+TEST(GpuCli, EvalDisplacedBadInputIsAOneLineError) {
+    expect_one_line_error(run("eval displaced teapot --displace /nonexistent/height.png --views 1"), "/nonexistent/height.png");
+    expect_one_line_error(run("eval displaced teapot --views 0"), "--views");
+    expect_one_line_error(run("eval displaced teapot --displace-scale nan --views 1"), "--displace-scale");
 }
 
 TEST(GpuCli, MissingOpenGlIsAOneLineError) {

@@ -1,0 +1,125 @@
+// `patchcull eval displaced MODEL [--split N] [--views N] [--displace FILE.png|procedural]
+// [--displace-scale X] --json`: seed 000's Table 1 (§4.2, §6.2): cull rates of the six bounds of a
+// displaced patch, {oobb, caf} x {full, acon, con} (patchcull/displaced_bounds.h), by the frustum
+// and by occlusion inside the object, over views that contain the whole object.
+//
+// Per view (camera.h, contain mode): the displaced model is rendered unculled (GPU, the renderer's
+// TES displaces along the unit normal of the patch's own derivatives, as the bounds assume); its
+// depth buffer gives the CPU Hi-Z pyramid (hiz.h), which is what seed 000 §3's pipeline converges
+// to on a static view (its visible set stable); each bound is then tested against the frustum and
+// that pyramid (cull_displaced_occlusion). A patch culled although its id is in the unculled id
+// buffer is a false cull. Output (--json):
+//   {"model","patches","views","displace","displace_scale","size","tess","seed",
+//    "rows":[{"bound":"oobb"|"caf","cone":"full"|"acon"|"con","cull_rate":0..1,"false_culls":n}, ...]}
+// with one row per combination (cull_rate: the mean over views of the culled fraction).
+#include "eval_displaced.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "patchcull/displaced_bounds.h"
+#include "patchcull/error.h"
+#include "render_support.h"
+
+namespace patchcull::cli {
+
+int run_displaced_eval(const DisplacedEvalOptions& o) {
+    int width = 0, height = 0;
+    parse_size("--size", o.size, width, height);
+    ModelOptions model_options;
+    model_options.model = o.model;
+    model_options.scheme = o.scheme;
+    model_options.split = o.split;
+    model_options.displace = o.displace;
+    model_options.displace_scale = o.displace_scale;
+    const LoadedModel model = load_model_from_options(model_options);
+    for (const std::string& w : model.warnings) std::cerr << "patchcull: warning: " << w << "\n";
+    const DisplacementMap map = displacement_from_options(model_options, model);
+    const std::vector<DisplacementRange> ranges = displacement_ranges(model.rest, &map);
+    const std::size_t patches = model.rest.patches.size();
+    const PatchBatch batch = make_batch(model.rest.patches);
+
+    gl::GlContext context = gl::GlContext::create_headless();
+    gl::PatchRenderer renderer(context);
+    gl::PatchAttributes attributes;
+    for (std::size_t p = 0; p < patches; ++p) {
+        attributes.max_displacement.push_back(ranges[p].max_abs());
+        const PatchInfo& info = model.rest.info[p];
+        attributes.texcoords.push_back({info.uv[0], info.uv[1], info.uv[2], info.uv[3]});
+    }
+    renderer.set_patches(model.rest.patches, attributes);
+    renderer.set_displacement_map(map);
+    ViewGenerator views(patch_bounds(model.rest), ViewMode::contain, o.seed, float(width) / float(height));
+
+    struct Row {
+        DisplacedBoundKind bound;
+        NormalConeKind cone;
+        double rate_sum = 0;
+        std::size_t false_culls = 0;
+    };
+    std::vector<Row> rows;
+    for (DisplacedBoundKind bound : {DisplacedBoundKind::oobb, DisplacedBoundKind::caf})
+        for (NormalConeKind cone : {NormalConeKind::full, NormalConeKind::acon, NormalConeKind::con})
+            rows.push_back({bound, cone});
+    std::vector<float> depth_bottom_up(static_cast<std::size_t>(width) * height);
+    std::vector<std::uint8_t> decision(patches);
+    std::vector<bool> visible(patches);
+    HiZPyramid hiz;
+    for (int v = 0; v < o.views; ++v) {
+        const Camera camera = views.next();
+        gl::RenderParams params = render_params(camera, width, height, o.tess);
+        params.use_cull_flags = false;
+        renderer.render(params);
+        const std::vector<std::uint32_t> ids = renderer.read_ids();
+        const std::vector<float> depth = renderer.read_depth();  // top row first
+        for (int y = 0; y < height; ++y)
+            std::copy_n(depth.begin() + static_cast<std::ptrdiff_t>(y) * width, width,
+                        depth_bottom_up.begin() + static_cast<std::ptrdiff_t>(height - 1 - y) * width);
+        hiz.build(depth_bottom_up.data(), width, height);
+        std::fill(visible.begin(), visible.end(), false);
+        for (std::uint32_t id : ids)
+            if (id != 0 && (id & gl::kIdOccluderBit) == 0 && id <= patches) visible[id - 1] = true;
+        const DisplacedCullView cull_view = make_displaced_cull_view(camera.view(), camera.projection());
+        for (Row& row : rows) {
+            cull_displaced_occlusion(batch.view(), ranges.data(), row.bound, row.cone, cull_view, hiz, decision.data());
+            std::size_t culled = 0;
+            for (std::size_t p = 0; p < patches; ++p) {
+                if (decision[p] == kHiZVisible) continue;
+                ++culled;
+                row.false_culls += visible[p] ? 1 : 0;
+            }
+            row.rate_sum += double(culled) / double(std::max<std::size_t>(patches, 1));
+        }
+    }
+    nlohmann::json out;
+    out["model"] = model.name;
+    out["patches"] = patches;
+    out["views"] = o.views;
+    out["displace"] = o.displace;
+    out["displace_scale"] = map.scale;
+    out["size"] = {width, height};
+    out["tess"] = o.tess;
+    out["seed"] = o.seed;
+    out["rows"] = nlohmann::json::array();
+    for (const Row& row : rows)
+        out["rows"].push_back({{"bound", displaced_bound_name(row.bound)},
+                               {"cone", normal_cone_name(row.cone)},
+                               {"cull_rate", row.rate_sum / o.views},
+                               {"false_culls", row.false_culls}});
+    if (o.json) {
+        std::cout << out.dump() << "\n";
+    } else {
+        std::printf("%s: %zu patches, %d whole-object views at %dx%d, level %d, displacement %s (scale %g)\n",
+                    model.name.c_str(), patches, o.views, width, height, o.tess, o.displace.c_str(), map.scale);
+        for (const Row& row : rows)
+            std::printf("  %-4s %-4s  cull rate %6.2f%%  false culls %zu\n", displaced_bound_name(row.bound),
+                        normal_cone_name(row.cone), 100 * row.rate_sum / o.views, row.false_culls);
+    }
+    return 0;
+}
+
+}  // namespace patchcull::cli
