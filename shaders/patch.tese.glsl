@@ -1,7 +1,10 @@
 // Patch tessellation evaluation shader: evaluates the bicubic (rational) Bezier patch at the
 // tessellator's (u, v), control point (i, j) = tcs_point[4*j + i] (patch.h), and optionally
 // displaces it along the unit normal by D(s,t) = scale * (h(s,t) - midlevel) from the height map,
-// (s,t) interpolated bilinearly from the patch's corner texcoords (displacement.h).
+// (s,t) interpolated bilinearly from the patch's corner texcoords (displacement.h). The shading
+// normal is du x dv of the patch's ACC tangent patches when it has them (Loop & Schaefer 2008:
+// continuous across extraordinary vertices), else of its own derivatives; displacement always
+// follows the latter, which the cone bounds of seed 000 §4.2 bound (gl_renderer.h).
 #version 450 core
 #include "shared.h"
 
@@ -10,9 +13,13 @@ layout(quads, equal_spacing, ccw) in;
 layout(std430, binding = kBindingPatchTexcoords) readonly buffer PatchTexcoords {
     vec2 patch_texcoords[];  // 4 per patch: (u,v) = (0,0), (1,0), (0,1), (1,1)
 };
+layout(std430, binding = kBindingPatchTangents) readonly buffer PatchTangents {
+    vec4 patch_tangents[];  // kTangentVec4s per patch: du[12], dv[12]; [0].w = 1 when present
+};
 
 uniform mat4 u_object_to_clip;
 uniform bool u_displace;
+uniform bool u_has_tangents;  // the tangent buffer holds kTangentVec4s entries per patch
 uniform float u_displacement_scale;
 uniform float u_displacement_midlevel;
 layout(binding = kTextureUnitDisplacement) uniform sampler2D u_displacement_map;
@@ -21,13 +28,31 @@ in vec4 tcs_point[];
 patch in uint tcs_patch;
 
 out vec3 tes_position;  // object space, displaced
-out vec3 tes_normal;    // object space, unnormalized (zero at degenerate points)
+out vec3 tes_normal;    // object space, unnormalized (zero at degenerate points): the shading normal
 flat out uint tes_patch;
 
 void bernstein(float t, out vec4 b, out vec4 db) {
     const float s = 1.0 - t;
     b = vec4(s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t);
     db = vec4(-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t);
+}
+
+// Quadratic Bernstein polynomials.
+vec3 bernstein2(float t) {
+    const float s = 1.0 - t;
+    return vec3(s * s, 2.0 * t * s, t * t);
+}
+
+// du x dv of the tangent patches starting at patch_tangents[base] (patch.h's TangentPatches:
+// du[3*j + i] of degree (2, 3), dv[4*j + i] of degree (3, 2)) at (u, v).
+vec3 tangent_patch_normal(uint base, vec4 bu, vec4 bv, float u, float v) {
+    const vec3 qu = bernstein2(u), qv = bernstein2(v);
+    vec3 du = vec3(0.0), dv = vec3(0.0);
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 3; ++i) du += qu[i] * bv[j] * patch_tangents[base + uint(3 * j + i)].xyz;
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 4; ++i) dv += bu[i] * qv[j] * patch_tangents[base + 12u + uint(4 * j + i)].xyz;
+    return cross(du, dv);
 }
 
 void main() {
@@ -64,7 +89,9 @@ void main() {
         position += (u_displacement_scale * (height - u_displacement_midlevel) / len) * n;
     }
     tes_position = position;
-    tes_normal = n;
+    const uint tangent_base = kTangentVec4s * tcs_patch;
+    const bool has_tangents = u_has_tangents && patch_tangents[tangent_base].w == 1.0;
+    tes_normal = has_tangents ? tangent_patch_normal(tangent_base, bu, bv, u, v) : n;
     tes_patch = tcs_patch;
     gl_Position = u_object_to_clip * vec4(position, 1.0);
 }

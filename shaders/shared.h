@@ -27,6 +27,10 @@ PATCHCULL_CONST uint kBindingBackPatchFlags = 5u;  // uint backpatch[patch_count
                                                    // cull_occlusion: the back-patch hook, see gl_renderer.h)
 PATCHCULL_CONST uint kBindingCullCounters = 6u;    // uint counters[kCounterCount]: atomics of cull_occlusion
 PATCHCULL_CONST uint kBindingOccluderVertices = 7u; // vec4 v[3 * triangle_count]: triangle list, w = 1
+// vec4 t[kTangentVec4s * patch_count]: patch p's ACC tangent patches at kTangentVec4s p + (du[0..11],
+// dv[0..11]) as (x, y, z, 0); t[kTangentVec4s p].w = 1 when the patch has them (else unused).
+PATCHCULL_CONST uint kBindingPatchTangents = 10u;
+PATCHCULL_CONST uint kTangentVec4s = 24u;
 
 // Texture units.
 PATCHCULL_CONST uint kTextureUnitDisplacement = 0u;  // R32F height map, GL_REPEAT, bilinear

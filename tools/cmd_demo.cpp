@@ -51,12 +51,16 @@ int run_demo(const DemoOptions& options) {
     // Poses and cameras of every frame, computed once and replayed for every method.
     ScenePoser poser(scene);
     std::vector<std::vector<BezierPatch>> poses;
-    for (int f = 0; f < options.frames; ++f) poses.push_back(poser.pose(f * kSecondsPerFrame));
+    std::vector<gl::PatchAttributes> attributes;  // ACC tangent patches for shading
+    for (int f = 0; f < options.frames; ++f) {
+        poses.push_back(poser.pose(f * kSecondsPerFrame));
+        attributes.push_back(pose_attributes(poser));
+    }
     const std::vector<Camera> cameras = scene.camera_path(options.frames, float(width) / float(height));
     auto params_of = [&](int f) { return render_params(cameras[static_cast<std::size_t>(f)], width, height, options.tess); };
     const std::size_t patches = scene.patch_count();
 
-    pipeline.set_patches(poses[0]);
+    pipeline.set_patches(poses[0], attributes[0]);
     renderer.set_occluders(scene.occluder_vertices, scene.occluder_indices);
     std::printf("patchcull default scene: 3 BigGuy + 3 MonsterFrog (ACC, animated), %zu patches, %zu occluder "
                 "triangles;\n%d frames along the camera path, %dx%d, tessellation level %d; %s (%s).\n",
@@ -72,7 +76,7 @@ int run_demo(const DemoOptions& options) {
     std::vector<ReferenceFrame> references;
     double reference_ms = 0;
     for (int f = 0; f < options.frames; ++f) {
-        pipeline.update_patches(poses[static_cast<std::size_t>(f)]);
+        pipeline.update_patches(poses[static_cast<std::size_t>(f)], attributes[static_cast<std::size_t>(f)]);
         references.push_back(render_reference(renderer, params_of(f)));
         if (f > 0 || options.frames == 1) reference_ms += references.back().ms;
     }
@@ -98,10 +102,10 @@ int run_demo(const DemoOptions& options) {
     std::size_t total_false = 0;
     const std::filesystem::path out_dir(options.out_dir);
     for (const Method& method : methods) {
-        pipeline.set_patches(poses[0]);  // fresh statuses: a first frame
+        pipeline.set_patches(poses[0], attributes[0]);  // fresh statuses: a first frame
         Sums sums;
         for (int f = 0; f < options.frames; ++f) {
-            if (f > 0) pipeline.update_patches(poses[static_cast<std::size_t>(f)]);
+            if (f > 0) pipeline.update_patches(poses[static_cast<std::size_t>(f)], attributes[static_cast<std::size_t>(f)]);
             gl::PipelineParams params;
             params.frame.render = params_of(f);
             params.frame.cull = method.cull;

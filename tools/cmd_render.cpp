@@ -73,14 +73,18 @@ Runner add_render_command(CLI::App& app) {
         gl::GlContext context = gl::GlContext::create_headless();
         gl::CullPipeline pipeline(context);
         ScenePoser poser(scene);
-        pipeline.set_patches(poser.pose(0));
+        const std::vector<BezierPatch>& first_pose = poser.pose(0);  // before pose_attributes reads it
+        pipeline.set_patches(first_pose, pose_attributes(poser));
         pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
         const std::vector<Camera> cameras = scene.camera_path(state->frames, float(width) / float(height));
 
         nlohmann::json frames = nlohmann::json::array();
         std::size_t total_false = 0;
         for (int f = 0; f < state->frames; ++f) {
-            if (f > 0) pipeline.update_patches(poser.pose(f * kSecondsPerFrame));
+            if (f > 0) {
+                const std::vector<BezierPatch>& patches = poser.pose(f * kSecondsPerFrame);
+                pipeline.update_patches(patches, pose_attributes(poser));
+            }
             gl::PipelineParams params;
             params.frame.render = render_params(cameras[static_cast<std::size_t>(f)], width, height, state->tess);
             params.frame.cull = applied;

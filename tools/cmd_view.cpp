@@ -54,14 +54,18 @@ Runner add_view_command(CLI::App& app) {
         gl::GlContext context = gl::GlContext::create_window(width, height, "patchcull view: " + scene.name);
         gl::CullPipeline pipeline(context);
         ScenePoser poser(scene);
-        pipeline.set_patches(poser.pose(0));
+        const std::vector<BezierPatch>& first_pose = poser.pose(0);  // before pose_attributes reads it
+        pipeline.set_patches(first_pose, pose_attributes(poser));
         pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
         // One lap of the camera path, repeated (the same cameras as `render --frames lap`).
         const int lap = state->frames > 0 ? state->frames : 72;
         const std::vector<Camera> cameras = scene.camera_path(lap, float(width) / float(height));
         for (int f = 0; state->frames == 0 || f < state->frames; ++f) {
             if (!context.window_open()) break;
-            if (f > 0) pipeline.update_patches(poser.pose(f * kSecondsPerFrame));
+            if (f > 0) {
+                const std::vector<BezierPatch>& patches = poser.pose(f * kSecondsPerFrame);
+                pipeline.update_patches(patches, pose_attributes(poser));
+            }
             gl::PipelineParams params;
             params.frame.render = render_params(cameras[static_cast<std::size_t>(f % lap)], width, height, state->tess);
             params.frame.cull = applied;

@@ -37,6 +37,13 @@ gl::FrameComparison compare_with_reference(const gl::PatchRenderer& renderer, co
     return gl::compare_frames(reference.ids, reference.depth, renderer.read_ids(), renderer.read_depth());
 }
 
+gl::PatchAttributes pose_attributes(const ScenePoser& poser) {
+    gl::PatchAttributes attributes;
+    attributes.tangent_index = poser.tangent_index();
+    attributes.tangents = poser.tangents();
+    return attributes;
+}
+
 Scene load_scene(const std::string& model, const std::string& scheme_text, int split) {
     Scheme scheme = Scheme::acc;
     if (!parse_scheme(scheme_text, scheme)) throw Error("--scheme: unknown scheme '" + scheme_text + "'");

@@ -31,6 +31,9 @@ ReferenceFrame render_reference(gl::PatchRenderer& renderer, const gl::RenderPar
 /// Compares the renderer's current framebuffer (a culled frame) with a reference.
 gl::FrameComparison compare_with_reference(const gl::PatchRenderer& renderer, const ReferenceFrame& reference);
 
+/// The renderer's attributes of the poser's last pose: its ACC tangent patches (shading normals).
+gl::PatchAttributes pose_attributes(const ScenePoser& poser);
+
 /// The scene of a MODEL argument: "default" (the default scene; split must be 0) or a model
 /// (OBJ path or "teapot") as make_model_scene places it. Prints the models' loader warnings.
 /// Throws patchcull::Error naming the flag or file.

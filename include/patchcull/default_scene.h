@@ -85,12 +85,19 @@ public:
     /// World-space patches of every instance at time_seconds, instance by instance (each
     /// instance's patches in its model's order). The reference stays valid until the next call.
     const std::vector<BezierPatch>& pose(float time_seconds);
+    /// The ACC tangent patches of the last pose (PatchInfo::tangent_index semantics): the entry
+    /// of each patch of pose(), -1 when it has none, indexing tangents(), whose vectors are mapped
+    /// by the instances' linear parts. Empty before the first pose.
+    const std::vector<std::int32_t>& tangent_index() const { return tangent_index_; }
+    const std::vector<TangentPatches>& tangents() const { return tangents_; }
 
 private:
     const Scene* scene_;
     std::vector<Vec3> positions_;
     PatchFrame frame_;
     std::vector<BezierPatch> patches_;
+    std::vector<std::int32_t> tangent_index_;
+    std::vector<TangentPatches> tangents_;
 };
 
 }  // namespace patchcull

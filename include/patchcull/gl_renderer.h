@@ -23,6 +23,9 @@
 // - Tessellation: uniform integer level L (equal_spacing) on every edge and the interior, L in
 //   [1, 64], or adaptive by distance (RenderParams::adaptive_tess, seed 000 §6.3); the surface is
 //   evaluated exactly (rational Bezier) at the tessellator points.
+// - Shading normal: du x dv of the patch's ACC tangent patches where it has them
+//   (PatchAttributes::tangents; continuous across extraordinary vertices), else of the patch's own
+//   derivatives. The geometry never depends on it.
 // - Displacement (optional, the rendered surface): S = B + D(s,t) n as in displacement.h, D from a
 //   DisplacementMap uploaded as an R32F GL_REPEAT bilinear texture, (s,t) from per-patch corner
 //   texcoords. Points where du x dv = 0 (degenerate patch corners) are not displaced. The cull
@@ -167,6 +170,14 @@ struct PatchAttributes {
     /// Corner texcoords at (u,v) = (0,0), (1,0), (0,1), (1,1) (PatchInfo::uv) for displacement;
     /// absent means those same four values for every patch (PatchInfo's default).
     std::vector<std::array<Vec2, 4>> texcoords;
+    /// ACC tangent patches (Loop & Schaefer 2008; PatchFrame::tangents and PatchInfo::tangent_index):
+    /// patch p uses tangents[tangent_index[p]] when tangent_index[p] >= 0. The TES then shades
+    /// with their normal du x dv, continuous across extraordinary vertices, instead of the
+    /// patch's own derivatives. Displacement keeps the patch's own normal: seed 000 §4.2's cone
+    /// bounds (displaced_bounds.h), computed from the control points, bound that normal only.
+    /// tangent_index: empty (no tangents) or one per patch.
+    std::vector<std::int32_t> tangent_index;
+    std::vector<TangentPatches> tangents;
 };
 
 /// Parameters of one frame.

@@ -43,7 +43,7 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
                   glGetUniformLocation(dp, "u_tess_reference"),     glGetUniformLocation(dp, "u_object_to_clip"),
                   glGetUniformLocation(dp, "u_displace"),           glGetUniformLocation(dp, "u_displacement_scale"),
                   glGetUniformLocation(dp, "u_displacement_midlevel"), glGetUniformLocation(dp, "u_eye"),
-                  glGetUniformLocation(dp, "u_color_mode")};
+                  glGetUniformLocation(dp, "u_color_mode"),         glGetUniformLocation(dp, "u_has_tangents")};
     m.hiz_program = link_program({{"hiz_build.comp.glsl", GL_COMPUTE_SHADER}}, "hiz_build");
     const GLuint hp = m.hiz_program;
     m.hiz_loc = {glGetUniformLocation(hp, "u_from_depth"), glGetUniformLocation(hp, "u_source_level"),
@@ -54,8 +54,8 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
                       glGetUniformLocation(m.occluder_program, "u_eye")};
 
     glCreateVertexArrays(1, &m.vao);
-    GLuint buffers[8];
-    glCreateBuffers(8, buffers);
+    GLuint buffers[9];
+    glCreateBuffers(9, buffers);
     m.control_points = buffers[0];
     m.cull_flags = buffers[1];
     m.max_displacement = buffers[2];
@@ -64,6 +64,7 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
     m.backpatch_flags = buffers[5];
     m.counters = buffers[6];
     m.occluder_vertices = buffers[7];
+    m.tangents = buffers[8];
     upload(m.counters, sh::kCounterCount * sizeof(std::uint32_t), nullptr);
     upload(m.occluder_vertices, 0, nullptr);
     glCreateFramebuffers(1, &m.fbo);

@@ -127,11 +127,12 @@ struct PatchRenderer::Impl {
     GLuint vao = 0;
     GLuint draw_program = 0, frustum_program = 0, occlusion_program = 0, hiz_program = 0, occluder_program = 0;
     GLuint control_points = 0, cull_flags = 0, max_displacement = 0, texcoords = 0, plane_values = 0;
-    GLuint backpatch_flags = 0, counters = 0, occluder_vertices = 0;
+    GLuint backpatch_flags = 0, counters = 0, occluder_vertices = 0, tangents = 0;
     GLuint displacement_texture = 0;
     float displacement_scale = 0, displacement_midlevel = 0.5f;
     bool has_displacement_map = false;
     bool has_max_displacement = false;
+    bool has_tangents = false;  // the tangent buffer holds kTangentVec4s vec4 per patch
     bool fma_via_double = false;
     bool is_software = false;
     GLuint fbo = 0, color = 0, ids = 0, depth = 0;
@@ -151,7 +152,7 @@ struct PatchRenderer::Impl {
 
     struct {
         GLint tess_level, draw_mask, draw_value, adaptive, tess_reference, object_to_clip, displace,
-            displacement_scale, displacement_midlevel, eye, color_mode;
+            displacement_scale, displacement_midlevel, eye, color_mode, has_tangents;
     } draw_loc{};
     struct {
         GLint rows, normal_length, patch_count, has_displacement, write_plane_values;
@@ -171,8 +172,8 @@ struct PatchRenderer::Impl {
         for (GLuint p : {draw_program, frustum_program, occlusion_program, hiz_program, occluder_program})
             glDeleteProgram(p);
         const GLuint buffers[] = {control_points, cull_flags, max_displacement, texcoords, plane_values,
-                                  backpatch_flags, counters, occluder_vertices};
-        glDeleteBuffers(8, buffers);
+                                  backpatch_flags, counters, occluder_vertices, tangents};
+        glDeleteBuffers(9, buffers);
         const GLuint textures[] = {displacement_texture, color, ids, depth, hiz, vis_color, vis_depth};
         glDeleteTextures(7, textures);
         glDeleteFramebuffers(1, &fbo);
@@ -237,6 +238,7 @@ struct PatchRenderer::Impl {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingBackPatchFlags, backpatch_flags);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullCounters, counters);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingOccluderVertices, occluder_vertices);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchTangents, tangents);
     }
 
     void set_patches(const float* aos_points, std::size_t n, const PatchAttributes& a, bool keep_flags = false) {
@@ -246,6 +248,13 @@ struct PatchRenderer::Impl {
         if (!a.texcoords.empty() && a.texcoords.size() != n)
             throw Error("GL: set_patches: texcoords has " + std::to_string(a.texcoords.size()) + " entries for " +
                         std::to_string(n) + " patches");
+        if (!a.tangent_index.empty() && a.tangent_index.size() != n)
+            throw Error("GL: set_patches: tangent_index has " + std::to_string(a.tangent_index.size()) +
+                        " entries for " + std::to_string(n) + " patches");
+        for (std::int32_t t : a.tangent_index)
+            if (t >= 0 && static_cast<std::size_t>(t) >= a.tangents.size())
+                throw Error("GL: set_patches: tangent_index " + std::to_string(t) + " is past the " +
+                            std::to_string(a.tangents.size()) + " tangent patches");
         if (n > 0x7FFFFFFFu / kPatchPoints) throw Error("GL: set_patches: too many patches for one draw (" + std::to_string(n) + ")");
         if (keep_flags && n != count)
             throw Error("GL: update_patches: " + std::to_string(n) + " patches for a set of " + std::to_string(count));
@@ -262,6 +271,19 @@ struct PatchRenderer::Impl {
             for (int c = 0; c < 4; ++c)
                 uv[4 * p + c] = a.texcoords.empty() ? Vec2{float(c & 1), float(c >> 1)} : a.texcoords[p][c];
         upload(texcoords, uv.size() * sizeof(Vec2), uv.data());
+        // Tangent patches: kTangentVec4s vec4 per patch (at least one vec4 so the buffer exists);
+        // element 0's w flags the patch as having them.
+        std::vector<Vec4> tangent_data(std::max<std::size_t>(1, a.tangent_index.empty() ? 1 : n * sh::kTangentVec4s));
+        for (std::size_t p = 0; p < a.tangent_index.size(); ++p) {
+            if (a.tangent_index[p] < 0) continue;
+            const TangentPatches& t = a.tangents[static_cast<std::size_t>(a.tangent_index[p])];
+            Vec4* out = &tangent_data[p * sh::kTangentVec4s];
+            for (int k = 0; k < 12; ++k) out[k] = {t.du[k].x, t.du[k].y, t.du[k].z, 0.0f};
+            for (int k = 0; k < 12; ++k) out[12 + k] = {t.dv[k].x, t.dv[k].y, t.dv[k].z, 0.0f};
+            out[0].w = 1.0f;
+        }
+        upload(tangents, tangent_data.size() * sizeof(Vec4), tangent_data.data());
+        has_tangents = !a.tangent_index.empty();
         upload(plane_values, 0, nullptr);
         if (!keep_flags) {
             upload(backpatch_flags, n * sizeof(std::uint32_t), nullptr);
@@ -296,6 +318,7 @@ struct PatchRenderer::Impl {
         glProgramUniform1f(dp, draw_loc.displacement_midlevel, displacement_midlevel);
         glProgramUniform3f(dp, draw_loc.eye, eye.x, eye.y, eye.z);
         glProgramUniform1ui(dp, draw_loc.color_mode, color_mode);
+        glProgramUniform1i(dp, draw_loc.has_tangents, has_tangents ? 1 : 0);
         glProgramUniformMatrix4fv(occluder_program, occluder_loc.object_to_clip, 1, GL_FALSE, object_to_clip.m);
         glProgramUniform3f(occluder_program, occluder_loc.eye, eye.x, eye.y, eye.z);
         return level;

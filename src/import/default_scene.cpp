@@ -180,6 +180,8 @@ ScenePoser::ScenePoser(const Scene& scene) : scene_(&scene) {}
 const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
     const Scene& scene = *scene_;
     patches_.resize(scene.patch_count());
+    tangent_index_.assign(scene.patch_count(), -1);
+    tangents_.clear();
     std::size_t next = 0;
     for (const SceneInstance& instance : scene.instances) {
         const LoadedModel& model = scene.models.at(instance.model);
@@ -189,9 +191,23 @@ const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
             evaluate_frame(model, positions_, frame_);
             frame = &frame_;
         }
-        for (const BezierPatch& patch : frame->patches) {
-            BezierPatch& out = patches_[next++];
-            for (int k = 0; k < kPatchPoints; ++k) out.cp[k] = instance.object_to_world * patch.cp[k];
+        // Tangent vectors map by the linear part of the affine object_to_world (w = 0).
+        auto linear = [&](Vec3 d) {
+            const Vec4 m = instance.object_to_world * Vec4{d.x, d.y, d.z, 0.0f};
+            return Vec3{m.x, m.y, m.z};
+        };
+        for (std::size_t p = 0; p < frame->patches.size(); ++p) {
+            BezierPatch& out = patches_[next];
+            for (int k = 0; k < kPatchPoints; ++k) out.cp[k] = instance.object_to_world * frame->patches[p].cp[k];
+            const std::int32_t t = frame->info[p].tangent_index;
+            if (t >= 0) {
+                TangentPatches mapped;
+                const TangentPatches& source = frame->tangents[static_cast<std::size_t>(t)];
+                for (int k = 0; k < 12; ++k) mapped.du[k] = linear(source.du[k]), mapped.dv[k] = linear(source.dv[k]);
+                tangent_index_[next] = static_cast<std::int32_t>(tangents_.size());
+                tangents_.push_back(mapped);
+            }
+            ++next;
         }
     }
     return patches_;

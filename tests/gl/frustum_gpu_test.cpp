@@ -194,7 +194,7 @@ TEST(GpuFrustumCull, MarginIsUsedAndFlagsAreOverwritten) {
     BezierPatch patch;
     for (int k = 0; k < 16; ++k) patch.cp[k] = homogeneous(Vec3{-5.0f - 0.1f * (k % 4), 0.1f * (k / 4), 0.0f});
     PatchRenderer r(test::context());
-    r.set_patches({patch, patch}, PatchAttributes{{0.0f, 10.0f}, {}});
+    r.set_patches({patch, patch}, test::margins_only({0.0f, 10.0f}));
     const std::uint8_t stale[2] = {0, 1};
     r.set_cull_flags(stale);
     r.cull_frustum(make_frustum_planes(vp));

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "patchcull/gl_renderer.h"
@@ -20,6 +21,13 @@ namespace patchcull::gl::test {
 inline GlContext& context() {
     static GlContext ctx = GlContext::create_headless();
     return ctx;
+}
+
+/// Attributes with only the cull margins set.
+inline PatchAttributes margins_only(std::vector<float> max_displacement) {
+    PatchAttributes a;
+    a.max_displacement = std::move(max_displacement);
+    return a;
 }
 
 /// The teapot's 32 patches after `levels` 1-to-4 splits (32 * 4^levels patches).

@@ -669,7 +669,7 @@ TEST(OcclusionPipeline, DisplacedPatchesAreNotHiZTested) {
     }
     // Margins of zero where the surface is not displaced (no map): the test runs again.
     PatchRenderer r(test::context());
-    r.set_patches(patches, PatchAttributes{std::vector<float>(patches.size(), 0.0f), {}});
+    r.set_patches(patches, test::margins_only(std::vector<float>(patches.size(), 0.0f)));
     r.set_occluders(occ.vertices, occ.indices);
     Totals total;
     for (int frame = 0; frame < 2; ++frame)

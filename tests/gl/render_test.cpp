@@ -212,5 +212,5 @@ TEST(PatchRenderer, DisplacementMovesTheSurface) {
     off.displace = false;
     r.render(off);
     EXPECT_EQ(r.read_depth(), flat_depth);
-    EXPECT_THROW(r.set_patches(patches, PatchAttributes{{1.0f}, {}}), patchcull::Error);
+    EXPECT_THROW(r.set_patches(patches, test::margins_only({1.0f})), patchcull::Error);
 }
