@@ -65,6 +65,7 @@ uniform int u_hiz_levels;
 layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 
 #include "displaced_bounds.h"
+#include "hiz_box_test.h"
 
 /// cone_of: the cone of the compiled kind (none for rational patches).
 PcCone pc_displaced_cone(vec4 P[16]) {
@@ -82,40 +83,12 @@ PcCone pc_displaced_cone(vec4 P[16]) {
 }
 
 /// hiz_decision of displaced_bounds.cpp: frustum, then hiz.h steps 5-9 on a projected bound
-/// (the same code as cull_occlusion.comp.glsl's steps 5-9).
+/// (hiz_box_test.h, shared with cull_occlusion.comp.glsl).
 uint pc_hiz_decision(PcDisplacedBound b) {
     if (pc_bound_outside_frustum(b)) return kPcHiZFrustumCulled;
     if (b.status != kPcBoundProjected) return kPcHiZVisible;
-    // Step 5: window box.
-    const float half_w = 0.5 * float(u_screen.x), half_h = 0.5 * float(u_screen.y);
-    precise float xlo = pc_fma(b.ndc_xmin, half_w, half_w);
-    precise float xhi = pc_fma(b.ndc_xmax, half_w, half_w);
-    precise float ylo = pc_fma(b.ndc_ymin, half_h, half_h);
-    precise float yhi = pc_fma(b.ndc_ymax, half_h, half_h);
-    // Step 6: pixel rectangle, clamped in float (hiz_rect_from_window_box).
-    const float wmax = float(u_screen.x - 1), hmax = float(u_screen.y - 1);
-    const int x0 = int(pc_min_like(pc_max_like(floor(xlo), 0.0), wmax));
-    const int x1 = int(pc_min_like(pc_max_like(floor(xhi), 0.0), wmax));
-    const int y0 = int(pc_min_like(pc_max_like(floor(ylo), 0.0), hmax));
-    const int y1 = int(pc_min_like(pc_max_like(floor(yhi), 0.0), hmax));
-    // Step 7: level (hiz_select_level): Lc = bit_width(span - 1) - 1 = findMSB(span - 1).
-    const int span = max(x1 - x0, y1 - y0);
-    int level = span <= 2 ? 0 : findMSB(uint(span - 1));
-    if (level > 0) {
-        const int sh = level;  // shift of level - 1
-        if ((x1 >> sh) - (x0 >> sh) <= 1 && (y1 >> sh) - (y0 >> sh) <= 1) --level;
-    }
-    level = min(level, u_hiz_levels - 1);
-    // Step 8: max of the (at most) 2x2 texels, in hiz_rect_max's order.
-    const int sh = level + 1;
-    const int tx0 = x0 >> sh, tx1 = x1 >> sh, ty0 = y0 >> sh, ty1 = y1 >> sh;
-    const float t00 = texelFetch(u_hiz, ivec2(tx0, ty0), level).r;
-    const float t10 = texelFetch(u_hiz, ivec2(tx1, ty0), level).r;
-    const float t01 = texelFetch(u_hiz, ivec2(tx0, ty1), level).r;
-    const float t11 = texelFetch(u_hiz, ivec2(tx1, ty1), level).r;
-    const float h = pc_max_like(pc_max_like(t00, t10), pc_max_like(t01, t11));
-    // Step 9: strictly nearer everywhere.
-    return h < b.depth_near ? kPcHiZOccluded : kPcHiZVisible;
+    return hiz_box_occluded(b.ndc_xmin, b.ndc_xmax, b.ndc_ymin, b.ndc_ymax, b.depth_near) ? kPcHiZOccluded
+                                                                                          : kPcHiZVisible;
 }
 
 void main() {
