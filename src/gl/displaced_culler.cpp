@@ -206,12 +206,8 @@ void DisplacedCuller::set_patches(const std::vector<BezierPatch>& patches, const
 }
 
 void DisplacedCuller::set_patches(const PatchBatchView& patches, const DisplacementRange* ranges) {
-    std::vector<float> aos(patches.count * kPatchPoints * 4);
-    for (std::size_t p = 0; p < patches.count; ++p)
-        for (int k = 0; k < kPatchPoints; ++k)
-            for (int c = 0; c < 4; ++c) aos[(p * kPatchPoints + k) * 4 + c] = patches.component(k, c)[p];
     Impl& m = *impl_;
-    upload(m.own_points, aos.size() * sizeof(float), aos.data());
+    detail::upload_patch_batch(m.own_points, patches);
     m.points = m.own_points;
     m.resize_flags(patches.count);
     m.upload_ranges(ranges, patches.count);
@@ -220,12 +216,7 @@ void DisplacedCuller::set_patches(const PatchBatchView& patches, const Displacem
 
 void DisplacedCuller::use_patch_buffer(std::uint32_t buffer, std::size_t count) {
     Impl& m = *impl_;
-    if (!glIsBuffer(buffer)) throw Error("GL: DisplacedCuller::use_patch_buffer: " + std::to_string(buffer) + " is not a buffer");
-    GLint64 size = 0;
-    glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &size);
-    if (static_cast<std::uint64_t>(size) < count * sizeof(BezierPatch))
-        throw Error("GL: DisplacedCuller::use_patch_buffer: buffer of " + std::to_string(size) + " bytes for " +
-                    std::to_string(count) + " patches");
+    detail::check_patch_buffer("DisplacedCuller::use_patch_buffer", buffer, count);
     m.points = buffer;
     m.resize_flags(count);
     m.upload_ranges(nullptr, 0);

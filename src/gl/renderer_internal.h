@@ -109,6 +109,27 @@ inline void upload(GLuint buffer, std::size_t size, const void* data) {
     if (size && data) glNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(size), data);
 }
 
+// Uploads a structure-of-arrays batch as the GPU passes' control-point layout (16 vec4 per patch,
+// patch.h order) into buffer.
+inline void upload_patch_batch(GLuint buffer, const PatchBatchView& patches) {
+    std::vector<float> aos(patches.count * kPatchPoints * 4);
+    for (std::size_t p = 0; p < patches.count; ++p)
+        for (int k = 0; k < kPatchPoints; ++k)
+            for (int c = 0; c < 4; ++c) aos[(p * kPatchPoints + k) * 4 + c] = patches.component(k, c)[p];
+    upload(buffer, aos.size() * sizeof(float), aos.data());
+}
+
+// Throws (a one-line message starting with `who`) unless buffer is a GL buffer holding at least
+// count patches in that layout (a caller's control points read in place by a cull pass).
+inline void check_patch_buffer(const std::string& who, std::uint32_t buffer, std::size_t count) {
+    if (!glIsBuffer(buffer)) throw Error("GL: " + who + ": " + std::to_string(buffer) + " is not a buffer");
+    GLint64 size = 0;
+    glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &size);
+    if (static_cast<std::uint64_t>(size) < count * sizeof(BezierPatch))
+        throw Error("GL: " + who + ": buffer of " + std::to_string(size) + " bytes for " + std::to_string(count) +
+                    " patches");
+}
+
 template <class T>
 std::vector<T> flip_rows(const std::vector<T>& in, int width, int height, int per_pixel) {
     std::vector<T> out(in.size());
