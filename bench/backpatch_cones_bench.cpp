@@ -21,12 +21,12 @@
 #include "patchcull/frustum.h"  // simd_target_name
 #include "patchcull/parallel.h"
 #include "patchcull/patch.h"
+#include "cull_bench_loop.h"
 
 using namespace patchcull;
 
 namespace {
 
-constexpr std::size_t kGrain = 1024;
 
 struct ConeWorkload {
     PatchBatch batch;
@@ -87,21 +87,9 @@ void bm_cone(benchmark::State& state, Kernel k, Impl impl, bool all_threads) {
     const std::size_t n = static_cast<std::size_t>(state.range(0));
     ConeWorkload& w = cone_workload(n);
     std::uint8_t* culled = w.culled.data();
-    for (auto _ : state) {
-        if (all_threads) {
-            parallel_for_ranges(n, kGrain, [&](std::size_t a, std::size_t b) { run_range(w, k, impl, a, b, culled); });
-        } else {
-            run_range(w, k, impl, 0, n, culled);
-        }
-        benchmark::DoNotOptimize(culled);
-        benchmark::ClobberMemory();
-    }
-    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));
-    std::size_t c = 0;
-    for (std::size_t i = 0; i < n; ++i) c += culled[i];
-    state.counters["culled"] = static_cast<double>(c) / static_cast<double>(n);
-    state.counters["threads"] = all_threads ? hardware_threads() : 1;
-    state.SetLabel(impl == Impl::kSimd ? simd_target_name() : "scalar");
+    bench::run_cull_benchmark(
+        state, n, culled, all_threads, 0, [&](std::size_t a, std::size_t b) { run_range(w, k, impl, a, b, culled); },
+        [&] { return impl == Impl::kSimd ? simd_target_name() : "scalar"; });
 }
 
 int register_cones() {

@@ -26,12 +26,12 @@
 #include "patchcull/frustum.h"
 #include "patchcull/parallel.h"
 #include "patchcull/patch.h"
+#include "cull_bench_loop.h"
 
 using namespace patchcull;
 
 namespace {
 
-constexpr std::size_t kGrain = 1024;
 constexpr std::size_t kBytesPerPatch = 16 * 4 * sizeof(float);  // 256
 
 struct Workload {
@@ -93,30 +93,12 @@ void run_range(const Workload& w, Kernel k, Impl impl, std::size_t first, std::s
 void bm_cull(benchmark::State& state, Kernel k, Impl impl, bool all_threads, bool rational,
              std::int64_t forced_target = 0) {
     const std::size_t n = static_cast<std::size_t>(state.range(0));
-    if (forced_target != 0) {
-        if ((hwy::SupportedTargets() & forced_target) == 0) {
-            state.SkipWithError("target not supported on this CPU");
-            return;
-        }
-        hwy::SetSupportedTargetsForTest(forced_target);
-    }
     Workload& w = workload(n, rational);
     std::uint8_t* culled = w.culled.data();
-    for (auto _ : state) {
-        if (all_threads) {
-            parallel_for_ranges(n, kGrain, [&](std::size_t a, std::size_t b) { run_range(w, k, impl, a, b, culled); });
-        } else {
-            run_range(w, k, impl, 0, n, culled);
-        }
-        benchmark::DoNotOptimize(culled);
-        benchmark::ClobberMemory();
-    }
-    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));
-    std::size_t c = 0;
-    for (std::size_t i = 0; i < n; ++i) c += culled[i];
-    state.counters["culled"] = static_cast<double>(c) / static_cast<double>(n);
-    state.SetLabel(impl == Impl::kSimd ? simd_target_name() : "scalar");
-    if (forced_target != 0) hwy::SetSupportedTargetsForTest(0);
+    bench::run_cull_benchmark(
+        state, n, culled, all_threads, forced_target,
+        [&](std::size_t a, std::size_t b) { run_range(w, k, impl, a, b, culled); },
+        [&] { return impl == Impl::kSimd ? simd_target_name() : "scalar"; });
 }
 
 // ---- memory roof -------------------------------------------------------------------------------
@@ -169,7 +151,7 @@ void bm_stream(benchmark::State& state, bool all_threads) {
         std::uint64_t r = 0;
         if (all_threads) {
             // Same split as the kernels: grain 1024 patches -> chunks of 1024 * 64 floats.
-            const std::size_t chunk = kGrain * floats_per_patch;
+            const std::size_t chunk = bench::kBenchGrain * floats_per_patch;
             std::vector<std::uint64_t> part((total + chunk - 1) / chunk, 0);
             parallel_for_ranges(part.size(), 1, [&](std::size_t a, std::size_t b) {
                 for (std::size_t c = a; c < b; ++c) {

@@ -24,12 +24,12 @@
 #include "patchcull/frustum.h"
 #include "patchcull/parallel.h"
 #include "patchcull/patch.h"
+#include "cull_bench_loop.h"
 
 using namespace patchcull;
 
 namespace {
 
-constexpr std::size_t kPtpGrain = 1024;
 
 struct PtpWorkload {
     PatchBatch batch;
@@ -76,30 +76,12 @@ void run_ptp_range(const PtpWorkload& w, PtpImpl impl, PtpRule rule, std::size_t
 void bm_ptp(benchmark::State& state, PtpImpl impl, bool all_threads, PtpRule rule, bool rational,
             std::int64_t forced_target) {
     const std::size_t n = static_cast<std::size_t>(state.range(0));
-    if (forced_target != 0) {
-        if ((hwy::SupportedTargets() & forced_target) == 0) {
-            state.SkipWithError("target not supported on this CPU");
-            return;
-        }
-        hwy::SetSupportedTargetsForTest(forced_target);
-    }
     PtpWorkload& w = ptp_workload(n, rational);
     std::uint8_t* culled = w.culled.data();
-    for (auto _ : state) {
-        if (all_threads) {
-            parallel_for_ranges(n, kPtpGrain, [&](std::size_t a, std::size_t b) { run_ptp_range(w, impl, rule, a, b, culled); });
-        } else {
-            run_ptp_range(w, impl, rule, 0, n, culled);
-        }
-        benchmark::DoNotOptimize(culled);
-        benchmark::ClobberMemory();
-    }
-    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));
-    std::size_t c = 0;
-    for (std::size_t i = 0; i < n; ++i) c += culled[i];
-    state.counters["culled"] = static_cast<double>(c) / static_cast<double>(n);
-    state.SetLabel(impl == PtpImpl::kSimd ? simd_target_name() : "scalar");
-    if (forced_target != 0) hwy::SetSupportedTargetsForTest(0);
+    bench::run_cull_benchmark(
+        state, n, culled, all_threads, forced_target,
+        [&](std::size_t a, std::size_t b) { run_ptp_range(w, impl, rule, a, b, culled); },
+        [&] { return impl == PtpImpl::kSimd ? simd_target_name() : "scalar"; });
 }
 
 int register_ptp() {
