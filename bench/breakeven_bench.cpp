@@ -96,11 +96,11 @@ void BM_break_even(benchmark::State& state) {
     BreakEvenScene& s = scene();
     const int level = static_cast<int>(state.range(0));
     const auto cone = static_cast<NormalConeKind>(state.range(1));
-    const DisplacedCullView view = make_displaced_cull_view(s.camera.view(), s.camera.projection());
+    const DisplacedCullView view = make_displaced_cull_view(s.camera.view(), s.camera.projection(), ClipDepth::zero_to_one);
     // Every patch culled: the frustum planes of the opposite view direction.
     Camera away = s.camera;
     away.target = s.camera.eye + (s.camera.eye - s.camera.target);
-    const FrustumPlanes away_planes = make_frustum_planes(away.projection() * away.view());
+    const FrustumPlanes away_planes = make_frustum_planes(away.projection() * away.view(), ClipDepth::zero_to_one);
     // Warm-up outside the timing: shader compilation (seconds for con on llvmpipe) and first use.
     s.culler->cull_occlusion(DisplacedBoundKind::caf, cone, view);
     s.renderer->render(s.render_params(level, false));

@@ -69,7 +69,7 @@ DisplacedWorkload& displaced_workload(std::size_t n) {
     w.batch = make_batch(patches);
     w.view = look_at({0, 3, 15}, {0, 0, 0}, {0, 1, 0});
     w.projection = perspective(60.0f * 3.14159265f / 180, 16.0f / 9.0f, 0.1f, 200.0f);
-    w.cull_view = make_displaced_cull_view(w.view, w.projection);
+    w.cull_view = make_displaced_cull_view(w.view, w.projection, ClipDepth::zero_to_one);
     // Occluders: a wall over the lower 40% of the screen at distance ~12, far background elsewhere.
     const int W = 1920, H = 1080;
     std::vector<float> depth(static_cast<std::size_t>(W) * H, 1.0f);
@@ -114,7 +114,7 @@ void bm_nodisp(benchmark::State& state, bool hiz_kernel) {
     const Mat4 object_to_clip = w.projection * w.view;
     for (auto _ : state) {
         if (hiz_kernel) {
-            cull_occlusion_scalar(w.batch.view(), object_to_clip, w.hiz, w.decision.data());
+            cull_occlusion_scalar(w.batch.view(), object_to_clip, ClipDepth::zero_to_one, w.hiz, w.decision.data());
         } else {
             cull_displaced_occlusion(w.batch.view(), nullptr, DisplacedBoundKind::caf, NormalConeKind::full,
                                      w.cull_view, w.hiz, w.decision.data());

@@ -70,7 +70,7 @@ Workload& workload(std::size_t n, bool rational) {
     w.batch = make_batch(patches);
     w.object_to_clip = perspective(60.0f * 3.14159265f / 180, 16.0f / 9.0f, 0.1f, 200.0f) *
                        look_at({0, 3, 15}, {0, 0, 0}, {0, 1, 0});
-    w.planes = make_frustum_planes(w.object_to_clip);
+    w.planes = make_frustum_planes(w.object_to_clip, ClipDepth::zero_to_one);
     w.culled.assign(n, 0);
     return w;
 }
@@ -85,7 +85,7 @@ void run_range(const Workload& w, Kernel k, Impl impl, std::size_t first, std::s
     if (k == Kernel::kFrustum) {
         (impl == Impl::kSimd ? cull_frustum_simd : cull_frustum_scalar)(v, d, w.planes, out);
     } else {
-        (impl == Impl::kSimd ? cull_frustum_disp_simd : cull_frustum_disp_scalar)(v, d, w.object_to_clip, out);
+        (impl == Impl::kSimd ? cull_frustum_disp_simd : cull_frustum_disp_scalar)(v, d, w.object_to_clip, ClipDepth::zero_to_one, out);
     }
 }
 

@@ -114,10 +114,10 @@ void bm_occlusion(benchmark::State& state, bool simd, bool all_threads, bool tin
     for (auto _ : state) {
         if (all_threads) {
             parallel_for_ranges(n, kHiZGrain, [&](std::size_t a, std::size_t b) {
-                kernel(w.batch.view().subrange(a, b - a), w.object_to_clip, hiz, out + a);
+                kernel(w.batch.view().subrange(a, b - a), w.object_to_clip, ClipDepth::zero_to_one, hiz, out + a);
             });
         } else {
-            kernel(w.batch.view(), w.object_to_clip, hiz, out);
+            kernel(w.batch.view(), w.object_to_clip, ClipDepth::zero_to_one, hiz, out);
         }
         benchmark::DoNotOptimize(out);
         benchmark::ClobberMemory();

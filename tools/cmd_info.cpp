@@ -34,7 +34,10 @@ Runner add_info_command(CLI::App& app) {
             out["control_vertices"] = model.subdiv->mesh.positions.size();
             out["faces"] = model.subdiv->mesh.face_count();
         }
-        out["bounds"] = {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
+        // World (file) coordinates: the patches are relative to model.origin (mesh.h), added in double.
+        const DVec3 o = model.origin, lo = o + to_double(b.min), hi = o + to_double(b.max);
+        out["origin"] = {o.x, o.y, o.z};
+        out["bounds"] = {{"min", {lo.x, lo.y, lo.z}}, {"max", {hi.x, hi.y, hi.z}}};
         out["warnings"] = model.warnings;
         if (state->json) {
             std::cout << out.dump() << "\n";

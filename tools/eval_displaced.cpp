@@ -83,7 +83,7 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
         std::fill(visible.begin(), visible.end(), false);
         for (std::uint32_t id : ids)
             if (id != 0 && (id & gl::kIdOccluderBit) == 0 && id <= patches) visible[id - 1] = true;
-        const DisplacedCullView cull_view = make_displaced_cull_view(camera.view(), camera.projection());
+        const DisplacedCullView cull_view = make_displaced_cull_view(camera.view(), camera.projection(), ClipDepth::zero_to_one);
         for (Row& row : rows) {
             cull_displaced_occlusion(batch.view(), ranges.data(), row.bound, row.cone, cull_view, hiz, decision.data());
             std::size_t culled = 0;

@@ -33,6 +33,34 @@ struct Camera {
     Mat4 view_projection() const { return projection() * view(); }
 };
 
+/// A camera placed in world coordinates (double), as an engine keeps it: objects and cameras at
+/// 1e4 - 1e7 units. The kernels never see it: local() moves it into an object's local frame
+/// (ControlMesh::origin, mesh.h), subtracting in double, so the float Camera, its view matrix
+/// and object_to_clip hold only object-sized numbers and cull exactly as the same scene would at
+/// the origin. (Composing view * translate(origin) in float instead, or float patches at world
+/// coordinates, costs |translation| * 6e-8 units of precision: at 1e5 BigGuy's frustum tests
+/// culled visible patches and ptp's rounding margin swallowed every cull.)
+struct WorldCamera {
+    DVec3 eye{0, 0, 5};
+    DVec3 target{0, 0, 0};
+    Vec3 up{0, 1, 0};
+    float fovy_radians = 1.0471976f;
+    float aspect = 1.0f;
+    float z_near = 0.1f;
+    float z_far = 100.0f;
+
+    /// The same camera in the frame whose 0 is the world point origin: eye - origin and
+    /// target - origin in double, each rounded once to float; other fields copied. A target
+    /// nearer the eye than the eye is to origin first moves out along the view ray to that
+    /// distance (the direction is what counts, and it survives the rounding). Its
+    /// view_projection() is the object_to_clip of patches stored relative to origin.
+    Camera local(DVec3 origin) const;
+};
+
+/// The world camera of a local one: eye and target plus origin, in double (inverse of local up
+/// to the rounding of local's results).
+WorldCamera to_world(const Camera& local_camera, DVec3 origin);
+
 enum class ViewMode { contain, free };
 const char* view_mode_name(ViewMode mode);
 bool parse_view_mode(const char* text, ViewMode& mode);

@@ -159,8 +159,9 @@ struct DisplacedCullView {
 };
 
 /// Prepares the per-frame constants. object_to_view = view * model (any affine matrix with
-/// non-degenerate rows); projection as described above.
-DisplacedCullView make_displaced_cull_view(const Mat4& object_to_view, const Mat4& projection);
+/// non-degenerate rows); projection as described above, in convention depth (clip_space.h;
+/// stored converted to zero_to_one).
+DisplacedCullView make_displaced_cull_view(const Mat4& object_to_view, const Mat4& projection, ClipDepth depth);
 
 /// Status of a computed bound.
 enum DisplacedBoundStatus : std::uint8_t {

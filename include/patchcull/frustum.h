@@ -1,6 +1,8 @@
 // patchcull/frustum.h: view-frustum cull kernels over patch batches (seed 000 §4.1.1, seed 002).
 //
-// Clip space as in math.h: inside means -w <= x <= w, -w <= y <= w, 0 <= z <= w. A patch is
+// Clip space as in math.h: inside means -w <= x <= w, -w <= y <= w, 0 <= z <= w. Entries that
+// take a clip matrix also take its ClipDepth (clip_space.h), with no default: a standard OpenGL
+// projection (-w <= z <= w) is converted, never misread. A patch is
 // culled (culled[i] = 1) only when no point of the (displaced) patch can be inside; otherwise
 // culled[i] = 0. Both kernels are plane tests in homogeneous clip space, so they stay correct
 // when control points straddle w <= 0 (behind the eye): no division by w ever happens.
@@ -22,10 +24,15 @@
 // patch within ~1e-6 (relative) of a plane may go either way. That is far below the rasterizer's
 // own precision (GL snaps vertices to 1/256 pixel after the same float transform; 1e-6 of the
 // clip cube is 0.002 pixel at 4096 pixels), so it cannot change which pixels are covered.
+// "Relative" means relative to the terms' magnitude, |control point| and the eye's distance from
+// the frame's 0: patches must be in a local frame near them (ControlMesh::origin, mesh.h; a
+// world camera comes in through WorldCamera::local, camera.h). World coordinates of 1e5 in float
+// made visible BigGuy patches cull (issue 9); in the local frame any translation culls alike.
 #pragma once
 
 #include <cstdint>
 
+#include "patchcull/clip_space.h"
 #include "patchcull/math.h"
 #include "patchcull/patch.h"
 
@@ -39,8 +46,10 @@ struct FrustumPlanes {
     float normal_length[6];  ///< |rows[k].xyz|: bound on the change per unit object-space motion
 };
 
-/// Planes of the clip volume of object_to_clip (projection * view * model).
-FrustumPlanes make_frustum_planes(const Mat4& object_to_clip);
+/// Planes of the clip volume of object_to_clip (projection * view * model) whose depth
+/// convention is depth (to_zero_to_one first, so the planes, and every kernel decision on them,
+/// are the same for one camera written in either convention).
+FrustumPlanes make_frustum_planes(const Mat4& object_to_clip, ClipDepth depth);
 
 /// frustum kernel, scalar reference.
 void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement,
@@ -51,10 +60,10 @@ void cull_frustum_simd(const PatchBatchView& patches, const float* max_displacem
 
 /// frustum-disp kernel (seed 002), scalar reference.
 void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement,
-                              const Mat4& object_to_clip, std::uint8_t* culled);
+                              const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled);
 /// frustum-disp kernel, SIMD.
 void cull_frustum_disp_simd(const PatchBatchView& patches, const float* max_displacement,
-                            const Mat4& object_to_clip, std::uint8_t* culled);
+                            const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled);
 
 /// Name of the instruction set the SIMD kernels dispatch to on this machine (e.g. "AVX2").
 const char* simd_target_name();

@@ -8,7 +8,10 @@
 // - Patches are in object space = world space (no model matrix); render parameters give view and
 //   projection, object_to_clip = projection * view. Clip space is GL's with
 //   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE): depth z/w in [0,1], larger = farther, cleared to 1,
-//   depth test GL_LESS.
+//   depth test GL_LESS. RenderParams::projection must be of that convention (a standard OpenGL
+//   projection first goes through to_zero_to_one, clip_space.h). An object far from the origin
+//   stays in its local frame (ControlMesh::origin) and the camera comes into it in double
+//   (WorldCamera::local, camera.h): every GL float then holds object-sized numbers.
 // - Framebuffer: RGBA8 colour, R32UI patch id, DEPTH32F; all read-backs of it are width*height
 //   values in image order: row 0 is the TOP row (GL window row height-1), pixel (x, row) at
 //   [row*width + x]. (The Hi-Z read-back, read_hiz, keeps hiz.h's order instead: row 0 = bottom.)

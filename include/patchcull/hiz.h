@@ -111,6 +111,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "patchcull/clip_space.h"
 #include "patchcull/math.h"
 #include "patchcull/patch.h"
 
@@ -183,8 +184,10 @@ struct PatchScreenBounds {
     PixelRect rect;
     float zmin = 0;
 };
+/// object_to_clip's depth convention is depth (clip_space.h); zmin is in zero_to_one depth, the
+/// depth buffer's window depth with glDepthRange(0, 1) in either convention.
 bool patch_screen_bounds(const PatchBatchView& patches, std::size_t index, const Mat4& object_to_clip,
-                         int width, int height, PatchScreenBounds& out);
+                         ClipDepth depth, int width, int height, PatchScreenBounds& out);
 
 /// Per-patch decision bytes written by the kernels.
 enum HiZDecision : std::uint8_t {
@@ -194,11 +197,12 @@ enum HiZDecision : std::uint8_t {
 };
 
 /// Frustum + occlusion test (steps 1-9), scalar reference. The screen is the pyramid's depth buffer
-/// (viewport (0, 0, W, H)). decision must hold patches.count bytes.
-void cull_occlusion_scalar(const PatchBatchView& patches, const Mat4& object_to_clip, const HiZPyramid& hiz,
-                           std::uint8_t* decision);
+/// (viewport (0, 0, W, H)). decision must hold patches.count bytes. depth: object_to_clip's
+/// convention (clip_space.h; the pyramid holds window depths in [0, 1] either way).
+void cull_occlusion_scalar(const PatchBatchView& patches, const Mat4& object_to_clip, ClipDepth depth,
+                           const HiZPyramid& hiz, std::uint8_t* decision);
 /// Same decisions, steps 1-6 in SIMD (Highway, target chosen once at run time).
-void cull_occlusion_simd(const PatchBatchView& patches, const Mat4& object_to_clip, const HiZPyramid& hiz,
-                         std::uint8_t* decision);
+void cull_occlusion_simd(const PatchBatchView& patches, const Mat4& object_to_clip, ClipDepth depth,
+                         const HiZPyramid& hiz, std::uint8_t* decision);
 
 }  // namespace patchcull

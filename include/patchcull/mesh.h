@@ -9,6 +9,21 @@
 
 namespace patchcull {
 
+/// A point or offset in double precision, for world positions far from the origin: engines
+/// place objects at 1e4 - 1e7 units, where a float's spacing is 1e-3 - 1 unit. Patches and
+/// kernels stay in float, in a local frame around such a point (ControlMesh::origin, the "local
+/// test coordinates" of Zachmann's lecture "Advanced Visibility Computations"); only the
+/// translation between the frames is carried in double, so float data never holds a large
+/// coordinate and the kernels' rounding stays relative to the object's own size.
+struct DVec3 {
+    double x = 0, y = 0, z = 0;
+};
+inline DVec3 operator+(DVec3 a, DVec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline DVec3 operator-(DVec3 a, DVec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline DVec3 to_double(Vec3 a) { return {a.x, a.y, a.z}; }
+/// Rounds each component to the nearest float: for offsets that are small (local coordinates).
+inline Vec3 to_float(DVec3 a) { return {static_cast<float>(a.x), static_cast<float>(a.y), static_cast<float>(a.z)}; }
+
 /// A semi-sharp or sharp crease on the edge (v0, v1), or a corner on vertex v0 (v1 unused).
 /// Sharpness follows OpenSubdiv: 0 smooth, >= 10 infinitely sharp.
 struct Crease {
@@ -20,8 +35,17 @@ struct Crease {
 /// corner c uses position face_vertices[c] and, when the mesh has texture coordinates,
 /// texcoord face_texcoords[c] (face_texcoords is then the same size as face_vertices, else empty).
 /// Faces are counter-clockwise seen from outside (OBJ convention).
+///
+/// Positions are relative to `origin`: the file's point X is origin + positions[i] (exactly up
+/// to one float rounding of the difference, done in double). Everything built from a mesh
+/// (patches, bounds, views, ground truth, GPU buffers) lives in this local frame; a camera or
+/// object_to_clip given in the file's (world) frame must be moved into it in double
+/// (WorldCamera::local, camera.h). origin is 0 for meshes near the origin (OBJ files whose
+/// bounding-box centre is within the box's diagonal of 0, so their float positions are as
+/// precise as centred ones and unchanged), else the bounding-box centre (parse_obj).
 struct ControlMesh {
     std::string name;  ///< source file or built-in name, used in messages
+    DVec3 origin;      ///< world position of the local frame's 0 (see above)
     std::vector<Vec3> positions;
     std::vector<Vec2> texcoords;
     std::vector<std::uint32_t> face_offsets{0};

@@ -20,7 +20,10 @@ namespace patchcull {
 /// ControlMesh::warnings: displacement then falls back to each patch's own (u,v) domain.
 ControlMesh load_obj(const std::string& path);
 
-/// Parses OBJ text from a stream; name is used in error messages.
+/// Parses OBJ text from a stream; name is used in error messages. Vertex coordinates are parsed
+/// in double (each must fit a float) and, when the bounding-box centre is farther from 0 than
+/// the box's diagonal, stored relative to that centre (ControlMesh::origin): a model at 1e7
+/// keeps its shape to float precision of its own size.
 ControlMesh parse_obj(std::istream& in, const std::string& name);
 
 }  // namespace patchcull

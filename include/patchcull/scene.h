@@ -12,6 +12,9 @@ namespace patchcull {
 
 struct LoadedModel {
     std::string name;                        ///< path or "teapot"
+    /// World position of the local frame the patches live in (ControlMesh::origin; 0 for the
+    /// teapot): a world-space camera must be moved into that frame (WorldCamera::local).
+    DVec3 origin;
     std::optional<SubdivisionModel> subdiv;  ///< absent for the built-in teapot (already Bezier)
     int split_levels = 0;
     PatchFrame rest;                         ///< patches at rest, after split_levels splits

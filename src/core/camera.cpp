@@ -17,6 +17,38 @@ bool parse_view_mode(const char* text, ViewMode& mode) {
     return true;
 }
 
+Camera WorldCamera::local(DVec3 origin) const {
+    Camera cam;
+    const DVec3 e = eye - origin;
+    DVec3 d = target - eye;
+    // look_at uses only the direction to the target; a target much nearer the eye than the eye
+    // is to the origin would lose that direction in the rounding of both points to float, so it
+    // moves out along the same ray, as far from the eye as the eye is from the origin.
+    const double de = std::sqrt(e.x * e.x + e.y * e.y + e.z * e.z);
+    const double dd = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    if (dd > 0 && dd < de) d = {d.x * (de / dd), d.y * (de / dd), d.z * (de / dd)};
+    cam.eye = to_float(e);
+    cam.target = to_float(e + d);
+    cam.up = up;
+    cam.fovy_radians = fovy_radians;
+    cam.aspect = aspect;
+    cam.z_near = z_near;
+    cam.z_far = z_far;
+    return cam;
+}
+
+WorldCamera to_world(const Camera& c, DVec3 origin) {
+    WorldCamera w;
+    w.eye = to_double(c.eye) + origin;
+    w.target = to_double(c.target) + origin;
+    w.up = c.up;
+    w.fovy_radians = c.fovy_radians;
+    w.aspect = c.aspect;
+    w.z_near = c.z_near;
+    w.z_far = c.z_far;
+    return w;
+}
+
 ViewGenerator::ViewGenerator(const Bounds& object, ViewMode mode, std::uint64_t seed, float aspect)
     : object_(object), mode_(mode), state_(seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull), aspect_(aspect) {}
 

@@ -357,11 +357,12 @@ bool parse_normal_cone(const char* text, NormalConeKind& kind) {
     return true;
 }
 
-DisplacedCullView make_displaced_cull_view(const Mat4& object_to_view, const Mat4& projection) {
+DisplacedCullView make_displaced_cull_view(const Mat4& object_to_view, const Mat4& any_projection, ClipDepth depth) {
     DisplacedCullView v;
+    const Mat4 projection = to_zero_to_one(any_projection, depth);
     v.object_to_view = object_to_view;
     v.projection = projection;
-    v.view_planes = make_frustum_planes(projection);
+    v.view_planes = make_frustum_planes(projection, ClipDepth::zero_to_one);
     const Mat4& p = projection;
     const bool frustum_form = p.at(0, 1) == 0 && p.at(0, 3) == 0 && p.at(1, 0) == 0 && p.at(1, 3) == 0 &&
                               p.at(2, 0) == 0 && p.at(2, 1) == 0 && p.at(3, 0) == 0 && p.at(3, 1) == 0 &&

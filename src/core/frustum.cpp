@@ -37,7 +37,8 @@ inline const float* comp(const PatchBatchView& v, int k, int c) { return v.compo
 
 }  // namespace
 
-FrustumPlanes make_frustum_planes(const Mat4& object_to_clip) {
+FrustumPlanes make_frustum_planes(const Mat4& any_object_to_clip, ClipDepth depth) {
+    const Mat4 object_to_clip = to_zero_to_one(any_object_to_clip, depth);
     const Vec4 x = object_to_clip.row(0);
     const Vec4 y = object_to_clip.row(1);
     const Vec4 z = object_to_clip.row(2);
@@ -97,8 +98,8 @@ void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displac
 // and the patch is culled when all 8 corners fail the same clip-plane inequality.
 PATCHCULL_SCALAR_CLONES
 void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement,
-                              const Mat4& object_to_clip, std::uint8_t* culled) {
-    const Mat4& m = object_to_clip;
+                              const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled) {
+    const Mat4 m = to_zero_to_one(object_to_clip, depth);
     for (std::size_t p = 0; p < patches.count; ++p) {
         const float d = max_displacement ? max_displacement[p] : 0.0f;
         float lo[3], hi[3];

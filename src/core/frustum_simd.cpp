@@ -175,9 +175,9 @@ void cull_frustum_simd(const PatchBatchView& patches, const float* max_displacem
 }
 
 void cull_frustum_disp_simd(const PatchBatchView& patches, const float* max_displacement,
-                            const Mat4& object_to_clip, std::uint8_t* culled) {
+                            const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled) {
     if (patches.count == 0) return;
-    HWY_DYNAMIC_DISPATCH(CullFrustumDisp)(patches, max_displacement, object_to_clip, culled);
+    HWY_DYNAMIC_DISPATCH(CullFrustumDisp)(patches, max_displacement, to_zero_to_one(object_to_clip, depth), culled);
 }
 
 const char* simd_target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }

@@ -184,15 +184,17 @@ constexpr std::size_t kChunk = 256;  // patches per frustum pass (64 KiB of cont
 }  // namespace
 
 PATCHCULL_HIZ_CLONES
-bool patch_screen_bounds(const PatchBatchView& patches, std::size_t index, const Mat4& object_to_clip, int width,
-                         int height, PatchScreenBounds& out) {
-    return patch_bounds(patches, index, make_clip_rows(object_to_clip, width, height), width, height, out);
+bool patch_screen_bounds(const PatchBatchView& patches, std::size_t index, const Mat4& object_to_clip, ClipDepth depth,
+                         int width, int height, PatchScreenBounds& out) {
+    return patch_bounds(patches, index, make_clip_rows(to_zero_to_one(object_to_clip, depth), width, height), width,
+                        height, out);
 }
 
 PATCHCULL_HIZ_CLONES
-void cull_occlusion_scalar(const PatchBatchView& patches, const Mat4& object_to_clip, const HiZPyramid& hiz,
-                           std::uint8_t* decision) {
-    const FrustumPlanes planes = make_frustum_planes(object_to_clip);
+void cull_occlusion_scalar(const PatchBatchView& patches, const Mat4& any_object_to_clip, ClipDepth depth,
+                           const HiZPyramid& hiz, std::uint8_t* decision) {
+    const Mat4 object_to_clip = to_zero_to_one(any_object_to_clip, depth);
+    const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
     const int width = hiz.depth_width(), height = hiz.depth_height();
     const ClipRows cr = make_clip_rows(object_to_clip, width, height);
     for (std::size_t first = 0; first < patches.count; first += kChunk) {

@@ -109,7 +109,7 @@ void CullOcclusion(const PatchBatchView& patches, const Mat4& object_to_clip, co
                    std::uint8_t* decision) {
     const DF d;
     const std::size_t N = hn::Lanes(d);
-    const FrustumPlanes planes = make_frustum_planes(object_to_clip);
+    const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);  // converted below
     const int width = hiz.depth_width(), height = hiz.depth_height();
     Consts k_;
     for (int r = 0; r < 4; ++r)
@@ -144,10 +144,10 @@ namespace patchcull {
 
 HWY_EXPORT(CullOcclusion);
 
-void cull_occlusion_simd(const PatchBatchView& patches, const Mat4& object_to_clip, const HiZPyramid& hiz,
-                         std::uint8_t* decision) {
+void cull_occlusion_simd(const PatchBatchView& patches, const Mat4& object_to_clip, ClipDepth depth,
+                         const HiZPyramid& hiz, std::uint8_t* decision) {
     if (patches.count == 0) return;
-    HWY_DYNAMIC_DISPATCH(CullOcclusion)(patches, object_to_clip, hiz, decision);
+    HWY_DYNAMIC_DISPATCH(CullOcclusion)(patches, to_zero_to_one(object_to_clip, depth), hiz, decision);
 }
 
 }  // namespace patchcull

@@ -45,7 +45,7 @@ const std::vector<Method>& methods() {
          }},
         {"frustum-disp", Truth::frustum,
          [](const PatchBatchView& b, const float* d, const ViewContext& v, std::uint8_t* out) {
-             cull_frustum_disp_simd(b, d, v.object_to_clip, out);
+             cull_frustum_disp_simd(b, d, v.object_to_clip, ClipDepth::zero_to_one, out);
          }},
         {"tcone", Truth::backface,
          [](const PatchBatchView& b, const float*, const ViewContext& v, std::uint8_t* out) {
@@ -139,7 +139,7 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
         const Camera camera = views.next();
         ViewContext ctx;
         ctx.object_to_clip = camera.view_projection();
-        ctx.planes = make_frustum_planes(ctx.object_to_clip);
+        ctx.planes = make_frustum_planes(ctx.object_to_clip, ClipDepth::zero_to_one);
         ctx.eye = camera.eye;
         ctx.alpha = clip_space_eye_alpha(camera.projection());
         for (std::size_t m = 0; m < selected.size(); ++m) {

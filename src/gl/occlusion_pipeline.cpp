@@ -114,7 +114,7 @@ void PatchRenderer::Impl::cull_occlusion(const Mat4& object_to_clip, std::uint32
         glNamedBufferSubData(backpatch_flags, 0, static_cast<GLsizeiptr>(flags.size() * sizeof(std::uint32_t)),
                              flags.data());
     }
-    const FrustumPlanes planes = make_frustum_planes(object_to_clip);
+    const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
     const GLuint op = occlusion_program;
     glProgramUniform4fv(op, occlusion_loc.rows, 6, &planes.rows[0].x);
     glProgramUniform1fv(op, occlusion_loc.normal_length, 6, planes.normal_length);

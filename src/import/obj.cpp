@@ -49,6 +49,40 @@ float parse_float(std::string_view token, const LineContext& ctx) {
     return value;
 }
 
+// A vertex coordinate, parsed in double so that a model far from the origin can be re-centred
+// before the rounding to float (recentre below). parse_float checks it first: the same errors,
+// and the value must fit a float.
+double parse_coordinate(std::string_view token, const LineContext& ctx) {
+    parse_float(token, ctx);
+    double value = 0;
+    const char* first = token.data();
+    if (*first == '+') ++first;
+    std::from_chars(first, token.data() + token.size(), value);
+    return value;
+}
+
+// Moves the positions into a local frame (ControlMesh::origin, mesh.h) when the model lies far
+// from 0. At a translation of 1e7 a float's spacing is 1 unit, so float positions would already
+// be wrong by a good part of a model's size (BigGuy is about 20 units); and every later float
+// computation (patches, clip transforms, ptp's rounding margin) loses precision in proportion
+// to |position|, not to the model's size. A model whose bounding-box centre is within the box's
+// diagonal of 0 keeps origin 0 and its positions exactly as before (they are as precise as
+// centred ones, within a factor 3).
+void recentre(const std::vector<DVec3>& world, ControlMesh& mesh) {
+    if (world.empty()) return;
+    DVec3 lo = world[0], hi = world[0];
+    for (const DVec3& p : world) {
+        lo = {std::fmin(lo.x, p.x), std::fmin(lo.y, p.y), std::fmin(lo.z, p.z)};
+        hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y), std::fmax(hi.z, p.z)};
+    }
+    const DVec3 centre{0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.5 * (lo.z + hi.z)};
+    const DVec3 d = hi - lo;
+    const double diagonal = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    if (std::fmax(std::fabs(centre.x), std::fmax(std::fabs(centre.y), std::fabs(centre.z))) <= diagonal) return;
+    mesh.origin = centre;
+    for (std::size_t i = 0; i < world.size(); ++i) mesh.positions[i] = to_float(world[i] - centre);
+}
+
 long parse_int(std::string_view token, const LineContext& ctx, const char* what) {
     long value = 0;
     auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
@@ -98,6 +132,7 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
     mesh.name = name;
     bool faces_with_uv = false, faces_without_uv = false;
     std::vector<std::uint32_t> face_uv_scratch;
+    std::vector<DVec3> world_positions;  // as in the file, for recentre()
     std::string line;
     std::size_t line_number = 0;
     while (std::getline(in, line)) {
@@ -113,8 +148,9 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
             // [a]); both are checked and ignored (control meshes are polynomial, colour unused).
             const std::size_t values = tokens.size() - 1;
             if (values != 3 && values != 4 && values != 6 && values != 7) ctx.fail("vertex needs 3 coordinates");
-            mesh.positions.push_back({parse_float(tokens[1], ctx), parse_float(tokens[2], ctx),
-                                      parse_float(tokens[3], ctx)});
+            world_positions.push_back({parse_coordinate(tokens[1], ctx), parse_coordinate(tokens[2], ctx),
+                                       parse_coordinate(tokens[3], ctx)});
+            mesh.positions.push_back(to_float(world_positions.back()));  // origin 0 until recentre()
             for (std::size_t k = 4; k < tokens.size(); ++k) parse_float(tokens[k], ctx);
         } else if (key == "vt") {
             if (tokens.size() < 3 || tokens.size() > 4) ctx.fail("texture coordinate needs 2 values");
@@ -168,6 +204,7 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
     }
     if (in.bad()) throw Error(name + ": read error");
     if (mesh.face_count() == 0) throw Error(name + ": no faces");
+    recentre(world_positions, mesh);
     if (faces_with_uv && faces_without_uv) {
         mesh.face_texcoords.clear();
         mesh.warnings.push_back(name + ": some faces lack texture coordinates; texture coordinates ignored");

@@ -45,6 +45,7 @@ struct FVarUV {
 RefinedMesh refine_uniform_once(const ControlMesh& mesh) {
     RefinedMesh out;
     out.mesh.name = mesh.name;
+    out.mesh.origin = mesh.origin;  // refined positions are stencils of the local ones
     out.mesh.warnings = mesh.warnings;
     osd_detail::RefinerPtr refiner = osd_detail::create_refiner(mesh, &out.mesh.warnings);
 

@@ -47,6 +47,7 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
     model.subdiv = build_model(mesh, scheme);
     for (const std::string& w : model.subdiv->mesh.warnings)
         if (std::find(model.warnings.begin(), model.warnings.end(), w) == model.warnings.end()) model.warnings.push_back(w);
+    model.origin = mesh.origin;
     evaluate_patches(*model.subdiv, model.subdiv->mesh.positions, split_levels, model.rest);
     model.closed = model.subdiv->mesh.is_closed();
     return model;

@@ -377,7 +377,7 @@ std::vector<Tally> run_property(Variant variant, int patches, unsigned seed) {
         for (int cam_index = 0; cam_index < 3; ++cam_index) {
             const Camera cam = views.next();
             const Mat4 object_to_view = rng() % 4 == 0 ? cam.view() * random_model(rng) : cam.view();
-            const DisplacedCullView view = make_displaced_cull_view(object_to_view, cam.projection());
+            const DisplacedCullView view = make_displaced_cull_view(object_to_view, cam.projection(), ClipDepth::zero_to_one);
             EXPECT_TRUE(view.valid);
             Checker ck(object_to_view, cam.projection());
             ck.set_slack(patch, range);
@@ -459,7 +459,7 @@ BezierPatch facing_square(float distance) {
 // square is the same box.
 TEST(DisplacedBounds, FacingSquareByHand) {
     const Mat4 proj = perspective(1.0f, 1.0f, 0.5f, 50.0f);
-    const DisplacedCullView view = make_displaced_cull_view(Mat4{}, proj);
+    const DisplacedCullView view = make_displaced_cull_view(Mat4{}, proj, ClipDepth::zero_to_one);
     ASSERT_TRUE(view.valid);
     const BezierPatch square = facing_square(10);
     const DisplacementRange range{-0.5f, 0.5f};
@@ -490,7 +490,7 @@ TEST(DisplacedBounds, FacingSquareByHand) {
 // only away from the eye (d_max = 0 with du x dv towards the eye) keeps its front at t = 10.
 TEST(DisplacedBounds, OneSidedRangeUsesTheCone) {
     const Mat4 proj = perspective(1.0f, 1.0f, 0.5f, 50.0f);
-    const DisplacedCullView view = make_displaced_cull_view(Mat4{}, proj);
+    const DisplacedCullView view = make_displaced_cull_view(Mat4{}, proj, ClipDepth::zero_to_one);
     const BezierPatch square = facing_square(10);
     auto depth_at = [&](double t) { return -proj.at(2, 2) + proj.at(2, 3) / t; };
     for (DisplacedBoundKind b : kBounds) {
@@ -504,7 +504,7 @@ TEST(DisplacedBounds, OneSidedRangeUsesTheCone) {
 
 TEST(DisplacedBounds, BehindAndAcrossTheEye) {
     const Mat4 proj = perspective(1.0f, 1.0f, 0.5f, 50.0f);
-    const DisplacedCullView view = make_displaced_cull_view(Mat4{}, proj);
+    const DisplacedCullView view = make_displaced_cull_view(Mat4{}, proj, ClipDepth::zero_to_one);
     HiZPyramid hiz;
     const std::vector<float> zero(64 * 64, 0.0f);  // everything is occluded, if projectable
     hiz.build(zero.data(), 64, 64);
@@ -533,7 +533,7 @@ TEST(DisplacedBounds, BehindAndAcrossTheEye) {
 
 TEST(DisplacedBounds, NonFiniteInputsAndUnsupportedViewsAreNeverCulled) {
     const Mat4 proj = perspective(1.0f, 1.0f, 0.5f, 50.0f);
-    const DisplacedCullView view = make_displaced_cull_view(Mat4{}, proj);
+    const DisplacedCullView view = make_displaced_cull_view(Mat4{}, proj, ClipDepth::zero_to_one);
     HiZPyramid hiz;
     const std::vector<float> zero(16 * 16, 0.0f);
     hiz.build(zero.data(), 16, 16);
@@ -559,7 +559,7 @@ TEST(DisplacedBounds, NonFiniteInputsAndUnsupportedViewsAreNeverCulled) {
                 }
                 Mat4 bad_view;
                 bad_view.at(1, 3) = bad;
-                EXPECT_FALSE(make_displaced_cull_view(bad_view, proj).valid);
+                EXPECT_FALSE(make_displaced_cull_view(bad_view, proj, ClipDepth::zero_to_one).valid);
             }
     // Zero or negative weights, and 16 huge coordinates whose sums overflow: never culled.
     for (DisplacedBoundKind b : kBounds) {
@@ -573,7 +573,7 @@ TEST(DisplacedBounds, NonFiniteInputsAndUnsupportedViewsAreNeverCulled) {
         for (Vec4& cp : huge.cp) cp.x = cp.x * 3e38f;
         Mat4 scale10;
         scale10.at(0, 0) = scale10.at(1, 1) = scale10.at(2, 2) = 10.0f;
-        const DisplacedCullView scaled = make_displaced_cull_view(scale10, proj);
+        const DisplacedCullView scaled = make_displaced_cull_view(scale10, proj, ClipDepth::zero_to_one);
         ASSERT_EQ(displaced_bound_hiz_decision(
                       compute_displaced_bound(facing_square(2), {}, b, NormalConeKind::acon, scaled), hiz),
                   kHiZOccluded);
@@ -589,8 +589,8 @@ TEST(DisplacedBounds, NonFiniteInputsAndUnsupportedViewsAreNeverCulled) {
     shifted.at(0, 3) = 0.5f;
     Mat4 singular;
     singular.at(1, 0) = singular.at(1, 1) = singular.at(1, 2) = 0.0f;
-    for (const DisplacedCullView& v : {make_displaced_cull_view(Mat4{}, ortho), make_displaced_cull_view(Mat4{}, shifted),
-                                       make_displaced_cull_view(singular, proj)}) {
+    for (const DisplacedCullView& v : {make_displaced_cull_view(Mat4{}, ortho, ClipDepth::zero_to_one), make_displaced_cull_view(Mat4{}, shifted, ClipDepth::zero_to_one),
+                                       make_displaced_cull_view(singular, proj, ClipDepth::zero_to_one)}) {
         EXPECT_FALSE(v.valid);
         for (DisplacedBoundKind b : kBounds) {
             const DisplacedBound bound = compute_displaced_bound(behind, {}, b, NormalConeKind::full, v);
@@ -605,7 +605,7 @@ TEST(DisplacedBounds, RationalPatchesFallBackToFull) {
     PatchGen gen(5);
     std::mt19937 rng(5);
     const Camera cam;  // at (0,0,5) looking at the origin
-    const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection());
+    const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection(), ClipDepth::zero_to_one);
     for (int trial = 0; trial < 50; ++trial) {
         BezierPatch p = gen.sheet(0.05);
         std::uniform_real_distribution<float> w(0.5f, 2.0f);
@@ -636,7 +636,7 @@ TEST(DisplacedBounds, CafWithAConeLiesInsideTheFullCaf) {
         const DisplacementRange range = random_range(rng, size);
         ViewGenerator views(bounds_of(p, float(size)), trial % 2 ? ViewMode::free : ViewMode::contain, trial);
         const Camera cam = views.next();
-        const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection());
+        const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection(), ClipDepth::zero_to_one);
         const DisplacedBound full = compute_displaced_bound(p, range, DisplacedBoundKind::caf, NormalConeKind::full, view);
         for (NormalConeKind c : {NormalConeKind::acon, NormalConeKind::con}) {
             const DisplacedBound b = compute_displaced_bound(p, range, DisplacedBoundKind::caf, c, view);
@@ -680,7 +680,7 @@ TEST(DisplacedBounds, BatchMatchesSinglePatch) {
     const PatchBatch batch = make_batch(patches);
     Camera cam;
     cam.eye = {3, 2, 30};
-    const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection());
+    const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection(), ClipDepth::zero_to_one);
     const std::vector<float> depth = random_depth_buffer(rng, 40, 30, 0.9, 1.0);
     HiZPyramid hiz;
     hiz.build(depth.data(), 40, 30);
@@ -793,7 +793,7 @@ TEST(DisplacedBoundsTruth, TeapotWithADisplacementMap) {
     std::string first;
     for (int v = 0; v < 60 / kSanitizerDivisor; ++v) {
         const Camera cam = views.next();
-        const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection());
+        const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection(), ClipDepth::zero_to_one);
         Checker ck(cam.view(), cam.projection());
         // A wall over the left half of the screen at the depth of the box centre.
         std::vector<float> depth(kW * kH, 1.0f);

@@ -33,10 +33,10 @@ std::vector<std::uint8_t> run_cull(Kernel kernel, Impl impl, const PatchBatchVie
     constexpr std::size_t kGuard = 64;
     std::vector<std::uint8_t> out(view.count + kGuard, 0xAB);
     if (kernel == Kernel::kFrustum) {
-        const FrustumPlanes planes = make_frustum_planes(object_to_clip);
+        const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
         (impl == Impl::kScalar ? cull_frustum_scalar : cull_frustum_simd)(view, disp, planes, out.data());
     } else {
-        (impl == Impl::kScalar ? cull_frustum_disp_scalar : cull_frustum_disp_simd)(view, disp, object_to_clip,
+        (impl == Impl::kScalar ? cull_frustum_disp_scalar : cull_frustum_disp_simd)(view, disp, object_to_clip, ClipDepth::zero_to_one,
                                                                                      out.data());
     }
     for (std::size_t i = view.count; i < out.size(); ++i) EXPECT_EQ(out[i], 0xAB) << "wrote past count at " << i;
@@ -108,7 +108,7 @@ TEST(FrustumPlanes, ExtractsRowsAsDocumented) {
     std::uniform_real_distribution<float> r(-3, 3);
     Mat4 m;
     for (float& v : m.m) v = r(rng);
-    const FrustumPlanes p = make_frustum_planes(m);
+    const FrustumPlanes p = make_frustum_planes(m, ClipDepth::zero_to_one);
     auto same = [](Vec4 a, Vec4 b) { return a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w; };
     const Vec4 x = m.row(0), y = m.row(1), z = m.row(2), w = m.row(3);
     EXPECT_TRUE(same(p.rows[0], w + x));

@@ -311,7 +311,7 @@ enum class Impl { kScalar, kSimd };
 std::vector<std::uint8_t> run_kernel(Impl impl, const PatchBatchView& v, const Mat4& m, const HiZPyramid& hiz) {
     constexpr std::size_t kGuard = 64;
     std::vector<std::uint8_t> out(v.count + kGuard, 0xAB);
-    (impl == Impl::kScalar ? cull_occlusion_scalar : cull_occlusion_simd)(v, m, hiz, out.data());
+    (impl == Impl::kScalar ? cull_occlusion_scalar : cull_occlusion_simd)(v, m, ClipDepth::zero_to_one, hiz, out.data());
     for (std::size_t i = v.count; i < out.size(); ++i) EXPECT_EQ(out[i], 0xAB) << "wrote past count at " << i;
     out.resize(v.count);
     return out;
@@ -375,20 +375,20 @@ TEST(HiZKernels, HandBuiltDecisions) {
 
     // Patch 4 is not projectable; its bounds say so.
     PatchScreenBounds b;
-    EXPECT_FALSE(patch_screen_bounds(batch.view(), 4, proj, W, H, b));
-    ASSERT_TRUE(patch_screen_bounds(batch.view(), 0, proj, W, H, b));
+    EXPECT_FALSE(patch_screen_bounds(batch.view(), 4, proj, ClipDepth::zero_to_one, W, H, b));
+    ASSERT_TRUE(patch_screen_bounds(batch.view(), 0, proj, ClipDepth::zero_to_one, W, H, b));
     EXPECT_GT(b.zmin, wall);
 
     // Patch 6 (tiny) seen through a one-pixel hole in the wall is visible; the frustum result is the
     // frustum kernel's.
-    ASSERT_TRUE(patch_screen_bounds(batch.view(), 6, proj, W, H, b));
+    ASSERT_TRUE(patch_screen_bounds(batch.view(), 6, proj, ClipDepth::zero_to_one, W, H, b));
     EXPECT_EQ(b.rect.x0, b.rect.x1);
     depth[static_cast<std::size_t>(b.rect.y0) * W + b.rect.x0] = 1.0f;
     hiz.build(depth.data(), W, H);
     EXPECT_EQ(run_kernel(Impl::kScalar, batch.view(), proj, hiz)[6], kHiZVisible);
     EXPECT_EQ(run_kernel(Impl::kSimd, batch.view(), proj, hiz)[6], kHiZVisible);
     std::vector<std::uint8_t> frustum(patches.size());
-    cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(proj), frustum.data());
+    cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(proj, ClipDepth::zero_to_one), frustum.data());
     const auto got = run_kernel(Impl::kScalar, batch.view(), proj, hiz);
     for (std::size_t i = 0; i < patches.size(); ++i) EXPECT_EQ(got[i] == kHiZFrustumCulled, frustum[i] == 1) << i;
 }
@@ -416,7 +416,7 @@ TEST(HiZKernels, PatchStraddlingTheEyePlaneIsNeverOccluded) {
         for (std::size_t i = 0; i < d.size(); ++i) {
             ASSERT_NE(d[i], kHiZOccluded) << i;
             PatchScreenBounds b;
-            ASSERT_FALSE(patch_screen_bounds(batch.view(), i, proj, W, H, b)) << i;
+            ASSERT_FALSE(patch_screen_bounds(batch.view(), i, proj, ClipDepth::zero_to_one, W, H, b)) << i;
         }
     }
 }
@@ -632,11 +632,11 @@ enum class Broken { kFloorLevel, kMaxZ };
 std::vector<std::uint8_t> broken_decisions(const Scene& s, const HiZPyramid& hiz, Broken how) {
     std::vector<std::uint8_t> d(s.patches.size());
     const PatchBatch batch = make_batch(s.patches);
-    cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(s.object_to_clip), d.data());
+    cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(s.object_to_clip, ClipDepth::zero_to_one), d.data());
     for (std::size_t i = 0; i < d.size(); ++i) {
         if (d[i]) continue;
         PatchScreenBounds b;
-        if (!patch_screen_bounds(batch.view(), i, s.object_to_clip, s.W, s.H, b)) continue;
+        if (!patch_screen_bounds(batch.view(), i, s.object_to_clip, ClipDepth::zero_to_one, s.W, s.H, b)) continue;
         if (how == Broken::kFloorLevel) {
             d[i] = corner_max(hiz, b.rect, floor_level(b.rect, hiz.levels())) < b.zmin ? kHiZOccluded : kHiZVisible;
         } else {

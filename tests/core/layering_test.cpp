@@ -15,7 +15,8 @@ namespace {
 // Public headers by layer.
 const std::set<std::string> kCoreHeaders = {"math.h", "patch.h", "mesh.h", "displacement.h", "camera.h",
                                             "frustum.h", "ground_truth.h", "parallel.h", "teapot.h", "error.h",
-                                            "hiz.h", "cones.h", "backpatch.h", "displaced_bounds.h"};
+                                            "hiz.h", "cones.h", "backpatch.h", "displaced_bounds.h",
+                                            "clip_space.h"};
 const std::set<std::string> kImportHeaders = {"obj.h", "subdivision.h", "image.h", "animation.h", "scene.h",
                                               "default_scene.h"};
 

@@ -155,11 +155,11 @@ std::vector<TestView> make_views(const Scene& s, unsigned seed) {
     ViewGenerator free_views(s.bounds, ViewMode::free, seed + 1, aspect);
     for (int i = 0; i < 2; ++i) {
         const Camera c = contain.next();
-        views.push_back({"contain " + std::to_string(i), make_displaced_cull_view(c.view(), c.projection())});
+        views.push_back({"contain " + std::to_string(i), make_displaced_cull_view(c.view(), c.projection(), ClipDepth::zero_to_one)});
     }
     for (int i = 0; i < 2; ++i) {
         const Camera c = free_views.next();
-        views.push_back({"free " + std::to_string(i), make_displaced_cull_view(c.view(), c.projection())});
+        views.push_back({"free " + std::to_string(i), make_displaced_cull_view(c.view(), c.projection(), ClipDepth::zero_to_one)});
     }
     {
         // The eye 0.02 in front of a teapot patch's centre, looking across the scene.
@@ -172,12 +172,12 @@ std::vector<TestView> make_views(const Scene& s, unsigned seed) {
         c.aspect = aspect;
         c.z_near = 0.005f;
         c.z_far = 40.0f;
-        views.push_back({"eye close", make_displaced_cull_view(c.view(), c.projection())});
+        views.push_back({"eye close", make_displaced_cull_view(c.view(), c.projection(), ClipDepth::zero_to_one)});
     }
     {
         std::mt19937 rng(seed);
         const Camera c = contain.next();
-        views.push_back({"non-rigid model", make_displaced_cull_view(c.view() * random_model(rng), c.projection())});
+        views.push_back({"non-rigid model", make_displaced_cull_view(c.view() * random_model(rng), c.projection(), ClipDepth::zero_to_one)});
     }
     for (const TestView& v : views) EXPECT_TRUE(v.view.valid) << v.name;
     return views;
@@ -373,7 +373,7 @@ TEST(DisplacedGpu, InvalidViewCullsNothing) {
     Mat4 ortho_like = cam.projection();
     ortho_like.at(3, 2) = 0.0f;  // not of the glFrustum form: make_displaced_cull_view refuses it
     ortho_like.at(3, 3) = 1.0f;
-    const DisplacedCullView view = make_displaced_cull_view(cam.view(), ortho_like);
+    const DisplacedCullView view = make_displaced_cull_view(cam.view(), ortho_like, ClipDepth::zero_to_one);
     ASSERT_FALSE(view.valid);
     DisplacedCuller& g = culler();
     g.set_patches(s.patches, s.ranges);
@@ -405,7 +405,7 @@ TEST(DisplacedGpu, ReadsTheRenderersPatchBuffer) {
     cam.target = {1, 0, 1.2f};
     cam.z_near = 0.05f;
     cam.up = {0, 0, 1};
-    const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection());
+    const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection(), ClipDepth::zero_to_one);
     std::vector<std::uint8_t> cpu(patches.size()), gpu;
     cull_displaced_frustum(batch.view(), ranges.data(), DisplacedBoundKind::caf, NormalConeKind::con, view, cpu.data());
     g.cull_frustum(DisplacedBoundKind::caf, NormalConeKind::con, view, &gpu);
@@ -440,7 +440,7 @@ TEST(DisplacedGpu, MisuseThrows) {
     DisplacedCuller fresh(test::context());
     fresh.set_patches(test::split_teapot(0));
     const Camera cam;
-    const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection());
+    const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection(), ClipDepth::zero_to_one);
     EXPECT_THROW(fresh.cull_occlusion(DisplacedBoundKind::caf, NormalConeKind::full, view), Error);  // no Hi-Z
     EXPECT_THROW(fresh.set_ranges(std::vector<DisplacementRange>(3)), Error);
     EXPECT_THROW(fresh.set_patches(test::split_teapot(0), std::vector<DisplacementRange>(5)), Error);

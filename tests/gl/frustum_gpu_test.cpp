@@ -99,7 +99,7 @@ TEST(GpuFrustumCull, SameDecisionsAsCpuKernelOnRandomInputs) {
         PatchAttributes attributes;
         attributes.max_displacement = c.displacement;
         r.set_patches(c.patches, attributes);
-        const FrustumPlanes planes = make_frustum_planes(c.object_to_clip);
+        const FrustumPlanes planes = make_frustum_planes(c.object_to_clip, ClipDepth::zero_to_one);
         std::vector<float> gpu_values;
         r.cull_frustum(planes, &gpu_values);
         const std::vector<std::uint32_t> gpu = r.read_cull_flags();
@@ -197,7 +197,7 @@ TEST(GpuFrustumCull, MarginIsUsedAndFlagsAreOverwritten) {
     r.set_patches({patch, patch}, test::margins_only({0.0f, 10.0f}));
     const std::uint8_t stale[2] = {0, 1};
     r.set_cull_flags(stale);
-    r.cull_frustum(make_frustum_planes(vp));
+    r.cull_frustum(make_frustum_planes(vp, ClipDepth::zero_to_one));
     const auto flags = r.read_cull_flags();
     EXPECT_EQ(flags[0], 1u);
     EXPECT_EQ(flags[1], 0u);
@@ -231,7 +231,7 @@ void strict_views(PatchRenderer& r, const std::vector<BezierPatch>& patches, con
         r.render(params);
         const std::vector<std::uint32_t> reference = r.read_ids();
 
-        const FrustumPlanes planes = make_frustum_planes(cam.view_projection());
+        const FrustumPlanes planes = make_frustum_planes(cam.view_projection(), ClipDepth::zero_to_one);
         r.cull_frustum(planes);
         const std::vector<std::uint32_t> flags = r.read_cull_flags();
         params.use_cull_flags = true;

@@ -97,7 +97,7 @@ DecisionCounts compare_decisions(PatchRenderer& r, const std::vector<BezierPatch
                                  const HiZPyramid& cpu_hiz, const char* what) {
     const PatchBatch batch = make_batch(patches);
     std::vector<std::uint8_t> cpu(patches.size(), 0xEE);
-    cull_occlusion_scalar(batch.view(), m, cpu_hiz, cpu.data());
+    cull_occlusion_scalar(batch.view(), m, ClipDepth::zero_to_one, cpu_hiz, cpu.data());
     r.cull_occlusion(m, CullMode::all);
     const std::vector<std::uint32_t> words = r.read_cull_flags();
     DecisionCounts n;

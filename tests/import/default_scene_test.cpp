@@ -69,7 +69,7 @@ TEST(DefaultScene, CameraPathSeesTheGroupAndCutsSomePatches) {
     const PatchBatch batch = make_batch(patches);
     for (const Camera& camera : path) {
         std::vector<std::uint8_t> culled(patches.size());
-        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(camera.view_projection()), culled.data());
+        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(camera.view_projection(), ClipDepth::zero_to_one), culled.data());
         const auto n = static_cast<std::size_t>(std::count(culled.begin(), culled.end(), 1));
         // Most of the scene is in view, but not all of it: frustum culling has work.
         EXPECT_GT(n, 0u);
@@ -89,7 +89,7 @@ TEST(DefaultScene, ModelSceneStandsOnTheGroundInView) {
     const PatchBatch batch = make_batch(patches);
     for (const Camera& camera : scene.camera_path(4, 1.0f)) {
         std::vector<std::uint8_t> culled(patches.size());
-        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(camera.view_projection()), culled.data());
+        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(camera.view_projection(), ClipDepth::zero_to_one), culled.data());
         EXPECT_EQ(std::count(culled.begin(), culled.end(), 1), 0);  // the whole teapot is in view
     }
 }

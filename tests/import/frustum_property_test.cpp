@@ -92,7 +92,7 @@ TEST(FrustumProperty, GroundTruthCatchesAKernelThatIgnoresDisplacement) {
     std::uint64_t false_culls = 0;
     for (int v = 0; v < 200; ++v) {
         const Mat4 clip = views.next().view_projection();
-        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(clip), culled.data());  // margin dropped
+        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(clip, ClipDepth::zero_to_one), culled.data());  // margin dropped
         for (std::size_t p = 0; p < n; ++p)
             if (culled[p] && any_point_in_clip_volume(clip, &samples[p * 289], 289)) ++false_culls;
     }
