@@ -1,19 +1,48 @@
 // Patch fragment shader: patch id = patch index + 1 (0 is the background); colour = a per-patch
 // hue (kColorPatch) or the patch's status in its flag word (kColorStatus, the legend of
 // gl_renderer.h's render_status_image), shaded two-sided by the angle to the eye.
+//
+// One-sided surfaces (u_discard_back_facing, RenderParams::discard_back_facing): a closed,
+// outward-oriented surface contributes only the points whose exact tangent plane faces the eye.
+// The fragment re-evaluates the patch at its interpolated (u, v) (patch_eval.h, the TES's own
+// evaluation) and is discarded unless cos(normal, to eye) > kFrontFacingMinCosine. This is the
+// visibility that the back-patch tests of Loop, Niessner & Eisenacher ("Effective Back-Patch
+// Culling for Hardware Tessellation") decide on, whatever the tessellation: secant triangles that
+// face the eye while the surface does not, and cracks between patches (through which the inside
+// of a closed surface would show), never put a back-facing point on screen.
+//
+// PATCHCULL_MARK_FRONT (the mark-front pass, PatchRenderer::mark_front_patches): early depth test
+// GL_EQUAL against the reference's depth buffer, no colour or depth writes; a fragment that passes
+// (and is kept by the test above) marks its patch, so every patch with a fragment at the front
+// depth is found, including both sides of a depth tie.
 #version 450 core
 #include "shared.h"
+#include "patch_eval.h"
 
+#ifdef PATCHCULL_MARK_FRONT
+layout(early_fragment_tests) in;
+#endif
+
+layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
+    vec4 control_points[];
+};
 layout(std430, binding = kBindingCullFlags) readonly buffer CullFlags {
     uint cull_flags[];
 };
+#ifdef PATCHCULL_MARK_FRONT
+layout(std430, binding = kBindingPatchMarks) writeonly buffer PatchMarks {
+    uint patch_marks[];
+};
+#endif
 
 uniform vec3 u_eye;  // object-space eye position
 uniform uint u_color_mode;
+uniform bool u_discard_back_facing;
 
 in vec3 tes_position;
 in vec3 tes_normal;
 flat in uint tes_patch;
+in vec2 tes_uv;
 
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out uint out_id;
@@ -35,7 +64,24 @@ vec3 status_color(uint word) {
     return vec3(0.6, 0.6, 0.6);                                        // grey: no status yet
 }
 
+// The exact surface at the fragment's (u, v) faces the eye (by more than the grazing margin).
+bool surface_faces_eye() {
+    vec4 cp[16];
+    for (int k = 0; k < 16; ++k) cp[k] = control_points[16u * tes_patch + uint(k)];
+    const vec2 uv = clamp(tes_uv, 0.0, 1.0);  // interpolation may round just outside the domain
+    vec3 p, pu, pv;
+    vec4 bu, bv;
+    evaluate_patch(cp, uv.x, uv.y, p, pu, pv, bu, bv);
+    const vec3 n = cross(pu, pv);
+    const vec3 to_eye = u_eye - p;
+    return dot(n, to_eye) > kFrontFacingMinCosine * length(n) * length(to_eye);
+}
+
 void main() {
+    if (u_discard_back_facing && !surface_faces_eye()) discard;
+#ifdef PATCHCULL_MARK_FRONT
+    patch_marks[tes_patch] = 1u;
+#endif
     const float len = length(tes_normal);
     const vec3 to_eye = normalize(u_eye - tes_position);
     const float facing = len > 0.0 ? abs(dot(tes_normal / len, to_eye)) : 1.0;

@@ -18,6 +18,10 @@ layout(vertices = 16) out;
 layout(std430, binding = kBindingCullFlags) readonly buffer CullFlags {
     uint cull_flags[];
 };
+// Drawn patches of this render (PatchRenderer::read_drawn_patches: what --verify compares).
+layout(std430, binding = kBindingPatchMarks) writeonly buffer PatchMarks {
+    uint patch_marks[];
+};
 
 uniform float u_tess_level;    // uniform level (or the adaptive maximum), in [1, 64]
 uniform uint u_draw_mask;
@@ -25,6 +29,7 @@ uniform uint u_draw_value;
 uniform bool u_adaptive;
 uniform float u_tess_reference;  // distance at which the adaptive level is u_tess_level, > 0
 uniform vec3 u_eye;              // object-space eye position
+uniform bool u_mark_drawn;       // record drawn patches in patch_marks
 
 in vec4 vs_point[];
 flat in uint vs_patch[];
@@ -50,6 +55,7 @@ void main() {
                          edge_level(vs_point[3], vs_point[15]), edge_level(vs_point[12], vs_point[15]));
         }
         if (!drawn) outer = vec4(0.0);
+        if (drawn && u_mark_drawn) patch_marks[p] = 1u;
         gl_TessLevelOuter[0] = outer[0];
         gl_TessLevelOuter[1] = outer[1];
         gl_TessLevelOuter[2] = outer[2];

@@ -7,6 +7,7 @@
 // follows the latter, which the cone bounds of seed 000 §4.2 bound (gl_renderer.h).
 #version 450 core
 #include "shared.h"
+#include "patch_eval.h"
 
 layout(quads, equal_spacing, ccw) in;
 
@@ -30,12 +31,10 @@ patch in uint tcs_patch;
 out vec3 tes_position;  // object space, displaced
 out vec3 tes_normal;    // object space, unnormalized (zero at degenerate points): the shading normal
 flat out uint tes_patch;
-
-void bernstein(float t, out vec4 b, out vec4 db) {
-    const float s = 1.0 - t;
-    b = vec4(s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t);
-    db = vec4(-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t);
-}
+out vec2 tes_uv;        // the tessellator's (u, v): the fragment shader re-evaluates the surface there
+// The mark-front pass (PATCHCULL_MARK_FRONT) is another program with the same TES source: the
+// same gl_Position in both, so its GL_EQUAL depth test matches the reference's depth exactly.
+invariant gl_Position;
 
 // Quadratic Bernstein polynomials.
 vec3 bernstein2(float t) {
@@ -58,25 +57,11 @@ vec3 tangent_patch_normal(uint base, vec4 bu, vec4 bv, float u, float v) {
 void main() {
     const float u = gl_TessCoord.x;
     const float v = gl_TessCoord.y;
-    vec4 bu, dbu, bv, dbv;
-    bernstein(u, bu, dbu);
-    bernstein(v, bv, dbv);
-
-    vec4 h = vec4(0.0), hu = vec4(0.0), hv = vec4(0.0);
-    for (int j = 0; j < 4; ++j) {
-        vec4 row = vec4(0.0), row_du = vec4(0.0);
-        for (int i = 0; i < 4; ++i) {
-            row += bu[i] * tcs_point[4 * j + i];
-            row_du += dbu[i] * tcs_point[4 * j + i];
-        }
-        h += bv[j] * row;
-        hu += bv[j] * row_du;
-        hv += dbv[j] * row;
-    }
-    // Cartesian position and derivatives (quotient rule for rational patches, weights > 0).
-    const vec3 p = h.xyz / h.w;
-    const vec3 pu = (hu.xyz - p * hu.w) / h.w;
-    const vec3 pv = (hv.xyz - p * hv.w) / h.w;
+    vec4 cp[16];
+    for (int k = 0; k < 16; ++k) cp[k] = tcs_point[k];
+    vec3 p, pu, pv;
+    vec4 bu, bv;
+    evaluate_patch(cp, u, v, p, pu, pv, bu, bv);
     const vec3 n = cross(pu, pv);
     const float len = length(n);
 
@@ -93,5 +78,6 @@ void main() {
     const bool has_tangents = u_has_tangents && patch_tangents[tangent_base].w == 1.0;
     tes_normal = has_tangents ? tangent_patch_normal(tangent_base, bu, bv, u, v) : n;
     tes_patch = tcs_patch;
+    tes_uv = vec2(u, v);
     gl_Position = u_object_to_clip * vec4(position, 1.0);
 }

@@ -3,8 +3,8 @@
 // Valid C++20 and GLSL 4.50 at once. Shaders pull it in with `#include "shared.h"`, which the
 // build replaces by this file's text (cmake/GlShaders.cmake) before validating the expanded
 // shader with glslangValidator and embedding it into the binary; C++ includes it directly.
-// Only `const uint` constants live here: they are the contract between the two languages
-// (buffer binding points, flag bits, work-group sizes, id encoding).
+// Constants only (uint and float): they are the contract between the two languages (buffer
+// binding points, flag bits, work-group sizes, id encoding, the front-facing threshold).
 #ifndef PATCHCULL_SHADERS_SHARED_H
 #define PATCHCULL_SHADERS_SHARED_H
 
@@ -31,6 +31,11 @@ PATCHCULL_CONST uint kBindingOccluderVertices = 7u; // vec4 v[3 * triangle_count
 // dv[0..11]) as (x, y, z, 0); t[kTangentVec4s p].w = 1 when the patch has them (else unused).
 PATCHCULL_CONST uint kBindingPatchTangents = 10u;
 PATCHCULL_CONST uint kTangentVec4s = 24u;
+// uint marks[patch_count], one per patch, written as 1 (never read by a draw): the patches the
+// TCS tessellated (PatchRenderer::read_drawn_patches), or the patches with a fragment at the
+// front depth (the mark-front pass, PatchRenderer::mark_front_patches). The renderer binds the
+// buffer of the pass at hand.
+PATCHCULL_CONST uint kBindingPatchMarks = 11u;
 
 // Texture units.
 PATCHCULL_CONST uint kTextureUnitDisplacement = 0u;  // R32F height map, GL_REPEAT, bilinear
@@ -66,6 +71,15 @@ PATCHCULL_CONST uint kCounterCount = 8u;
 // Patch fragment colour modes (u_color_mode).
 PATCHCULL_CONST uint kColorPatch = 0u;   // per-patch hue, shaded
 PATCHCULL_CONST uint kColorStatus = 1u;  // status of the flag word (gl_renderer.h's legend), shaded
+
+// One-sided drawing of closed, outward-oriented surfaces (RenderParams::discard_back_facing): the
+// patch fragment shader re-evaluates the exact surface at the fragment's (u, v) and keeps the
+// fragment only when cos(angle between the normal du x dv and the direction to the eye) exceeds
+// this value. Every back-patch test culls only patches whose tangent planes all face away
+// (cos <= 0), so a culled patch never has a kept fragment even with the fragment shader's float
+// rounding (~1e-6 here); what the margin drops is a sub-pixel band of grazing fragments at
+// silhouettes, in the culled and the unculled render alike.
+PATCHCULL_CONST float kFrontFacingMinCosine = 1.0e-3f;
 
 // Patch-ID buffer encoding (R32UI): 0 = background, patch p writes p + 1; triangle t of the
 // occluder mesh writes kIdOccluderBit | t.

@@ -57,7 +57,10 @@ int run_demo(const DemoOptions& options) {
         attributes.push_back(pose_attributes(poser));
     }
     const std::vector<Camera> cameras = scene.camera_path(options.frames, float(width) / float(height));
-    auto params_of = [&](int f) { return render_params(cameras[static_cast<std::size_t>(f)], width, height, options.tess); };
+    const bool one_sided = scene_is_one_sided(scene);
+    auto params_of = [&](int f) {
+        return render_params(cameras[static_cast<std::size_t>(f)], width, height, options.tess, one_sided);
+    };
     const std::size_t patches = scene.patch_count();
 
     pipeline.set_patches(poses[0], attributes[0]);
@@ -141,7 +144,7 @@ int run_demo(const DemoOptions& options) {
             overview.eye = overview.target + Vec3{-d.z, 0, d.x} * 1.4f + Vec3{0, 1.8f, 0};
             overview.fovy_radians = 1.0471976f;
             overview.z_far *= 2;
-            renderer.write_status_png((out_dir / "cull.png").string(), render_params(overview, width, height, options.tess));
+            renderer.write_status_png((out_dir / "cull.png").string(), render_params(overview, width, height, options.tess, one_sided));
         }
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -71,7 +71,7 @@ int run_occlusion(const OcclusionOptions& o) {
     for (int v = 0; v < o.views; ++v) {
         const Camera camera = views.next();
         gl::PipelineParams params;
-        params.frame.render = render_params(camera, width, height, o.tess);
+        params.frame.render = render_params(camera, width, height, o.tess, model.closed);
         params.frame.cull = gl::CullMode::occlusion;
         params.frame.timing = gl::TimingMethod::off;
         pipeline.renderer().reset_visibility();
@@ -93,10 +93,9 @@ int run_occlusion(const OcclusionOptions& o) {
         occluded_min = std::min(occluded_min, occluded);
         occluded_max = std::max(occluded_max, occluded);
         frustum_sum += double(stats.frustum_culled) / double(std::max<std::size_t>(patches, 1));
-        const std::vector<std::uint32_t> ids = pipeline.renderer().read_ids();
-        const std::vector<float> depth = pipeline.renderer().read_depth();
+        const gl::FrameCapture culled_frame = capture_culled_frame(pipeline.renderer());
         const ReferenceFrame reference = render_reference(pipeline.renderer(), params.frame.render);
-        false_culls += gl::compare_frames(reference.ids, reference.depth, ids, depth).false_culled.size();
+        false_culls += gl::compare_frames(reference.capture, culled_frame).false_culled.size();
 
         const gl::RenderParams& rp = params.frame.render;
         const Vec3 eye = gl::eye_of_view(rp.view);

@@ -69,6 +69,7 @@ Runner add_render_command(CLI::App& app) {
         // that --verify can show what it would remove.
         const gl::CullMode applied = applicable_cull_mode(scene, cull, "render");
         const bool backpatch_applied = (static_cast<std::uint32_t>(applied) & gl::kFlagBackPatch) != 0;
+        const bool one_sided = scene_is_one_sided(scene);
 
         gl::GlContext context = gl::GlContext::create_headless();
         gl::CullPipeline pipeline(context);
@@ -86,7 +87,8 @@ Runner add_render_command(CLI::App& app) {
                 pipeline.update_patches(patches, pose_attributes(poser));
             }
             gl::PipelineParams params;
-            params.frame.render = render_params(cameras[static_cast<std::size_t>(f)], width, height, state->tess);
+            params.frame.render =
+                render_params(cameras[static_cast<std::size_t>(f)], width, height, state->tess, one_sided);
             params.frame.cull = applied;
             params.frame.aggressive = state->aggressive;
             params.backpatch = backpatch;
@@ -95,15 +97,15 @@ Runner add_render_command(CLI::App& app) {
             if (last && !state->out.empty()) pipeline.renderer().write_color_png(state->out);
             nlohmann::json ms = {{"pass1", stats.pass1_ms}, {"hiz", stats.hiz_ms}, {"cull", stats.cull_ms},
                                  {"pass2", stats.pass2_ms}, {"total", stats.total_ms}};
-            std::size_t false_culls = 0;
+            std::size_t false_culls = 0, depth_ties = 0;
             std::vector<std::uint32_t> false_culled;  // patch indices, ascending
             if (state->verify) {
-                const std::vector<std::uint32_t> ids = pipeline.renderer().read_ids();
-                const std::vector<float> depth = pipeline.renderer().read_depth();
+                const gl::FrameCapture culled = capture_culled_frame(pipeline.renderer());
                 const ReferenceFrame reference = render_reference(pipeline.renderer(), params.frame.render);
-                const gl::FrameComparison cmp = gl::compare_frames(reference.ids, reference.depth, ids, depth);
+                const gl::FrameComparison cmp = gl::compare_frames(reference.capture, culled);
                 false_culls = cmp.false_culled.size();
                 false_culled = cmp.false_culled;
+                depth_ties = cmp.depth_ties;
                 ms["reference"] = reference.ms;
             }
             total_false += false_culls;
@@ -116,7 +118,8 @@ Runner add_render_command(CLI::App& app) {
                               {"visible", stats.visible},
                               {"newly_visible", stats.newly_visible},
                               {"ms", ms},
-                              {"false_culls", false_culls}});
+                              {"false_culls", false_culls},
+                              {"depth_ties", depth_ties}});
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
             if (!state->json) {
                 std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu; "

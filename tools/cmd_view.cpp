@@ -67,7 +67,8 @@ Runner add_view_command(CLI::App& app) {
                 pipeline.update_patches(patches, pose_attributes(poser));
             }
             gl::PipelineParams params;
-            params.frame.render = render_params(cameras[static_cast<std::size_t>(f % lap)], width, height, state->tess);
+            params.frame.render = render_params(cameras[static_cast<std::size_t>(f % lap)], width, height, state->tess,
+                                                scene_is_one_sided(scene));
             params.frame.cull = applied;
             params.backpatch = backpatch;
             const gl::FrameStats stats = pipeline.render_frame(params);

@@ -71,7 +71,7 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
     HiZPyramid hiz;
     for (int v = 0; v < o.views; ++v) {
         const Camera camera = views.next();
-        gl::RenderParams params = render_params(camera, width, height, o.tess);
+        gl::RenderParams params = render_params(camera, width, height, o.tess, false);  // displaced: two-sided
         params.use_cull_flags = false;
         renderer.render(params);
         const std::vector<std::uint32_t> ids = renderer.read_ids();

@@ -1,6 +1,7 @@
 // Helpers shared by the CLI's GPU commands (render_support.h).
 #include "render_support.h"
 
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 
@@ -9,8 +10,9 @@
 
 namespace patchcull::cli {
 
-gl::RenderParams render_params(const Camera& camera, int width, int height, int tess_level) {
+gl::RenderParams render_params(const Camera& camera, int width, int height, int tess_level, bool one_sided) {
     gl::RenderParams params;
+    params.discard_back_facing = one_sided;
     params.view = camera.view();
     params.projection = camera.projection();
     params.width = width;
@@ -28,13 +30,22 @@ ReferenceFrame render_reference(gl::PatchRenderer& renderer, const gl::RenderPar
     renderer.finish();
     ReferenceFrame reference;
     reference.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    reference.ids = renderer.read_ids();
-    reference.depth = renderer.read_depth();
+    reference.capture.ids = renderer.read_ids();
+    reference.capture.depth = renderer.read_depth();
+    reference.capture.patches = renderer.mark_front_patches(unculled);
     return reference;
 }
 
+gl::FrameCapture capture_culled_frame(const gl::PatchRenderer& renderer) {
+    return {renderer.read_ids(), renderer.read_depth(), renderer.read_drawn_patches()};
+}
+
 gl::FrameComparison compare_with_reference(const gl::PatchRenderer& renderer, const ReferenceFrame& reference) {
-    return gl::compare_frames(reference.ids, reference.depth, renderer.read_ids(), renderer.read_depth());
+    return gl::compare_frames(reference.capture, capture_culled_frame(renderer));
+}
+
+bool scene_is_one_sided(const Scene& scene) {
+    return std::all_of(scene.models.begin(), scene.models.end(), [](const LoadedModel& m) { return m.closed; });
 }
 
 gl::PatchAttributes pose_attributes(const ScenePoser& poser) {

@@ -17,16 +17,25 @@ namespace patchcull::cli {
 /// motion per frame, as a character at 12 poses per second).
 inline constexpr float kSecondsPerFrame = 1.0f / 12.0f;
 
-gl::RenderParams render_params(const Camera& camera, int width, int height, int tess_level);
+/// one_sided: RenderParams::discard_back_facing (scene_is_one_sided for the scene drawn).
+gl::RenderParams render_params(const Camera& camera, int width, int height, int tess_level, bool one_sided);
 
-/// The unculled render of the current patches (every patch drawn, flags ignored, statuses kept)
-/// and its wall-clock time (glFinish before and after).
+/// True when every model of the scene is a closed, outward-oriented surface (LoadedModel::closed):
+/// the scene is drawn one-sided (README: "What contributes a pixel") and back-patch culling is
+/// conservative on it.
+bool scene_is_one_sided(const Scene& scene);
+
+/// The unculled render of the current patches (every patch drawn, flags ignored, statuses kept),
+/// its front set (PatchRenderer::mark_front_patches) and the wall-clock time of the render alone
+/// (glFinish before and after; the front-set pass is not timed).
 struct ReferenceFrame {
-    std::vector<std::uint32_t> ids;
-    std::vector<float> depth;
+    gl::FrameCapture capture;
     double ms = 0;
 };
 ReferenceFrame render_reference(gl::PatchRenderer& renderer, const gl::RenderParams& params);
+
+/// The renderer's last frame as compare_frames takes a culled frame: ids, depth, drawn patches.
+gl::FrameCapture capture_culled_frame(const gl::PatchRenderer& renderer);
 
 /// Compares the renderer's current framebuffer (a culled frame) with a reference.
 gl::FrameComparison compare_with_reference(const gl::PatchRenderer& renderer, const ReferenceFrame& reference);

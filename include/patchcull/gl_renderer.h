@@ -198,6 +198,14 @@ struct RenderParams {
     /// Shared edges get equal levels (no T-junction cracks). false: tess_level everywhere.
     bool adaptive_tess = false;
     float tess_reference_distance = 1.0f;  ///< > 0, object-space units
+    /// One-sided drawing for closed, outward-oriented surfaces (LoadedModel::closed): a fragment
+    /// is kept only where the exact patch at its (u, v) faces the eye, cos(du x dv, to eye) >
+    /// kFrontFacingMinCosine (1e-3, shaders/shared.h); the rest is discarded, whatever the
+    /// triangles' own facing. This is the visibility the back-patch tests (gl_backpatch.h)
+    /// decide on, so they are conservative at every tessellation level (README: "What
+    /// contributes a pixel"). false (default): both sides of every patch are drawn (open
+    /// surfaces such as the teapot). Ignored while displacing (a displaced surface is two-sided).
+    bool discard_back_facing = false;
 };
 
 /// How render_frame times its passes.
@@ -397,6 +405,19 @@ public:
     /// wall-clock measurement.
     void finish() const;
 
+    // ---- what a frame drew, for verification (waits for the GPU) -----------------------------
+    /// One byte per patch: 1 when the last render() or render_frame() tessellated it (levels > 0
+    /// in the TCS, in either pass), else 0 (culled). This, not the id buffer, is what a false cull
+    /// is judged on: a drawn patch that loses a depth tie is absent from the id buffer.
+    std::vector<std::uint8_t> read_drawn_patches() const;
+    /// The front set of the last render: redraws the patches (params must be the last render's:
+    /// camera, size, tessellation, use_cull_flags, discard_back_facing) with depth test GL_EQUAL
+    /// against its depth buffer, no colour or depth writes, and returns one byte per patch: 1 when
+    /// some fragment of the patch lies exactly at the front depth of its pixel (the patch
+    /// contributes a pixel, including every patch of a depth tie, which the id buffer shows only
+    /// one of). Leaves the framebuffer as it was. Throws patchcull::Error on a size mismatch.
+    std::vector<std::uint8_t> mark_front_patches(const RenderParams& params);
+
     // ---- read-back of the last render (waits for the GPU; image order, row 0 = top) ----------
     int width() const;
     int height() const;
@@ -418,24 +439,34 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+/// One frame as --verify compares it: id and depth buffers (read_ids, read_depth) and one byte
+/// per patch: for the unculled reference its front set (mark_front_patches), for a culled frame
+/// its drawn set (read_drawn_patches).
+struct FrameCapture {
+    std::vector<std::uint32_t> ids;
+    std::vector<float> depth;
+    std::vector<std::uint8_t> patches;
+};
+
 /// A culled frame against the unculled render of the same camera, resolution and tessellation
-/// (DESIGN.md's GPU ground truth), e.g. for a --verify option.
+/// (the GPU ground truth), e.g. for a --verify option.
 struct FrameComparison {
     std::size_t differing_pixels = 0;  ///< pixels whose id differs
     /// Of those, pixels where both ids are patches and the depths are equal: two patches with
-    /// fragments at exactly the same depth, drawn in another order (GL_LESS keeps the first). With
-    /// no false cull these are the only possible differences (culling is per patch).
+    /// fragments at exactly the same depth, drawn in another order (GL_LESS keeps the first).
+    /// Reported apart from false culls; they never count as one and never hide one.
     std::size_t depth_ties = 0;
-    std::vector<std::uint32_t> false_culled;  ///< patch indices present unculled, absent culled (ascending)
+    /// False culls (ascending patch indices): patches in the reference's front set that the
+    /// culled frame did not draw. Judged per patch, not per pixel, so a patch that was drawn but
+    /// lost a depth tie is not one, and a culled patch that only ties at the front still is.
+    std::vector<std::uint32_t> false_culled;
     bool identical() const { return differing_pixels == 0; }
     /// No false cull and nothing but depth ties differs.
     bool conservative() const { return false_culled.empty() && differing_pixels == depth_ties; }
 };
-/// Compares id and depth buffers as read_ids()/read_depth() return them. Throws patchcull::Error
-/// when the four sizes differ.
-FrameComparison compare_frames(const std::vector<std::uint32_t>& unculled_ids,
-                               const std::vector<float>& unculled_depth,
-                               const std::vector<std::uint32_t>& culled_ids, const std::vector<float>& culled_depth);
+/// Compares a culled frame with its reference. Throws patchcull::Error when the buffer sizes or
+/// patch counts differ.
+FrameComparison compare_frames(const FrameCapture& reference, const FrameCapture& culled);
 
 /// Writes an id buffer (as read_ids returns it) as a PNG with one distinct colour per id, black
 /// for the background: for looking at false culls. Throws patchcull::Error on failure.

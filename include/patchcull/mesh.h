@@ -65,7 +65,31 @@ struct ControlMesh {
     /// the boundary of an open one (the teapot's lid gap) the inside of a patch facing away can
     /// show, so back-patch culling (seed 001) is not conservative there.
     bool is_closed() const;
+    /// Signed volume enclosed by the faces (divergence theorem over each face's triangle fan,
+    /// summed in double relative to the first position, so it does not depend on where the mesh
+    /// sits). Positive when the faces are oriented outward (counter-clockwise seen from outside),
+    /// negative for an inside-out mesh (every winding reversed, or mirrored). Meaningful for a
+    /// closed mesh (is_closed); for self-intersecting ones it is the winding-weighted volume, so
+    /// its sign is that of the larger part.
+    double signed_volume() const;
+    /// Reverses every face's corner order (and its texcoords): flips the surface's orientation.
+    void reverse_faces();
 };
+
+/// How a control mesh's surface may be drawn and back-patch culled (README: "What contributes
+/// a pixel"). Orientation comes from geometry (the signed volume), not from topology alone.
+enum class SurfaceOrientation {
+    open,     ///< not closed (is_closed false): drawn two-sided, no back-patch culling
+    flat,     ///< closed but encloses no volume (|V| <= 1e-6 d^3, d the bounding-box diagonal)
+    outward,  ///< closed, positive volume: one-sided, back-patch culling conservative
+    inward,   ///< closed, negative volume: inside out (reverse_faces makes it outward)
+};
+SurfaceOrientation classify_orientation(const ControlMesh& mesh);
+
+/// Makes a closed inside-out mesh outward (reverse_faces) and returns its orientation after
+/// that: outward, open or flat (never inward). Appends a one-line note to mesh.warnings when it
+/// reversed the faces or found a closed mesh without volume.
+SurfaceOrientation orient_outward(ControlMesh& mesh);
 
 /// Axis-aligned bounds of a point set.
 struct Bounds {

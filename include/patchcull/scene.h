@@ -19,8 +19,10 @@ struct LoadedModel {
     int split_levels = 0;
     PatchFrame rest;                         ///< patches at rest, after split_levels splits
     std::vector<std::string> warnings;
-    /// A closed surface (ControlMesh::is_closed): back-patch culling is conservative for it even
-    /// when both sides are drawn. False for the teapot (its lid sits loose in the rim).
+    /// A closed surface with positive volume (orient_outward: an inside-out mesh was reversed at
+    /// load, a flat one is not closed): drawn one-sided (RenderParams::discard_back_facing), and
+    /// back-patch culling is conservative for it. False for open meshes and the teapot (its lid
+    /// sits loose in the rim).
     bool closed = false;
 };
 

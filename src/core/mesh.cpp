@@ -2,6 +2,8 @@
 #include "patchcull/mesh.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 
 namespace patchcull {
 
@@ -31,6 +33,60 @@ bool ControlMesh::is_closed() const {
         if (!std::binary_search(directed.begin(), directed.end(), reverse)) return false;
     }
     return true;
+}
+
+double ControlMesh::signed_volume() const {
+    if (positions.empty()) return 0;
+    // Sum over fan triangles (a, b, c) of det[a-o, b-o, c-o] / 6, o = positions[0]: translation
+    // invariant for a closed mesh, and relative coordinates keep far-away meshes exact enough.
+    const Vec3 o = positions[0];
+    auto rel = [&](std::uint32_t v) {
+        const Vec3 p = positions[v];
+        return std::array<double, 3>{double(p.x) - o.x, double(p.y) - o.y, double(p.z) - o.z};
+    };
+    double six_volume = 0;
+    for (std::size_t f = 0; f < face_count(); ++f) {
+        const std::uint32_t first = face_offsets[f], n = face_size(f);
+        const auto a = rel(face_vertices[first]);
+        for (std::uint32_t i = 1; i + 1 < n; ++i) {
+            const auto b = rel(face_vertices[first + i]), c = rel(face_vertices[first + i + 1]);
+            six_volume += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+                          a[2] * (b[0] * c[1] - b[1] * c[0]);
+        }
+    }
+    return six_volume / 6.0;
+}
+
+void ControlMesh::reverse_faces() {
+    for (std::size_t f = 0; f < face_count(); ++f) {
+        const auto begin = static_cast<std::ptrdiff_t>(face_offsets[f]), end = static_cast<std::ptrdiff_t>(face_offsets[f + 1]);
+        std::reverse(face_vertices.begin() + begin, face_vertices.begin() + end);
+        if (has_texcoords()) std::reverse(face_texcoords.begin() + begin, face_texcoords.begin() + end);
+    }
+}
+
+SurfaceOrientation classify_orientation(const ControlMesh& mesh) {
+    if (!mesh.is_closed()) return SurfaceOrientation::open;
+    const Bounds b = compute_bounds(mesh.positions);
+    const Vec3 extent = b.max - b.min;
+    const double diagonal = std::sqrt(double(extent.x) * extent.x + double(extent.y) * extent.y + double(extent.z) * extent.z);
+    const double volume = mesh.signed_volume();
+    if (!(std::abs(volume) > 1e-6 * diagonal * diagonal * diagonal)) return SurfaceOrientation::flat;
+    return volume > 0 ? SurfaceOrientation::outward : SurfaceOrientation::inward;
+}
+
+SurfaceOrientation orient_outward(ControlMesh& mesh) {
+    SurfaceOrientation o = classify_orientation(mesh);
+    if (o == SurfaceOrientation::inward) {
+        mesh.reverse_faces();
+        mesh.warnings.push_back(mesh.name + ": closed surface oriented inward (negative signed volume): "
+                                "faces reversed, so that its outside faces out");
+        o = SurfaceOrientation::outward;
+    } else if (o == SurfaceOrientation::flat) {
+        mesh.warnings.push_back(mesh.name + ": closed surface encloses no volume: drawn two-sided, "
+                                "no back-patch culling");
+    }
+    return o;
 }
 
 Bounds compute_bounds(const std::vector<Vec3>& points) {

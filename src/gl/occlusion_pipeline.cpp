@@ -227,7 +227,7 @@ FrameStats PatchRenderer::render_frame(const FrameParams& params) {
     if (!m.primed) m.prime_statuses();
     const Mat4 object_to_clip = rp.projection * rp.view;
     const bool displaced = m.has_displacement_map && rp.displace;
-    const int level = m.set_draw_uniforms(rp, object_to_clip, sh::kColorPatch);
+    const int level = m.set_draw_uniforms(rp, object_to_clip, sh::kColorPatch, true);
     PassClock clock(method, m.timer_queries);
     clock.mark();
     if (two_pass) {
@@ -337,29 +337,25 @@ void PatchRenderer::write_status_png(const std::string& path, const RenderParams
 
 // ---- verification -----------------------------------------------------------------------------
 
-FrameComparison compare_frames(const std::vector<std::uint32_t>& unculled_ids, const std::vector<float>& unculled_depth,
-                               const std::vector<std::uint32_t>& culled_ids, const std::vector<float>& culled_depth) {
-    const std::size_t n = unculled_ids.size();
-    if (unculled_depth.size() != n || culled_ids.size() != n || culled_depth.size() != n)
+FrameComparison compare_frames(const FrameCapture& reference, const FrameCapture& culled) {
+    const std::size_t n = reference.ids.size();
+    if (reference.depth.size() != n || culled.ids.size() != n || culled.depth.size() != n)
         throw Error("compare_frames: id and depth buffers of different sizes");
+    if (reference.patches.size() != culled.patches.size())
+        throw Error("compare_frames: the frames have different patch counts");
     FrameComparison c;
-    std::vector<std::uint32_t> unculled_patches, culled_patches;
+    auto is_patch = [](std::uint32_t id) { return id != sh::kIdBackground && !(id & sh::kIdOccluderBit); };
     for (std::size_t i = 0; i < n; ++i) {
-        const std::uint32_t a = unculled_ids[i], b = culled_ids[i];
-        if (a != sh::kIdBackground && !(a & sh::kIdOccluderBit)) unculled_patches.push_back(a - 1);
-        if (b != sh::kIdBackground && !(b & sh::kIdOccluderBit)) culled_patches.push_back(b - 1);
+        const std::uint32_t a = reference.ids[i], b = culled.ids[i];
         if (a == b) continue;
         ++c.differing_pixels;
-        const bool patches = a != sh::kIdBackground && b != sh::kIdBackground && !(a & sh::kIdOccluderBit) &&
-                             !(b & sh::kIdOccluderBit);
-        if (patches && unculled_depth[i] == culled_depth[i]) ++c.depth_ties;
+        if (is_patch(a) && is_patch(b) && reference.depth[i] == culled.depth[i]) ++c.depth_ties;
     }
-    for (auto* v : {&unculled_patches, &culled_patches}) {
-        std::sort(v->begin(), v->end());
-        v->erase(std::unique(v->begin(), v->end()), v->end());
-    }
-    std::set_difference(unculled_patches.begin(), unculled_patches.end(), culled_patches.begin(), culled_patches.end(),
-                        std::back_inserter(c.false_culled));
+    // A false cull is decided per patch, never per pixel: culled (not drawn) here and at the front
+    // of the reference somewhere. The front set includes the losers of depth ties, so a tie
+    // cannot hide a culled patch.
+    for (std::size_t p = 0; p < reference.patches.size(); ++p)
+        if (reference.patches[p] && !culled.patches[p]) c.false_culled.push_back(static_cast<std::uint32_t>(p));
     return c;
 }
 

@@ -26,24 +26,20 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
     ctx.make_current();
     if (epoxy_gl_version() < 45) throw Error("GL: PatchRenderer needs OpenGL 4.5 (context has " + ctx.version() + ")");
     Impl& m = *impl_;
-    m.draw_program = link_program({{"patch.vert.glsl", GL_VERTEX_SHADER},
-                                   {"patch.tesc.glsl", GL_TESS_CONTROL_SHADER},
-                                   {"patch.tese.glsl", GL_TESS_EVALUATION_SHADER},
-                                   {"patch.frag.glsl", GL_FRAGMENT_SHADER}},
-                                  "patch");
+    const std::vector<std::pair<const char*, GLenum>> patch_stages = {{"patch.vert.glsl", GL_VERTEX_SHADER},
+                                                                      {"patch.tesc.glsl", GL_TESS_CONTROL_SHADER},
+                                                                      {"patch.tese.glsl", GL_TESS_EVALUATION_SHADER},
+                                                                      {"patch.frag.glsl", GL_FRAGMENT_SHADER}};
+    m.draw_program = link_program(patch_stages, "patch");
+    m.mark_program = link_program(patch_stages, "patch (mark front)", "#define PATCHCULL_MARK_FRONT 1\n");
     // Mesa's software rasterizers round GLSL fma() twice; the cull passes then compute it exactly
     // in double precision (shaders/exact_fma.h) so that decisions equal the CPU kernels'. On other
     // drivers native fma() is checked once below.
     m.fma_via_double = ctx.is_software();
     m.is_software = ctx.is_software();
     m.link_cull_programs();
-    const GLuint dp = m.draw_program;
-    m.draw_loc = {glGetUniformLocation(dp, "u_tess_level"),         glGetUniformLocation(dp, "u_draw_mask"),
-                  glGetUniformLocation(dp, "u_draw_value"),         glGetUniformLocation(dp, "u_adaptive"),
-                  glGetUniformLocation(dp, "u_tess_reference"),     glGetUniformLocation(dp, "u_object_to_clip"),
-                  glGetUniformLocation(dp, "u_displace"),           glGetUniformLocation(dp, "u_displacement_scale"),
-                  glGetUniformLocation(dp, "u_displacement_midlevel"), glGetUniformLocation(dp, "u_eye"),
-                  glGetUniformLocation(dp, "u_color_mode"),         glGetUniformLocation(dp, "u_has_tangents")};
+    m.draw_loc.locate(m.draw_program);
+    m.mark_loc.locate(m.mark_program);
     m.hiz_program = link_program({{"hiz_build.comp.glsl", GL_COMPUTE_SHADER}}, "hiz_build");
     const GLuint hp = m.hiz_program;
     m.hiz_loc = {glGetUniformLocation(hp, "u_from_depth"), glGetUniformLocation(hp, "u_source_level"),
@@ -54,8 +50,8 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
                       glGetUniformLocation(m.occluder_program, "u_eye")};
 
     glCreateVertexArrays(1, &m.vao);
-    GLuint buffers[9];
-    glCreateBuffers(9, buffers);
+    GLuint buffers[11];
+    glCreateBuffers(11, buffers);
     m.control_points = buffers[0];
     m.cull_flags = buffers[1];
     m.max_displacement = buffers[2];
@@ -65,6 +61,8 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
     m.counters = buffers[6];
     m.occluder_vertices = buffers[7];
     m.tangents = buffers[8];
+    m.drawn_marks = buffers[9];
+    m.front_marks = buffers[10];
     upload(m.counters, sh::kCounterCount * sizeof(std::uint32_t), nullptr);
     upload(m.occluder_vertices, 0, nullptr);
     glCreateFramebuffers(1, &m.fbo);
@@ -214,12 +212,57 @@ void PatchRenderer::render(const RenderParams& params) {
     Impl& m = *impl_;
     m.resize(params.width, params.height);
     const Mat4 object_to_clip = params.projection * params.view;
-    const int level = m.set_draw_uniforms(params, object_to_clip, sh::kColorPatch);
+    const int level = m.set_draw_uniforms(params, object_to_clip, sh::kColorPatch, true);
     m.begin_target(m.fbo, m.width, m.height);
     m.draw_occluders();
     m.draw_patches(level, params.use_cull_flags ? sh::kCullReasonMask : 0u, 0u);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     check_gl("render");
+}
+
+namespace {
+
+std::vector<std::uint8_t> read_marks(GLuint buffer, std::size_t count) {
+    std::vector<std::uint32_t> words(count);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    if (count)
+        glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(count * sizeof(std::uint32_t)), words.data());
+    check_gl("read patch marks");
+    std::vector<std::uint8_t> marks(count);
+    for (std::size_t p = 0; p < count; ++p) marks[p] = words[p] != 0;
+    return marks;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> PatchRenderer::read_drawn_patches() const {
+    return read_marks(impl_->drawn_marks, impl_->count);
+}
+
+std::vector<std::uint8_t> PatchRenderer::mark_front_patches(const RenderParams& params) {
+    Impl& m = *impl_;
+    if (params.width != m.width || params.height != m.height)
+        throw Error("GL: mark_front_patches: params are not the last render's size");
+    if (m.count == 0) return {};
+    const Mat4 object_to_clip = params.projection * params.view;
+    const int level = m.set_draw_uniforms(params, object_to_clip, sh::kColorPatch);
+    glClearNamedBufferData(m.front_marks, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m.fbo);
+    glViewport(0, 0, m.width, m.height);
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_EQUAL);
+    glDepthMask(GL_FALSE);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glDisable(GL_CULL_FACE);
+    m.draw_patches(level, params.use_cull_flags ? sh::kCullReasonMask : 0u, 0u, true);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    check_gl("mark_front_patches");
+    return read_marks(m.front_marks, m.count);
 }
 
 // ---- occluders ---------------------------------------------------------------------------------

@@ -146,9 +146,11 @@ using namespace detail;
 
 struct PatchRenderer::Impl {
     GLuint vao = 0;
+    GLuint mark_program = 0;  // the patch program with PATCHCULL_MARK_FRONT (patch.frag.glsl)
     GLuint draw_program = 0, frustum_program = 0, occlusion_program = 0, hiz_program = 0, occluder_program = 0;
     GLuint control_points = 0, cull_flags = 0, max_displacement = 0, texcoords = 0, plane_values = 0;
     GLuint backpatch_flags = 0, counters = 0, occluder_vertices = 0, tangents = 0;
+    GLuint drawn_marks = 0, front_marks = 0;  // uint per patch at kBindingPatchMarks (shared.h)
     GLuint displacement_texture = 0;
     float displacement_scale = 0, displacement_midlevel = 0.5f;
     bool has_displacement_map = false;
@@ -171,10 +173,22 @@ struct PatchRenderer::Impl {
     GLuint timer_queries[5] = {};
     bool primed = false;  // statuses valid for the pipeline (else the next frame tags even patches)
 
-    struct {
+    // Uniform locations of a patch program (draw_program, mark_program).
+    struct DrawUniforms {
         GLint tess_level, draw_mask, draw_value, adaptive, tess_reference, object_to_clip, displace,
-            displacement_scale, displacement_midlevel, eye, color_mode, has_tangents;
-    } draw_loc{};
+            displacement_scale, displacement_midlevel, eye, color_mode, has_tangents, mark_drawn,
+            discard_back_facing;
+        void locate(GLuint p) {
+            *this = {glGetUniformLocation(p, "u_tess_level"),         glGetUniformLocation(p, "u_draw_mask"),
+                     glGetUniformLocation(p, "u_draw_value"),         glGetUniformLocation(p, "u_adaptive"),
+                     glGetUniformLocation(p, "u_tess_reference"),     glGetUniformLocation(p, "u_object_to_clip"),
+                     glGetUniformLocation(p, "u_displace"),           glGetUniformLocation(p, "u_displacement_scale"),
+                     glGetUniformLocation(p, "u_displacement_midlevel"), glGetUniformLocation(p, "u_eye"),
+                     glGetUniformLocation(p, "u_color_mode"),         glGetUniformLocation(p, "u_has_tangents"),
+                     glGetUniformLocation(p, "u_mark_drawn"),         glGetUniformLocation(p, "u_discard_back_facing")};
+        }
+    };
+    DrawUniforms draw_loc{}, mark_loc{};
     struct {
         GLint rows, normal_length, patch_count, has_displacement, write_plane_values;
     } frustum_loc{};
@@ -190,11 +204,12 @@ struct PatchRenderer::Impl {
     } occluder_loc{};
 
     ~Impl() {
-        for (GLuint p : {draw_program, frustum_program, occlusion_program, hiz_program, occluder_program})
+        for (GLuint p : {draw_program, mark_program, frustum_program, occlusion_program, hiz_program, occluder_program})
             glDeleteProgram(p);
-        const GLuint buffers[] = {control_points, cull_flags, max_displacement, texcoords, plane_values,
-                                  backpatch_flags, counters, occluder_vertices, tangents};
-        glDeleteBuffers(9, buffers);
+        const GLuint buffers[] = {control_points, cull_flags,        max_displacement, texcoords,   plane_values,
+                                  backpatch_flags, counters,         occluder_vertices, tangents,   drawn_marks,
+                                  front_marks};
+        glDeleteBuffers(11, buffers);
         const GLuint textures[] = {displacement_texture, color, ids, depth, hiz, vis_color, vis_depth};
         glDeleteTextures(7, textures);
         glDeleteFramebuffers(1, &fbo);
@@ -306,6 +321,8 @@ struct PatchRenderer::Impl {
         upload(tangents, tangent_data.size() * sizeof(Vec4), tangent_data.data());
         has_tangents = !a.tangent_index.empty();
         upload(plane_values, 0, nullptr);
+        upload(drawn_marks, n * sizeof(std::uint32_t), nullptr);
+        upload(front_marks, n * sizeof(std::uint32_t), nullptr);
         if (!keep_flags) {
             upload(backpatch_flags, n * sizeof(std::uint32_t), nullptr);
             primed = false;
@@ -322,24 +339,35 @@ struct PatchRenderer::Impl {
     void cull_occlusion(const Mat4& object_to_clip, std::uint32_t tests, const std::uint8_t* backpatch,
                         GLuint backpatch_buffer, bool displaced);
 
-    // Sets the draw program's uniforms for params; returns the effective tessellation level.
-    int set_draw_uniforms(const RenderParams& params, const Mat4& object_to_clip, GLuint color_mode) {
+    // Sets the patch programs' uniforms for params (draw_program with color_mode; mark_program the
+    // same geometry); returns the effective tessellation level. mark_drawn: the draw records the
+    // patches it tessellates in drawn_marks (render, render_frame; not the status image).
+    int set_draw_uniforms(const RenderParams& params, const Mat4& object_to_clip, GLuint color_mode,
+                          bool mark_drawn = false) {
         const int level = std::clamp(params.tess_level, 1, 64);
         Mat4 view_inverse;
         Vec3 eye{0, 0, 0};
         if (invert(params.view, view_inverse)) eye = {view_inverse.at(0, 3), view_inverse.at(1, 3), view_inverse.at(2, 3)};
-        const GLuint dp = draw_program;
-        glProgramUniform1f(dp, draw_loc.tess_level, static_cast<float>(level));
-        glProgramUniform1i(dp, draw_loc.adaptive, params.adaptive_tess ? 1 : 0);
-        glProgramUniform1f(dp, draw_loc.tess_reference,
-                           params.tess_reference_distance > 0 ? params.tess_reference_distance : 1.0f);
-        glProgramUniformMatrix4fv(dp, draw_loc.object_to_clip, 1, GL_FALSE, object_to_clip.m);
-        glProgramUniform1i(dp, draw_loc.displace, params.displace && has_displacement_map ? 1 : 0);
-        glProgramUniform1f(dp, draw_loc.displacement_scale, displacement_scale);
-        glProgramUniform1f(dp, draw_loc.displacement_midlevel, displacement_midlevel);
-        glProgramUniform3f(dp, draw_loc.eye, eye.x, eye.y, eye.z);
-        glProgramUniform1ui(dp, draw_loc.color_mode, color_mode);
-        glProgramUniform1i(dp, draw_loc.has_tangents, has_tangents ? 1 : 0);
+        const bool displace = params.displace && has_displacement_map;
+        // The front-facing test evaluates the undisplaced patch: a displaced surface is drawn
+        // two-sided (no back-patch test bounds it; backpatch.h).
+        const bool one_sided = params.discard_back_facing && !displace;
+        for (const auto& [dp, loc] : {std::pair{draw_program, &draw_loc}, std::pair{mark_program, &mark_loc}}) {
+            glProgramUniform1f(dp, loc->tess_level, static_cast<float>(level));
+            glProgramUniform1i(dp, loc->adaptive, params.adaptive_tess ? 1 : 0);
+            glProgramUniform1f(dp, loc->tess_reference,
+                               params.tess_reference_distance > 0 ? params.tess_reference_distance : 1.0f);
+            glProgramUniformMatrix4fv(dp, loc->object_to_clip, 1, GL_FALSE, object_to_clip.m);
+            glProgramUniform1i(dp, loc->displace, displace ? 1 : 0);
+            glProgramUniform1f(dp, loc->displacement_scale, displacement_scale);
+            glProgramUniform1f(dp, loc->displacement_midlevel, displacement_midlevel);
+            glProgramUniform3f(dp, loc->eye, eye.x, eye.y, eye.z);
+            glProgramUniform1ui(dp, loc->color_mode, color_mode);
+            glProgramUniform1i(dp, loc->has_tangents, has_tangents ? 1 : 0);
+            glProgramUniform1i(dp, loc->discard_back_facing, one_sided ? 1 : 0);
+            glProgramUniform1i(dp, loc->mark_drawn, dp == draw_program && mark_drawn ? 1 : 0);
+        }
+        if (mark_drawn && count > 0) glClearNamedBufferData(drawn_marks, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
         glProgramUniformMatrix4fv(occluder_program, occluder_loc.object_to_clip, 1, GL_FALSE, object_to_clip.m);
         glProgramUniform3f(occluder_program, occluder_loc.eye, eye.x, eye.y, eye.z);
         return level;
@@ -373,15 +401,18 @@ struct PatchRenderer::Impl {
         glUseProgram(0);
     }
 
-    // Draws the patches whose flag word w has (w & mask) == value (into the bound framebuffer).
-    void draw_patches(int level, GLuint mask, GLuint value) {
+    // Draws the patches whose flag word w has (w & mask) == value (into the bound framebuffer)
+    // with the draw program, or with the mark program (mark_front: marks into front_marks).
+    void draw_patches(int level, GLuint mask, GLuint value, bool mark_front = false) {
         if (count == 0) return;
-        const GLuint dp = draw_program;
-        glProgramUniform1ui(dp, draw_loc.draw_mask, mask);
-        glProgramUniform1ui(dp, draw_loc.draw_value, value);
+        const GLuint dp = mark_front ? mark_program : draw_program;
+        const DrawUniforms& loc = mark_front ? mark_loc : draw_loc;
+        glProgramUniform1ui(dp, loc.draw_mask, mask);
+        glProgramUniform1ui(dp, loc.draw_value, value);
         glUseProgram(dp);
         glBindVertexArray(vao);
         bind_buffers();
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchMarks, mark_front ? front_marks : drawn_marks);
         glBindTextureUnit(sh::kTextureUnitDisplacement, displacement_texture);
         glPatchParameteri(GL_PATCH_VERTICES, kPatchPoints);
         // llvmpipe workaround 2 (header): at most 65536 / (L+1)^2 patches per sub-draw.

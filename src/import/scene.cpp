@@ -43,13 +43,15 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
         return model;
     }
     ControlMesh mesh = load_obj(spec);
+    // Orientation from geometry: an inside-out closed mesh is reversed, a flat one is two-sided.
+    const SurfaceOrientation orientation = orient_outward(mesh);
     model.warnings = mesh.warnings;
     model.subdiv = build_model(mesh, scheme);
+    model.origin = mesh.origin;
     for (const std::string& w : model.subdiv->mesh.warnings)
         if (std::find(model.warnings.begin(), model.warnings.end(), w) == model.warnings.end()) model.warnings.push_back(w);
-    model.origin = mesh.origin;
     evaluate_patches(*model.subdiv, model.subdiv->mesh.positions, split_levels, model.rest);
-    model.closed = model.subdiv->mesh.is_closed();
+    model.closed = orientation == SurfaceOrientation::outward;
     return model;
 }
 

@@ -110,12 +110,14 @@ TEST(CullPipeline, BackPatchPassFeedsTheFrameForEveryMethod) {
             EXPECT_GT(s.backpatch_ms, 0.0) << name;
             EXPECT_GE(s.cull_ms, s.backpatch_ms) << name;
 
-            const std::vector<std::uint32_t> ids = p.renderer().read_ids();
-            const std::vector<float> depth = p.renderer().read_depth();
+            const FrameCapture culled = {p.renderer().read_ids(), p.renderer().read_depth(),
+                                         p.renderer().read_drawn_patches()};
             RenderParams unculled = rp;
             unculled.use_cull_flags = false;
             p.renderer().render(unculled);
-            const FrameComparison cmp = compare_frames(p.renderer().read_ids(), p.renderer().read_depth(), ids, depth);
+            const FrameCapture reference = {p.renderer().read_ids(), p.renderer().read_depth(),
+                                            p.renderer().mark_front_patches(unculled)};
+            const FrameComparison cmp = compare_frames(reference, culled);
             EXPECT_TRUE(cmp.false_culled.empty()) << name << ": " << cmp.false_culled.size() << " false culls";
             EXPECT_TRUE(cmp.conservative()) << name;
         }

@@ -227,6 +227,7 @@ Totals strict_frame(PatchRenderer& r, const std::vector<BezierPatch>& patches, c
     unculled.use_cull_flags = false;
     r.render(unculled);
     const Frame ref = read_frame(r);
+    const std::vector<std::uint8_t> front = r.mark_front_patches(unculled);
     FrameParams fp;
     fp.render = params;
     fp.cull = mode;
@@ -234,7 +235,8 @@ Totals strict_frame(PatchRenderer& r, const std::vector<BezierPatch>& patches, c
     const Frame got = read_frame(r);
     const std::vector<std::uint32_t> words = r.read_cull_flags();
     const Diff d = compare_frames(ref, got, words, &patches, occ, params, what);
-    const FrameComparison cmp = gl::compare_frames(ref.ids, ref.depth, got.ids, got.depth);  // the library's
+    // The library's comparison: per patch, the front set against the drawn set.
+    const FrameComparison cmp = gl::compare_frames({ref.ids, ref.depth, front}, {got.ids, got.depth, r.read_drawn_patches()});
     EXPECT_TRUE(cmp.conservative()) << what;
     EXPECT_EQ(cmp.depth_ties, d.ties) << what;
     EXPECT_EQ(d.pixels, 0u) << what;
@@ -616,22 +618,45 @@ TEST(OcclusionPipeline, UpdatePatchesKeepsStatusAndChecksCount) {
     EXPECT_STREQ(cull_mode_name(CullMode::backpatch), "backpatch");
 }
 
-TEST(OcclusionPipeline, CompareFramesClassifiesDifferences) {
-    // 6 pixels: equal; a tie (ids 2 and 3 at the same depth); id 5 replaced by a farther id 3 (id 5
-    // absent elsewhere: a false cull, as is id 2); an occluder vs a patch; background vs a patch;
-    // an equal occluder.
-    const std::vector<std::uint32_t> unculled = {1, 2, 5, kIdOccluderBit | 1, 0, kIdOccluderBit};
-    const std::vector<float> unculled_depth = {0.5f, 0.4f, 0.3f, 0.2f, 1.0f, 0.1f};
-    const std::vector<std::uint32_t> culled = {1, 3, 3, 7, 6, kIdOccluderBit};
-    const std::vector<float> culled_depth = {0.5f, 0.4f, 0.35f, 0.2f, 0.9f, 0.1f};
-    const FrameComparison c = gl::compare_frames(unculled, unculled_depth, culled, culled_depth);
+TEST(OcclusionPipeline, CompareFramesJudgesFalseCullsPerPatch) {
+    // 6 pixels: equal; a tie (ids 2 and 3 at the same depth); id 5 replaced by a farther id 3; an
+    // occluder vs a patch; background vs a patch; an equal occluder. 8 patches: the reference's
+    // front set is patches 0, 1, 4 (ids 1, 2, 5) and 6, which lost a depth tie in the reference
+    // (absent from its id buffer, found by mark_front_patches).
+    const FrameCapture reference = {{1, 2, 5, kIdOccluderBit | 1, 0, kIdOccluderBit},
+                                    {0.5f, 0.4f, 0.3f, 0.2f, 1.0f, 0.1f},
+                                    {1, 1, 0, 0, 1, 0, 1, 0}};
+    // Patch 1 (id 2) was drawn and lost the tie at pixel 1: a tie, not a false cull. Patch 4
+    // (id 5) was not drawn: a false cull. Patch 6 was not drawn either: a false cull although the
+    // reference's id buffer never shows it (a tie must not hide a culled patch). Patch 3 was not
+    // drawn and is not at the front: a correct cull.
+    const FrameCapture culled = {{1, 3, 3, 7, 6, kIdOccluderBit},
+                                 {0.5f, 0.4f, 0.35f, 0.2f, 0.9f, 0.1f},
+                                 {1, 1, 1, 0, 0, 1, 0, 1}};
+    const FrameComparison c = gl::compare_frames(reference, culled);
     EXPECT_EQ(c.differing_pixels, 4u);
     EXPECT_EQ(c.depth_ties, 1u);
-    EXPECT_EQ(c.false_culled, (std::vector<std::uint32_t>{1, 4}));  // ids 2 and 5
+    EXPECT_EQ(c.false_culled, (std::vector<std::uint32_t>{4, 6}));
     EXPECT_FALSE(c.conservative());
     EXPECT_FALSE(c.identical());
-    EXPECT_TRUE(gl::compare_frames(unculled, unculled_depth, unculled, unculled_depth).identical());
-    EXPECT_THROW(gl::compare_frames(unculled, unculled_depth, culled, {}), patchcull::Error);
+
+    // Only the tie differs and every front patch was drawn: conservative, not identical.
+    FrameCapture tie_only = reference;
+    tie_only.ids[1] = 3;
+    tie_only.patches = {1, 1, 1, 1, 1, 1, 1, 1};
+    const FrameComparison t = gl::compare_frames(reference, tie_only);
+    EXPECT_TRUE(t.false_culled.empty());
+    EXPECT_EQ(t.depth_ties, 1u);
+    EXPECT_TRUE(t.conservative());
+    EXPECT_FALSE(t.identical());
+
+    EXPECT_TRUE(gl::compare_frames(reference, reference).identical());
+    FrameCapture short_depth = culled;
+    short_depth.depth.clear();
+    EXPECT_THROW(gl::compare_frames(reference, short_depth), patchcull::Error);
+    FrameCapture fewer_patches = culled;
+    fewer_patches.patches.pop_back();
+    EXPECT_THROW(gl::compare_frames(reference, fewer_patches), patchcull::Error);
 }
 
 TEST(OcclusionPipeline, DisplacedPatchesAreNotHiZTested) {
