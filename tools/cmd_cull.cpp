@@ -1,12 +1,14 @@
 // `patchcull cull MODEL ... --json`: CPU cull kernels over random views, checked against the
 // dense-sample ground truth. Output: {"model","patches","views","methods":{name:{cull_rate,
 // false_culls, ns_per_patch}}}.
+#include <algorithm>
+#include <cstdint>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "cli_options.h"
 #include "commands.h"
 #include "patchcull/cull_eval.h"
 #include "patchcull/error.h"
@@ -15,13 +17,22 @@
 namespace patchcull::cli {
 namespace {
 
-std::vector<std::string> split_list(const std::string& list) {
+// "a,b,c" -> {a, b, c}. An empty item ("a,,b", a trailing comma) or a repeated one is an error:
+// either is a typo that would otherwise run a different list than the one meant.
+std::vector<std::string> split_methods(const std::string& list) {
     std::vector<std::string> items;
-    std::stringstream in(list);
-    std::string item;
-    while (std::getline(in, item, ','))
-        if (!item.empty()) items.push_back(item);
-    return items;
+    std::size_t begin = 0;
+    while (true) {
+        const std::size_t comma = list.find(',', begin);
+        const std::string item = list.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
+        if (item.empty()) throw Error("--methods: empty item in " + quote_input(list));
+        if (!is_cull_method(item)) throw Error("--methods: unknown cull method " + quote_input(item));
+        if (std::find(items.begin(), items.end(), item) != items.end())
+            throw Error("--methods: " + quote_input(item) + " listed twice");
+        items.push_back(item);
+        if (comma == std::string::npos) return items;
+        begin = comma + 1;
+    }
 }
 
 }  // namespace
@@ -38,21 +49,18 @@ Runner add_cull_command(CLI::App& app) {
     auto state = std::make_shared<State>();
     CLI::App* command = app.add_subcommand("cull", "Run the CPU cull kernels over random views");
     add_model_options(*command, state->model, true);
-    command->add_option("--views", state->views, "number of random views")->check(CLI::Range(0, 10000000));
-    command->add_option("--seed", state->seed, "view generator seed");
-    command->add_option("--view-mode", state->view_mode, "contain: whole object in view; free: anywhere")
-        ->check(CLI::IsMember({"contain", "free"}));
-    command->add_option("--methods", state->methods, "comma-separated cull methods");
+    add_int_option(*command, "--views", state->views, 1, 10000000, "number of random views");
+    add_uint64_option(*command, "--seed", state->seed, UINT64_MAX, "view generator seed");
+    add_choice_option(*command, "--view-mode", state->view_mode, {"contain", "free"},
+                      "contain: whole object in view; free: anywhere");
+    add_text_option(*command, "--methods", state->methods, "comma-separated cull methods");
     command->add_flag("--json", state->json, "print one JSON object");
     return [state]() {
         CullEvalOptions options;
         options.views = state->views;
         options.seed = state->seed;
         parse_view_mode(state->view_mode.c_str(), options.mode);
-        options.methods = split_list(state->methods);
-        if (options.methods.empty()) throw Error("--methods: empty list");
-        for (const std::string& m : options.methods)
-            if (!is_cull_method(m)) throw Error("--methods: unknown cull method '" + m + "'");
+        options.methods = split_methods(state->methods);
         const LoadedModel model = load_model_from_options(state->model);
         for (const std::string& w : model.warnings) std::cerr << "patchcull: warning: " << w << "\n";
         const DisplacementMap displacement = displacement_from_options(state->model, model);

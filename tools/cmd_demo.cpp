@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <memory>
 
+#include "cli_options.h"
 #include "commands.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
@@ -43,6 +44,9 @@ int run_demo(const DemoOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     int width = 0, height = 0;
     parse_size("--size", options.size, width, height);
+    // Before any rendering: a bad --out-dir (the default `out` included) is an error now, not
+    // after the whole job (seconds to minutes) has run.
+    prepare_output_dir("--out-dir", options.out_dir, {"frame.png", "cull.png"});
     const Scene scene = make_default_scene();
     gl::GlContext context = gl::GlContext::create_headless();
     gl::CullPipeline pipeline(context);
@@ -135,7 +139,6 @@ int run_demo(const DemoOptions& options) {
                     sums.cull / n, sums.pass2 / n, sums.total / n, sums.total / n / reference_ms, sums.false_culls);
         total_false += sums.false_culls;
         if (method.cull == gl::CullMode::all) {
-            std::filesystem::create_directories(out_dir);
             renderer.write_color_png((out_dir / "frame.png").string());
             // The last camera's view turned 90 degrees about the target, farther out and above:
             // the sides facing away from the path's camera (back-patch and occlusion culled) show.
@@ -162,11 +165,10 @@ Runner add_demo_command(CLI::App& app) {
     auto options = std::make_shared<DemoOptions>();
     CLI::App* command =
         app.add_subcommand("demo", "Render the built-in default scene (the main job; the default command)");
-    command->add_option("--size", options->size, "framebuffer size WxH (default 640x360)");
-    command->add_option("--frames", options->frames, "frames along the camera path (2..100, default 6)")
-        ->check(CLI::Range(2, 100));
-    command->add_option("--tess", options->tess, "uniform tessellation level (1..64, default 8)")->check(CLI::Range(1, 64));
-    command->add_option("--out-dir", options->out_dir, "directory of frame.png and cull.png (default out)");
+    add_size_option(*command, "--size", options->size, "framebuffer size");
+    add_int_option(*command, "--frames", options->frames, 2, 100, "frames along the camera path");
+    add_int_option(*command, "--tess", options->tess, 1, 64, "uniform tessellation level");
+    add_text_option(*command, "--out-dir", options->out_dir, "directory of frame.png and cull.png (created if missing)");
     return [options]() { return run_demo(*options); };
 }
 

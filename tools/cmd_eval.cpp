@@ -19,6 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_options.h"
 #include "commands.h"
 #include "eval_displaced.h"
 #include "patchcull/error.h"
@@ -147,36 +148,30 @@ Runner add_eval_command(CLI::App& app) {
     auto occlusion = std::make_shared<OcclusionOptions>();
     CLI::App* command = eval->add_subcommand(
         "occlusion", "Seed 000 §6.2: occluded fraction of a non-displaced model over whole-object views");
-    command->add_option("MODEL", occlusion->model, "OBJ control mesh, or 'teapot'")->required();
-    command->add_option("--scheme", occlusion->scheme, "Catmull-Clark to Bezier scheme: acc or osd")
-        ->check(CLI::IsMember({"acc", "osd"}));
-    command->add_option("--split", occlusion->split, "uniform 1-to-4 patch splits (0..4)")->check(CLI::Range(0, 4));
-    command->add_option("--views", occlusion->views, "number of whole-object views (1..100000)")
-        ->check(CLI::Range(1, 100000));
-    command->add_option("--seed", occlusion->seed, "view generator seed");
-    command->add_option("--size", occlusion->size, "framebuffer size WxH (default 512x512)");
-    command->add_option("--tess", occlusion->tess, "uniform tessellation level (1..64)")->check(CLI::Range(1, 64));
-    command->add_option("--max-frames", occlusion->max_frames, "frames per view at most (2..100)")
-        ->check(CLI::Range(2, 100));
+    add_text_option(*command, "MODEL", occlusion->model, "OBJ control mesh, or 'teapot'")->required();
+    add_choice_option(*command, "--scheme", occlusion->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
+    add_int_option(*command, "--split", occlusion->split, 0, 4, "uniform 1-to-4 patch splits");
+    add_int_option(*command, "--views", occlusion->views, 1, 100000, "number of whole-object views");
+    add_uint64_option(*command, "--seed", occlusion->seed, UINT64_MAX, "view generator seed");
+    add_size_option(*command, "--size", occlusion->size, "framebuffer size");
+    add_int_option(*command, "--tess", occlusion->tess, 1, 64, "uniform tessellation level");
+    add_int_option(*command, "--max-frames", occlusion->max_frames, 2, 100, "frames per view at most");
     command->add_flag("--json", occlusion->json, "print one JSON object");
 
     auto displaced = std::make_shared<DisplacedEvalOptions>();
     CLI::App* displaced_command = eval->add_subcommand(
         "displaced", "Seed 000 Table 1: cull rates of the six displaced-patch bounds over whole-object views");
-    displaced_command->add_option("MODEL", displaced->model, "OBJ control mesh, or 'teapot'")->required();
-    displaced_command->add_option("--scheme", displaced->scheme, "Catmull-Clark to Bezier scheme: acc or osd")
-        ->check(CLI::IsMember({"acc", "osd"}));
-    displaced_command->add_option("--split", displaced->split, "uniform 1-to-4 patch splits (0..4)")
-        ->check(CLI::Range(0, 4));
-    displaced_command->add_option("--views", displaced->views, "number of whole-object views (1..100000)")
-        ->check(CLI::Range(1, 100000));
-    displaced_command->add_option("--seed", displaced->seed, "view generator seed");
-    displaced_command->add_option("--displace", displaced->displace, "height map: a PNG file or 'procedural' (default)");
-    displaced_command->add_option("--displace-scale", displaced->displace_scale,
-                                  "displacement of height 1 in object units (default 2% of the model's diagonal)");
-    displaced_command->add_option("--size", displaced->size, "framebuffer size WxH (default 512x512)");
-    displaced_command->add_option("--tess", displaced->tess, "uniform tessellation level (1..64)")
-        ->check(CLI::Range(1, 64));
+    add_text_option(*displaced_command, "MODEL", displaced->model, "OBJ control mesh, or 'teapot'")->required();
+    add_choice_option(*displaced_command, "--scheme", displaced->scheme, {"acc", "osd"},
+                      "Catmull-Clark to Bezier scheme");
+    add_int_option(*displaced_command, "--split", displaced->split, 0, 4, "uniform 1-to-4 patch splits");
+    add_int_option(*displaced_command, "--views", displaced->views, 1, 100000, "number of whole-object views");
+    add_uint64_option(*displaced_command, "--seed", displaced->seed, UINT64_MAX, "view generator seed");
+    add_text_option(*displaced_command, "--displace", displaced->displace, "height map: a PNG file or 'procedural'");
+    add_float_option(*displaced_command, "--displace-scale", displaced->displace_scale, 0, kMaxDisplaceScale,
+                     "displacement of height 1 in object units (default 2% of the model's diagonal)");
+    add_size_option(*displaced_command, "--size", displaced->size, "framebuffer size");
+    add_int_option(*displaced_command, "--tess", displaced->tess, 1, 64, "uniform tessellation level");
     displaced_command->add_flag("--json", displaced->json, "print one JSON object");
     return [command, occlusion, displaced_command, displaced]() {
         if (command->parsed()) return run_occlusion(*occlusion);

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_options.h"
 #include "commands.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
@@ -41,21 +42,20 @@ Runner add_render_command(CLI::App& app) {
     };
     auto state = std::make_shared<State>();
     CLI::App* command = app.add_subcommand("render", "Render an animated camera path with the GPU cull pipeline");
-    command->add_option("MODEL", state->model, "OBJ control mesh, 'teapot', or 'default' (the default scene)");
-    command->add_option("--scheme", state->scheme, "Catmull-Clark to Bezier scheme: acc or osd")
-        ->check(CLI::IsMember({"acc", "osd"}));
-    command->add_option("--split", state->split, "uniform 1-to-4 patch splits of MODEL (0..4)")
-        ->check(CLI::Range(0, 4));
-    command->add_option("--frames", state->frames, "number of frames (1..1000)")->check(CLI::Range(1, 1000));
-    command->add_option("--cull", state->cull, "none, frustum, backpatch, occlusion or all")
-        ->check(CLI::IsMember({"none", "frustum", "backpatch", "occlusion", "all"}));
-    command->add_option("--backpatch", state->backpatch, "back-patch test of backpatch/all: tcone, ncone or ptp")
-        ->check(CLI::IsMember({"tcone", "ncone", "ptp"}));
-    command->add_option("--tess", state->tess, "uniform tessellation level (1..64)")->check(CLI::Range(1, 64));
-    command->add_option("--size", state->size, "framebuffer size WxH");
+    add_text_option(*command, "MODEL", state->model, "OBJ control mesh, 'teapot', or 'default' (the default scene)");
+    add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
+    add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
+    add_int_option(*command, "--frames", state->frames, 1, 1000, "number of frames");
+    add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all"},
+                      "cull tests of the pipeline");
+    add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
+                      "back-patch test of backpatch/all");
+    add_int_option(*command, "--tess", state->tess, 1, 64, "uniform tessellation level");
+    add_size_option(*command, "--size", state->size, "framebuffer size");
     command->add_flag("--aggressive", state->aggressive, "skip the second pass (seed 000 §3.1; not conservative)");
-    command->add_flag("--verify", state->verify, "render the unculled reference of every frame and count false culls");
-    command->add_option("--out", state->out, "write the colour image of the last frame as a PNG");
+    command->add_flag("--verify", state->verify,
+                      "render the unculled reference of every frame and count false culls (exit status 1 if any)");
+    add_output_file_option(*command, "--out", state->out, "write the colour image of the last frame as a PNG");
     command->add_flag("--json", state->json, "print one JSON object");
     return [state]() {
         int width = 0, height = 0;
@@ -148,7 +148,8 @@ Runner add_render_command(CLI::App& app) {
         } else if (state->verify) {
             std::printf("false culls in total: %zu\n", total_false);
         }
-        return 0;
+        // A false cull breaks the conservative promise: a failure, as in the main job (demo).
+        return total_false > 0 ? 1 : 0;
     };
 }
 

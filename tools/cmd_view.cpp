@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "cli_options.h"
 #include "commands.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
@@ -28,19 +29,19 @@ Runner add_view_command(CLI::App& app) {
     };
     auto state = std::make_shared<State>();
     CLI::App* command = app.add_subcommand("view", "Show the GPU cull pipeline in a window (GLFW)");
-    command->add_option("MODEL", state->model, "OBJ control mesh, 'teapot', or 'default' (the default scene)");
-    command->add_option("--scheme", state->scheme, "Catmull-Clark to Bezier scheme: acc or osd")
-        ->check(CLI::IsMember({"acc", "osd"}));
-    command->add_option("--split", state->split, "uniform 1-to-4 patch splits of MODEL (0..4)")->check(CLI::Range(0, 4));
-    command->add_option("--frames", state->frames, "stop after N frames (0: loop until the window is closed)")
-        ->check(CLI::Range(0, 1000000));
-    command->add_option("--cull", state->cull, "none, frustum, backpatch, occlusion or all")
-        ->check(CLI::IsMember({"none", "frustum", "backpatch", "occlusion", "all"}));
-    command->add_option("--backpatch", state->backpatch, "back-patch test of backpatch/all: tcone, ncone or ptp")
-        ->check(CLI::IsMember({"tcone", "ncone", "ptp"}));
-    command->add_option("--tess", state->tess, "uniform tessellation level (1..64)")->check(CLI::Range(1, 64));
-    command->add_option("--size", state->size, "window size WxH");
-    command->add_option("--screenshot", state->screenshot, "after the last frame, write the window's content as a PNG");
+    add_text_option(*command, "MODEL", state->model, "OBJ control mesh, 'teapot', or 'default' (the default scene)");
+    add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
+    add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
+    add_int_option(*command, "--frames", state->frames, 0, 1000000,
+                   "stop after N frames (0: loop until the window is closed)");
+    add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all"},
+                      "cull tests of the pipeline");
+    add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
+                      "back-patch test of backpatch/all");
+    add_int_option(*command, "--tess", state->tess, 1, 64, "uniform tessellation level");
+    add_size_option(*command, "--size", state->size, "window size");
+    add_output_file_option(*command, "--screenshot", state->screenshot,
+                           "after the last frame, write the window's content as a PNG");
     return [state]() {
         int width = 0, height = 0;
         parse_size("--size", state->size, width, height);

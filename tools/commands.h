@@ -35,8 +35,12 @@ struct ModelOptions {
     std::string scheme = "acc";
     int split = 0;
     std::string displace;        ///< "", "procedural" or a PNG path
-    float displace_scale = -1;   ///< object units; < 0 means 2% of the model's bounding-box diagonal
+    float displace_scale = -1;   ///< object units; -1 (no flag gives < 0) means 2% of the bounding-box diagonal
 };
+
+/// The largest --displace-scale accepted (object units): large enough for any model, small
+/// enough that products of a few such values stay finite in float.
+inline constexpr double kMaxDisplaceScale = 1e9;
 
 void add_model_options(CLI::App& command, ModelOptions& options, bool with_displacement);
 /// Loads the model (throws patchcull::Error with file/flag in the message).

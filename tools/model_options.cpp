@@ -1,6 +1,7 @@
 // Model, scheme, split and displacement options shared by the CLI's commands.
 #include <cmath>
 
+#include "cli_options.h"
 #include "commands.h"
 #include "patchcull/error.h"
 #include "patchcull/image.h"
@@ -8,15 +9,17 @@
 namespace patchcull::cli {
 
 void add_model_options(CLI::App& command, ModelOptions& options, bool with_displacement) {
-    command.add_option("MODEL", options.model, "OBJ control mesh, or 'teapot' for the built-in Utah teapot")
+    add_text_option(command, "MODEL", options.model, "OBJ control mesh, or 'teapot' for the built-in Utah teapot")
         ->required();
-    command.add_option("--scheme", options.scheme, "Catmull-Clark to Bezier scheme: acc or osd")
-        ->check(CLI::IsMember({"acc", "osd"}));
-    command.add_option("--split", options.split, "uniform 1-to-4 patch splits (0..4)")->check(CLI::Range(0, 4));
+    add_choice_option(command, "--scheme", options.scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
+    add_int_option(command, "--split", options.split, 0, 4, "uniform 1-to-4 patch splits");
     if (with_displacement) {
-        command.add_option("--displace", options.displace, "displacement map: a PNG file or 'procedural'");
-        command.add_option("--displace-scale", options.displace_scale,
-                           "object-space displacement of a full height step (default: 2% of the model's size)");
+        CLI::Option* displace =
+            add_text_option(command, "--displace", options.displace, "displacement map: a PNG file or 'procedural'");
+        // Without a map the scale would mean nothing: an error rather than silently ignored.
+        add_float_option(command, "--displace-scale", options.displace_scale, 0, kMaxDisplaceScale,
+                         "object-space displacement of a full height step (default: 2% of the model's size)")
+            ->needs(displace);
     }
 }
 

@@ -2,6 +2,11 @@
 // exit status 2 for every kind of bad input.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "cli_test_util.h"
@@ -124,4 +129,134 @@ TEST(Cli, CullBackPatchMethodsOnTheTeapot) {
 
 TEST(Cli, BackPatchMethodsRefuseDisplacement) {
     expect_one_line_error(run("cull teapot --methods ptp --displace procedural --views 1 --json"), "--displace");
+}
+
+// Issue 9, flags: every numeric or string option of every command is parsed strictly
+// (tools/cli_options.h). Each bad value is one line on stderr naming the flag, exit status 2.
+// The GPU commands' flags are checked as they are parsed, before any OpenGL context exists, so
+// they are tested here too. The old CLI accepted most of these: `--views 0` ran with rate 0,
+// `--seed -1` wrapped to 2^64-1, `1e23` clamped, `--displace-scale -1` meant the default, an
+// empty `--displace` or a scale without a map were ignored, integers took octal and hex.
+TEST(Cli, EveryNumericAndStringFlagRejectsBadValues) {
+    struct Case {
+        const char* command;  // everything but the bad option
+        const char* flag;
+        std::vector<const char*> values;  // as the shell sees them (quoted where needed)
+    };
+    const std::string bigguy = model("bigguy.obj");
+    const Case cases[] = {
+        {"info teapot", "--split", {"-1", "5", "1.5", "0x1", "' 1'", "''", "1e0", "+1", "99999999999999999999"}},
+        {"info teapot", "--scheme", {"''", "ACC", "loop"}},
+        {"cull teapot --views 1", "--seed", {"-1", "1e23", "18446744073709551616", "0x10", "+5", "''", "1.0"}},
+        {"cull teapot", "--views", {"0", "-1", "10000001", "1e3", "99999999999999999999", "''", "nan"}},
+        {"cull teapot --views 1 --methods frustum --displace procedural", "--displace-scale",
+         {"-1", "nan", "inf", "-inf", "1e999", "''", "1e10", "0x1p3", "'1 '"}},
+        {"cull teapot --views 1 --methods frustum", "--displace", {"''"}},
+        {"cull teapot --views 1", "--methods", {"''", "frustum,,ncone", "frustum,frustum", "frustum,", ",frustum"}},
+        {"cull teapot --views 1", "--view-mode", {"''", "Free"}},
+        {"render teapot", "--frames", {"0", "1001", "-1", "2.5", "''"}},
+        {"render teapot", "--tess", {"0", "65", "nan", "08x"}},
+        {"render teapot", "--split", {"5", "-0x1"}},
+        {"render teapot", "--size", {"0x64", "64x", "8193x1", "64x64x1", "-1x-1", "1e2x1", "''"}},
+        {"render teapot", "--cull", {"''", "All"}},
+        {"render teapot", "--backpatch", {"''", "cone"}},
+        {"view teapot", "--frames", {"-1", "1000001"}},
+        {"view teapot --frames 1", "--tess", {"0", "65"}},
+        {"view teapot --frames 1", "--size", {"0x0", "x"}},
+        {"eval occlusion teapot", "--views", {"0", "100001"}},
+        {"eval occlusion teapot", "--seed", {"-1", "1e23"}},
+        {"eval occlusion teapot", "--max-frames", {"1", "101"}},
+        {"eval occlusion teapot", "--tess", {"0"}},
+        {"eval occlusion teapot", "--size", {"1x0"}},
+        {"eval displaced teapot", "--views", {"0"}},
+        {"eval displaced teapot", "--seed", {"-1"}},
+        {"eval displaced teapot", "--displace", {"''"}},
+        {"eval displaced teapot", "--displace-scale", {"-1", "nan", "inf", "1e10"}},
+        {"eval displaced teapot", "--tess", {"65"}},
+        {"demo", "--frames", {"1", "101", "-6"}},
+        {"demo", "--tess", {"0", "65"}},
+        {"demo", "--size", {"''", "64"}},
+        {"demo", "--out-dir", {"''"}},
+    };
+    for (const Case& c : cases)
+        for (const char* value : c.values) {
+            SCOPED_TRACE(std::string(c.command) + " " + c.flag + " " + value);
+            expect_one_line_error(run(std::string(c.command) + " " + c.flag + " " + value), c.flag);
+        }
+    // Positional MODEL: empty.
+    for (const char* command : {"info", "cull", "render", "view", "eval occlusion", "eval displaced"}) {
+        SCOPED_TRACE(command);
+        expect_one_line_error(run(std::string(command) + " ''"), "MODEL");
+    }
+    // A scale without a map would be ignored: `cull` (no default map) refuses it.
+    expect_one_line_error(run("cull teapot --views 1 --displace-scale 0.1"), "--displace-scale");
+}
+
+TEST(Cli, BadFlagValuesAreQuotedOnOneLine) {
+    // A control byte or a newline in a value must not break the one-line error.
+    expect_one_line_error(run("cull teapot --views \"$(printf '1\\n2')\""), "--views: expected an integer in 1..10000000");
+    expect_one_line_error(run("render teapot --size \"$(printf '64\\nx64')\""), "--size");
+    expect_one_line_error(run("info teapot --scheme \"$(printf 'a\\033[31m')\""), "--scheme: expected one of acc|osd");
+    const CliRun r = run("cull teapot --views 1 --methods \"$(printf 'frustum,x\\001y')\"");
+    expect_one_line_error(r, "--methods: unknown cull method 'x\\x01y'");
+}
+
+TEST(Cli, StrictFlagsStillTakeEveryValidValue) {
+    // The range ends: seed 0 and 2^64-1, one view, split 4 (info is fast).
+    CliRun r = run("cull teapot --views 1 --seed 18446744073709551615 --methods frustum --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["seed"].get<std::uint64_t>(), 18446744073709551615ull);
+    EXPECT_EQ(nlohmann::json::parse(r.out)["views"], 1);
+    r = run("cull teapot --views 1 --seed 0 --methods frustum --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["seed"], 0);
+    r = run("info teapot --split 4 --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["patches"], 32 * 256);
+    // Reals: exponent notation, 0 (no displacement) and the upper end.
+    for (const char* scale : {"2.5e-2", "0", "1e9"}) {
+        r = run(std::string("cull teapot --views 2 --methods frustum --displace procedural --displace-scale ") + scale +
+                " --json");
+        ASSERT_EQ(r.status, 0) << scale << ": " << r.err;
+        EXPECT_EQ(nlohmann::json::parse(r.out)["methods"]["frustum"]["false_culls"], 0) << scale;
+    }
+}
+
+// Issue 9, output paths: checked before any work (no model loaded, no OpenGL context), one line
+// naming the flag and the path, exit 2. The old `demo --out-dir /proc/nonexistent` rendered the
+// whole job and then exited 3 ("internal error: filesystem error").
+TEST(Cli, OutputPathsAreCheckedBeforeTheWork) {
+    const std::string file = write_file("a_file", "x");
+    const std::string dir = scratch_dir();
+    std::filesystem::create_directories(dir + "/blocked/frame.png");  // a directory where a file goes
+    // demo: the directory cannot be created, its parent is a file, or one of its files cannot be written.
+    expect_one_line_error(run("demo --out-dir /proc/nonexistent"), "--out-dir: cannot create directory '/proc/nonexistent'");
+    expect_one_line_error(run("demo --out-dir " + file + "/sub"), "--out-dir: cannot create directory '" + file + "/sub'");
+    expect_one_line_error(run("demo --out-dir " + file), "--out-dir: cannot create directory '" + file + "'");
+    expect_one_line_error(run("demo --out-dir " + dir + "/blocked"),
+                          "--out-dir: cannot write '" + dir + "/blocked/frame.png': is a directory");
+    // render --out and view --screenshot: a missing directory, a directory, a file as the parent, empty.
+    for (const std::string command : {"render teapot --frames 1 --size 8x8", "view teapot --frames 1 --size 8x8"}) {
+        const std::string flag = command.rfind("render", 0) == 0 ? "--out" : "--screenshot";
+        SCOPED_TRACE(command);
+        expect_one_line_error(run(command + " " + flag + " /nonexistent/dir/x.png"),
+                              flag + ": cannot write '/nonexistent/dir/x.png': No such file or directory");
+        expect_one_line_error(run(command + " " + flag + " " + dir), flag + ": cannot write '" + dir + "': is a directory");
+        expect_one_line_error(run(command + " " + flag + " " + file + "/x.png"),
+                              flag + ": cannot write '" + file + "/x.png': Not a directory");
+        expect_one_line_error(run(command + " " + flag + " ''"), flag + ": empty path");
+    }
+}
+
+TEST(Cli, OutputPathProbeLeavesNothingBehind) {
+    // The probe file is created and removed: a run that fails later (here at --split, in the
+    // command's own checks after parsing, still before OpenGL) leaves no file, and an existing
+    // file is left as it was.
+    const std::string png = scratch_dir() + "/probe.png";
+    std::filesystem::remove(png);
+    expect_one_line_error(run("render default --split 1 --out " + png), "--split");
+    EXPECT_FALSE(std::filesystem::exists(png));
+    const std::string existing = write_file("existing.png", "old");
+    expect_one_line_error(run("render default --split 1 --out " + existing), "--split");
+    EXPECT_EQ(slurp(existing), "old");
 }

@@ -108,9 +108,10 @@ TEST(GpuCli, VerifyCatchesBackFacingPatchesSeenThroughTheTeapotsLidGap) {
     // The teapot is not closed: its lid sits loose inside the rim, and from above the inside of the
     // far upper body (patches 4-7, whose outside faces away) shows through the gap. An explicit
     // --cull backpatch still runs there (with a warning): its test culls those patches although
-    // they contribute pixels, and --verify must report them.
+    // they contribute pixels, and --verify must report them, and fail: exit status 1, as the main
+    // job does (issue 9: it exited 0).
     const CliRun r = run(kSmallTeapot + "--frames 3 --cull backpatch --backpatch tcone --verify --json");
-    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_EQ(r.status, 1) << r.err;
     EXPECT_NE(r.err.find("warning: render: teapot is not a closed surface"), std::string::npos) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_GT(j["false_culls"].get<std::size_t>(), 0u);
