@@ -69,8 +69,27 @@ struct SubdivisionModel {
     std::size_t extraordinary_count() const;
 };
 
+/// Largest face (corners) and vertex valence (faces around a vertex) either scheme takes.
+/// Why a limit: both schemes store every Bezier control point as a flat stencil over control
+/// vertices, and next to a vertex of valence n (an n-gon becomes one: its face point) each of the
+/// n patches has points that depend on the whole one-ring, so preprocessing costs ~n^2 time and
+/// memory per such vertex or face, which is linear in the mesh only for bounded n (and Far's own
+/// stencils for two n-gons sharing their edges cost ~n^3). Measured with `patchcull info` (one
+/// vertex or face, Release, 2-core machine under load): at n = 64 every generated case (an open
+/// or closed n-gon, an open or closed fan of n quads or n triangles) takes at most 0.33 s and
+/// 28 MB with either scheme; at n = 128 a closed 128-gon takes 2.7 s (acc) and 1.4 s (osd), at
+/// 256 18 s and 12 s.
+inline constexpr std::uint32_t kMaxFaceCorners = 64;
+inline constexpr std::uint32_t kMaxValence = 64;
+
+/// Throws patchcull::Error "<mesh.name>: face F has N corners; ..." or "<mesh.name>: vertex V
+/// has valence N; ..." (F, V 1-based as in the OBJ, the first offender) when the mesh exceeds
+/// kMaxFaceCorners or kMaxValence. O(corners); vertex indices out of range are left to the
+/// schemes' own validation. build_model and both back ends call it before any other work.
+void check_preprocessing_limits(const ControlMesh& mesh);
+
 /// Builds the patches of mesh under scheme. Throws patchcull::Error for meshes the scheme cannot
-/// take (e.g. non-manifold topology), naming mesh.name.
+/// take (e.g. non-manifold topology, check_preprocessing_limits), naming mesh.name.
 SubdivisionModel build_model(const ControlMesh& mesh, Scheme scheme);
 
 /// Patches of one frame.

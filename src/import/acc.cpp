@@ -352,6 +352,7 @@ SubdivisionModel build_acc_model(const ControlMesh& mesh) {
     model.scheme = Scheme::acc;
     model.mesh = mesh;
     if (mesh.face_count() == 0) throw Error(mesh.name + ": mesh has no faces");
+    check_preprocessing_limits(mesh);  // rules and rows below cost ~valence^2 per vertex
 
     QuadPatches quads;
     if (mesh.all_quads()) {

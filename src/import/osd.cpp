@@ -15,8 +15,10 @@
 //    patch is then a 16-point B-spline patch (type REGULAR); patches around extraordinary
 //    vertices (and unresolved semi-sharp features) at the isolation level are "end caps": B-spline
 //    approximations whose points are local points with their own stencils.
-// 3. Stencils for every refined vertex over the control vertices (factorized through the levels)
-//    with the local-point stencils appended: every patch point is a row over control vertices.
+// 3. Stencils for every refined vertex over the level above, with the local-point stencils
+//    appended; each patch point is composed through the levels into a row over control vertices
+//    (StencilExpander: time linear in the terms touched, where Far's own factorization is cubic
+//    in the valence).
 // 4. Per patch: extrapolate the phantom points of boundary edges, convert B-spline -> Bezier per
 //    direction with [1 4 1 0; 0 4 2 0; 0 2 4 0; 0 1 4 1]/6, and emit 16 rows cp[4*j+i].
 //    Far orders the 16 points of a patch as 4*row + column with the column along the patch's s
@@ -42,6 +44,7 @@
 //   semi-sharp or non-boundary sharp feature).
 // - tangent_index: -1 (the osd patches are exact polynomial patches; normals come from their
 //   own derivatives).
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -135,6 +138,88 @@ Vec2 ptex_texcoord(const ControlMesh& mesh, std::uint32_t f, int sub, double u, 
             static_cast<float>(w0 * c[0].y + w1 * c[1].y + w2 * c[2].y + w3 * c[3].y)};
 }
 
+// Composes weighted sums of stencil rows into one row over the control vertices. The rows of
+// level 0 are the control vertices themselves (identity stencils); a row of level L > 0 is a
+// stencil over level L-1 (indices within that level), a local point one over absolute rows. Terms are accumulated densely and expanded from the highest touched row down, so each
+// touched row is expanded once: the cost is the sum of the touched rows' sizes.
+class StencilExpander {
+public:
+    /// Rows: base's (level by level, level 0 the control vertices), then local's (null: none).
+    StencilExpander(const ControlMesh& mesh, const Far::TopologyRefiner& refiner,
+                    const Far::StencilTableReal<double>& base, const Far::StencilTableReal<double>* local)
+        : mesh_(mesh), base_(base), local_(local), base_count_(base.GetNumStencils()),
+          control_count_(refiner.GetLevel(0).GetNumVertices()),
+          acc_(static_cast<std::size_t>(base_count_ + (local ? local->GetNumStencils() : 0)), 0.0),
+          seen_(acc_.size(), 0) {
+        for (int l = 0, start = 0; l <= refiner.GetMaxLevel(); ++l) {
+            level_start_.push_back(start);
+            start += refiner.GetLevel(l).GetNumVertices();
+        }
+    }
+
+    void add(int row, double w) {
+        if (row < 0 || static_cast<std::size_t>(row) >= acc_.size())
+            throw Error(mesh_.name + ": OpenSubdiv produced a stencil source out of range");
+        if (!seen_[static_cast<std::size_t>(row)]) {
+            seen_[static_cast<std::size_t>(row)] = 1;
+            if (row < control_count_) {
+                control_.push_back(static_cast<std::uint32_t>(row));
+            } else {
+                pending_.push_back(row);
+                std::push_heap(pending_.begin(), pending_.end());
+            }
+        }
+        acc_[static_cast<std::size_t>(row)] += w;
+    }
+
+    /// The accumulated row over the control vertices (sorted, zeros dropped); resets the scratch.
+    void finish(std::vector<std::pair<std::uint32_t, float>>& terms) {
+        while (!pending_.empty()) {
+            std::pop_heap(pending_.begin(), pending_.end());
+            const int row = pending_.back();
+            pending_.pop_back();
+            const double w = acc_[static_cast<std::size_t>(row)];
+            acc_[static_cast<std::size_t>(row)] = 0.0;
+            seen_[static_cast<std::size_t>(row)] = 0;
+            if (w == 0.0) continue;
+            const bool is_local = row >= base_count_;
+            const auto s = is_local ? local_->GetStencil(row - base_count_) : base_.GetStencil(row);
+            // A refined vertex's sources are numbered within the level above it.
+            const int source_offset = is_local ? 0 : level_start_[level_of(row) - 1];
+            for (int k = 0; k < s.GetSize(); ++k) {
+                const int source = source_offset + s.GetVertexIndices()[k];
+                if (source >= row || source < 0)
+                    throw Error(mesh_.name + ": OpenSubdiv produced a stencil that is not over earlier points");
+                add(source, w * s.GetWeights()[k]);
+            }
+        }
+        std::sort(control_.begin(), control_.end());
+        terms.clear();
+        for (std::uint32_t v : control_) {
+            if (acc_[v] != 0.0) terms.emplace_back(v, static_cast<float>(acc_[v]));
+            acc_[v] = 0.0;
+            seen_[v] = 0;
+        }
+        control_.clear();
+    }
+
+private:
+    int level_of(int row) const {
+        return static_cast<int>(std::upper_bound(level_start_.begin(), level_start_.end(), row) - level_start_.begin()) - 1;
+    }
+
+    const ControlMesh& mesh_;
+    const Far::StencilTableReal<double>& base_;
+    const Far::StencilTableReal<double>* local_;
+    int base_count_;
+    int control_count_;
+    std::vector<double> acc_;
+    std::vector<std::uint8_t> seen_;
+    std::vector<int> level_start_;  // first base row of each refinement level
+    std::vector<int> pending_;  // max-heap of touched rows above the control vertices
+    std::vector<std::uint32_t> control_;
+};
+
 }  // namespace
 
 SubdivisionModel build_osd_model(const ControlMesh& mesh) {
@@ -142,6 +227,7 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh) {
     model.name = mesh.name;
     model.scheme = Scheme::osd;
     model.mesh = mesh;
+    check_preprocessing_limits(mesh);  // end caps cost ~valence^2 per vertex (subdivision.h)
     osd_detail::RefinerPtr refiner = osd_detail::create_refiner(mesh, &model.mesh.warnings);
 
     Far::PatchTableFactory::Options popt(kIsolationLevel);
@@ -156,21 +242,28 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh) {
     std::unique_ptr<const Far::PatchTable> table(Far::PatchTableFactory::Create(*refiner, popt));
     if (!table) throw Error(mesh.name + ": OpenSubdiv could not build the patch table");
 
-    // Stencils of all vertices (control vertices, every refined level) over the control vertices,
-    // then the end caps' local points appended: row k is patch-point index k.
+    // Stencils of all vertices (control vertices, every refined level), then the end caps' local
+    // points: patch-point index k is row k of that sequence. Not factorized: each refined vertex
+    // is a stencil over the level above, each local point one over refined vertices, so every row's
+    // sources are lower rows (checked in StencilExpander). Far's factorization merges each term
+    // into the growing stencil with a linear search: around a vertex of valence n (or an n-gon,
+    // whose face point has valence n) its rows have O(n) terms over sources with O(n) terms, and
+    // the end caps' O(n) local points each cost up to O(n^3) (measured with the CLI's info
+    // command: 9.6 s for one 200-sided face, over 60 s for a valence-256 vertex of an all-quad
+    // fan, almost all inside appendLocalPointStencilTable). StencilExpander composes each patch
+    // point through the levels instead, in time linear in the terms it touches.
     Far::StencilTableFactoryReal<double>::Options sopt;
     sopt.generateOffsets = true;
     sopt.generateControlVerts = true;
     sopt.generateIntermediateLevels = true;
-    sopt.factorizeIntermediateLevels = true;
+    sopt.factorizeIntermediateLevels = false;
     std::unique_ptr<const Far::StencilTableReal<double>> base(Far::StencilTableFactoryReal<double>::Create(*refiner, sopt));
-    std::unique_ptr<const Far::StencilTableReal<double>> all;
-    const Far::StencilTableReal<double>* points = base.get();
-    if (const auto* local = table->GetLocalPointStencilTable<double>(); local && local->GetNumStencils() > 0) {
-        all.reset(Far::StencilTableFactoryReal<double>::AppendLocalPointStencilTable(*refiner, base.get(), local));
-        if (!all) throw Error(mesh.name + ": OpenSubdiv could not append the end-cap stencils");
-        points = all.get();
-    }
+    if (!base || base->GetNumStencils() != refiner->GetNumVerticesTotal())
+        throw Error(mesh.name + ": OpenSubdiv produced an unexpected number of refinement stencils");
+    // Local points are stencils over absolute vertex indices (control vertices included), the
+    // rows of base; Far's non-factorizing AppendLocalPointStencilTable crashes in 3.5, so the
+    // expander reads the two tables side by side.
+    const Far::StencilTableReal<double>* local = table->GetLocalPointStencilTable<double>();
 
     // ptex face -> (base face, sub-face).
     const Far::PtexIndices ptex(*refiner);
@@ -185,10 +278,7 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh) {
         }
     }
 
-    const std::size_t nv = mesh.positions.size();
-    std::vector<double> accum(nv, 0.0);  // dense scratch row over the control vertices
-    std::vector<std::uint8_t> seen(nv, 0);
-    std::vector<std::uint32_t> touched;
+    StencilExpander expander(mesh, *refiner, *base, local);
     std::vector<std::pair<std::uint32_t, float>> terms;
     model.patches.reserve(static_cast<std::size_t>(table->GetNumPatchesTotal()));
 
@@ -221,26 +311,9 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh) {
                     for (int row = 0; row < 4; ++row)
                         for (int col = 0; col < 4; ++col) {
                             const double w = mt[j][row] * ms[i][col];
-                            if (w == 0.0) continue;
-                            const auto s = points->GetStencil(cvs[4 * row + col]);
-                            const int* idx = s.GetVertexIndices();
-                            const double* wt = s.GetWeights();
-                            for (int k = 0; k < s.GetSize(); ++k) {
-                                const auto v = static_cast<std::uint32_t>(idx[k]);
-                                if (!seen[v]) {
-                                    seen[v] = 1;
-                                    touched.push_back(v);
-                                }
-                                accum[v] += w * wt[k];
-                            }
+                            if (w != 0.0) expander.add(cvs[4 * row + col], w);
                         }
-                    terms.clear();
-                    for (std::uint32_t v : touched) {
-                        if (accum[v] != 0.0) terms.emplace_back(v, static_cast<float>(accum[v]));
-                        accum[v] = 0.0;
-                        seen[v] = 0;
-                    }
-                    touched.clear();
+                    expander.finish(terms);
                     model.patch_points.add_row(terms);
                 }
 

@@ -47,6 +47,7 @@ RefinedMesh refine_uniform_once(const ControlMesh& mesh) {
     out.mesh.name = mesh.name;
     out.mesh.origin = mesh.origin;  // refined positions are stencils of the local ones
     out.mesh.warnings = mesh.warnings;
+    check_preprocessing_limits(mesh);  // Far's factorized stencils cost up to ~n^3 (subdivision.h)
     osd_detail::RefinerPtr refiner = osd_detail::create_refiner(mesh, &out.mesh.warnings);
 
     Far::TopologyRefiner::UniformOptions uniform(1);

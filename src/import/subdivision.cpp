@@ -2,7 +2,7 @@
 #include "patchcull/subdivision.h"
 
 #include <algorithm>
-#include <map>
+#include <string>
 
 #include "patchcull/error.h"
 
@@ -18,9 +18,15 @@ bool parse_scheme(const std::string& text, Scheme& scheme) {
 }
 
 void PointStencils::add_row(const std::vector<std::pair<std::uint32_t, float>>& terms) {
-    std::map<std::uint32_t, float> merged;
-    for (const auto& [index, weight] : terms) merged[index] += weight;
-    for (const auto& [index, weight] : merged) {
+    // Sorted merge (O(k log k), no per-row node allocations: rows next to a high-valence vertex
+    // have hundreds of terms).
+    thread_local std::vector<std::pair<std::uint32_t, float>> sorted;
+    sorted.assign(terms.begin(), terms.end());
+    std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t k = 0; k < sorted.size();) {
+        const std::uint32_t index = sorted[k].first;
+        float weight = 0.0f;
+        for (; k < sorted.size() && sorted[k].first == index; ++k) weight += sorted[k].second;
         if (weight == 0.0f) continue;
         indices.push_back(index);
         weights.push_back(weight);
@@ -49,8 +55,28 @@ std::size_t SubdivisionModel::extraordinary_count() const {
         std::count_if(patches.begin(), patches.end(), [](const PatchInfo& p) { return p.extraordinary; }));
 }
 
+void check_preprocessing_limits(const ControlMesh& mesh) {
+    const std::size_t nf = mesh.face_count();
+    for (std::size_t f = 0; f < nf; ++f)
+        if (mesh.face_size(f) > kMaxFaceCorners)
+            throw Error(mesh.name + ": face " + std::to_string(f + 1) + " has " + std::to_string(mesh.face_size(f)) +
+                        " corners; patchcull takes faces of at most " + std::to_string(kMaxFaceCorners) +
+                        " corners (preprocessing costs ~n^2 in a face's corner count n)");
+    std::vector<std::uint32_t> valence(mesh.positions.size(), 0);
+    for (const std::uint32_t v : mesh.face_vertices)
+        if (v < valence.size() && ++valence[v] > kMaxValence) {
+            // Report the vertex with its full valence.
+            std::uint32_t n = 0;
+            for (const std::uint32_t w : mesh.face_vertices) n += w == v;
+            throw Error(mesh.name + ": vertex " + std::to_string(std::uint64_t{v} + 1) + " has valence " + std::to_string(n) +
+                        " (faces around it); patchcull takes vertices of valence at most " + std::to_string(kMaxValence) +
+                        " (preprocessing costs ~n^2 in a vertex's valence n)");
+        }
+}
+
 SubdivisionModel build_model(const ControlMesh& mesh, Scheme scheme) {
     if (mesh.face_count() == 0) throw Error(mesh.name + ": mesh has no faces");
+    check_preprocessing_limits(mesh);
     return scheme == Scheme::acc ? build_acc_model(mesh) : build_osd_model(mesh);
 }
 
