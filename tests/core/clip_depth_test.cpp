@@ -122,7 +122,9 @@ TEST(ClipDepth, EveryDepthSensitiveEntryDecidesAlikeInBothConventions) {
         differences += count_differences(a, b);
         frustum_culled += count_set(b);
         for (std::size_t i = 0; i < n; ++i)
-            if (b[i]) EXPECT_FALSE(any_point_in_clip_volume(c.zo, &samples[i * kGrid * kGrid], kGrid * kGrid)) << v << " " << i;
+            if (b[i]) {
+                EXPECT_FALSE(any_point_in_clip_volume(c.zo, &samples[i * kGrid * kGrid], kGrid * kGrid)) << v << " " << i;
+            }
 
         cull_frustum_disp_scalar(batch.view(), nullptr, c.zo, ClipDepth::zero_to_one, a.data());
         cull_frustum_disp_simd(batch.view(), nullptr, c.no, ClipDepth::minus_one_to_one, b.data());
