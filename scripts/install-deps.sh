@@ -11,6 +11,7 @@ PACKAGES=(
   libgtest-dev libbenchmark-dev
   libglfw3-dev xvfb xauth  # the window context; its test runs under xvfb-run
   assimp-testmodels  # third-party OBJ files for the unseen-models test
+  clang-14 libclang-rt-14-dev  # libFuzzer for the fuzz targets (scripts/fuzz.sh)
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # README command 2: runs every test. Installs the Debian packages if missing, builds the core
-# tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs them, then builds everything
-# in Release and runs the whole suite (ctest's summary line comes last).
+# tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs them, runs a short fuzz
+# campaign over the input loaders (scripts/fuzz.sh, clang), then builds everything in Release and
+# runs the whole suite (ctest's summary line comes last).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS="$(nproc)"
@@ -12,6 +13,9 @@ echo "== core tests under ASan + UBSan =="
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DPATCHCULL_SANITIZE=ON -DPATCHCULL_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build build-asan -j"$JOBS" --target patchcull_core_tests patchcull_cli patchcull_cli_tests
 ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -L "core|cli" --output-on-failure
+
+echo "== fuzz campaign (libFuzzer, clang: OBJ reader and PNG loader, 20 s each) =="
+./scripts/fuzz.sh 20
 
 echo "== full suite (Release) =="
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null

@@ -1,6 +1,8 @@
 // patchcull: command-line entry point. With no arguments it runs the main job on the built-in
 // default scene (tools/cmd_demo.cpp). Every error is one line on stderr and exit status 2 (a
-// missing OpenGL driver included: GlContext::create_headless throws patchcull::Error).
+// missing OpenGL driver included: GlContext::create_headless throws patchcull::Error). Messages go
+// through printable_line as a last line of defence: whatever a flag, path or library put in them,
+// the user sees one printable line of bounded length.
 #include <iostream>
 
 #include "commands.h"
@@ -29,13 +31,13 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForAllHelp& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::cerr << "patchcull: error: " << e.what() << "\n";
+        std::cerr << "patchcull: error: " << patchcull::printable_line(e.what()) << "\n";
         return 2;
     } catch (const patchcull::Error& e) {
-        std::cerr << "patchcull: error: " << e.what() << "\n";
+        std::cerr << "patchcull: error: " << patchcull::printable_line(e.what()) << "\n";
         return 2;
     } catch (const std::exception& e) {
-        std::cerr << "patchcull: internal error: " << e.what() << "\n";
+        std::cerr << "patchcull: internal error: " << patchcull::printable_line(e.what()) << "\n";
         return 3;
     }
 }

@@ -1,7 +1,7 @@
-// patchcull/image.h: loading displacement maps from PNG files (8- or 16-bit, any channel count;
-// the first channel is the height).
+// patchcull/image.h: loading displacement maps from PNG files (8- or 16-bit, grey or colour).
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "patchcull/displacement.h"
@@ -10,7 +10,15 @@ namespace patchcull {
 
 /// Loads path as a height map with D = scale * (h - midlevel), h in [0,1]. Rows are flipped so
 /// that row 0 is t = 0 (OBJ texture origin bottom-left, image origin top-left).
-/// Throws patchcull::Error("path: cannot read image: <reason>").
+/// h is the grey value of a grey image; of a colour image, stb_image's luminance
+/// (77 R + 150 G + 29 B) / 256 (alpha is ignored). 16-bit files keep their 16 bits.
+/// Only PNG is read. Throws patchcull::Error("path: cannot read image: <reason>"), one short
+/// line for every malformed, truncated or non-PNG file; never crashes on one.
 DisplacementMap load_displacement_png(const std::string& path, float scale, float midlevel = 0.5f);
+
+/// The same from the size bytes of a PNG file in memory; name is used in error messages (the
+/// fuzz target and tests call it without a file).
+DisplacementMap decode_displacement_png(const unsigned char* data, std::size_t size, const std::string& name,
+                                        float scale, float midlevel = 0.5f);
 
 }  // namespace patchcull

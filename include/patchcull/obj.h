@@ -1,11 +1,17 @@
 // patchcull/obj.h: a strict Wavefront OBJ reader for subdivision control meshes.
 //
-// Reads v, vt and f records (f with v, v/vt, v//vn or v/vt/vn corners, negative indices allowed);
-// accepts vertex weights and colours (x y z [w] or x y z r g b [a], ignored); ignores vn, o, g,
-// s, usemtl, mtllib, l, p, comments and blank lines. Strict by design: every
-// malformed number, non-finite coordinate, out-of-range index or face with fewer than 3 corners
-// is a patchcull::Error naming "file:line". (tinyobjloader, tried first, reads "abc" and "nan"
-// as 0 and only warns on out-of-range indices: a silently wrong mesh, so it is not used.)
+// Reads v, vt and f records (f with v, v/vt, v//vn or v/vt/vn corners, negative indices allowed)
+// and OpenSubdiv's "t crease 2/1/0 v0 v1 s" and "t corner n/1/0 v.. s" tags (0-based vertices);
+// accepts vertex weights and colours (x y z [w] or x y z r g b [a], ignored); checks vn records
+// and the normal indices that name them, then drops them; ignores o, g, s, usemtl, mtllib, l, p,
+// comments, blank lines and a UTF-8 byte-order mark. Strict by design: every malformed number,
+// non-finite coordinate, out-of-range index (vertex, texture coordinate or normal), malformed
+// corner, face with fewer than 3 corners or a repeated vertex, unknown or unsupported tag (a
+// misspelt "crease" must not drop a crease), crease from a vertex to itself or negative sharpness
+// is a patchcull::Error naming "file:line", one short printable line (offending text is quoted
+// through quote_input, patchcull/error.h). Work is O(n log n) in the file size for any face size.
+// (tinyobjloader, tried first, reads "abc" and "nan" as 0 and only warns on out-of-range indices:
+// a silently wrong mesh, so it is not used.)
 #pragma once
 
 #include <istream>

@@ -1,48 +1,123 @@
 // PNG height maps through stb_image (patchcull/image.h). libstb ships the implementation.
+//
+// Only PNG is accepted (checked by its signature before stb_image sees the bytes): stb_image also
+// decodes JPEG, GIF, PSD, HDR, TGA and others, but a height map needs 8 or 16 bits of grey, and
+// every decoder not used is attack surface for a malformed file.
 #include "patchcull/image.h"
 
 #include <stb/stb_image.h>
 
+#include <climits>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <vector>
 
 #include "patchcull/error.h"
 
 namespace patchcull {
+namespace {
 
-DisplacementMap load_displacement_png(const std::string& path, float scale, float midlevel) {
-    if (!std::isfinite(scale)) throw Error(path + ": displacement scale is not finite");
+[[noreturn]] void fail(const std::string& name, const char* why) {
+    // stb_image's reasons are short fixed strings; printable_line keeps that true whatever the
+    // build of libstb returns (it may be compiled with STBI_NO_FAILURE_STRINGS: null).
+    throw Error(name + ": cannot read image: " + printable_line(why ? why : "unknown reason", 80));
+}
+
+struct StbiFree {
+    void operator()(void* pixels) const { stbi_image_free(pixels); }
+};
+
+// Copies stb_image's rows (top first) into texels (bottom first), as heights in [0,1].
+template <class Pixel>
+void copy_flipped(const Pixel* pixels, float full_scale, DisplacementMap& map) {
+    const auto w = static_cast<std::size_t>(map.width), h = static_cast<std::size_t>(map.height);
+    map.texels.resize(w * h);
+    for (std::size_t y = 0; y < h; ++y)
+        for (std::size_t x = 0; x < w; ++x) map.texels[(h - 1 - y) * w + x] = pixels[y * w + x] / full_scale;
+}
+
+std::uint32_t big_endian32(const unsigned char* p) {
+    return std::uint32_t{p[0]} << 24 | std::uint32_t{p[1]} << 16 | std::uint32_t{p[2]} << 8 | p[3];
+}
+
+// Checks the chunk layout and the header's size against the data before stb_image allocates
+// anything. stb_image trusts both: an IDAT chunk whose length field claims 2 GB in a 100-byte
+// file makes it reserve 2 GB before it notices the data is missing, and it sizes its buffers by
+// the header's width x height before it has decompressed a byte. A file whose chunks run past
+// its end is truncated; one whose pixels cannot come out of the compressed data it holds
+// (deflate expands at most 1032:1) is corrupt. Both are refused here; what passes is exactly
+// what stb_image could decode, so no valid file is refused.
+void check_png_layout(const unsigned char* data, std::size_t size, const std::string& name) {
+    std::size_t at = 8;  // after the signature
+    std::uint64_t width = 0, height = 0, bits_per_pixel = 0, compressed = 0;
+    for (bool first = true; size - at >= 8; first = false) {  // a chunk header: length and type
+        const std::uint32_t length = big_endian32(data + at);
+        if (size - at < 12 || length > size - at - 12) fail(name, "truncated PNG chunk");
+        const unsigned char* type = data + at + 4;
+        const unsigned char* body = data + at + 8;
+        if (first) {
+            if (std::memcmp(type, "IHDR", 4) != 0 || length != 13) fail(name, "PNG does not start with IHDR");
+            width = big_endian32(body);
+            height = big_endian32(body + 4);
+            const unsigned depth = body[8], colour = body[9];
+            const unsigned samples = colour == 2 ? 3 : colour == 4 ? 2 : colour == 6 ? 4 : 1;
+            bits_per_pixel = std::uint64_t{samples} * depth;  // bad depths and colours: stb_image says so
+            if (width > (1u << 24) || height > (1u << 24)) fail(name, "image too large");
+        }
+        if (std::memcmp(type, "IDAT", 4) == 0) compressed += length;
+        if (std::memcmp(type, "IEND", 4) == 0) break;
+        at += 12 + std::size_t{length};
+    }
+    if (width == 0) return;  // no complete header: stb_image names what is missing
+    const std::uint64_t pixel_bytes = (width * height * bits_per_pixel + 7) / 8;
+    if (pixel_bytes > 1100 * compressed + 1024)
+        fail(name, ("image data too short for " + std::to_string(width) + "x" + std::to_string(height)).c_str());
+}
+
+}  // namespace
+
+DisplacementMap decode_displacement_png(const unsigned char* data, std::size_t size, const std::string& name,
+                                        float scale, float midlevel) {
+    if (!std::isfinite(scale)) throw Error(name + ": displacement scale is not finite");
+    static constexpr unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    if (size < sizeof kSignature || std::memcmp(data, kSignature, sizeof kSignature) != 0)
+        fail(name, "not a PNG file");
+    if (size > static_cast<std::size_t>(INT_MAX)) fail(name, "file too large");
+    check_png_layout(data, size, name);
+    const int length = static_cast<int>(size);
     int width = 0, height = 0, channels = 0;
-    FILE* file = std::fopen(path.c_str(), "rb");
-    if (!file) throw Error(path + ": cannot read image: cannot open file");
-    const bool sixteen = stbi_is_16_bit_from_file(file);
-    std::fseek(file, 0, SEEK_SET);
     DisplacementMap map;
     map.scale = scale;
     map.midlevel = midlevel;
-    if (sixteen) {
-        stbi_us* pixels = stbi_load_from_file_16(file, &width, &height, &channels, 1);
-        std::fclose(file);
-        if (!pixels) throw Error(path + ": cannot read image: " + stbi_failure_reason());
+    if (stbi_is_16_bit_from_memory(data, length)) {
+        const std::unique_ptr<stbi_us, StbiFree> pixels(
+            stbi_load_16_from_memory(data, length, &width, &height, &channels, 1));
+        if (!pixels) fail(name, stbi_failure_reason());
         map.width = width;
         map.height = height;
-        map.texels.resize(static_cast<std::size_t>(width) * height);
-        for (int y = 0; y < height; ++y)
-            for (int x = 0; x < width; ++x)
-                map.texels[static_cast<std::size_t>(height - 1 - y) * width + x] = pixels[y * width + x] / 65535.0f;
-        stbi_image_free(pixels);
+        copy_flipped(pixels.get(), 65535.0f, map);
     } else {
-        stbi_uc* pixels = stbi_load_from_file(file, &width, &height, &channels, 1);
-        std::fclose(file);
-        if (!pixels) throw Error(path + ": cannot read image: " + stbi_failure_reason());
+        const std::unique_ptr<stbi_uc, StbiFree> pixels(
+            stbi_load_from_memory(data, length, &width, &height, &channels, 1));
+        if (!pixels) fail(name, stbi_failure_reason());
         map.width = width;
         map.height = height;
-        map.texels.resize(static_cast<std::size_t>(width) * height);
-        for (int y = 0; y < height; ++y)
-            for (int x = 0; x < width; ++x)
-                map.texels[static_cast<std::size_t>(height - 1 - y) * width + x] = pixels[y * width + x] / 255.0f;
-        stbi_image_free(pixels);
+        copy_flipped(pixels.get(), 255.0f, map);
     }
     return map;
+}
+
+DisplacementMap load_displacement_png(const std::string& path, float scale, float midlevel) {
+    if (!std::isfinite(scale)) throw Error(path + ": displacement scale is not finite");
+    std::ifstream file(path, std::ios::binary);
+    if (!file) fail(path, "cannot open file");
+    const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    if (file.bad()) fail(path, "read error");
+    return decode_displacement_png(bytes.data(), bytes.size(), path, scale, midlevel);
 }
 
 }  // namespace patchcull

@@ -5,6 +5,7 @@
 // (and OpenSubdiv's "t crease/corner" tags), so a strict line-numbered reader is small.
 #include "patchcull/obj.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -43,9 +44,9 @@ float parse_float(std::string_view token, const LineContext& ctx) {
     const char* last = token.data() + token.size();
     if (first != last && *first == '+') ++first;  // from_chars rejects a leading '+'
     auto [ptr, ec] = std::from_chars(first, last, value);
-    if (ec == std::errc::result_out_of_range) ctx.fail("number out of range '" + std::string(token) + "'");
-    if (ec != std::errc() || ptr != last) ctx.fail("malformed number '" + std::string(token) + "'");
-    if (!std::isfinite(value)) ctx.fail("non-finite coordinate '" + std::string(token) + "'");
+    if (ec == std::errc::result_out_of_range) ctx.fail("number out of range " + quote_input(token));
+    if (ec != std::errc() || ptr != last) ctx.fail("malformed number " + quote_input(token));
+    if (!std::isfinite(value)) ctx.fail("non-finite coordinate " + quote_input(token));
     return value;
 }
 
@@ -87,7 +88,7 @@ long parse_int(std::string_view token, const LineContext& ctx, const char* what)
     long value = 0;
     auto [ptr, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
     if (ec != std::errc() || ptr != token.data() + token.size() || token.empty())
-        ctx.fail(std::string("malformed ") + what + " '" + std::string(token) + "'");
+        ctx.fail(std::string("malformed ") + what + " " + quote_input(token));
     return value;
 }
 
@@ -100,29 +101,115 @@ std::uint32_t resolve_index(long index, std::size_t count, const LineContext& ct
     return static_cast<std::uint32_t>(resolved);
 }
 
-// "t crease 2/1/0 v0 v1 s" and "t corner 1/1/0 v s" (OpenSubdiv's shape format, 0-based vertices).
-void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, const LineContext& ctx) {
-    if (tokens.size() < 2) ctx.fail("malformed tag line");
-    const std::string_view kind = tokens[1];
-    if (kind != "crease" && kind != "corner") return;  // other OpenSubdiv tags are not used here
-    const bool crease = kind == "crease";
-    const std::size_t vertex_count = crease ? 2 : 1;
-    if (tokens.size() != 3 + vertex_count + 1)
-        ctx.fail(std::string("malformed '") + std::string(kind) + "' tag: expected " +
-                 (crease ? "'t crease 2/1/0 v0 v1 sharpness'" : "'t corner 1/1/0 v sharpness'"));
-    Crease c;
-    long v[2] = {0, 0};
-    for (std::size_t k = 0; k < vertex_count; ++k) {
-        v[k] = parse_int(tokens[3 + k], ctx, "vertex index");
-        if (v[k] < 0 || v[k] >= static_cast<long>(mesh.positions.size()))
-            ctx.fail("tag vertex index " + std::to_string(v[k]) + " out of range (have " +
-                     std::to_string(mesh.positions.size()) + ")");
+// Parses a tag's "ints/floats/strings" argument counts (OpenSubdiv's shape format).
+void parse_tag_counts(std::string_view token, long counts[3], const LineContext& ctx) {
+    const char* p = token.data();
+    const char* const end = p + token.size();
+    for (int k = 0; k < 3; ++k) {
+        const auto [next, ec] = std::from_chars(p, end, counts[k]);
+        const bool separated = k < 2 ? next != end && *next == '/' : next == end;
+        if (ec != std::errc() || counts[k] < 0 || !separated) ctx.fail("malformed tag argument counts " + quote_input(token));
+        p = k < 2 ? next + 1 : next;
     }
-    c.v0 = static_cast<std::uint32_t>(v[0]);
-    c.v1 = static_cast<std::uint32_t>(v[1]);
-    c.sharpness = parse_float(tokens.back(), ctx);
-    if (c.sharpness < 0) ctx.fail("negative sharpness");
-    (crease ? mesh.creases : mesh.corners).push_back(c);
+}
+
+// OpenSubdiv's shape-format tags, 0-based vertices: "t crease 2/1/0 v0 v1 s" (one edge) and
+// "t corner n/1/0 v1..vn s" or "t corner n/n/0 v1..vn s1..sn". Every other tag is an error, not
+// ignored: a misspelt "crease" would silently drop a crease the user asked for, and OpenSubdiv's
+// other tags (interpolateboundary, hole, creasemethod, ...) change the surface in ways patchcull
+// does not model. A crease over more than two vertices is refused as well: RenderMan reads its
+// vertices as a chain, OpenSubdiv's shapes as pairs, so either reading could be the wrong one.
+void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, const LineContext& ctx) {
+    if (tokens.size() < 3) ctx.fail("malformed tag line (expected 't crease 2/1/0 v0 v1 sharpness' or 't corner 1/1/0 v sharpness')");
+    const std::string_view kind = tokens[1];
+    const bool crease = kind == "crease";
+    if (!crease && kind != "corner") {
+        static constexpr std::string_view kOpenSubdivTags[] = {"interpolateboundary", "facevaryinginterpolateboundary",
+                                                                "facevaryingpropagatecorners", "creasemethod",
+                                                                "smoothtriangles", "hole"};
+        for (const std::string_view known : kOpenSubdivTags)
+            if (kind == known) ctx.fail("unsupported tag " + quote_input(kind) + " (only 't crease' and 't corner' are read)");
+        ctx.fail("unknown tag " + quote_input(kind) + " (expected 't crease' or 't corner')");
+    }
+    long counts[3];
+    parse_tag_counts(tokens[2], counts, ctx);
+    const long ints = counts[0], floats = counts[1], strings = counts[2];
+    if (crease && ints != 2)
+        ctx.fail(ints > 2 ? "crease tag over more than 2 vertices: write one 't crease 2/1/0 v0 v1 sharpness' per edge"
+                          : "malformed 'crease' tag: expected 't crease 2/1/0 v0 v1 sharpness'");
+    if (!crease && ints < 1) ctx.fail("malformed 'corner' tag: expected 't corner 1/1/0 v sharpness'");
+    if (strings != 0 || (floats != 1 && (crease || floats != ints)))
+        ctx.fail(std::string("malformed '") + std::string(kind) + "' tag: expected " +
+                 (crease ? "one sharpness ('t crease 2/1/0 v0 v1 s')" : "one sharpness or one per vertex"));
+    if (tokens.size() - 3 != static_cast<std::size_t>(ints + floats))
+        ctx.fail(std::string("malformed '") + std::string(kind) + "' tag: " + std::to_string(tokens.size() - 3) +
+                 " arguments for counts " + quote_input(tokens[2]));
+    std::vector<std::uint32_t> vertices;
+    for (long k = 0; k < ints; ++k) {
+        const long v = parse_int(tokens[3 + k], ctx, "vertex index");
+        if (v < 0 || v >= static_cast<long>(mesh.positions.size()))
+            ctx.fail("tag vertex index " + std::to_string(v) + " out of range (have " +
+                     std::to_string(mesh.positions.size()) + ")");
+        vertices.push_back(static_cast<std::uint32_t>(v));
+    }
+    std::vector<float> sharpness;
+    for (long k = 0; k < floats; ++k) {
+        sharpness.push_back(parse_float(tokens[3 + ints + k], ctx));
+        if (sharpness.back() < 0) ctx.fail("negative sharpness");
+    }
+    if (crease) {
+        if (vertices[0] == vertices[1]) ctx.fail("crease from vertex " + std::to_string(vertices[0]) + " to itself");
+        mesh.creases.push_back({vertices[0], vertices[1], sharpness[0]});
+        return;
+    }
+    for (std::size_t k = 0; k < vertices.size(); ++k)
+        mesh.corners.push_back({vertices[k], 0, sharpness[floats == 1 ? 0 : k]});
+}
+
+// Scratch buffers reused across faces (one allocation per mesh, not per face).
+struct FaceScratch {
+    std::vector<std::uint32_t> uvs, sorted;
+};
+
+// Parses "f c1 c2 c3 ...", each corner v, v/vt, v//vn or v/vt/vn, every index checked against
+// the elements read so far (normals too: they are not kept, but a corner naming a missing one is
+// a broken file). Appends the face to mesh; returns whether every corner has a texture coordinate
+// (they are then appended to mesh.face_texcoords).
+bool parse_face(const std::vector<std::string_view>& tokens, ControlMesh& mesh, std::size_t normal_count,
+                FaceScratch& scratch, const LineContext& ctx) {
+    if (tokens.size() < 4) ctx.fail("face needs at least 3 vertices");
+    scratch.uvs.clear();
+    const std::size_t first_corner = mesh.face_vertices.size();
+    for (std::size_t k = 1; k < tokens.size(); ++k) {
+        const std::string_view corner = tokens[k];
+        std::string_view parts[3];
+        std::size_t count = 0, begin = 0;
+        for (;;) {
+            const std::size_t slash = corner.find('/', begin);
+            if (count == 3) ctx.fail("malformed face corner " + quote_input(corner) + " (expected v, v/vt, v//vn or v/vt/vn)");
+            parts[count++] = corner.substr(begin, slash == std::string_view::npos ? std::string_view::npos : slash - begin);
+            if (slash == std::string_view::npos) break;
+            begin = slash + 1;
+        }
+        // Empty parts are allowed only as the texture coordinate of v//vn.
+        if (parts[0].empty() || (count >= 2 && parts[count - 1].empty()))
+            ctx.fail("malformed face corner " + quote_input(corner) + " (expected v, v/vt, v//vn or v/vt/vn)");
+        mesh.face_vertices.push_back(
+            resolve_index(parse_int(parts[0], ctx, "vertex index"), mesh.positions.size(), ctx, "vertex"));
+        if (count >= 2 && !parts[1].empty())
+            scratch.uvs.push_back(resolve_index(parse_int(parts[1], ctx, "texture index"), mesh.texcoords.size(), ctx,
+                                                "texture coordinate"));
+        if (count == 3) resolve_index(parse_int(parts[2], ctx, "normal index"), normal_count, ctx, "normal");
+    }
+    // Repeated vertices: sorted, so that a face of a million corners costs n log n, not n^2.
+    scratch.sorted.assign(mesh.face_vertices.begin() + first_corner, mesh.face_vertices.end());
+    std::sort(scratch.sorted.begin(), scratch.sorted.end());
+    const auto repeated = std::adjacent_find(scratch.sorted.begin(), scratch.sorted.end());
+    if (repeated != scratch.sorted.end()) ctx.fail("face uses vertex " + std::to_string(*repeated + 1) + " twice");
+    mesh.face_offsets.push_back(static_cast<std::uint32_t>(mesh.face_vertices.size()));
+    if (scratch.uvs.size() != tokens.size() - 1) return false;
+    mesh.face_texcoords.insert(mesh.face_texcoords.end(), scratch.uvs.begin(), scratch.uvs.end());
+    return true;
 }
 
 }  // namespace
@@ -131,13 +218,16 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
     ControlMesh mesh;
     mesh.name = name;
     bool faces_with_uv = false, faces_without_uv = false;
-    std::vector<std::uint32_t> face_uv_scratch;
+    std::size_t normal_count = 0;
+    FaceScratch scratch;
     std::vector<DVec3> world_positions;  // as in the file, for recentre()
     std::string line;
     std::size_t line_number = 0;
     while (std::getline(in, line)) {
         ++line_number;
         const LineContext ctx{name, line_number};
+        // A UTF-8 byte-order mark (written by some Windows editors) is not part of the first record.
+        if (line_number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
         const auto hash = line.find('#');
         std::string_view content(line.data(), hash == std::string::npos ? line.size() : hash);
         const auto tokens = split_tokens(content);
@@ -159,47 +249,19 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
         } else if (key == "vn") {
             if (tokens.size() != 4) ctx.fail("normal needs 3 values");
             for (int k = 1; k <= 3; ++k) parse_float(tokens[k], ctx);
+            ++normal_count;  // normals are not kept, but face corners that name one are checked
         } else if (key == "f") {
-            if (tokens.size() < 4) ctx.fail("face needs at least 3 vertices");
-            bool has_uv = true;
-            face_uv_scratch.clear();
-            const std::size_t first_corner = mesh.face_vertices.size();
-            for (std::size_t k = 1; k < tokens.size(); ++k) {
-                const std::string_view corner = tokens[k];
-                const auto slash1 = corner.find('/');
-                const std::string_view vpart = corner.substr(0, slash1);
-                mesh.face_vertices.push_back(
-                    resolve_index(parse_int(vpart, ctx, "vertex index"), mesh.positions.size(), ctx, "vertex"));
-                std::string_view tpart;
-                if (slash1 != std::string_view::npos) {
-                    const auto rest = corner.substr(slash1 + 1);
-                    tpart = rest.substr(0, rest.find('/'));
-                }
-                if (tpart.empty()) {
-                    has_uv = false;
-                } else {
-                    face_uv_scratch.push_back(resolve_index(parse_int(tpart, ctx, "texture index"),
-                                                            mesh.texcoords.size(), ctx, "texture coordinate"));
-                }
-            }
-            for (std::size_t a = first_corner; a < mesh.face_vertices.size(); ++a)
-                for (std::size_t b = a + 1; b < mesh.face_vertices.size(); ++b)
-                    if (mesh.face_vertices[a] == mesh.face_vertices[b])
-                        ctx.fail("face uses vertex " + std::to_string(mesh.face_vertices[a] + 1) + " twice");
-            if (has_uv && face_uv_scratch.size() == tokens.size() - 1) {
+            if (parse_face(tokens, mesh, normal_count, scratch, ctx))
                 faces_with_uv = true;
-                mesh.face_texcoords.insert(mesh.face_texcoords.end(), face_uv_scratch.begin(), face_uv_scratch.end());
-            } else {
+            else
                 faces_without_uv = true;
-            }
-            mesh.face_offsets.push_back(static_cast<std::uint32_t>(mesh.face_vertices.size()));
         } else if (key == "t") {
             parse_tag(tokens, mesh, ctx);
         } else if (key == "o" || key == "g" || key == "s" || key == "usemtl" || key == "mtllib" || key == "l" ||
                    key == "p" || key == "vp" || key == "cstype" || key == "deg") {
             // Grouping, materials, points and lines: no effect on a control mesh.
         } else {
-            ctx.fail("unknown record '" + std::string(key) + "'");
+            ctx.fail("unknown record " + quote_input(key));
         }
     }
     if (in.bad()) throw Error(name + ": read error");

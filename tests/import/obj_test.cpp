@@ -1,6 +1,7 @@
 // Strict OBJ reader: accepted forms, and one-line file:line errors for every malformed input.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <sstream>
 
 #include "patchcull/error.h"
@@ -40,7 +41,8 @@ TEST(Obj, ReadsQuadWithTexcoordsAndNegativeIndices) {
 }
 
 TEST(Obj, ReadsMixedPolygonsWithoutTexcoords) {
-    const ControlMesh m = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2 5 3\nf 1//1 2//1 3//1\n");
+    const ControlMesh m =
+        parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nvn 0 0 1\nf 1 2 3 4\nf 2 5 3\nf 1//1 2//1 3//1\n");
     EXPECT_EQ(m.face_count(), 3u);
     EXPECT_FALSE(m.has_texcoords());
     EXPECT_FALSE(m.all_quads());
@@ -121,4 +123,114 @@ TEST(Obj, AcceptsVertexColoursAndPointRecords) {
     EXPECT_EQ(m.face_count(), 1u);
     EXPECT_EQ(error_of("v 0 0 0 1 nan 1\n"), "mesh.obj:1: non-finite coordinate 'nan'");
     EXPECT_EQ(error_of("v 0 0 0 1 1\n"), "mesh.obj:1: vertex needs 3 coordinates");
+}
+
+namespace {
+const char* kQuad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n";
+}  // namespace
+
+TEST(Obj, NormalIndicesAreChecked) {
+    // Normals are dropped, but a corner naming one that does not exist is a broken file.
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//999999999\n"),
+              "mesh.obj:5: normal index 999999999 out of range (have 1)");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1/abc 2/1/1 3/1/1\n"),
+              "mesh.obj:5: malformed normal index 'abc'");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n"),
+              "mesh.obj:4: normal index 1 out of range (have 0)");
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//-2 2//1 3//1\n"),
+              "mesh.obj:5: normal index -2 out of range (have 1)");
+    const ControlMesh m = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nvn 0 1 0\nf 1/1/1 2/1/-1 3/-1/2\n");
+    EXPECT_EQ(m.face_count(), 1u);
+    EXPECT_TRUE(m.has_texcoords());
+}
+
+TEST(Obj, MalformedFaceCornersAreErrors) {
+    const std::string prefix = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";
+    const std::string expected = " (expected v, v/vt, v//vn or v/vt/vn)";
+    EXPECT_EQ(error_of(prefix + "f 1/ 2/ 3/\n"), "mesh.obj:6: malformed face corner '1/'" + expected);
+    EXPECT_EQ(error_of(prefix + "f 1// 2 3\n"), "mesh.obj:6: malformed face corner '1//'" + expected);
+    EXPECT_EQ(error_of(prefix + "f 1/1/1/1 2 3\n"), "mesh.obj:6: malformed face corner '1/1/1/1'" + expected);
+    EXPECT_EQ(error_of(prefix + "f /1 2 3\n"), "mesh.obj:6: malformed face corner '/1'" + expected);
+    EXPECT_EQ(error_of(prefix + "f 1/x 2 3\n"), "mesh.obj:6: malformed texture index 'x'");
+}
+
+TEST(Obj, UnknownAndUnsupportedTagsAreErrors) {
+    // A misspelt crease used to be ignored: the crease the user asked for silently vanished.
+    EXPECT_EQ(error_of(std::string(kQuad) + "t creese 2/1/0 0 1 10\n"),
+              "mesh.obj:6: unknown tag 'creese' (expected 't crease' or 't corner')");
+    EXPECT_EQ(error_of(std::string(kQuad) + "t interpolateboundary 1/0/0 1\n"),
+              "mesh.obj:6: unsupported tag 'interpolateboundary' (only 't crease' and 't corner' are read)");
+    EXPECT_EQ(error_of(std::string(kQuad) + "t hole 1/0/0 0\n"),
+              "mesh.obj:6: unsupported tag 'hole' (only 't crease' and 't corner' are read)");
+    EXPECT_EQ(error_of(std::string(kQuad) + "t crease\n"),
+              "mesh.obj:6: malformed tag line (expected 't crease 2/1/0 v0 v1 sharpness' or 't corner 1/1/0 v sharpness')");
+}
+
+TEST(Obj, TagArgumentCountsAreChecked) {
+    const std::string q = kQuad;
+    EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1\n"), "mesh.obj:6: malformed 'crease' tag: 2 arguments for counts '2/1/0'");
+    EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1 2 3\n"), "mesh.obj:6: malformed 'crease' tag: 4 arguments for counts '2/1/0'");
+    EXPECT_EQ(error_of(q + "t crease 4/1/0 0 1 2 3 1\n"),
+              "mesh.obj:6: crease tag over more than 2 vertices: write one 't crease 2/1/0 v0 v1 sharpness' per edge");
+    EXPECT_EQ(error_of(q + "t crease 2/2/0 0 1 1 1\n"),
+              "mesh.obj:6: malformed 'crease' tag: expected one sharpness ('t crease 2/1/0 v0 v1 s')");
+    EXPECT_EQ(error_of(q + "t crease 2/1/1 0 1 1 x\n"),
+              "mesh.obj:6: malformed 'crease' tag: expected one sharpness ('t crease 2/1/0 v0 v1 s')");
+    EXPECT_EQ(error_of(q + "t crease 2/1 0 1 1\n"), "mesh.obj:6: malformed tag argument counts '2/1'");
+    EXPECT_EQ(error_of(q + "t crease 2/1/0/0 0 1 1\n"), "mesh.obj:6: malformed tag argument counts '2/1/0/0'");
+    EXPECT_EQ(error_of(q + "t crease 2/-1/0 0 1 1\n"), "mesh.obj:6: malformed tag argument counts '2/-1/0'");
+    EXPECT_EQ(error_of(q + "t corner 0/1/0 1\n"), "mesh.obj:6: malformed 'corner' tag: expected 't corner 1/1/0 v sharpness'");
+    EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1 -1\n"), "mesh.obj:6: negative sharpness");
+    EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1 nan\n"), "mesh.obj:6: non-finite coordinate 'nan'");
+}
+
+TEST(Obj, CreaseFromAVertexToItselfIsAnError) {
+    EXPECT_EQ(error_of(std::string(kQuad) + "t crease 2/1/0 2 2 1\n"), "mesh.obj:6: crease from vertex 2 to itself");
+}
+
+TEST(Obj, CornerTagsWithSeveralVertices) {
+    const ControlMesh m = parse(std::string(kQuad) + "t corner 2/1/0 0 2 10\nt corner 2/2/0 1 3 0.5 2\n");
+    ASSERT_EQ(m.corners.size(), 4u);
+    EXPECT_EQ(m.corners[1].v0, 2u);
+    EXPECT_FLOAT_EQ(m.corners[1].sharpness, 10.0f);
+    EXPECT_EQ(m.corners[3].v0, 3u);
+    EXPECT_FLOAT_EQ(m.corners[3].sharpness, 2.0f);
+    EXPECT_EQ(error_of(std::string(kQuad) + "t corner 2/3/0 0 1 1 1 1\n"),
+              "mesh.obj:6: malformed 'corner' tag: expected one sharpness or one per vertex");
+}
+
+TEST(Obj, AcceptsAUtf8ByteOrderMark) {
+    const ControlMesh m = parse("\xEF\xBB\xBFv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    EXPECT_EQ(m.positions.size(), 3u);
+    EXPECT_EQ(m.face_count(), 1u);
+    // Only at the start of the file: elsewhere it is an invisible character, shown escaped.
+    EXPECT_EQ(error_of("v 0 0 0\n\xEF\xBB\xBFv 1 0 0\n"), "mesh.obj:2: unknown record '\\uFEFFv'");
+}
+
+TEST(Obj, ErrorsQuoteInputEscapedAndShort) {
+    EXPECT_EQ(error_of("v 0 \x1B[2J 0\n"), "mesh.obj:1: malformed number '\\x1B[2J'");
+    EXPECT_EQ(error_of("v 0 0 0\x01\n"), "mesh.obj:1: malformed number '0\\x01'");
+    EXPECT_EQ(error_of("\xFF\xFE\n"), "mesh.obj:1: unknown record '\\xFF\\xFE'");
+    // A token of a megabyte (no newline in sight) is quoted by its first few dozen bytes only.
+    const std::string message = error_of("v 0 0 " + std::string(1 << 20, '7') + "\n");
+    EXPECT_EQ(message, "mesh.obj:1: number out of range '" + std::string(40, '7') + "'...");
+}
+
+TEST(Obj, HugeFacesCostNLogN) {
+    // A face of 400000 corners: the repeated-vertex check used to compare every pair (8e10
+    // comparisons, minutes); sorted it takes milliseconds.
+    const int n = 400000;
+    std::string text;
+    for (int i = 0; i < n; ++i) text += "v " + std::to_string(i) + " 0 0\n";
+    text += "f";
+    for (int i = 1; i <= n; ++i) text += " " + std::to_string(i);
+    text += "\n";
+    const auto start = std::chrono::steady_clock::now();
+    const ControlMesh m = parse(text);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(m.face_size(0), static_cast<std::uint32_t>(n));
+    EXPECT_LT(seconds, 5.0);
+    text.back() = ' ';  // the same face, with vertex 17 once more
+    text += "17\n";
+    EXPECT_EQ(error_of(text), "mesh.obj:400001: face uses vertex 17 twice");
 }
