@@ -1,9 +1,16 @@
 // Displacement sampling and seed 002's per-patch maximum-displacement pre-processing step
-// (patchcull/displacement.h; seed 002 "Pre-Processing Step", seed 000 §4.2's [D_min, D_max]).
+// (patchcull/displacement.h; Sathe, "View Frustum Culling of Catmull-Clark Patches in
+// DirectX 11", pre-processing step; the [D_min, D_max] of Niessner & Loop, "Patch-Based Occlusion
+// Culling for Hardware Tessellation", §4.2).
+//
+// Why a pyramid: the exact range scans every texel of a patch's footprint, and a face whose
+// texcoords span a 4096^2 map costs 16M reads per patch (48 s for BigGuy's patches). A min/max
+// pyramid of blocks makes every query a bounded number of reads, built once per map.
 #include "patchcull/displacement.h"
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 namespace patchcull {
 namespace {
@@ -30,37 +37,198 @@ float DisplacementMap::sample(Vec2 st) const {
     return scale * (h - midlevel);
 }
 
-DisplacementRange DisplacementMap::patch_range(const Vec2 uv[4]) const {
-    DisplacementRange range;
-    if (empty()) return range;
-    // The bilinear texcoord map keeps the patch's footprint inside the bounding box of its corner
-    // texcoords; a bilinear texture sample blends the 2x2 texels around it, so the box's texel
-    // range, widened by one texel on each side, holds every texel the patch can read.
-    float s_min = uv[0].x, s_max = uv[0].x, t_min = uv[0].y, t_max = uv[0].y;
+namespace {
+
+// The texels a patch can read along one axis (see displacement.h): up to two intervals of texel
+// indices in [0, n) after wrap-around, the whole axis when the window is as wide as the map.
+struct AxisWindow {
+    int first[2] = {0, 0};
+    int last[2] = {-1, -1};  // empty when last < first
+    int intervals = 0;
+};
+
+AxisWindow axis_window(float lo, float hi, int n) {
+    AxisWindow w;
+    const double a = std::floor(static_cast<double>(lo) * n - 0.5) - 1;  // first texel of a 2x2
+    const double b = std::floor(static_cast<double>(hi) * n - 0.5) + 2;  // second texel, + 1
+    constexpr double kHuge = 1099511627776.0;                            // 2^40
+    if (!(std::fabs(a) <= kHuge && std::fabs(b) <= kHuge) || b - a + 1 >= n) {
+        w.first[0] = 0;
+        w.last[0] = n - 1;
+        w.intervals = 1;
+        return w;
+    }
+    const long first = static_cast<long>(a), count = static_cast<long>(b - a) + 1;
+    const int start = wrap(first, n);
+    const long end = start + count - 1;  // may pass n - 1 once: then the window wraps
+    w.first[0] = start;
+    w.last[0] = static_cast<int>(std::min<long>(end, n - 1));
+    w.intervals = 1;
+    if (end >= n) {
+        w.first[1] = 0;
+        w.last[1] = static_cast<int>(end - n);
+        w.intervals = 2;
+    }
+    return w;
+}
+
+void corner_box(const Vec2 uv[4], float& s_min, float& s_max, float& t_min, float& t_max) {
+    s_min = s_max = uv[0].x;
+    t_min = t_max = uv[0].y;
     for (int k = 1; k < 4; ++k) {
         s_min = std::min(s_min, uv[k].x); s_max = std::max(s_max, uv[k].x);
         t_min = std::min(t_min, uv[k].y); t_max = std::max(t_max, uv[k].y);
     }
-    const long x_first = static_cast<long>(std::floor(static_cast<double>(s_min) * width - 0.5)) - 1;
-    const long x_last = static_cast<long>(std::floor(static_cast<double>(s_max) * width - 0.5)) + 2;
-    const long y_first = static_cast<long>(std::floor(static_cast<double>(t_min) * height - 0.5)) - 1;
-    const long y_last = static_cast<long>(std::floor(static_cast<double>(t_max) * height - 0.5)) + 2;
-    float h_min = 1e30f, h_max = -1e30f;
-    const long nx = std::min<long>(x_last - x_first + 1, width);
-    const long ny = std::min<long>(y_last - y_first + 1, height);
-    for (long j = 0; j < ny; ++j) {
-        const int y = wrap(y_first + j, height);
-        for (long i = 0; i < nx; ++i) {
-            const float h = texels[y * width + wrap(x_first + i, width)];
-            h_min = std::min(h_min, h);
-            h_max = std::max(h_max, h);
-        }
-    }
-    // D = scale * (h - midlevel) is monotonic in h; scale may be negative.
+    // std::min/max drop a NaN in some argument orders: make a NaN corner poison the box.
+    for (int k = 0; k < 4; ++k)
+        if (!std::isfinite(uv[k].x) || !std::isfinite(uv[k].y)) s_min = t_min = -INFINITY, s_max = t_max = INFINITY;
+}
+
+// D = scale * (h - midlevel) is monotonic in h; scale may be negative.
+DisplacementRange to_range(float h_min, float h_max, float scale, float midlevel) {
     const float d0 = scale * (h_min - midlevel), d1 = scale * (h_max - midlevel);
+    DisplacementRange range;
     range.d_min = std::min({0.0f, d0, d1});
     range.d_max = std::max({0.0f, d0, d1});
     return range;
+}
+
+// Blocks (texels at level 0) an axis window touches at a level with block size 2^shift.
+int block_count(const AxisWindow& w, int shift) {
+    int count = 0;
+    for (int i = 0; i < w.intervals; ++i) count += (w.last[i] >> shift) - (w.first[i] >> shift) + 1;
+    return count;
+}
+
+constexpr int kLookupBudget = 36;  // blocks per query (6x6), see DisplacementMap::patch_range
+constexpr int kFirstShift = 2;     // the first pyramid level has 4x4-texel blocks
+
+}  // namespace
+
+namespace detail {
+
+// Min/max pyramid: level k (k = 0, 1, ...) has blocks of 2^(kFirstShift + k) texels a side,
+// ceil(width / 2^shift) x ceil(height / 2^shift) of them, each the min and max of the texels
+// (clipped at the map's edge) it covers; the last level is 1x1. Level 0 of the map (the texels)
+// is not copied: queries read it from the map.
+struct RangePyramid {
+    struct Level {
+        int shift = 0, width = 0, height = 0;
+        std::vector<float> lo, hi;  // [y * width + x]
+    };
+    const float* key_texels = nullptr;
+    std::size_t key_count = 0;
+    int key_width = 0, key_height = 0;
+    std::vector<Level> levels;
+
+    void build(const float* texels, int width, int height) {
+        levels.clear();
+        int shift = kFirstShift;
+        do {
+            Level l;
+            l.shift = shift;
+            l.width = ((width - 1) >> shift) + 1;
+            l.height = ((height - 1) >> shift) + 1;
+            l.lo.assign(static_cast<std::size_t>(l.width) * l.height, INFINITY);
+            l.hi.assign(l.lo.size(), -INFINITY);
+            if (levels.empty()) {
+                for (int y = 0; y < height; ++y) {
+                    const float* row = texels + static_cast<std::size_t>(y) * width;
+                    float* lo = &l.lo[static_cast<std::size_t>(y >> shift) * l.width];
+                    float* hi = &l.hi[static_cast<std::size_t>(y >> shift) * l.width];
+                    for (int x = 0; x < width; ++x) {
+                        lo[x >> shift] = std::min(lo[x >> shift], row[x]);
+                        hi[x >> shift] = std::max(hi[x >> shift], row[x]);
+                    }
+                }
+            } else {
+                const Level& f = levels.back();
+                for (int y = 0; y < f.height; ++y)
+                    for (int x = 0; x < f.width; ++x) {
+                        const std::size_t src = static_cast<std::size_t>(y) * f.width + x;
+                        const std::size_t dst = static_cast<std::size_t>(y >> 1) * l.width + (x >> 1);
+                        l.lo[dst] = std::min(l.lo[dst], f.lo[src]);
+                        l.hi[dst] = std::max(l.hi[dst], f.hi[src]);
+                    }
+            }
+            levels.push_back(std::move(l));
+            ++shift;
+        } while (levels.back().width > 1 || levels.back().height > 1);
+    }
+};
+
+RangePyramidCache::RangePyramidCache() = default;
+RangePyramidCache::~RangePyramidCache() = default;
+RangePyramidCache::RangePyramidCache(const RangePyramidCache&) {}
+RangePyramidCache& RangePyramidCache::operator=(const RangePyramidCache& other) {
+    if (this != &other) reset();
+    return *this;
+}
+
+void RangePyramidCache::reset() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    pyramid_.reset();
+}
+
+const RangePyramid& RangePyramidCache::get(const float* texels, std::size_t count, int width, int height) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (!pyramid_ || pyramid_->key_texels != texels || pyramid_->key_count != count ||
+        pyramid_->key_width != width || pyramid_->key_height != height) {
+        auto p = std::make_unique<RangePyramid>();
+        p->build(texels, width, height);
+        p->key_texels = texels;
+        p->key_count = count;
+        p->key_width = width;
+        p->key_height = height;
+        pyramid_ = std::move(p);
+    }
+    return *pyramid_;
+}
+
+}  // namespace detail
+
+DisplacementRange DisplacementMap::patch_range_exact(const Vec2 uv[4]) const {
+    if (empty()) return {};
+    float s_min, s_max, t_min, t_max;
+    corner_box(uv, s_min, s_max, t_min, t_max);
+    const AxisWindow wx = axis_window(s_min, s_max, width), wy = axis_window(t_min, t_max, height);
+    float h_min = INFINITY, h_max = -INFINITY;
+    for (int iy = 0; iy < wy.intervals; ++iy)
+        for (int y = wy.first[iy]; y <= wy.last[iy]; ++y)
+            for (int ix = 0; ix < wx.intervals; ++ix)
+                for (int x = wx.first[ix]; x <= wx.last[ix]; ++x) {
+                    const float h = texels[static_cast<std::size_t>(y) * width + x];
+                    h_min = std::min(h_min, h);
+                    h_max = std::max(h_max, h);
+                }
+    return to_range(h_min, h_max, scale, midlevel);
+}
+
+DisplacementRange DisplacementMap::patch_range(const Vec2 uv[4]) const {
+    if (empty()) return {};
+    float s_min, s_max, t_min, t_max;
+    corner_box(uv, s_min, s_max, t_min, t_max);
+    const AxisWindow wx = axis_window(s_min, s_max, width), wy = axis_window(t_min, t_max, height);
+    if (block_count(wx, 0) * block_count(wy, 0) <= kLookupBudget) return patch_range_exact(uv);
+
+    const detail::RangePyramid& pyramid = range_pyramid_.get(texels.data(), texels.size(), width, height);
+    // The coarsest level is 1x1, where each axis counts at most 2 (one per interval): always in budget.
+    const detail::RangePyramid::Level* level = &pyramid.levels.back();
+    for (const auto& l : pyramid.levels)
+        if (block_count(wx, l.shift) * block_count(wy, l.shift) <= kLookupBudget) {
+            level = &l;
+            break;
+        }
+    float h_min = INFINITY, h_max = -INFINITY;
+    for (int iy = 0; iy < wy.intervals; ++iy)
+        for (int y = wy.first[iy] >> level->shift; y <= wy.last[iy] >> level->shift; ++y)
+            for (int ix = 0; ix < wx.intervals; ++ix)
+                for (int x = wx.first[ix] >> level->shift; x <= wx.last[ix] >> level->shift; ++x) {
+                    const std::size_t i = static_cast<std::size_t>(y) * level->width + x;
+                    h_min = std::min(h_min, level->lo[i]);
+                    h_max = std::max(h_max, level->hi[i]);
+                }
+    return to_range(h_min, h_max, scale, midlevel);
 }
 
 DisplacementMap make_procedural_displacement(int size, float scale, std::uint32_t seed) {
