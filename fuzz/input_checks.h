@@ -64,7 +64,7 @@ inline std::string check_mesh(const ControlMesh& mesh) {
         if (c.v0 >= mesh.positions.size() || !std::isfinite(c.sharpness) || c.sharpness < 0) return "invalid corner";
     for (const std::string& w : mesh.warnings)
         if (const std::string bad = check_message(w.c_str()); !bad.empty()) return "warning: " + bad;
-    (void)mesh.is_closed();  // the orientation check every render runs: must not crash
+    (void)classify_orientation(mesh);  // the orientation check every render runs: must not crash
     return {};
 }
 
