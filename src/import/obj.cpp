@@ -141,7 +141,8 @@ void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, c
     if (strings != 0 || (floats != 1 && (crease || floats != ints)))
         ctx.fail(std::string("malformed '") + std::string(kind) + "' tag: expected " +
                  (crease ? "one sharpness ('t crease 2/1/0 v0 v1 s')" : "one sharpness or one per vertex"));
-    if (tokens.size() - 3 != static_cast<std::size_t>(ints + floats))
+    const auto arguments = static_cast<long>(tokens.size() - 3);
+    if (ints > arguments || floats != arguments - ints)  // (not ints + floats: that can overflow)
         ctx.fail(std::string("malformed '") + std::string(kind) + "' tag: " + std::to_string(tokens.size() - 3) +
                  " arguments for counts " + quote_input(tokens[2]));
     std::vector<std::uint32_t> vertices;

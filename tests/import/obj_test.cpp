@@ -179,6 +179,8 @@ TEST(Obj, TagArgumentCountsAreChecked) {
     EXPECT_EQ(error_of(q + "t crease 2/1 0 1 1\n"), "mesh.obj:6: malformed tag argument counts '2/1'");
     EXPECT_EQ(error_of(q + "t crease 2/1/0/0 0 1 1\n"), "mesh.obj:6: malformed tag argument counts '2/1/0/0'");
     EXPECT_EQ(error_of(q + "t crease 2/-1/0 0 1 1\n"), "mesh.obj:6: malformed tag argument counts '2/-1/0'");
+    EXPECT_EQ(error_of(q + "t corner 9223372036854775807/9223372036854775807/0 0 1\n"),
+              "mesh.obj:6: malformed 'corner' tag: 2 arguments for counts '9223372036854775807/9223372036854775807/'...");
     EXPECT_EQ(error_of(q + "t corner 0/1/0 1\n"), "mesh.obj:6: malformed 'corner' tag: expected 't corner 1/1/0 v sharpness'");
     EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1 -1\n"), "mesh.obj:6: negative sharpness");
     EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1 nan\n"), "mesh.obj:6: non-finite coordinate 'nan'");
