@@ -70,7 +70,7 @@ struct DisplacementMap {
     /// Conservative [D_min, D_max] of the patch whose corner texcoords are uv[4] (patch.h order):
     /// it contains patch_range_exact(uv), so every D(s,t) the patch samples.
     /// Cost: constant per call (at most 36 texel or block look-ups), after the first call, which
-    /// builds a min/max pyramid of the texels in O(width * height) time (about 30 ms for 4096^2)
+    /// builds a min/max pyramid of the texels in O(width * height) time (25 ms CPU for 4096^2)
     /// and 8 bytes per 16 texels x 4/3 of memory (levels with 4x4, 8x8, ... texel blocks, up to
     /// 1x1 block; non-power-of-two sizes have clipped last blocks). A query takes the finest level
     /// (the texels themselves first, then the blocks) on which the window touches at most 36

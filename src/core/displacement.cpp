@@ -4,7 +4,7 @@
 // Culling for Hardware Tessellation", §4.2).
 //
 // Why a pyramid: the exact range scans every texel of a patch's footprint, and a face whose
-// texcoords span a 4096^2 map costs 16M reads per patch (48 s for BigGuy's patches). A min/max
+// texcoords span a 4096^2 map costs 16M reads per patch (56 s for BigGuy, docs/PERFORMANCE.md). A min/max
 // pyramid of blocks makes every query a bounded number of reads, built once per map.
 #include "patchcull/displacement.h"
 
