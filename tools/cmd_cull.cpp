@@ -62,7 +62,7 @@ Runner add_cull_command(CLI::App& app) {
         parse_view_mode(state->view_mode.c_str(), options.mode);
         options.methods = split_methods(state->methods);
         const LoadedModel model = load_model_from_options(state->model);
-        for (const std::string& w : model.warnings) std::cerr << "patchcull: warning: " << w << "\n";
+        print_warnings(model.warnings);
         const DisplacementMap displacement = displacement_from_options(state->model, model);
         const CullEvalResult result = evaluate_cull(model.rest, displacement.empty() ? nullptr : &displacement, options);
         nlohmann::json out;

@@ -57,7 +57,7 @@ int run_occlusion(const OcclusionOptions& o) {
     Scheme scheme = Scheme::acc;
     if (!parse_scheme(o.scheme, scheme)) throw Error("--scheme: unknown scheme '" + o.scheme + "'");
     const LoadedModel model = load_model(o.model, scheme, o.split);
-    for (const std::string& w : model.warnings) std::cerr << "patchcull: warning: " << w << "\n";
+    print_warnings(model.warnings);
     const std::size_t patches = model.rest.patches.size();
 
     gl::GlContext context = gl::GlContext::create_headless();

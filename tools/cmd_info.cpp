@@ -19,7 +19,7 @@ Runner add_info_command(CLI::App& app) {
     command->add_flag("--json", state->json, "print one JSON object");
     return [state]() {
         const LoadedModel model = load_model_from_options(state->model);
-        for (const std::string& w : model.warnings) std::cerr << "patchcull: warning: " << w << "\n";
+        print_warnings(model.warnings);
         std::size_t extraordinary = 0;
         for (const PatchInfo& p : model.rest.info) extraordinary += p.extraordinary ? 1 : 0;
         const Bounds b = patch_bounds(model.rest);

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "patchcull/displacement.h"
 #include "patchcull/scene.h"
@@ -43,6 +44,9 @@ struct ModelOptions {
 inline constexpr double kMaxDisplaceScale = 1e9;
 
 void add_model_options(CLI::App& command, ModelOptions& options, bool with_displacement);
+/// Prints "patchcull: warning: W" on stderr for each of warnings, as one printable line each
+/// (printable_line: a warning quotes a path, which may hold any bytes).
+void print_warnings(const std::vector<std::string>& warnings);
 /// Loads the model (throws patchcull::Error with file/flag in the message).
 LoadedModel load_model_from_options(const ModelOptions& options);
 /// Builds the displacement map the options ask for (empty map when none).

@@ -37,7 +37,7 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
     model_options.displace = o.displace;
     model_options.displace_scale = o.displace_scale;
     const LoadedModel model = load_model_from_options(model_options);
-    for (const std::string& w : model.warnings) std::cerr << "patchcull: warning: " << w << "\n";
+    print_warnings(model.warnings);
     const DisplacementMap map = displacement_from_options(model_options, model);
     const std::vector<DisplacementRange> ranges = displacement_ranges(model.rest, &map);
     const std::size_t patches = model.rest.patches.size();

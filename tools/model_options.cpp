@@ -1,5 +1,6 @@
 // Model, scheme, split and displacement options shared by the CLI's commands.
 #include <cmath>
+#include <iostream>
 
 #include "cli_options.h"
 #include "commands.h"
@@ -7,6 +8,10 @@
 #include "patchcull/image.h"
 
 namespace patchcull::cli {
+
+void print_warnings(const std::vector<std::string>& warnings) {
+    for (const std::string& w : warnings) std::cerr << printable_line("patchcull: warning: " + w) << "\n";
+}
 
 void add_model_options(CLI::App& command, ModelOptions& options, bool with_displacement) {
     add_text_option(command, "MODEL", options.model, "OBJ control mesh, or 'teapot' for the built-in Utah teapot")

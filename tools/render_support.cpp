@@ -62,7 +62,7 @@ Scene load_scene(const std::string& model, const std::string& scheme_text, int s
         throw Error("--split: not available for the default scene (its models are not split)");
     const Scene scene = model == "default" ? make_default_scene(scheme) : make_model_scene(load_model(model, scheme, split));
     for (const LoadedModel& m : scene.models)
-        for (const std::string& w : m.warnings) std::cerr << "patchcull: warning: " << w << "\n";
+        print_warnings(m.warnings);
     return scene;
 }
 
@@ -73,8 +73,8 @@ gl::CullMode applicable_cull_mode(const Scene& scene, gl::CullMode requested, co
         if (model.closed) continue;
         // Silently: `all` is the default, and the JSON says "backpatch": "off".
         if (requested == gl::CullMode::all) return static_cast<gl::CullMode>(bits & ~gl::kFlagBackPatch);
-        std::cerr << "patchcull: warning: " << command << ": " << model.name
-                  << " is not a closed surface: back-patch culling may remove patches seen through its openings\n";
+        print_warnings({command + ": " + model.name +
+                        " is not a closed surface: back-patch culling may remove patches seen through its openings"});
         return requested;
     }
     return requested;

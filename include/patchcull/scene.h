@@ -26,6 +26,13 @@ struct LoadedModel {
     bool closed = false;
 };
 
+/// The largest extent (bounding-box side, in the mesh's local frame) load_model accepts. The
+/// kernels work in float: ptp's rounding margin grows with the fourth power of the size and
+/// blocks every cull from about 2e12 units (measured on a box, free views), squared lengths
+/// overflow near 1e19. Up to this limit every method culls as at unit size; a wider mesh is
+/// refused with one line instead of silently culling less (or nothing, through infinities).
+inline constexpr double kMaxMeshExtent = 2e11;
+
 /// Loads spec ("teapot" or an OBJ path), builds patches with scheme (ignored for the teapot) and
 /// applies split_levels 1-to-4 splits. Throws patchcull::Error naming the file and line.
 LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels);

@@ -103,7 +103,9 @@ Camera ViewGenerator::next() {
         cam.eye = c + Vec3{(2 * uniform() - 1) * half.x, (2 * uniform() - 1) * half.y, (2 * uniform() - 1) * half.z};
         const Vec3 toward_centre = normalize(c - cam.eye);
         const Vec3 dir = normalize(toward_centre * (uniform() < 0.6f ? 1.0f : 0.0f) + unit_vector() * 0.8f);
-        cam.target = cam.eye + (length(dir) > 0 ? dir : Vec3{0, 0, -1});
+        // A target `radius` away, not one unit: eye + a unit vector rounds to a few directions
+        // once the eye's coordinates reach ~1e6 (a large object in its own local frame).
+        cam.target = cam.eye + (length(dir) > 0 ? dir : Vec3{0, 0, -1}) * radius;
         cam.up = unit_vector();
         cam.fovy_radians = (20.0f + 70.0f * uniform()) * 3.14159265f / 180.0f;
         cam.z_near = radius * (0.002f + 0.2f * uniform() * uniform());

@@ -68,8 +68,9 @@ void ControlMesh::reverse_faces() {
 SurfaceOrientation classify_orientation(const ControlMesh& mesh) {
     if (!mesh.is_closed()) return SurfaceOrientation::open;
     const Bounds b = compute_bounds(mesh.positions);
-    const Vec3 extent = b.max - b.min;
-    const double diagonal = std::sqrt(double(extent.x) * extent.x + double(extent.y) * extent.y + double(extent.z) * extent.z);
+    // In double: the float extent of coordinates near the float maximum overflows.
+    const double ex = double(b.max.x) - b.min.x, ey = double(b.max.y) - b.min.y, ez = double(b.max.z) - b.min.z;
+    const double diagonal = std::sqrt(ex * ex + ey * ey + ez * ez);
     const double volume = mesh.signed_volume();
     if (!(std::abs(volume) > 1e-6 * diagonal * diagonal * diagonal)) return SurfaceOrientation::flat;
     return volume > 0 ? SurfaceOrientation::outward : SurfaceOrientation::inward;

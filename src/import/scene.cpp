@@ -2,6 +2,7 @@
 #include "patchcull/scene.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 
 #include "patchcull/error.h"
@@ -45,6 +46,16 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
     ControlMesh mesh = load_obj(spec);
     // Orientation from geometry: an inside-out closed mesh is reversed, a flat one is two-sided.
     const SurfaceOrientation orientation = orient_outward(mesh);
+    const Bounds bounds = compute_bounds(mesh.positions);
+    for (int axis = 0; axis < 3; ++axis) {
+        const double extent = double((&bounds.max.x)[axis]) - double((&bounds.min.x)[axis]);
+        if (!(extent <= kMaxMeshExtent)) {
+            char text[32];
+            std::snprintf(text, sizeof text, "%.3g", extent);
+            throw Error(spec + ": the mesh is " + text + " units across; patchcull takes meshes up to " +
+                        "2e+11 units across (the kernels work in float)");
+        }
+    }
     model.warnings = mesh.warnings;
     model.subdiv = build_model(mesh, scheme);
     model.origin = mesh.origin;
