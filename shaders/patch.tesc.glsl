@@ -5,7 +5,9 @@
 // value 0 = "no cull reason" (render()); kStatusVisible = the first pass of the pipeline;
 // kStatusVisible | kStatusNewlyVisible = its second pass; mask 0 = every patch (the reference).
 //
-// Levels: uniform u_tess_level on every edge and the interior, or adaptive by distance (seed 000
+// Levels: uniform u_tess_level times the patch's depth scale (kBindingPatchTessScale: patches of
+// different refinement depth get equal vertex density, so shared edges match) on every edge and
+// the interior, or adaptive by distance (seed 000
 // §6.3, like DirectX's DetailTessellation11): edge level = clamp(u_tess_level * u_tess_reference /
 // distance(eye, midpoint of the edge's two corner points), 1, u_tess_level), inner levels the max
 // of the two opposite edges. An edge's level depends only on its two corner points (symmetric in
@@ -17,6 +19,9 @@ layout(vertices = 16) out;
 
 layout(std430, binding = kBindingCullFlags) readonly buffer CullFlags {
     uint cull_flags[];
+};
+layout(std430, binding = kBindingPatchTessScale) readonly buffer PatchTessScale {
+    float patch_tess_scale[];
 };
 // Drawn patches of this render (PatchRenderer::read_drawn_patches: what --verify compares).
 layout(std430, binding = kBindingPatchMarks) writeonly buffer PatchMarks {
@@ -47,7 +52,7 @@ void main() {
     if (gl_InvocationID == 0) {
         const uint p = vs_patch[0];
         const bool drawn = (cull_flags[p] & u_draw_mask) == u_draw_value;
-        vec4 outer = vec4(u_tess_level);
+        vec4 outer = vec4(min(u_tess_level * patch_tess_scale[p], 64.0));
         if (u_adaptive) {
             // Quad domain: outer[0] is the edge u = 0, [1] v = 0, [2] u = 1, [3] v = 1; control
             // point (i, j) (u index i) is vs_point[4j + i].

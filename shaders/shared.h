@@ -36,6 +36,9 @@ PATCHCULL_CONST uint kTangentVec4s = 24u;
 // front depth (the mark-front pass, PatchRenderer::mark_front_patches). The renderer binds the
 // buffer of the pass at hand.
 PATCHCULL_CONST uint kBindingPatchMarks = 11u;
+// float scale[patch_count]: patch p's uniform tessellation level is min(64, level * scale[p]),
+// scale = 2^(D - depth) (PatchAttributes::depth): equal vertex density across refinement depths.
+PATCHCULL_CONST uint kBindingPatchTessScale = 12u;
 
 // Texture units.
 PATCHCULL_CONST uint kTextureUnitDisplacement = 0u;  // R32F height map, GL_REPEAT, bilinear

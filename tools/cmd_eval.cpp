@@ -62,7 +62,9 @@ int run_occlusion(const OcclusionOptions& o) {
 
     gl::GlContext context = gl::GlContext::create_headless();
     gl::CullPipeline pipeline(context);
-    pipeline.set_patches(model.rest.patches);
+    gl::PatchAttributes attributes;  // refinement depths: osd patches meet without cracks
+    for (const PatchInfo& info : model.rest.info) attributes.depth.push_back(info.depth);
+    pipeline.set_patches(model.rest.patches, attributes);
     ViewGenerator views(patch_bounds(model.rest), ViewMode::contain, o.seed, float(width) / float(height));
 
     double occluded_sum = 0, occluded_min = 1, occluded_max = 0, frustum_sum = 0, tcone_sum = 0, ncone_sum = 0;

@@ -50,6 +50,7 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
         attributes.max_displacement.push_back(ranges[p].max_abs());
         const PatchInfo& info = model.rest.info[p];
         attributes.texcoords.push_back({info.uv[0], info.uv[1], info.uv[2], info.uv[3]});
+        attributes.depth.push_back(info.depth);
     }
     renderer.set_patches(model.rest.patches, attributes);
     renderer.set_displacement_map(map);

@@ -52,6 +52,7 @@ gl::PatchAttributes pose_attributes(const ScenePoser& poser) {
     gl::PatchAttributes attributes;
     attributes.tangent_index = poser.tangent_index();
     attributes.tangents = poser.tangents();
+    attributes.depth = poser.depth();
     return attributes;
 }
 

@@ -90,6 +90,8 @@ public:
     /// by the instances' linear parts. Empty before the first pose.
     const std::vector<std::int32_t>& tangent_index() const { return tangent_index_; }
     const std::vector<TangentPatches>& tangents() const { return tangents_; }
+    /// PatchInfo::depth of each patch of the last pose (for gl::PatchAttributes::depth).
+    const std::vector<std::uint8_t>& depth() const { return depth_; }
 
 private:
     const Scene* scene_;
@@ -98,6 +100,7 @@ private:
     std::vector<BezierPatch> patches_;
     std::vector<std::int32_t> tangent_index_;
     std::vector<TangentPatches> tangents_;
+    std::vector<std::uint8_t> depth_;
 };
 
 }  // namespace patchcull

@@ -24,8 +24,9 @@
 //   tagged visible before). A culled patch gets tessellation levels 0 in the TCS and is discarded
 //   by the tessellator (seed 000 §3, seed 002: cull in the patch-constant phase).
 // - Tessellation: uniform integer level L (equal_spacing) on every edge and the interior, L in
-//   [1, 64], or adaptive by distance (RenderParams::adaptive_tess, seed 000 §6.3); the surface is
-//   evaluated exactly (rational Bezier) at the tessellator points.
+//   [1, 64], scaled by 2^(D - depth) per patch for sets of mixed refinement depth
+//   (PatchAttributes::depth), or adaptive by distance (RenderParams::adaptive_tess, seed 000
+//   §6.3); the surface is evaluated exactly (rational Bezier) at the tessellator points.
 // - Shading normal: du x dv of the patch's ACC tangent patches where it has them
 //   (PatchAttributes::tangents; continuous across extraordinary vertices), else of the patch's own
 //   derivatives. The geometry never depends on it.
@@ -181,6 +182,13 @@ struct PatchAttributes {
     /// tangent_index: empty (no tangents) or one per patch.
     std::vector<std::int32_t> tangent_index;
     std::vector<TangentPatches> tangents;
+    /// Refinement depth of each patch (PatchInfo::depth), or empty (all 0). With the uniform
+    /// level L a patch of depth d is tessellated at min(64, L * 2^(D - d)), D the largest depth of
+    /// the set: every patch then has the same vertex density along its base edges, so where an
+    /// adaptive (osd) patch meets two of the next depth, its edge vertices are exactly theirs and
+    /// no T-junction crack opens (up to float evaluation of the shared curve). Not applied to
+    /// adaptive_tess, whose levels follow the eye distance.
+    std::vector<std::uint8_t> depth;
 };
 
 /// Parameters of one frame.

@@ -55,6 +55,12 @@ struct PatchInfo {
     std::uint32_t base_face = 0;     ///< control-mesh face the patch comes from
     bool extraordinary = false;      ///< acc: touches an extraordinary vertex; osd: end-cap patch
     std::int32_t tangent_index = -1; ///< row block in SubdivisionModel::tangent_points, or -1
+    /// Refinement depth of the patch's domain (osd: Far::PatchParam::GetDepth(), which counts an
+    /// n-gon's quadrangulation so that a depth-d patch spans 2^-d of a base edge in every face;
+    /// acc: 0). Adaptive refinement puts patches of different depths side by side; the renderer
+    /// scales their tessellation by it so that shared edges get matching vertices
+    /// (gl::PatchAttributes::depth). 1-to-4 splits keep it (every patch is split alike).
+    std::uint8_t depth = 0;
 };
 
 struct SubdivisionModel {

@@ -50,8 +50,8 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
                       glGetUniformLocation(m.occluder_program, "u_eye")};
 
     glCreateVertexArrays(1, &m.vao);
-    GLuint buffers[11];
-    glCreateBuffers(11, buffers);
+    GLuint buffers[12];
+    glCreateBuffers(12, buffers);
     m.control_points = buffers[0];
     m.cull_flags = buffers[1];
     m.max_displacement = buffers[2];
@@ -63,6 +63,7 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
     m.tangents = buffers[8];
     m.drawn_marks = buffers[9];
     m.front_marks = buffers[10];
+    m.tess_scale = buffers[11];
     upload(m.counters, sh::kCounterCount * sizeof(std::uint32_t), nullptr);
     upload(m.occluder_vertices, 0, nullptr);
     glCreateFramebuffers(1, &m.fbo);

@@ -7,6 +7,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -151,6 +152,8 @@ struct PatchRenderer::Impl {
     GLuint control_points = 0, cull_flags = 0, max_displacement = 0, texcoords = 0, plane_values = 0;
     GLuint backpatch_flags = 0, counters = 0, occluder_vertices = 0, tangents = 0;
     GLuint drawn_marks = 0, front_marks = 0;  // uint per patch at kBindingPatchMarks (shared.h)
+    GLuint tess_scale = 0;                    // float per patch at kBindingPatchTessScale
+    float max_tess_scale = 1;                 // largest entry of tess_scale (the draw split)
     GLuint displacement_texture = 0;
     float displacement_scale = 0, displacement_midlevel = 0.5f;
     bool has_displacement_map = false;
@@ -208,8 +211,8 @@ struct PatchRenderer::Impl {
             glDeleteProgram(p);
         const GLuint buffers[] = {control_points, cull_flags,        max_displacement, texcoords,   plane_values,
                                   backpatch_flags, counters,         occluder_vertices, tangents,   drawn_marks,
-                                  front_marks};
-        glDeleteBuffers(11, buffers);
+                                  front_marks,     tess_scale};
+        glDeleteBuffers(12, buffers);
         const GLuint textures[] = {displacement_texture, color, ids, depth, hiz, vis_color, vis_depth};
         glDeleteTextures(7, textures);
         glDeleteFramebuffers(1, &fbo);
@@ -275,6 +278,7 @@ struct PatchRenderer::Impl {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullCounters, counters);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingOccluderVertices, occluder_vertices);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchTangents, tangents);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchTessScale, tess_scale);
     }
 
     void set_patches(const float* aos_points, std::size_t n, const PatchAttributes& a, bool keep_flags = false) {
@@ -287,6 +291,9 @@ struct PatchRenderer::Impl {
         if (!a.tangent_index.empty() && a.tangent_index.size() != n)
             throw Error("GL: set_patches: tangent_index has " + std::to_string(a.tangent_index.size()) +
                         " entries for " + std::to_string(n) + " patches");
+        if (!a.depth.empty() && a.depth.size() != n)
+            throw Error("GL: set_patches: depth has " + std::to_string(a.depth.size()) + " entries for " +
+                        std::to_string(n) + " patches");
         for (std::int32_t t : a.tangent_index)
             if (t >= 0 && static_cast<std::size_t>(t) >= a.tangents.size())
                 throw Error("GL: set_patches: tangent_index " + std::to_string(t) + " is past the " +
@@ -321,6 +328,12 @@ struct PatchRenderer::Impl {
         upload(tangents, tangent_data.size() * sizeof(Vec4), tangent_data.data());
         has_tangents = !a.tangent_index.empty();
         upload(plane_values, 0, nullptr);
+        const int deepest = a.depth.empty() ? 0 : *std::max_element(a.depth.begin(), a.depth.end());
+        std::vector<float> scales(std::max<std::size_t>(n, 1), 1.0f);
+        for (std::size_t p = 0; p < a.depth.size(); ++p)
+            scales[p] = std::ldexp(1.0f, std::min(deepest - int(a.depth[p]), 6));  // 2^6 = 64: any level saturates
+        max_tess_scale = *std::max_element(scales.begin(), scales.end());
+        upload(tess_scale, scales.size() * sizeof(float), scales.data());
         upload(drawn_marks, n * sizeof(std::uint32_t), nullptr);
         upload(front_marks, n * sizeof(std::uint32_t), nullptr);
         if (!keep_flags) {
@@ -415,8 +428,10 @@ struct PatchRenderer::Impl {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchMarks, mark_front ? front_marks : drawn_marks);
         glBindTextureUnit(sh::kTextureUnitDisplacement, displacement_texture);
         glPatchParameteri(GL_PATCH_VERTICES, kPatchPoints);
-        // llvmpipe workaround 2 (header): at most 65536 / (L+1)^2 patches per sub-draw.
-        const std::size_t per_draw = std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((level + 1) * (level + 1)));
+        // llvmpipe workaround 2 (header): at most 65536 / (L+1)^2 patches per sub-draw, L the
+        // largest level of the set (depth scales included).
+        const int top = std::min(64, static_cast<int>(static_cast<float>(level) * max_tess_scale));
+        const std::size_t per_draw = std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((top + 1) * (top + 1)));
         std::vector<GLint> firsts;
         std::vector<GLsizei> counts;
         for (std::size_t first = 0; first < count; first += per_draw) {

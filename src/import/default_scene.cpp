@@ -181,6 +181,7 @@ const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
     const Scene& scene = *scene_;
     patches_.resize(scene.patch_count());
     tangent_index_.assign(scene.patch_count(), -1);
+    depth_.assign(scene.patch_count(), 0);
     tangents_.clear();
     std::size_t next = 0;
     for (const SceneInstance& instance : scene.instances) {
@@ -199,6 +200,7 @@ const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
         for (std::size_t p = 0; p < frame->patches.size(); ++p) {
             BezierPatch& out = patches_[next];
             for (int k = 0; k < kPatchPoints; ++k) out.cp[k] = instance.object_to_world * frame->patches[p].cp[k];
+            depth_[next] = frame->info[p].depth;
             const std::int32_t t = frame->info[p].tangent_index;
             if (t >= 0) {
                 TangentPatches mapped;

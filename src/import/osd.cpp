@@ -331,6 +331,7 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh) {
             }
             info.extraordinary = !param.IsRegular() || param.GetDepth() > 0;
             info.tangent_index = -1;
+            info.depth = static_cast<std::uint8_t>(param.GetDepth());
             model.patches.push_back(info);
         }
     }
