@@ -63,6 +63,14 @@ Runner add_cull_command(CLI::App& app) {
         options.methods = split_methods(state->methods);
         const LoadedModel model = load_model_from_options(state->model);
         print_warnings(model.warnings);
+        // The back-patch truth is one-sided (sampled tangent planes facing the eye): it is the
+        // renderer's visibility only for closed solids (README, "What contributes a pixel").
+        const bool backpatch_requested = std::any_of(options.methods.begin(), options.methods.end(), [](const std::string& m) {
+            return m != "frustum" && m != "frustum-disp";
+        });
+        if (backpatch_requested && !model.closed)
+            print_warnings({"cull: " + model.name + " is not a closed solid: it is drawn two-sided, and the back-patch "
+                            "methods' false culls here count only front-facing samples"});
         const DisplacementMap displacement = displacement_from_options(state->model, model);
         const CullEvalResult result = evaluate_cull(model.rest, displacement.empty() ? nullptr : &displacement, options);
         nlohmann::json out;

@@ -75,7 +75,7 @@ gl::CullMode applicable_cull_mode(const Scene& scene, gl::CullMode requested, co
         // Silently: `all` is the default, and the JSON says "backpatch": "off".
         if (requested == gl::CullMode::all) return static_cast<gl::CullMode>(bits & ~gl::kFlagBackPatch);
         print_warnings({command + ": " + model.name +
-                        " is not a closed surface: back-patch culling may remove patches seen through its openings"});
+                        " is not a closed solid: back-patch culling may remove patches seen through its openings"});
         return requested;
     }
     return requested;

@@ -1,12 +1,18 @@
 // patchcull/image.h: loading displacement maps from PNG files (8- or 16-bit, grey or colour).
 #pragma once
 
+#include <cstdint>
+
 #include <cstddef>
 #include <string>
 
 #include "patchcull/displacement.h"
 
 namespace patchcull {
+
+/// Largest PNG file load_displacement_png reads: 1 GiB (a regular file; devices and FIFOs are
+/// refused before any read).
+inline constexpr std::uintmax_t kMaxPngFileBytes = std::uintmax_t{1} << 30;
 
 /// Loads path as a height map with D = scale * (h - midlevel), h in [0,1]. Rows are flipped so
 /// that row 0 is t = 0 (OBJ texture origin bottom-left, image origin top-left).

@@ -14,6 +14,8 @@
 // a silently wrong mesh, so it is not used.)
 #pragma once
 
+#include <cstdint>
+
 #include <istream>
 #include <string>
 
@@ -21,7 +23,11 @@
 
 namespace patchcull {
 
-/// Loads an OBJ file. Throws patchcull::Error ("path: cannot open ...", "path:line: ...").
+/// Largest OBJ file load_obj reads (it reads the whole file): 2 GiB.
+inline constexpr std::uintmax_t kMaxObjFileBytes = std::uintmax_t{2} << 30;
+
+/// Loads an OBJ file: a regular file of at most kMaxObjFileBytes (a device, FIFO or directory is
+/// refused before any read). Throws patchcull::Error ("path: cannot open ...", "path:line: ...").
 /// A mesh where some faces have texture coordinates and others not drops them all and says so in
 /// ControlMesh::warnings: displacement then falls back to each patch's own (u,v) domain.
 ControlMesh load_obj(const std::string& path);

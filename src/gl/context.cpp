@@ -22,6 +22,7 @@
 
 #include "patchcull/error.h"
 #include "patchcull/gl_renderer.h"
+#include "png_file.h"
 
 namespace patchcull::gl {
 
@@ -277,8 +278,7 @@ void GlContext::write_window_png(const std::string& path) const {
         std::swap_ranges(rgba.begin() + static_cast<std::ptrdiff_t>(y * row),
                          rgba.begin() + static_cast<std::ptrdiff_t>((y + 1) * row),
                          rgba.begin() + static_cast<std::ptrdiff_t>((height - 1 - y) * row));
-    if (!stbi_write_png(path.c_str(), width, height, 4, rgba.data(), static_cast<int>(row)))
-        throw Error(path + ": cannot write PNG");
+    detail::write_png_file(path, width, height, 4, rgba.data(), static_cast<int>(row));
 }
 const std::string& GlContext::renderer() const { return impl_->renderer; }
 const std::string& GlContext::vendor() const { return impl_->vendor; }

@@ -331,8 +331,7 @@ std::vector<std::uint8_t> PatchRenderer::render_status_image(const RenderParams&
 
 void PatchRenderer::write_status_png(const std::string& path, const RenderParams& view) {
     const std::vector<std::uint8_t> rgba = render_status_image(view);
-    if (!stbi_write_png(path.c_str(), view.width, view.height, 4, rgba.data(), view.width * 4))
-        throw Error(path + ": cannot write PNG");
+    write_png_file(path, view.width, view.height, 4, rgba.data(), view.width * 4);
 }
 
 // ---- verification -----------------------------------------------------------------------------

@@ -332,8 +332,7 @@ void PatchRenderer::blit_color_to_window(int window_width, int window_height) co
 
 void PatchRenderer::write_color_png(const std::string& path) const {
     const std::vector<std::uint8_t> rgba = read_color();
-    if (!stbi_write_png(path.c_str(), impl_->width, impl_->height, 4, rgba.data(), impl_->width * 4))
-        throw Error(path + ": cannot write PNG");
+    write_png_file(path, impl_->width, impl_->height, 4, rgba.data(), impl_->width * 4);
 }
 
 void write_ids_png(const std::string& path, const std::vector<std::uint32_t>& ids, int width, int height) {
@@ -348,7 +347,7 @@ void write_ids_png(const std::string& path, const std::vector<std::uint32_t>& id
         for (int c = 0; c < 3; ++c)
             rgb[3 * i + c] = ids[i] == sh::kIdBackground ? 0 : static_cast<std::uint8_t>(64 + ((h >> (8 * c)) & 191));
     }
-    if (!stbi_write_png(path.c_str(), width, height, 3, rgb.data(), width * 3)) throw Error(path + ": cannot write PNG");
+    write_png_file(path, width, height, 3, rgb.data(), width * 3);
 }
 
 }  // namespace patchcull::gl

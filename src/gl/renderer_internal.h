@@ -18,6 +18,7 @@
 #include "patchcull/error.h"
 #include "patchcull/gl_renderer.h"
 #include "patchcull/hiz.h"
+#include "png_file.h"
 #include "shader_sources.h"
 #include "shared.h"
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "patchcull/error.h"
+#include "input_file.h"
 
 namespace patchcull {
 namespace {
@@ -113,6 +114,7 @@ DisplacementMap decode_displacement_png(const unsigned char* data, std::size_t s
 
 DisplacementMap load_displacement_png(const std::string& path, float scale, float midlevel) {
     if (!std::isfinite(scale)) throw Error(path + ": displacement scale is not finite");
+    detail::check_input_file(path, kMaxPngFileBytes, "PNG");
     std::ifstream file(path, std::ios::binary);
     if (!file) fail(path, "cannot open file");
     const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());

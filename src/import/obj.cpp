@@ -13,6 +13,7 @@
 #include <string_view>
 
 #include "patchcull/error.h"
+#include "input_file.h"
 
 namespace patchcull {
 namespace {
@@ -276,6 +277,7 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
 }
 
 ControlMesh load_obj(const std::string& path) {
+    detail::check_input_file(path, kMaxObjFileBytes, "OBJ");
     std::ifstream file(path, std::ios::binary);
     if (!file) throw Error(path + ": cannot open file");
     return parse_obj(file, path);

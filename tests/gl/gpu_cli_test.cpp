@@ -112,7 +112,7 @@ TEST(GpuCli, VerifyCatchesBackFacingPatchesSeenThroughTheTeapotsLidGap) {
     // job does (issue 9: it exited 0).
     const CliRun r = run(kSmallTeapot + "--frames 3 --cull backpatch --backpatch tcone --verify --json");
     ASSERT_EQ(r.status, 1) << r.err;
-    EXPECT_NE(r.err.find("warning: render: teapot is not a closed surface"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("warning: render: teapot is not a closed solid"), std::string::npos) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_GT(j["false_culls"].get<std::size_t>(), 0u);
     std::size_t listed = 0;
