@@ -68,11 +68,11 @@ Runner add_cull_command(CLI::App& app) {
         const bool backpatch_requested = std::any_of(options.methods.begin(), options.methods.end(), [](const std::string& m) {
             return m != "frustum" && m != "frustum-disp";
         });
-        if (backpatch_requested && !model.closed)
-            print_warnings({"cull: " + model.name + " is not a closed solid: it is drawn two-sided, and the back-patch "
-                            "methods' false culls here count only front-facing samples"});
         const DisplacementMap displacement = displacement_from_options(state->model, model);
         const CullEvalResult result = evaluate_cull(model.rest, displacement.empty() ? nullptr : &displacement, options);
+        if (backpatch_requested && !model.closed)  // after the run: an error stays the only line
+            print_warnings({"cull: " + model.name + " is not a closed solid: it is drawn two-sided, and the back-patch "
+                            "methods' false culls here count only front-facing samples"});
         nlohmann::json out;
         out["model"] = model.name;
         out["patches"] = result.patches;

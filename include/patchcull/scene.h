@@ -32,6 +32,10 @@ struct LoadedModel {
 /// overflow near 1e19. Up to this limit every method culls as at unit size; a wider mesh is
 /// refused with one line instead of silently culling less (or nothing, through infinities).
 inline constexpr double kMaxMeshExtent = 2e11;
+/// The smallest bounding-box diagonal load_model accepts: below it the cameras' float products
+/// (near planes, squared radii) reach the subnormal range, and at 1e-10 every free view culled
+/// everything (the views lost the object). A smaller mesh is refused with one line.
+inline constexpr double kMinMeshDiagonal = 1e-6;
 
 /// Loads spec ("teapot" or an OBJ path), builds patches with scheme (ignored for the teapot) and
 /// applies split_levels 1-to-4 splits. Throws patchcull::Error naming the file and line.

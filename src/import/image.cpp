@@ -114,7 +114,8 @@ DisplacementMap decode_displacement_png(const unsigned char* data, std::size_t s
 
 DisplacementMap load_displacement_png(const std::string& path, float scale, float midlevel) {
     if (!std::isfinite(scale)) throw Error(path + ": displacement scale is not finite");
-    detail::check_input_file(path, kMaxPngFileBytes, "PNG");
+    if (const std::string problem = detail::input_file_problem(path, kMaxPngFileBytes, "PNG"); !problem.empty())
+        fail(path, problem.c_str());
     std::ifstream file(path, std::ios::binary);
     if (!file) fail(path, "cannot open file");
     const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());

@@ -8,23 +8,23 @@
 #include <string>
 #include <system_error>
 
-#include "patchcull/error.h"
-
 namespace patchcull::detail {
 
-/// Throws patchcull::Error("PATH: ...") unless path names a regular file (symbolic links
-/// followed) of at most max_bytes bytes.
-inline void check_input_file(const std::string& path, std::uintmax_t max_bytes, const char* what) {
+/// Empty when path names a regular file (symbolic links followed) of at most max_bytes bytes;
+/// else why not, for the loader's one-line error ("cannot open file", "not a regular file ...",
+/// "N bytes, larger than ...").
+inline std::string input_file_problem(const std::string& path, std::uintmax_t max_bytes, const char* what) {
     std::error_code ec;
     const std::filesystem::file_status status = std::filesystem::status(path, ec);
-    if (ec || !std::filesystem::exists(status)) throw Error(path + ": cannot open file");
+    if (ec || !std::filesystem::exists(status)) return "cannot open file";
     if (!std::filesystem::is_regular_file(status))
-        throw Error(path + ": not a regular file (patchcull reads " + what + " files only)");
+        return std::string("not a regular file (patchcull reads ") + what + " files only)";
     const std::uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec) throw Error(path + ": cannot read the file size");
+    if (ec) return "cannot read the file size";
     if (size > max_bytes)
-        throw Error(path + ": " + std::to_string(size) + " bytes, larger than the " +
-                    std::to_string(max_bytes >> 20) + " MiB patchcull reads for " + what + " files");
+        return std::to_string(size) + " bytes, larger than the " + std::to_string(max_bytes >> 20) +
+               " MiB patchcull reads for " + what + " files";
+    return {};
 }
 
 }  // namespace patchcull::detail

@@ -277,7 +277,8 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
 }
 
 ControlMesh load_obj(const std::string& path) {
-    detail::check_input_file(path, kMaxObjFileBytes, "OBJ");
+    if (const std::string problem = detail::input_file_problem(path, kMaxObjFileBytes, "OBJ"); !problem.empty())
+        throw Error(path + ": " + problem);
     std::ifstream file(path, std::ios::binary);
     if (!file) throw Error(path + ": cannot open file");
     return parse_obj(file, path);

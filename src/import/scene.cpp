@@ -2,6 +2,7 @@
 #include "patchcull/scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -47,6 +48,17 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
     // Orientation from geometry: an inside-out closed mesh is reversed, a flat one is two-sided.
     const SurfaceOrientation orientation = orient_outward(mesh);
     const Bounds bounds = compute_bounds(mesh.positions);
+    double diagonal_squared = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double side = double((&bounds.max.x)[axis]) - double((&bounds.min.x)[axis]);
+        diagonal_squared += side * side;
+    }
+    if (!(diagonal_squared >= kMinMeshDiagonal * kMinMeshDiagonal)) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.3g", std::sqrt(diagonal_squared));
+        throw Error(spec + ": the mesh is " + text + " units across; patchcull takes meshes of at least " +
+                    "1e-06 units across (the kernels work in float)");
+    }
     for (int axis = 0; axis < 3; ++axis) {
         const double extent = double((&bounds.max.x)[axis]) - double((&bounds.min.x)[axis]);
         if (!(extent <= kMaxMeshExtent)) {

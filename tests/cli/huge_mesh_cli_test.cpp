@@ -36,6 +36,16 @@ TEST(CliHugeMesh, MeshWiderThanFloatArithmeticIsRefused) {
     }
 }
 
+TEST(CliHugeMesh, MeshTooSmallForFloatIsRefused) {
+    // 1e-40 is subnormal in float; 1e-10 used to make every free view cull everything.
+    for (const char* half : {"1e-40", "1e-10"}) {
+        const CliRun r = run("cull " + write_file("tiny_box.obj", box_obj(half)) + " --views 3");
+        expect_one_line_error(r, "units across");
+    }
+    const CliRun ok = run("info " + write_file("small_box.obj", box_obj("1e-6")));
+    EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
 TEST(CliHugeMesh, MeshAtTheLimitCullsAsAUnitBox) {
     const std::string args = " --views 100 --view-mode free --methods frustum,frustum-disp,ptp --json";
     const CliRun unit = run("cull " + write_file("unit_box.obj", box_obj("1")) + args);
