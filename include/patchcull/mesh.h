@@ -80,7 +80,7 @@ struct ControlMesh {
 /// a pixel"). Orientation comes from geometry (the signed volume), not from topology alone.
 enum class SurfaceOrientation {
     open,     ///< not closed (is_closed false): drawn two-sided, no back-patch culling
-    flat,     ///< closed but encloses no volume (|V| <= 1e-6 d^3, d the bounding-box diagonal)
+    flat,     ///< closed but encloses no volume (|V| <= 1e-9 A^1.5, A the faces' area)
     outward,  ///< closed, positive volume: one-sided, back-patch culling conservative
     inward,   ///< closed, negative volume: inside out (reverse_faces makes it outward)
 };

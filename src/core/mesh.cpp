@@ -65,14 +65,37 @@ void ControlMesh::reverse_faces() {
     }
 }
 
+namespace {
+
+// Total area of the faces' triangle fans, in double.
+double surface_area(const ControlMesh& mesh) {
+    double area = 0;
+    for (std::size_t f = 0; f < mesh.face_count(); ++f) {
+        const std::uint32_t first = mesh.face_offsets[f], n = mesh.face_size(f);
+        const Vec3 a = mesh.positions[mesh.face_vertices[first]];
+        for (std::uint32_t i = 1; i + 1 < n; ++i) {
+            const Vec3 b = mesh.positions[mesh.face_vertices[first + i]];
+            const Vec3 c = mesh.positions[mesh.face_vertices[first + i + 1]];
+            const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
+            const double vx = double(c.x) - a.x, vy = double(c.y) - a.y, vz = double(c.z) - a.z;
+            const double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
+            area += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+        }
+    }
+    return area;
+}
+
+}  // namespace
+
 SurfaceOrientation classify_orientation(const ControlMesh& mesh) {
     if (!mesh.is_closed()) return SurfaceOrientation::open;
-    const Bounds b = compute_bounds(mesh.positions);
-    // In double: the float extent of coordinates near the float maximum overflows.
-    const double ex = double(b.max.x) - b.min.x, ey = double(b.max.y) - b.min.y, ez = double(b.max.z) - b.min.z;
-    const double diagonal = std::sqrt(ex * ex + ey * ey + ez * ez);
+    // Flat against the mesh's own surface (|V| <= 1e-9 A^1.5; a sphere has V = 0.094 A^1.5), not
+    // against its bounding box, so that a thin but real solid (a squashed character, a plate of
+    // 1e-5 relative thickness) keeps its orientation while a zero-volume sheet (two coincident
+    // layers, a flattened mesh, whose volume is rounding noise ~1e-16 A^1.5) does not.
+    const double area = surface_area(mesh);
     const double volume = mesh.signed_volume();
-    if (!(std::abs(volume) > 1e-6 * diagonal * diagonal * diagonal)) return SurfaceOrientation::flat;
+    if (!(std::abs(volume) > 1e-9 * area * std::sqrt(area))) return SurfaceOrientation::flat;
     return volume > 0 ? SurfaceOrientation::outward : SurfaceOrientation::inward;
 }
 

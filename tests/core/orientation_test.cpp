@@ -67,6 +67,16 @@ TEST(Orientation, FlatAndOpenMeshesAreNotSolids) {
     EXPECT_TRUE(open.warnings.empty());
 }
 
+TEST(Orientation, ThinSolidsKeepTheirOrientation) {
+    // A plate 1e-5 as thick as it is wide, and the same squashed 100 : 1 : 0.01 (the bounding-box
+    // rule called both flat): real solids, oriented outward; inverted, inward.
+    EXPECT_EQ(classify_orientation(box(1, 1, 1e-5f)), SurfaceOrientation::outward);
+    EXPECT_EQ(classify_orientation(box(100, 1, 0.01f)), SurfaceOrientation::outward);
+    ControlMesh inverted = box(100, 1, 0.01f);
+    inverted.reverse_faces();
+    EXPECT_EQ(classify_orientation(inverted), SurfaceOrientation::inward);
+}
+
 TEST(Orientation, ReverseFacesKeepsTexcoordsWithTheirCorners) {
     ControlMesh m = box(1, 1, 1);
     m.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
