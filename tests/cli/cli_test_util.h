@@ -6,11 +6,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace patchcull::cli_test {
 
@@ -56,6 +59,45 @@ inline std::string write_file(const std::string& name, const std::string& conten
     const std::string path = scratch_dir() + "/" + name;
     std::ofstream(path, std::ios::binary) << content;
     return path;
+}
+
+/// The OBJ file at path with every vertex (x, y, z) -> move(index, x, y, z) (written with 17
+/// significant digits, so a file's own decimals survive translations up to 1e7) and, when
+/// reverse is set, every face's corner order reversed; other lines as they are. For tests of
+/// edits of the shipped models: translated, mirrored, inside out, folded, flat.
+inline std::string edited_obj(const std::string& path,
+                              const std::function<void(int, double&, double&, double&)>& move,
+                              bool reverse = false) {
+    std::istringstream in(slurp(path));
+    std::ostringstream out;
+    std::string line;
+    int vertex = 0;
+    char buf[128];
+    while (std::getline(in, line)) {
+        std::istringstream fields(line);
+        std::string tag;
+        fields >> tag;
+        double x = 0, y = 0, z = 0;
+        if (tag == "v" && (fields >> x >> y >> z)) {
+            move(vertex++, x, y, z);
+            std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g", x, y, z);
+            out << buf << '\n';
+        } else if (tag == "f" && reverse) {
+            std::vector<std::string> corners;
+            for (std::string c; fields >> c;) corners.push_back(c);
+            out << 'f';
+            for (auto it = corners.rbegin(); it != corners.rend(); ++it) out << ' ' << *it;
+            out << '\n';
+        } else {
+            out << line << '\n';
+        }
+    }
+    return out.str();
+}
+
+/// edited_obj of the shipped BigGuy translated by (t, t, t).
+inline std::string translated_bigguy(double t) {
+    return edited_obj(model("bigguy.obj"), [t](int, double& x, double& y, double& z) { x += t, y += t, z += t; });
 }
 
 /// The error must be exactly one line, name the culprit, and exit with status 2.

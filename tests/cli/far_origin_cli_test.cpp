@@ -12,27 +12,6 @@
 
 using namespace patchcull::cli_test;
 
-namespace {
-
-std::string translated_bigguy(double t) {
-    std::ifstream in(model("bigguy.obj"));
-    std::ostringstream out;
-    std::string line;
-    char buf[128];
-    while (std::getline(in, line)) {
-        double x, y, z;
-        if (line.rfind("v ", 0) == 0 && std::sscanf(line.c_str() + 2, "%lf %lf %lf", &x, &y, &z) == 3) {
-            std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g", x + t, y + t, z + t);
-            out << buf << "\n";
-        } else {
-            out << line << "\n";
-        }
-    }
-    return out.str();
-}
-
-}  // namespace
-
 TEST(CliFarOrigin, TranslatedBigGuyCullsAsAtTheOrigin) {
     const std::string far = write_file("bigguy_far.obj", translated_bigguy(1e6));
     const std::string args = " --views 24 --view-mode free --methods frustum,frustum-disp,tcone,ncone,ptp,ptp-pcnt --json";

@@ -23,34 +23,10 @@ using namespace patchcull::cli_test;
 
 namespace {
 
-// BigGuy's OBJ text with each vertex (x, y, z) -> move(index, x, y, z) and, when reverse is set,
-// every face's corner order reversed.
+// BigGuy edited (cli_test_util.h's edited_obj), written to the scratch directory.
 std::string edited_bigguy(const std::string& name, const std::function<void(int, double&, double&, double&)>& move,
                           bool reverse = false) {
-    std::istringstream in(slurp(model("bigguy.obj")));
-    std::ostringstream out;
-    std::string line;
-    int vertex = 0;
-    while (std::getline(in, line)) {
-        std::istringstream fields(line);
-        std::string tag;
-        fields >> tag;
-        if (tag == "v") {
-            double x = 0, y = 0, z = 0;
-            fields >> x >> y >> z;
-            move(vertex++, x, y, z);
-            out << "v " << x << ' ' << y << ' ' << z << '\n';
-        } else if (tag == "f" && reverse) {
-            std::vector<std::string> corners;
-            for (std::string c; fields >> c;) corners.push_back(c);
-            out << 'f';
-            for (auto it = corners.rbegin(); it != corners.rend(); ++it) out << ' ' << *it;
-            out << '\n';
-        } else {
-            out << line << '\n';
-        }
-    }
-    return write_file(name, out.str());
+    return write_file(name, edited_obj(model("bigguy.obj"), move, reverse));
 }
 
 void unchanged(int, double&, double&, double&) {}

@@ -14,6 +14,7 @@
 #include <string>
 #include <unistd.h>
 
+#include "cli/cli_test_util.h"
 #include "patchcull/camera.h"
 #include "patchcull/cull_eval.h"
 #include "patchcull/frustum.h"
@@ -23,33 +24,6 @@
 using namespace patchcull;
 
 namespace {
-
-// BigGuy's OBJ with every vertex moved by (t, t, t), written with 17 significant digits (the
-// file's own 6 decimals survive exactly up to t = 1e7).
-std::string translated_bigguy(double t) {
-    std::ifstream in(shipped_model_path("bigguy.obj"));
-    std::ostringstream out;
-    std::string line;
-    char buf[128];
-    while (std::getline(in, line)) {
-        double x, y, z;
-        if (line.rfind("v ", 0) == 0 && std::sscanf(line.c_str() + 2, "%lf %lf %lf", &x, &y, &z) == 3) {
-            std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g", x + t, y + t, z + t);
-            out << buf << "\n";
-        } else {
-            out << line << "\n";
-        }
-    }
-    return out.str();
-}
-
-std::string write_temp(const std::string& name, const std::string& text) {
-    const auto dir = std::filesystem::temp_directory_path() / ("patchcull_far_" + std::to_string(getpid()));
-    std::filesystem::create_directories(dir);
-    const std::string path = (dir / name).string();
-    std::ofstream(path, std::ios::binary) << text;
-    return path;
-}
 
 std::map<std::string, CullMethodResult> cull(const PatchFrame& frame, ViewMode mode, int views) {
     CullEvalOptions options;
@@ -111,7 +85,7 @@ TEST(FarOrigin, TranslatedBigGuyCullsAsAtTheOrigin) {
             const int views = mode == ViewMode::free ? 24 : 8;
             const auto reference = cull(base.rest, mode, views);
             for (double t : {1e5, 1e7}) {
-                const std::string path = write_temp("bigguy_" + std::to_string(int(std::log10(t))) + ".obj", translated_bigguy(t));
+                const std::string path = patchcull::cli_test::write_file("bigguy_" + std::to_string(int(std::log10(t))) + ".obj", patchcull::cli_test::translated_bigguy(t));
                 const LoadedModel far = load_model(path, scheme, 0);
                 EXPECT_NEAR(far.origin.x, t, 10.0);
                 const auto r = cull(far.rest, mode, views);
