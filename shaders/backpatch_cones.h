@@ -1,6 +1,6 @@
 // shaders/backpatch_cones.h (GLSL only; include after exact_fma.h and backpatch_exact.h): the
-// GPU twin of src/core/cones_internal.h, operation by operation (cull_tcone.comp.glsl,
-// cull_ncone.comp.glsl). Every std::fma there is pc_fma here, sqrt and division are pc_sqrt and
+// GPU twin of src/core/cones_internal.h, operation by operation (backpatch_cones.comp.glsl,
+// tcone and ncone). Every std::fma there is pc_fma here, sqrt and division are pc_sqrt and
 // pc_div (correctly rounded, backpatch_exact.h), every other operation is one separately rounded
 // float operation in the same order (all marked precise so the compiler neither fuses nor
 // reorders them). The derivations and the error analysis behind the constants are in
@@ -30,10 +30,11 @@
 
 #define kPcInf uintBitsToFloat(0x7F800000u)
 
-// Always 0.0 (the host sets it): sums start from this run-time zero, not from a literal, because
-// Mesa folds `x + 0.0` into x even in precise code (the CPU's fma(a, b, +0) is +0 for a*b = -0; see
-// cull_ptp.comp.glsl, where this was measured).
-uniform float u_zero;
+// u_zero: always 0.0, provided by the including shader as a member of its parameter block (a
+// #define, pass_params.h: BackpatchConeParams::zero, DisplacedParams::zero; the host sets it).
+// Sums start from this run-time zero, not from a literal, because Mesa folds `x + 0.0` into x even
+// in precise code (the CPU's fma(a, b, +0) is +0 for a*b = -0; see backpatch_ptp.comp.glsl, where
+// this was measured).
 
 struct PcCone {
     vec3 axis;

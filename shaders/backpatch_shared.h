@@ -1,8 +1,8 @@
 // shaders/backpatch_shared.h: constants shared by the GPU back-patch culler
 // (include/patchcull/gl_backpatch.h, src/gl/backpatch_culler.cpp) and its compute shaders
-// (cull_tcone, cull_ncone, cull_ptp, backpatch_probe). Valid C++20 and GLSL 4.50 at once, like
+// (backpatch_cones, backpatch_ptp, backpatch_probe). Valid C++20 and GLSL 4.50 at once, like
 // shared.h (whose buffer bindings the culler uses for the control points and the flag words:
-// kBindingControlPoints and kBindingBackPatchFlags). Only `const uint` constants.
+// kBindingControlPoints and kBindingCullFlags). Only `const uint` constants.
 #ifndef PATCHCULL_SHADERS_BACKPATCH_SHARED_H
 #define PATCHCULL_SHADERS_BACKPATCH_SHARED_H
 
@@ -15,10 +15,10 @@ using uint = std::uint32_t;
 #define PATCHCULL_BP_CONST const
 #endif
 
-// Diagnostics buffer of cull_ptp (std430 float t[64 * patch_count]: patch p's control plane z
+// Diagnostics buffer of backpatch_ptp (std430 float t[64 * patch_count]: patch p's control plane z
 // components at 64p + 8 jv + iu, exactly the CPU kernel's t), written only on request.
 PATCHCULL_BP_CONST uint kBindingPtpPlanes = 12u;
-// Diagnostics buffer of cull_tcone / cull_ncone (std430 float c[kConeValues * patch_count]):
+// Diagnostics buffer of backpatch_cones (tcone / ncone) (std430 float c[kConeValues * patch_count]):
 // patch p's cone and sphere at kConeValues p + (axis.x, axis.y, axis.z, cos, sin, valid (1 or 0),
 // center.x, center.y, center.z, radius, 0, 0), written only on request.
 PATCHCULL_BP_CONST uint kBindingConeValues = 15u;

@@ -17,9 +17,10 @@
 //   kDisplacedFramePad, kDisplacedDepthSafety) are uniforms set from the C++ constants, so the two
 //   sides cannot drift apart (and no decimal literal is parsed by the GLSL compiler).
 //
-// The including shader declares the uniforms used here (see cull_displaced.comp.glsl): the
-// DisplacedCullView (u_object_to_view, u_abs_row_z, u_axis_unit, u_axis_length, u_proj = (P00, P02,
-// P11, P12), u_proj_z = (P22, P23), u_view_planes) and the constants (u_delta_slack, u_ext_scale,
+// The including shader provides the names used here (displaced.comp.glsl: #defines onto its
+// parameter block, pass_params.h's DisplacedParams): the DisplacedCullView (u_object_to_view,
+// u_abs_row_z (4 values), u_axis_unit (vec4s, xyz used), u_axis_length (4 values, 3 used), u_proj =
+// (P00, P02, P11, P12), u_proj_z = (P22, P23, -, -), u_view_planes) and the constants (u_delta_slack, u_ext_scale,
 // u_frame_pad, u_depth_safety).
 
 // DisplacedBoundStatus of displaced_bounds.h.
@@ -141,7 +142,7 @@ float pc_plane_value(vec4 r, vec4 q) {
 PcDisplacedBound pc_caf_bound(vec3 p[16], PcCone cone, float d_min, float d_max, float radius) {
     // Step 2: extensions along the view axes (rows of L): ext[i] = (plus, minus).
     vec2 ext[3];
-    for (int i = 0; i < 3; ++i) ext[i] = pc_extension_along(u_axis_unit[i], u_axis_length[i], cone, d_min, d_max, radius);
+    for (int i = 0; i < 3; ++i) ext[i] = pc_extension_along(u_axis_unit[i].xyz, u_axis_length[i], cone, d_min, d_max, radius);
     const float t_near_ext = ext[2].x, t_far_ext = ext[2].y;
 
     // Steps 1 and 3.

@@ -1,6 +1,6 @@
 // shaders/displaced_shared.h: constants shared by the GPU displaced-patch culler
 // (include/patchcull/gl_displaced.h, src/gl/displaced_culler.cpp) and its compute shader
-// (cull_displaced.comp.glsl). Valid C++20 and GLSL 4.50 at once, like shared.h, whose bindings the
+// (displaced.comp.glsl). Valid C++20 and GLSL 4.50 at once, like shared.h, whose bindings the
 // culler uses for the control points (kBindingControlPoints) and the flag words (kBindingCullFlags),
 // and whose texture unit kTextureUnitHiZ holds the Hi-Z pyramid. Only `const uint` constants.
 #ifndef PATCHCULL_SHADERS_DISPLACED_SHARED_H

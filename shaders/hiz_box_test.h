@@ -1,8 +1,8 @@
 // Hi-Z test of a screen box: hiz.h steps 5-9 (seed 000 §4.1.1), the GPU twin of
 // hiz_rect_from_window_box, hiz_select_level and hiz_rect_max (src/core/hiz.cpp), operation by
 // operation (pc_fma = std::fma, `a < b ? a : b` min/max, floor, integer shifts), so the decisions
-// equal the CPU's. Shared by cull_occlusion.comp.glsl (a patch's control-point box) and
-// cull_displaced.comp.glsl (a displaced patch's bound). The including shader includes exact_fma.h
+// equal the CPU's. Shared by occlusion.comp.glsl (a patch's control-point box) and
+// displaced.comp.glsl (a displaced patch's bound). The including shader includes exact_fma.h
 // first and declares the pyramid: uniform ivec2 u_screen (W, H: its depth buffer, viewport
 // 0,0,W,H), uniform int u_hiz_levels (HiZPyramid::level_count(W, H)), sampler2D u_hiz.
 

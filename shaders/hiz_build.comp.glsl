@@ -1,4 +1,4 @@
-// Hi-Z build pass (seed 000 §4.1): one dispatch per pyramid level, one invocation per texel of the
+// Hi-Z build pass (HiZBuildPass, src/gl/hiz_build_pass.cpp; seed 000 §4.1): one dispatch per pyramid level, one invocation per texel of the
 // level written. Level 0 (half resolution) reduces the depth buffer (u_depth), level l > 0 reduces
 // level l-1 of the pyramid itself (u_hiz, another level of the same texture than the one written).
 // Texel (tx, ty) = max of its (up to) 2x2 children (2tx+i, 2ty+j); a child past the last
@@ -8,6 +8,7 @@
 // HiZPyramid::build on the same depth buffer. Row 0 = bottom in both.
 #version 450 core
 #include "shared.h"
+#include "pass_params.h"
 
 layout(local_size_x = kHiZGroupSize, local_size_y = kHiZGroupSize) in;
 
@@ -15,22 +16,19 @@ layout(binding = kTextureUnitDepth) uniform sampler2D u_depth;  // DEPTH32F, no 
 layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;      // the pyramid (source level)
 layout(binding = kImageUnitHiZOut, r32f) writeonly uniform image2D u_out;
 
-uniform bool u_from_depth;   // level 0: read u_depth, else u_hiz at u_source_level
-uniform int u_source_level;
-uniform ivec2 u_source_size; // used size of the source (depth W x H, or W_{l-1} x H_{l-1})
-uniform ivec2 u_out_size;    // W_l x H_l
 
 float pc_max(float a, float b) { return a > b ? a : b; }
 
 float source(int x, int y) {
-    return u_from_depth ? texelFetch(u_depth, ivec2(x, y), 0).r : texelFetch(u_hiz, ivec2(x, y), u_source_level).r;
+    return hiz_build.from_depth != 0u ? texelFetch(u_depth, ivec2(x, y), 0).r
+                                      : texelFetch(u_hiz, ivec2(x, y), hiz_build.source_level).r;
 }
 
 void main() {
     const ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    if (t.x >= u_out_size.x || t.y >= u_out_size.y) return;
-    const int x0 = 2 * t.x, x1 = min(2 * t.x + 1, u_source_size.x - 1);
-    const int y0 = 2 * t.y, y1 = min(2 * t.y + 1, u_source_size.y - 1);
+    if (t.x >= hiz_build.out_width || t.y >= hiz_build.out_height) return;
+    const int x0 = 2 * t.x, x1 = min(2 * t.x + 1, hiz_build.source_width - 1);
+    const int y0 = 2 * t.y, y1 = min(2 * t.y + 1, hiz_build.source_height - 1);
     const float m0 = pc_max(source(x0, y0), source(x1, y0));
     const float m1 = pc_max(source(x0, y1), source(x1, y1));
     imageStore(u_out, t, vec4(pc_max(m0, m1), 0.0, 0.0, 0.0));

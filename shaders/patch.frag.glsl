@@ -2,7 +2,8 @@
 // hue (kColorPatch) or the patch's status in its flag word (kColorStatus, the legend of
 // gl_renderer.h's render_status_image), shaded two-sided by the angle to the eye.
 //
-// One-sided surfaces (u_discard_back_facing, RenderParams::discard_back_facing): a closed,
+// One-sided surfaces (u_discard_back_facing, RenderParams::discard_back_facing; displaced patches
+// excepted, patch_displaced.h): a closed,
 // outward-oriented surface contributes only the points whose exact tangent plane faces the eye.
 // The fragment re-evaluates the patch at its interpolated (u, v) (patch_eval.h, the TES's own
 // evaluation) and is discarded unless cos(normal, to eye) > kFrontFacingMinCosine. This is the
@@ -18,6 +19,7 @@
 #version 450 core
 #include "shared.h"
 #include "patch_eval.h"
+#include "patch_displaced.h"
 
 #ifdef PATCHCULL_MARK_FRONT
 layout(early_fragment_tests) in;
@@ -78,7 +80,7 @@ bool surface_faces_eye() {
 }
 
 void main() {
-    if (u_discard_back_facing && !surface_faces_eye()) discard;
+    if (u_discard_back_facing && !patch_is_displaced(tes_patch) && !surface_faces_eye()) discard;
 #ifdef PATCHCULL_MARK_FRONT
     patch_marks[tes_patch] = 1u;
 #endif

@@ -1,9 +1,8 @@
 // Patch tessellation control shader: passes the 16 control points through and sets the
 // tessellation factors. A patch that is not to be drawn gets outer and inner levels 0, so the
 // tessellator discards it (seed 000 §3: the decision lands where the tessellator reads it).
-// Drawn iff (flag word & u_draw_mask) == u_draw_value (gl_renderer.h): mask kCullReasonMask,
-// value 0 = "no cull reason" (render()); kStatusVisible = the first pass of the pipeline;
-// kStatusVisible | kStatusNewlyVisible = its second pass; mask 0 = every patch (the reference).
+// Drawn iff (flag word & u_draw_mask) == u_draw_value: the selections of shaders/patchcull_tcs.h
+// (the include an engine's TCS uses; this shader is its first user).
 //
 // Levels: uniform u_tess_level times the patch's depth scale (kBindingPatchTessScale: patches of
 // different refinement depth get equal vertex density, so shared edges match) on every edge and
@@ -14,12 +13,10 @@
 // them), so two patches sharing an edge give it the same level.
 #version 450 core
 #include "shared.h"
+#include "patchcull_tcs.h"
 
 layout(vertices = 16) out;
 
-layout(std430, binding = kBindingCullFlags) readonly buffer CullFlags {
-    uint cull_flags[];
-};
 layout(std430, binding = kBindingPatchTessScale) readonly buffer PatchTessScale {
     float patch_tess_scale[];
 };
@@ -51,7 +48,7 @@ void main() {
     tcs_point[gl_InvocationID] = vs_point[gl_InvocationID];
     if (gl_InvocationID == 0) {
         const uint p = vs_patch[0];
-        const bool drawn = (cull_flags[p] & u_draw_mask) == u_draw_value;
+        const bool drawn = patchcull_patch_drawn(p, u_draw_mask, u_draw_value);
         vec4 outer = vec4(min(u_tess_level * patch_tess_scale[p], 64.0));
         if (u_adaptive) {
             // Quad domain: outer[0] is the edge u = 0, [1] v = 0, [2] u = 1, [3] v = 1; control
@@ -59,7 +56,6 @@ void main() {
             outer = vec4(edge_level(vs_point[0], vs_point[12]), edge_level(vs_point[0], vs_point[3]),
                          edge_level(vs_point[3], vs_point[15]), edge_level(vs_point[12], vs_point[15]));
         }
-        if (!drawn) outer = vec4(0.0);
         if (drawn && u_mark_drawn) patch_marks[p] = 1u;
         gl_TessLevelOuter[0] = outer[0];
         gl_TessLevelOuter[1] = outer[1];
@@ -67,6 +63,7 @@ void main() {
         gl_TessLevelOuter[3] = outer[3];
         gl_TessLevelInner[0] = max(outer[1], outer[3]);
         gl_TessLevelInner[1] = max(outer[0], outer[2]);
+        if (!drawn) patchcull_skip_patch();
         tcs_patch = p;
     }
 }

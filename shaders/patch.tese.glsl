@@ -8,6 +8,7 @@
 #version 450 core
 #include "shared.h"
 #include "patch_eval.h"
+#include "patch_displaced.h"
 
 layout(quads, equal_spacing, ccw) in;
 
@@ -19,7 +20,6 @@ layout(std430, binding = kBindingPatchTangents) readonly buffer PatchTangents {
 };
 
 uniform mat4 u_object_to_clip;
-uniform bool u_displace;
 uniform bool u_has_tangents;  // the tangent buffer holds kTangentVec4s entries per patch
 uniform float u_displacement_scale;
 uniform float u_displacement_midlevel;
@@ -66,7 +66,7 @@ void main() {
     const float len = length(n);
 
     vec3 position = p;
-    if (u_displace && len > 0.0) {
+    if (len > 0.0 && patch_is_displaced(tcs_patch)) {
         const uint base = 4u * tcs_patch;
         const vec2 st = mix(mix(patch_texcoords[base], patch_texcoords[base + 1u], u),
                             mix(patch_texcoords[base + 2u], patch_texcoords[base + 3u], u), v);

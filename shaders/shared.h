@@ -23,9 +23,8 @@ PATCHCULL_CONST uint kBindingCullFlags = 1u;      // uint flags[patch_count]: 0 
 PATCHCULL_CONST uint kBindingMaxDisplacement = 2u; // float max_disp[patch_count], >= 0 (cull margin)
 PATCHCULL_CONST uint kBindingPatchTexcoords = 3u;  // vec2 uv[4 * patch_count]: corner texcoords (patch.h order)
 PATCHCULL_CONST uint kBindingPlaneValues = 4u;     // float values[6 * patch_count]: frustum diagnostics
-PATCHCULL_CONST uint kBindingBackPatchFlags = 5u;  // uint backpatch[patch_count]: nonzero = back-facing (input of
-                                                   // cull_occlusion: the back-patch hook, see gl_renderer.h)
-PATCHCULL_CONST uint kBindingCullCounters = 6u;    // uint counters[kCounterCount]: atomics of cull_occlusion
+// (5 is free: it held the back-patch hook's flags, replaced by the flag chain of gl_passes.h.)
+PATCHCULL_CONST uint kBindingCullCounters = 6u;    // uint counters[kCounterCount]: added by cull_status (end)
 PATCHCULL_CONST uint kBindingOccluderVertices = 7u; // vec4 v[3 * triangle_count]: triangle list, w = 1
 // vec4 t[kTangentVec4s * patch_count]: patch p's ACC tangent patches at kTangentVec4s p + (du[0..11],
 // dv[0..11]) as (x, y, z, 0); t[kTangentVec4s p].w = 1 when the patch has them (else unused).
@@ -40,6 +39,9 @@ PATCHCULL_CONST uint kBindingPatchMarks = 11u;
 // scale = 2^(D - depth) (PatchAttributes::depth): equal vertex density across refinement depths.
 PATCHCULL_CONST uint kBindingPatchTessScale = 12u;
 
+// Uniform buffer binding of the passes' parameter blocks (pass_params.h; one pass runs at a time).
+PATCHCULL_CONST uint kUniformPassParams = 0u;
+
 // Texture units.
 PATCHCULL_CONST uint kTextureUnitDisplacement = 0u;  // R32F height map, GL_REPEAT, bilinear
 PATCHCULL_CONST uint kTextureUnitDepth = 1u;         // DEPTH32F depth buffer (Hi-Z level 0 input)
@@ -48,27 +50,41 @@ PATCHCULL_CONST uint kTextureUnitHiZ = 2u;           // R32F Hi-Z pyramid, level
 // Image units.
 PATCHCULL_CONST uint kImageUnitHiZOut = 0u;          // R32F Hi-Z level being written
 
-// Per-patch flag word (kBindingCullFlags). Bits 0-7: the cull reason of the latest test (0 = not
-// culled); cull_frustum writes 0 or kCullFrustum, cull_occlusion exactly one reason (the first test
-// that culls, in the order frustum, back-patch, occlusion) or 0.
+// Per-patch flag word (kBindingCullFlags). Bits 0-7: the cull reason of the latest frame (0 = not
+// culled): the test passes form a chain (flag_chain.h, gl_passes.h) in which the first test that
+// culls a patch sets its reason and the later ones skip it.
 PATCHCULL_CONST uint kCullFrustum = 1u;
-PATCHCULL_CONST uint kCullBackPatch = 2u;   // from the back-patch hook (kBindingBackPatchFlags)
+PATCHCULL_CONST uint kCullBackPatch = 2u;   // back-facing (a back-patch pass: tcone, ncone or ptp)
 PATCHCULL_CONST uint kCullOcclusion = 4u;   // behind the Hi-Z pyramid
 PATCHCULL_CONST uint kCullReasonMask = 0xFFu;
-// Bits 8-9: temporal status of the two-pass pipeline (seed 000 §3), written by cull_occlusion:
+// Bits 8-9: temporal status of the two-pass pipeline (seed 000 §3), written by cull_status (end):
 // kStatusVisible = passed the latest test (drawn in the next frame's first pass); with
 // kStatusNewlyVisible also set it was not tagged visible before that test (drawn in the second
 // pass). Neither bit = occluded (or culled by another test).
 PATCHCULL_CONST uint kStatusVisible = 0x100u;
 PATCHCULL_CONST uint kStatusNewlyVisible = 0x200u;
 
-// Counters written by cull_occlusion (kBindingCullCounters), cleared before each dispatch.
-PATCHCULL_CONST uint kCounterFrustum = 0u;       // patches culled by the frustum test
-PATCHCULL_CONST uint kCounterBackPatch = 1u;     // ... by the back-patch hook
-PATCHCULL_CONST uint kCounterOcclusion = 2u;     // ... by the Hi-Z test
+// cull_status.comp.glsl's modes (CullStatusParams::mode).
+PATCHCULL_CONST uint kStatusBegin = 0u;  // clear the reasons, keep the statuses
+PATCHCULL_CONST uint kStatusEnd = 1u;    // reasons -> statuses, counters
+
+// Draw selections (mask, value) on the flag word (patchcull_tcs.h): a draw keeps patch p when
+// (flags[p] & mask) == value.
+PATCHCULL_CONST uint kDrawMaskUnculled = kCullReasonMask;  // no test culled it this frame
+PATCHCULL_CONST uint kDrawValueUnculled = 0u;
+PATCHCULL_CONST uint kDrawMaskFirstPass = kStatusVisible;  // tagged visible (by the previous frame)
+PATCHCULL_CONST uint kDrawValueFirstPass = kStatusVisible;
+PATCHCULL_CONST uint kDrawMaskSecondPass = kStatusVisible | kStatusNewlyVisible;  // newly visible
+PATCHCULL_CONST uint kDrawValueSecondPass = kStatusVisible | kStatusNewlyVisible;
+
+// Counters added by cull_status (end) (kBindingCullCounters); the caller clears them.
+PATCHCULL_CONST uint kCounterFrustum = 0u;       // patches culled by a frustum test (the bound's, for displaced ones)
+PATCHCULL_CONST uint kCounterBackPatch = 1u;     // ... by a back-patch test
+PATCHCULL_CONST uint kCounterOcclusion = 2u;     // ... by a Hi-Z test (control points or displaced bound)
 PATCHCULL_CONST uint kCounterWasVisible = 3u;    // tagged visible before the test (first-pass draws)
 PATCHCULL_CONST uint kCounterVisible = 4u;       // passed the test
 PATCHCULL_CONST uint kCounterNewlyVisible = 5u;  // passed the test, not tagged visible before
+PATCHCULL_CONST uint kCounterDisplacedOcclusion = 6u;  // of kCounterOcclusion: displaced patches (margin > 0)
 PATCHCULL_CONST uint kCounterCount = 8u;
 
 // Patch fragment colour modes (u_color_mode).

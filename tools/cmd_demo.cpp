@@ -74,11 +74,15 @@ int run_demo(const DemoOptions& options) {
                 patches, renderer.occluder_triangle_count(), options.frames, width, height, options.tess,
                 context.renderer().c_str(), context.is_software() ? "software: wall-clock pass times" : "GPU timer queries");
 
-    // Compiles every back-patch program before anything is timed (llvmpipe takes seconds for ncone).
+    // Compiles every pass's program before anything is timed (llvmpipe takes seconds for ncone):
+    // one untimed frame per back-patch method with every test.
     for (gl::BackpatchMethod m : {gl::BackpatchMethod::tcone, gl::BackpatchMethod::ncone, gl::BackpatchMethod::ptp}) {
-        const gl::RenderParams p = params_of(0);
-        pipeline.culler().cull(m, p.projection * p.view, gl::eye_of_view(p.view), clip_space_eye_alpha(p.projection),
-                               PtpRule::ncnt);
+        gl::PipelineParams warm_up;
+        warm_up.frame.render = params_of(0);
+        warm_up.frame.cull = gl::CullMode::all;
+        warm_up.frame.timing = gl::TimingMethod::off;
+        warm_up.backpatch = m;
+        pipeline.render_frame(warm_up);
     }
     std::vector<ReferenceFrame> references;
     double reference_ms = 0;

@@ -23,6 +23,7 @@
 #include "commands.h"
 #include "eval_displaced.h"
 #include "patchcull/error.h"
+#include "patchcull/gl_backpatch.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -65,6 +66,8 @@ int run_occlusion(const OcclusionOptions& o) {
     gl::PatchAttributes attributes;  // refinement depths: osd patches meet without cracks
     for (const PatchInfo& info : model.rest.info) attributes.depth.push_back(info.depth);
     pipeline.set_patches(model.rest.patches, attributes);
+    gl::BackpatchCuller culler(context);  // the back-patch fractions, on the pipeline's patches
+    culler.use_patch_buffer(pipeline.renderer().patch_buffer(), patches);
     ViewGenerator views(patch_bounds(model.rest), ViewMode::contain, o.seed, float(width) / float(height));
 
     double occluded_sum = 0, occluded_min = 1, occluded_max = 0, frustum_sum = 0, tcone_sum = 0, ncone_sum = 0;
@@ -77,7 +80,7 @@ int run_occlusion(const OcclusionOptions& o) {
         params.frame.render = render_params(camera, width, height, o.tess, model.closed);
         params.frame.cull = gl::CullMode::occlusion;
         params.frame.timing = gl::TimingMethod::off;
-        pipeline.renderer().reset_visibility();
+        pipeline.reset_visibility();
         gl::FrameStats stats;
         std::vector<bool> previous;
         bool stable = false;
@@ -102,9 +105,9 @@ int run_occlusion(const OcclusionOptions& o) {
 
         const gl::RenderParams& rp = params.frame.render;
         const Vec3 eye = gl::eye_of_view(rp.view);
-        pipeline.culler().cull(gl::BackpatchMethod::tcone, rp.projection * rp.view, eye, 0, PtpRule::ncnt, &culled);
+        culler.cull(gl::BackpatchMethod::tcone, rp.projection * rp.view, eye, 0, PtpRule::ncnt, &culled);
         tcone_sum += fraction_culled(culled);
-        pipeline.culler().cull(gl::BackpatchMethod::ncone, rp.projection * rp.view, eye, 0, PtpRule::ncnt, &culled);
+        culler.cull(gl::BackpatchMethod::ncone, rp.projection * rp.view, eye, 0, PtpRule::ncnt, &culled);
         ncone_sum += fraction_culled(culled);
     }
     const double n = std::max(o.views, 1);

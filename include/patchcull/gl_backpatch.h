@@ -1,9 +1,12 @@
-// patchcull/gl_backpatch.h: GPU back-patch culling (library patchcull_gl): compute shaders that
-// mirror the CPU kernels of backpatch.h, tcone, ncone and ptp, decision for decision.
+// patchcull/gl_backpatch.h: GPU back-patch culling (library patchcull_gl): the back-patch passes of
+// gl_passes.h (BackpatchConePass, BackpatchPtpPass), which mirror the CPU kernels of backpatch.h,
+// tcone, ncone and ptp, decision for decision, run over buffers that BackpatchCuller owns, with
+// read-backs of the decisions and diagnostics (tests, tools).
 //
-// Shaders: shaders/cull_tcone.comp.glsl and cull_ncone.comp.glsl (one invocation per patch, the
-// cone code in shaders/backpatch_cones.h mirrors src/core/cones_internal.h operation by
-// operation) and shaders/cull_ptp.comp.glsl (seed 001 §6: 16 invocations per patch, 8 patches per
+// Shaders: shaders/backpatch_cones.comp.glsl (tcone, and ncone with PATCHCULL_NCONE; one
+// invocation per patch, the cone code in shaders/backpatch_cones.h mirrors
+// src/core/cones_internal.h operation by operation) and shaders/backpatch_ptp.comp.glsl (seed 001
+// §6: 16 invocations per patch, 8 patches per
 // work group; lane tau owns the 4 destinations of its 4x4 block, summed in the CPU schedule's
 // order from shaders/ptp_schedule.h, generated from src/core/ptp_schedule.h; the signs are
 // counted by a parallel reduction in shared memory).
@@ -12,10 +15,8 @@
 // - control points, kBindingControlPoints (0): vec4 cp[16 * patch_count], patch p's point k
 //   (patch.h order) at 16p + k, the renderer's layout. Either uploaded by set_patches or an
 //   existing buffer of that layout (use_patch_buffer, e.g. the renderer's).
-// - flags, kBindingBackPatchFlags (5), flag_buffer(): uint flags[patch_count], written whole by
-//   every cull call: kFlagBackPatch (2, gl_renderer.h) = back-facing (culled), 0 = kept. This is
-//   the layout cull_occlusion reads as its back-patch hook ("nonzero = back-facing"), so the
-//   buffer can be bound there as is.
+// - flags, kBindingCullFlags (1), flag_buffer(): uint flags[patch_count], cleared and written by
+//   every cull call: kFlagBackPatch (2, gl_renderer.h) = back-facing (culled), 0 = kept.
 // - ptp diagnostics, backpatch_shared.h's kBindingPtpPlanes (12): float [128 * patch_count], per
 //   patch the 64 clip-space control plane z values (at 128p + 8 jv + iu) and then their 64
 //   rounding-error margins thr (at 128p + 64 + 8 jv + iu), written only when cull_ptp is asked
@@ -23,9 +24,7 @@
 // - cone diagnostics, kBindingConeValues (15): float c[12 * patch_count], per patch (axis.xyz,
 //   cos, sin, valid 1/0, sphere center.xyz, radius, 0, 0), written only when cull_tcone /
 //   cull_ncone are asked for them.
-// The culler binds these bindings (and 13, 14 for its probe) only around its own dispatches;
-// it restores nothing (callers bind their own buffers before their dispatches, as the renderer
-// does).
+// The bindings are the passes' (gl_passes.h's state contract).
 //
 // Equality with the CPU kernels (tests/gl/backpatch_gpu_test.cpp checks decisions on ~3000
 // random patches per method and rule, and the 64 ptp values bit for bit):
@@ -70,20 +69,12 @@
 #include <vector>
 
 #include "patchcull/backpatch.h"
+#include "patchcull/gl_passes.h"
 #include "patchcull/gl_renderer.h"
 #include "patchcull/math.h"
 #include "patchcull/patch.h"
 
 namespace patchcull::gl {
-
-enum class BackpatchMethod { tcone, ncone, ptp };
-/// "tcone", "ncone", "ptp" (the `patchcull cull` method names).
-const char* backpatch_method_name(BackpatchMethod method);
-
-/// The arithmetic the probe evaluates (tests, start-up check): pc_fma(a, b, c), pc_div(a, b),
-/// pc_sqrt(a), and the correction steps alone from a given guess: pc_div_from(a, b, guess = c),
-/// pc_sqrt_from(a, guess = b) (shaders/backpatch_exact.h).
-enum class BackpatchProbe { fma, div, sqrt, div_from, sqrt_from };
 
 class BackpatchCuller {
 public:

@@ -1,17 +1,27 @@
 // patchcull/gl_pipeline.h: the whole per-frame cull pipeline of one patch set on the GPU (library
-// patchcull_gl): seed 000 §3's frame (PatchRenderer::render_frame: frustum, Hi-Z occlusion with
-// temporal coherence, two passes) with seed 001's back-patch test (tcone, ncone or ptp) computed by
-// a GPU compute pass (BackpatchCuller, gl_backpatch.h) and handed to the frame through the
-// renderer's back-patch hook (FrameParams::backpatch_buffer). No decision is read back to the CPU.
+// patchcull_gl): Niessner & Loop's two-pass temporal-coherence frame ("Patch-Based Occlusion
+// Culling for Hardware Tessellation", seed 000 §3, Fig. 2), built from the passes of gl_passes.h
+// chained through the renderer's flag buffer, with PatchRenderer (gl_renderer.h) drawing. No
+// decision is read back to the CPU; only the counters are (FrameStats).
 //
-// The culler reads the renderer's own control-point buffer (PatchRenderer::patch_buffer), so
-// set_patches / update_patches upload each pose once.
+// One frame with occlusion in the mode:
+//   1. clear, occluders, the patches tagged visible by the previous frame (draw pass 1);
+//   2. HiZBuildPass from that depth buffer;
+//   3. the flag chain: CullStatusPass::begin; FrustumPass (with the displacement margins);
+//      the back-patch pass of PipelineParams::backpatch (BackpatchConePass or BackpatchPtpPass;
+//      displaced patches skipped); OcclusionPass (control-point boxes; displaced patches
+//      skipped); DisplacedPass (seed 000 §4.2's bound of each displaced patch, against the frustum
+//      and the same pyramid); CullStatusPass::end (statuses, counters);
+//   4. the newly visible patches (draw pass 2; skipped when aggressive).
+// Without occlusion: the chain (without the Hi-Z passes; the displaced pass then tests the
+// frustum only), then clear, occluders and the patches that passed (one draw).
+// The first frame after set_patches or reset_visibility tags the even-indexed patches visible
+// (seed 000 §3: half of them). Conservative (except aggressive): the final id buffer equals the
+// unculled render's, up to exact depth ties between patches (the draw order differs).
 //
-// Order within a frame: the back-patch pass writes its flag buffer first; render_frame then draws
-// pass 1, builds the Hi-Z and runs the combined cull pass, which reads those flags after a
-// shader-storage barrier (a patch outside the frustum keeps the frustum reason, see
-// gl_renderer.h). The back-patch pass's time is measured with the frame's timing method and added
-// to FrameStats::cull_ms and total_ms (and reported alone as FrameStats::backpatch_ms).
+// Timing: on llvmpipe GL timer queries measure only part of the work (the vertex/tessellation
+// stage, not rasterization), so passes are timed with a wall clock around glFinish() there; on a
+// real GPU with GL_TIMESTAMP queries (FrameStats::timing says which).
 //
 // Threads, lifetime and errors as gl_renderer.h (patchcull::Error with one-line messages).
 #pragma once
@@ -21,27 +31,73 @@
 #include <vector>
 
 #include "patchcull/backpatch.h"
-#include "patchcull/gl_backpatch.h"
+#include "patchcull/displaced_bounds.h"
+#include "patchcull/gl_passes.h"
 #include "patchcull/gl_renderer.h"
 #include "patchcull/patch.h"
 
 namespace patchcull::gl {
 
-/// Parameters of one pipeline frame.
+/// How a frame times its passes.
+enum class TimingMethod {
+    automatic,    ///< wall_clock on a software rasterizer, timer_query on a GPU
+    wall_clock,   ///< steady_clock around glFinish() after each pass (serializes the passes)
+    timer_query,  ///< GL_TIMESTAMP queries between passes (no stall; results read at frame end)
+    off,          ///< no timing (every *_ms is 0)
+};
+const char* timing_method_name(TimingMethod method);  ///< "automatic", "wall-clock", "timer-query", "off"
+
+/// Parameters of one frame of the culling pipeline.
+struct FrameParams {
+    RenderParams render;         ///< camera, size, tessellation (use_cull_flags is ignored)
+    CullMode cull = CullMode::all;
+    /// Seed 000 §3.1: skip the second pass (newly visible patches appear one frame late). NOT
+    /// conservative for the current frame: its image can miss patches that became visible; the
+    /// status update still fixes the next frame (identical again after one static frame).
+    bool aggressive = false;
+    TimingMethod timing = TimingMethod::automatic;
+};
+
+/// Parameters of one pipeline frame: the frame and the choice of each test.
 struct PipelineParams {
-    /// The frame (camera, size, tessellation, mode, aggressive, timing). Its back-patch hook fields
-    /// (backpatch_culled, backpatch_buffer) are ignored: when the mode includes backpatch the GPU
-    /// pass below supplies the decisions.
     FrameParams frame;
     BackpatchMethod backpatch = BackpatchMethod::tcone;  ///< the back-patch test (seed 001)
     PtpRule ptp_rule = PtpRule::ncnt;                    ///< rule of ptp (ignored by the cones)
+    /// Bound and cone of displaced patches (seed 000 §4.2; used when the set has
+    /// displacement_ranges and a displacement map is set).
+    DisplacedBoundKind bound = DisplacedBoundKind::caf;
+    NormalConeKind cone = NormalConeKind::acon;
 };
 
-/// A PatchRenderer and a BackpatchCuller sharing one uploaded patch set.
+/// What one frame did. Counts are patches; each patch has exactly one of: frustum_culled,
+/// backpatch_culled, occlusion_culled, or it passed (visible = tagged visible for the next frame).
+struct FrameStats {
+    std::size_t patches = 0;
+    bool two_pass = false;           ///< the mode includes occlusion (seed 000 §3's pipeline)
+    // Every pass issues all patches to the TCS (seed 000 §6.3's RT_0 cost per pass); "drawn" =
+    // tessellated (levels > 0), the others get levels 0 there.
+    std::size_t pass1_drawn = 0;     ///< patches drawn (tessellated) in the first pass
+    std::size_t pass2_drawn = 0;     ///< ... in the second pass (newly visible; 0 when aggressive)
+    std::size_t frustum_culled = 0;  ///< by a frustum test (a displaced patch's bound included)
+    std::size_t backpatch_culled = 0;
+    std::size_t occlusion_culled = 0;  ///< by a Hi-Z test (control points, or a displaced bound)
+    std::size_t displaced_occlusion_culled = 0;  ///< of occlusion_culled: displaced patches
+    std::size_t visible = 0;         ///< passed every test of the mode
+    std::size_t newly_visible = 0;   ///< passed, and were not tagged visible before (not drawn in pass 1)
+    /// Per-pass times in milliseconds. Two-pass: pass1 (clear, occluders, patches tagged visible),
+    /// hiz (build), cull (the whole flag chain), pass2 (newly visible). One pass (no occlusion):
+    /// cull first, then pass1 draws the patches that passed; hiz = pass2 = 0.
+    double pass1_ms = 0, hiz_ms = 0, cull_ms = 0, pass2_ms = 0, total_ms = 0;
+    /// Of cull_ms: the back-patch pass alone (0 when the mode has no back-patch test).
+    double backpatch_ms = 0;
+    TimingMethod timing = TimingMethod::off;  ///< the method used (never automatic)
+};
+
+/// A PatchRenderer and the cull passes of gl_passes.h on its buffers.
 class CullPipeline {
 public:
-    /// Creates both on ctx (see their constructors; the back-patch programs compile on first use,
-    /// which takes seconds for ncone and ptp on llvmpipe).
+    /// Creates the renderer and the passes on ctx (programs compile on first use, which takes
+    /// seconds for ncone, ptp and the displaced bounds on llvmpipe).
     explicit CullPipeline(const GlContext& ctx);
     CullPipeline(CullPipeline&&) noexcept;
     CullPipeline& operator=(CullPipeline&&) noexcept;
@@ -49,25 +105,30 @@ public:
     CullPipeline& operator=(const CullPipeline&) = delete;
     ~CullPipeline();
 
-    /// PatchRenderer::set_patches (statuses restart: the next frame is a first frame), and points
-    /// the culler at the renderer's control points.
+    /// PatchRenderer::set_patches; statuses restart (the next frame is a first frame).
     void set_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes = {});
     /// PatchRenderer::update_patches: a new pose of the same patches, statuses kept.
     void update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes = {});
     std::size_t patch_count() const;
 
-    /// One frame: when params.frame.cull includes backpatch, the GPU back-patch pass (eye and
-    /// object_to_clip from the frame's view and projection; patches are in world space), then
-    /// PatchRenderer::render_frame with its flag buffer as the hook. Throws patchcull::Error when
-    /// the view matrix is singular or a GL call fails.
+    /// One frame (see the header). Throws patchcull::Error when the view matrix is singular or a
+    /// GL call fails.
     FrameStats render_frame(const PipelineParams& params);
 
-    /// The parts, for read-backs (read_ids, read_depth, write_color_png, write_status_png),
-    /// occluders (set_occluders), the unculled reference (render with use_cull_flags = false) and
-    /// reset_visibility.
+    /// Makes the next frame a first frame (even-indexed patches tagged visible).
+    void reset_visibility();
+
+    /// The pyramid of the last two-pass frame (HiZPyramid::data()'s layout, row 0 = bottom), and
+    /// its level count (0 before any). Waits for the GPU.
+    std::vector<float> read_hiz() const;
+    int hiz_levels() const;
+
+    /// The parts: the renderer for read-backs (read_ids, read_depth, write_color_png,
+    /// write_status_png), occluders (set_occluders), the displacement map and the unculled
+    /// reference (render with use_cull_flags = false); the passes' context (fma mode, probe).
     PatchRenderer& renderer();
     const PatchRenderer& renderer() const;
-    BackpatchCuller& culler();
+    PassContext& passes();
 
 private:
     struct Impl;

@@ -1,8 +1,9 @@
-// patchcull/gl_renderer.h: the OpenGL 4.5 renderer (library patchcull_gl): a headless EGL
-// context, bicubic patches drawn through hardware tessellation (TCS/TES) into an off-screen
-// framebuffer, per-patch cull flags read by the TCS, GPU cull passes (compute shaders) that mirror
-// the CPU kernels, triangle-mesh occluders, a compute-built Hi-Z pyramid and seed 000 §3's
-// two-pass temporal-coherence occlusion pipeline (render_frame).
+// patchcull/gl_renderer.h: the OpenGL 4.5 renderer (library patchcull_gl): a headless EGL or
+// windowed context, and bicubic patches drawn through hardware tessellation (TCS/TES) into an
+// off-screen framebuffer, with per-patch cull flags read by the TCS and triangle-mesh occluders.
+// The renderer only draws: the cull passes are gl_passes.h's (they run on any context and any
+// buffers), and gl_pipeline.h's CullPipeline chains them with this renderer into seed 000 §3's
+// two-pass temporal-coherence frame.
 //
 // Conventions (as math.h, frustum.h, hiz.h and displacement.h):
 // - Patches are in object space = world space (no model matrix); render parameters give view and
@@ -14,15 +15,16 @@
 //   (WorldCamera::local, camera.h): every GL float then holds object-sized numbers.
 // - Framebuffer: RGBA8 colour, R32UI patch id, DEPTH32F; all read-backs of it are width*height
 //   values in image order: row 0 is the TOP row (GL window row height-1), pixel (x, row) at
-//   [row*width + x]. (The Hi-Z read-back, read_hiz, keeps hiz.h's order instead: row 0 = bottom.)
+//   [row*width + x]. (Hi-Z read-backs, read_hiz_texture, keep hiz.h's order instead: row 0 = bottom.)
 // - Patch id buffer: 0 = background, patch index p (its position in the uploaded set) writes p + 1.
 //   Triangle t of the occluder mesh (set_occluders) writes kIdOccluderBit | t.
-// - Flag word: one uint per patch, read by the TCS. Bits 0-7 = cull reason of the latest test,
-//   0 = not culled: kFlagFrustum (1), kFlagBackPatch (2), kFlagOcclusion (4) (shaders/shared.h).
-//   Bits 8-9 = temporal status of the pipeline, written by cull_occlusion/render_frame:
-//   kStatusVisible (passed the latest test) and kStatusNewlyVisible (passed it, and was not
-//   tagged visible before). A culled patch gets tessellation levels 0 in the TCS and is discarded
-//   by the tessellator (seed 000 §3, seed 002: cull in the patch-constant phase).
+// - Flag word: one uint per patch (flag_buffer()), read by the TCS (shaders/patchcull_tcs.h).
+//   Bits 0-7 = cull reason of the latest frame, 0 = not culled: kFlagFrustum (1), kFlagBackPatch
+//   (2), kFlagOcclusion (4) (shaders/shared.h). Bits 8-9 = temporal status of the pipeline:
+//   kStatusVisible (passed the latest tests) and kStatusNewlyVisible (passed them, and was not
+//   tagged visible before); gl_passes.h's flag chain writes both. A culled patch gets tessellation
+//   levels 0 in the TCS and is discarded by the tessellator (seed 000 §3, seed 002: cull in the
+//   patch-constant phase).
 // - Tessellation: uniform integer level L (equal_spacing) on every edge and the interior, L in
 //   [1, 64], scaled by 2^(D - depth) per patch for sets of mixed refinement depth
 //   (PatchAttributes::depth), or adaptive by distance (RenderParams::adaptive_tess, seed 000
@@ -33,11 +35,12 @@
 // - Displacement (optional, the rendered surface): S = B + D(s,t) n as in displacement.h, D from a
 //   DisplacementMap uploaded as an R32F GL_REPEAT bilinear texture, (s,t) from per-patch corner
 //   texcoords. Points where du x dv = 0 (degenerate patch corners) are not displaced. The cull
-//   margin (per-patch max |D|) is given separately, so tests can check that it bounds the surface.
-//   The Hi-Z test is applied only to patches whose margin is 0 (a displaced patch needs the
-//   camera-aligned frustum of seed 000 §4.2, not implemented here): displaced patches are culled
-//   by the frustum (with their margin) and back-patch tests only. While a displacement map is set
-//   and drawn without margins, no patch is Hi-Z tested (nothing says which ones are flat).
+//   margin (per-patch max |D|, PatchAttributes::max_displacement or the ranges' max_abs) is given
+//   separately, so tests can check that it bounds the surface. With margins, a patch whose margin
+//   is 0 is drawn undisplaced (D = 0 there anyway; shaders/patch_displaced.h), so one map can
+//   serve a scene of displaced and plain objects. Displaced patches are drawn two-sided and culled
+//   by the frustum pass (with their margin) and the displaced pass (seed 000 §4.2's bounds, from
+//   PatchAttributes::displacement_ranges); never by the back-patch or control-point Hi-Z tests.
 //
 // Workarounds for Mesa llvmpipe (../shared/PLATFORM.md), applied ALWAYS (they cost nothing
 // measurable on a GPU and keep one code path):
@@ -48,10 +51,7 @@
 //    every draw is split with glMultiDrawArrays into sub-draws of at most
 //    max(1, 65536 / (L+1)^2) patches (809 at L = 8, 226 at L = 16, 15 at L = 64), L the uniform
 //    level or the adaptive maximum.
-// Timing: on llvmpipe GL timer queries measure only part of the work (the vertex/tessellation
-// stage, not rasterization), so render_frame times passes with a wall clock around glFinish()
-// there; on a real GPU it uses GL_TIMESTAMP queries (FrameStats::timing says which).
-//
+
 // Threads and lifetime: a GlContext is current on the thread that created it; every other object
 // here must be created, used and destroyed on that thread while the context lives (destroy
 // renderers before their context). Objects are move-only.
@@ -59,12 +59,8 @@
 // Linking: patchcull_gl links libepoxy, which loads libEGL.so.1 and libOpenGL.so.0 (or libGL.so.1)
 // at run time; binaries start without them and create_headless() reports their absence.
 //
-// Back-patch culling (seed 001) plugs in through a hook: per-patch decisions from the CPU
-// (FrameParams::backpatch_culled) or a GL buffer written by a GPU pass (FrameParams::backpatch_buffer);
-// gl_pipeline.h's CullPipeline runs the GPU tcone/ncone/ptp pass (gl_backpatch.h) into that buffer.
-// Planned, not implemented yet: the camera-aligned frustum for displaced patches (seed 000 §4.2)
-// in render_frame. Contexts: headless EGL (create_headless) or a GLFW window (create_window); the
-// renderer is the same code in both.
+// Contexts: headless EGL (create_headless) or a GLFW window (create_window); the renderer is the
+// same code in both.
 //
 // Errors: factories and calls that can fail throw patchcull::Error with a one-line message
 // ("EGL: no display ...", "GL: shader patch.tesc.glsl: <first log line>", "GL: error 0x0502 after
@@ -81,6 +77,7 @@
 #include "patchcull/displacement.h"
 #include "patchcull/error.h"
 #include "patchcull/frustum.h"
+#include "patchcull/gl_passes.h"
 #include "patchcull/hiz.h"
 #include "patchcull/math.h"
 #include "patchcull/patch.h"
@@ -89,16 +86,15 @@ namespace patchcull::gl {
 
 // Flag word bits and id encoding (equal to shaders/shared.h's; static_asserts in the renderer).
 inline constexpr std::uint32_t kFlagFrustum = 1u;        ///< culled by the view frustum
-inline constexpr std::uint32_t kFlagBackPatch = 2u;      ///< culled as back-facing (the hook)
+inline constexpr std::uint32_t kFlagBackPatch = 2u;      ///< culled as back-facing (a back-patch pass)
 inline constexpr std::uint32_t kFlagOcclusion = 4u;      ///< culled behind the Hi-Z pyramid
 inline constexpr std::uint32_t kFlagReasonMask = 0xFFu;  ///< bits of the cull reason
 inline constexpr std::uint32_t kStatusVisible = 0x100u;  ///< passed the latest test
 inline constexpr std::uint32_t kStatusNewlyVisible = 0x200u;  ///< ... and was not tagged visible
 inline constexpr std::uint32_t kIdOccluderBit = 0x80000000u;  ///< id of occluder triangle t: bit | t
 
-/// Which tests a cull pass runs; the values are the flag bits a culled patch gets.
-/// backpatch uses the decisions handed to the hook (FrameParams::backpatch_culled); without
-/// them it culls nothing.
+/// Which tests a frame runs (CullPipeline, gl_pipeline.h); the values are the flag bits a culled
+/// patch gets.
 enum class CullMode : std::uint32_t {
     none = 0,
     frustum = kFlagFrustum,
@@ -169,7 +165,8 @@ private:
 /// patch.
 struct PatchAttributes {
     /// Cull margin: bound on |D| of the rendered displacement (DisplacementRange::max_abs()), >= 0.
-    /// Read by the GPU frustum pass exactly as cull_frustum_scalar reads max_displacement.
+    /// Read by the GPU frustum pass exactly as cull_frustum_scalar reads max_displacement. Empty:
+    /// the ranges' max_abs() when displacement_ranges is given, else no margins.
     std::vector<float> max_displacement;
     /// Corner texcoords at (u,v) = (0,0), (1,0), (0,1), (1,1) (PatchInfo::uv) for displacement;
     /// absent means those same four values for every patch (PatchInfo's default).
@@ -189,6 +186,10 @@ struct PatchAttributes {
     /// no T-junction crack opens (up to float evaluation of the shared curve). Not applied to
     /// adaptive_tess, whose levels follow the eye distance.
     std::vector<std::uint8_t> depth;
+    /// DisplacementRange of each patch (min and max of D over it, displacement.h), or empty: the
+    /// input of the displaced pass (gl_passes.h's DisplacedPass, seed 000 §4.2's bounds), uploaded
+    /// as vec2 per patch (range_buffer()). A patch with range (0, 0) is not displaced.
+    std::vector<DisplacementRange> displacement_ranges;
 };
 
 /// Parameters of one frame.
@@ -216,65 +217,12 @@ struct RenderParams {
     bool discard_back_facing = false;
 };
 
-/// How render_frame times its passes.
-enum class TimingMethod {
-    automatic,    ///< wall_clock on a software rasterizer, timer_query on a GPU
-    wall_clock,   ///< steady_clock around glFinish() after each pass (serializes the passes)
-    timer_query,  ///< GL_TIMESTAMP queries between passes (no stall; results read at frame end)
-    off,          ///< no timing (every *_ms is 0)
-};
-const char* timing_method_name(TimingMethod method);  ///< "automatic", "wall-clock", "timer-query", "off"
-
-/// Parameters of one frame of the culling pipeline.
-struct FrameParams {
-    RenderParams render;         ///< camera, size, tessellation (use_cull_flags is ignored)
-    CullMode cull = CullMode::all;
-    /// Seed 000 §3.1: skip the second pass (newly visible patches appear one frame late). NOT
-    /// conservative for the current frame: its image can miss patches that became visible; the
-    /// status update still fixes the next frame (identical again after one static frame).
-    bool aggressive = false;
-    TimingMethod timing = TimingMethod::automatic;
-    /// Back-patch hook, CPU side: null, or patch_count() bytes, nonzero = the patch faces away
-    /// (e.g. from a CPU back-patch kernel). Uploaded each frame; a patch flagged here (and inside
-    /// the frustum) gets kFlagBackPatch when the mode includes backpatch.
-    const std::uint8_t* backpatch_culled = nullptr;
-    /// Back-patch hook, GPU side (used instead of backpatch_culled when nonzero): the name of a GL
-    /// buffer object of this context holding patch_count() uints, nonzero = back-facing, written
-    /// before render_frame (e.g. by a back-patch compute pass; the cull pass reads it at binding
-    /// kBindingBackPatchFlags after a GL_SHADER_STORAGE_BARRIER_BIT barrier). No read-back.
-    std::uint32_t backpatch_buffer = 0;
-};
-
-/// What one render_frame did. Counts are patches; each patch has exactly one of: frustum_culled,
-/// backpatch_culled, occlusion_culled, or it passed (visible = tagged visible for the next frame).
-struct FrameStats {
-    std::size_t patches = 0;
-    bool two_pass = false;           ///< the mode includes occlusion (seed 000 §3's pipeline)
-    // Every pass issues all patches to the TCS (seed 000 §6.3's RT_0 cost per pass); "drawn" =
-    // tessellated (levels > 0), the others get levels 0 there.
-    std::size_t pass1_drawn = 0;     ///< patches drawn (tessellated) in the first pass
-    std::size_t pass2_drawn = 0;     ///< ... in the second pass (newly visible; 0 when aggressive)
-    std::size_t frustum_culled = 0;
-    std::size_t backpatch_culled = 0;
-    std::size_t occlusion_culled = 0;
-    std::size_t visible = 0;         ///< passed every test of the mode
-    std::size_t newly_visible = 0;   ///< passed, and were not tagged visible before (not drawn in pass 1)
-    /// Per-pass times in milliseconds. Two-pass: pass1 (clear, occluders, patches tagged visible),
-    /// hiz (build), cull (frustum + back-patch + occlusion test), pass2 (newly visible). One pass
-    /// (no occlusion): cull first, then pass1 draws the patches that passed; hiz = pass2 = 0.
-    double pass1_ms = 0, hiz_ms = 0, cull_ms = 0, pass2_ms = 0, total_ms = 0;
-    /// Time of a GPU back-patch pass run before the frame (CullPipeline::render_frame,
-    /// gl_pipeline.h); already included in cull_ms and total_ms. 0 from render_frame alone.
-    double backpatch_ms = 0;
-    TimingMethod timing = TimingMethod::off;  ///< the method used (never automatic)
-};
-
 /// Draws one uploaded set of patches with hardware tessellation into its own framebuffer.
 class PatchRenderer {
 public:
-    /// Makes ctx current and compiles the embedded shaders (shaders/*.glsl), then checks GLSL fma()
-    /// (see fma_via_double). Throws patchcull::Error("GL: shader NAME: <log>") when the driver
-    /// rejects one, or when ctx lacks GL 4.5 core. Control points must be finite with w > 0.
+    /// Makes ctx current and compiles the embedded drawing shaders (shaders/*.glsl). Throws
+    /// patchcull::Error("GL: shader NAME: <log>") when the driver rejects one, or when ctx lacks
+    /// GL 4.5 core. Control points must be finite with w > 0.
     explicit PatchRenderer(const GlContext& ctx);
     PatchRenderer(PatchRenderer&&) noexcept;
     PatchRenderer& operator=(PatchRenderer&&) noexcept;
@@ -290,21 +238,27 @@ public:
     void set_patches(const PatchBatchView& patches, const PatchAttributes& attributes = {});
     /// Animation: replaces the control points (and attributes) of the uploaded set by those of
     /// the same patches in a new pose, KEEPING the flag words, so the pipeline's temporal status
-    /// carries over to the next render_frame (seed 000 §3 with animated patches). Throws
+    /// carries over to the next frame (seed 000 §3 with animated patches). Throws
     /// patchcull::Error when patches.size() != patch_count() or an attribute vector has the
     /// wrong size.
     void update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes = {});
     std::size_t patch_count() const;
-    /// The GL buffer holding the uploaded control points (vec4 cp[16 * patch_count()], patch p's
-    /// point k at 16p + k), e.g. for BackpatchCuller::use_patch_buffer so that a GPU back-patch
-    /// pass reads the renderer's patches without a second upload. Its name stays the same for the
-    /// renderer's lifetime (set_patches/update_patches re-specify its storage, not its name).
+    /// The renderer's GL objects, in gl_passes.h's layouts, for the cull passes (CullPipeline, or
+    /// a caller's own chain). Their names stay the same for the renderer's lifetime
+    /// (set_patches/update_patches re-specify the buffers' storage, not their names).
+    /// patch_buffer: vec4 cp[16 * patch_count()]; flag_buffer: uint per patch (the TCS reads it);
+    /// margin_buffer: float per patch, 0 when the set has no margins; range_buffer: vec2
+    /// DisplacementRange per patch, 0 when the set has no ranges; depth_texture: the framebuffer's
+    /// DEPTH32F attachment (width() x height(): the Hi-Z build's input).
     std::uint32_t patch_buffer() const;
-
-    /// True when the cull passes compute once-rounded multiply-adds in double precision
-    /// (shaders/exact_fma.h): on software rasterizers (llvmpipe rounds GLSL fma() twice), and on a
-    /// GPU whose GLSL fma() failed the constructor's check (a few cases next to float midpoints).
-    bool fma_via_double() const;
+    std::uint32_t flag_buffer() const;
+    std::uint32_t margin_buffer() const;
+    std::uint32_t range_buffer() const;
+    std::uint32_t depth_texture() const;
+    /// {patch_buffer, flag_buffer, margin_buffer, 0, patch_count()}: the whole set for a pass.
+    PatchBuffers patch_buffers() const;
+    /// True while a displacement map is set (set_displacement_map with a non-empty map).
+    bool displaces() const;
 
     /// Sets the height map the TES samples (a copy goes to the GPU); an empty map (the initial
     /// state) turns displacement off. Throws patchcull::Error when texels.size() != width*height.
@@ -319,22 +273,14 @@ public:
     /// Reads the flag words back (patch_count() values; bits 0-7 = cull reason, 0 = drawn by
     /// render(); bits 8-9 = status). Waits for the GPU.
     std::vector<std::uint32_t> read_cull_flags() const;
-
-    /// The GPU frustum pass (shaders/cull_frustum.comp.glsl, one invocation per patch): writes
-    /// flag kCullFrustum (1) or 0 for every patch, overwriting the flags, from the control points,
-    /// the max_displacement margins and planes (the whole word: status bits cleared). Makes the same decisions as cull_frustum_scalar on
-    /// the same inputs (same operations, a once-rounded multiply-add where the CPU uses std::fma;
-    /// on llvmpipe, which flushes subnormals to zero, values below 1.2e-38 in magnitude may differ).
-    /// When plane_values is non-null it also receives, per patch, the six maxima over the control
-    /// points of the plane values that the decision compares with 0 (6 * patch_count() floats,
-    /// patch-major): a diagnostic for tests of the arithmetic. Only plane_values waits for the GPU.
-    /// At most 65535 * 64 patches (one dispatch), else throws patchcull::Error.
-    void cull_frustum(const FrustumPlanes& planes, std::vector<float>* plane_values = nullptr);
+    /// Writes the flag words (patch_count() values, else throws), e.g. a pipeline's first-frame
+    /// statuses.
+    void set_flag_words(const std::vector<std::uint32_t>& words);
 
     // ---- occluders ---------------------------------------------------------------------------
     /// Sets the triangle-mesh occluders (seed 000 §3), replacing the previous ones: triangle t has
-    /// corners vertices[indices[3t + i]] (object space). They are drawn by render() and by the
-    /// first pass of render_frame() before any patch, with ids kIdOccluderBit | t, so they occlude
+    /// corners vertices[indices[3t + i]] (object space). They are drawn by render() and
+    /// begin_frame() before any patch, with ids kIdOccluderBit | t, so they occlude
     /// patches through the depth buffer and the Hi-Z pyramid. Empty vectors remove them. Throws
     /// patchcull::Error when indices.size() is not a multiple of 3, an index is out of range, or
     /// there are 2^31 triangles or more.
@@ -349,49 +295,14 @@ public:
     /// an error.
     void render(const RenderParams& params);
 
-    /// One frame of the culling pipeline into the framebuffer (read back with read_ids() etc.).
-    /// With occlusion in the mode (seed 000 §3, Fig. 2):
-    ///   1. clear, draw the occluders and the patches tagged visible (kStatusVisible);
-    ///   2. build the Hi-Z pyramid from that depth buffer (build_hiz);
-    ///   3. test every patch (cull_occlusion: frustum, back-patch hook, Hi-Z, as the mode says) and
-    ///      update its status;
-    ///   4. draw the newly visible patches into the same framebuffer (skipped when aggressive).
-    /// Without occlusion: test every patch, then clear, draw the occluders and the patches that
-    /// passed (one pass). The first frame after set_patches(), set_cull_flags(), clear_cull_flags(),
-    /// cull_frustum() or reset_visibility() tags the even-indexed patches visible (seed 000 §3:
-    /// half of them). Conservative (except aggressive): the final id buffer equals render()'s with
-    /// use_cull_flags = false, up to exact depth ties between patches (draw order differs).
-    /// Returns the counts and per-pass times (FrameStats). Reads the counters back, so it waits for
-    /// the GPU at its end. Throws patchcull::Error like render() and cull_occlusion().
-    FrameStats render_frame(const FrameParams& params);
-
-    /// Makes the next render_frame a first frame (even-indexed patches tagged visible).
-    void reset_visibility();
-
-    // ---- Hi-Z (seed 000 §4.1; the pyramid of hiz.h) -----------------------------------------
-    /// Builds the Hi-Z pyramid from the depth buffer of the last render (compute shader
-    /// hiz_build.comp.glsl, one dispatch per level). The texels equal HiZPyramid::build's on the
-    /// same depth buffer (read_depth() with its rows flipped) bit for bit. Does not wait.
-    void build_hiz();
-    /// HiZPyramid::level_count(width(), height()).
-    int hiz_levels() const;
-    /// The pyramid last built, in HiZPyramid::data()'s layout (level l at HiZPyramid's
-    /// level(l).offset, W_l x H_l row-major, row 0 = BOTTOM). Waits for the GPU.
-    std::vector<float> read_hiz() const;
-
-    /// The combined cull pass (shaders/cull_occlusion.comp.glsl, one invocation per patch) against
-    /// the pyramid last built: per patch the frustum test (as cull_frustum, with the margins), the
-    /// back-patch hook (backpatch_culled / backpatch_buffer as in FrameParams), and
-    /// the Hi-Z test of hiz.h (steps 2-9, patches with a zero margin only), as mode enables them;
-    /// writes the flag word (reason of the first test that culls, else kStatusVisible, plus
-    /// kStatusNewlyVisible when the old word lacked kStatusVisible). The screen is the framebuffer
-    /// (width() x height(), the pyramid's size). Without displacement margins the decisions equal
-    /// cull_occlusion_scalar's (kHiZFrustumCulled <-> kFlagFrustum, kHiZOccluded <-> kFlagOcclusion)
-    /// on the same matrix and pyramid. Does not wait. At most 65535 * 64 patches.
-    /// Throws patchcull::Error when occlusion is tested without a pyramid of the framebuffer's size,
-    /// or when backpatch_buffer is not a buffer of at least patch_count() uints.
-    void cull_occlusion(const Mat4& object_to_clip, CullMode mode = CullMode::all,
-                        const std::uint8_t* backpatch_culled = nullptr, std::uint32_t backpatch_buffer = 0);
+    /// The two steps of render() for a pipeline's passes: begin_frame clears the framebuffer
+    /// (resized to params' size as render() does), draws the occluders and makes params the
+    /// frame's camera and tessellation (and clears the drawn marks, read_drawn_patches);
+    /// draw_selected then draws, over what is there, the patches whose flag word w has
+    /// (w & mask) == value (shaders/patchcull_tcs.h's selections, e.g. kStatusVisible twice for
+    /// the first pass of seed 000 §3), as many times as needed. params.use_cull_flags is ignored.
+    void begin_frame(const RenderParams& params);
+    void draw_selected(std::uint32_t mask, std::uint32_t value);
 
     /// Visualisation (seed 000 Fig. 2's statuses): renders every patch, ignoring the flags, with a
     /// colour from its flag word, and the occluders in grey, seen through `view` (its camera, size
@@ -414,8 +325,8 @@ public:
     void finish() const;
 
     // ---- what a frame drew, for verification (waits for the GPU) -----------------------------
-    /// One byte per patch: 1 when the last render() or render_frame() tessellated it (levels > 0
-    /// in the TCS, in either pass), else 0 (culled). This, not the id buffer, is what a false cull
+    /// One byte per patch: 1 when the last render(), or a draw_selected() since the last
+    /// begin_frame(), tessellated it (levels > 0 in the TCS, in any pass), else 0 (culled). This, not the id buffer, is what a false cull
     /// is judged on: a drawn patch that loses a depth tie is absent from the id buffer.
     std::vector<std::uint8_t> read_drawn_patches() const;
     /// The front set of the last render: redraws the patches (params must be the last render's:
@@ -443,7 +354,6 @@ public:
     struct Impl;
 
 private:
-    bool native_fma_rounds_once();
     std::unique_ptr<Impl> impl_;
 };
 

@@ -1,8 +1,9 @@
-// CullPipeline (patchcull/gl_pipeline.h): seed 000 §3's frame with seed 001's back-patch test as a
-// GPU pass feeding the renderer's back-patch hook.
+// CullPipeline (patchcull/gl_pipeline.h): seed 000 §3's two-pass frame, the passes of
+// gl_passes.h chained through the renderer's flag buffer.
 #include <epoxy/gl.h>
 
 #include <chrono>
+#include <vector>
 
 #include "patchcull/error.h"
 #include "patchcull/gl_pipeline.h"
@@ -10,34 +11,109 @@
 
 namespace patchcull::gl {
 
-struct CullPipeline::Impl {
-    Impl(const GlContext& ctx) : renderer(ctx), culler(ctx), software(ctx.is_software()) {}
-    ~Impl() {
-        if (timer_query) glDeleteQueries(1, &timer_query);
+static_assert(kFlagFrustum == sh::kCullFrustum && kFlagBackPatch == sh::kCullBackPatch &&
+              kFlagOcclusion == sh::kCullOcclusion && kFlagReasonMask == sh::kCullReasonMask);
+static_assert(kStatusVisible == sh::kStatusVisible && kStatusNewlyVisible == sh::kStatusNewlyVisible);
+
+namespace {
+
+// Marks pass boundaries: GL_TIMESTAMP queries, or steady_clock after glFinish().
+class PassClock {
+public:
+    static constexpr int kMaxMarks = 8;
+    PassClock(TimingMethod method, GLuint* queries) : method_(method), queries_(queries) {
+        if (method_ == TimingMethod::timer_query && !queries_[0]) glCreateQueries(GL_TIMESTAMP, kMaxMarks, queries_);
     }
-    PatchRenderer renderer;
-    BackpatchCuller culler;
-    bool software;
-    GLuint timer_query = 0;
+    void mark() {
+        if (method_ == TimingMethod::wall_clock) {
+            glFinish();
+            wall_[marks_] = std::chrono::steady_clock::now();
+        } else if (method_ == TimingMethod::timer_query) {
+            glQueryCounter(queries_[marks_], GL_TIMESTAMP);
+        }
+        ++marks_;
+    }
+    // Milliseconds between mark i and mark i + 1 (waits for query results); 0 when not timed.
+    std::vector<double> intervals() {
+        std::vector<double> ms(static_cast<std::size_t>(std::max(marks_ - 1, 0)), 0.0);
+        if (method_ == TimingMethod::wall_clock) {
+            for (int i = 0; i + 1 < marks_; ++i)
+                ms[static_cast<std::size_t>(i)] = std::chrono::duration<double, std::milli>(wall_[i + 1] - wall_[i]).count();
+        } else if (method_ == TimingMethod::timer_query) {
+            GLuint64 t[kMaxMarks] = {};
+            for (int i = 0; i < marks_; ++i) glGetQueryObjectui64v(queries_[i], GL_QUERY_RESULT, &t[i]);
+            for (int i = 0; i + 1 < marks_; ++i) ms[static_cast<std::size_t>(i)] = static_cast<double>(t[i + 1] - t[i]) * 1e-6;
+        }
+        return ms;
+    }
+
+private:
+    TimingMethod method_;
+    GLuint* queries_;
+    std::chrono::steady_clock::time_point wall_[kMaxMarks];
+    int marks_ = 0;
 };
 
-CullPipeline::CullPipeline(const GlContext& ctx) : impl_(std::make_unique<Impl>(ctx)) {}
+}  // namespace
+
+struct CullPipeline::Impl {
+    explicit Impl(const GlContext& ctx)
+        : renderer(ctx), frustum(passes), hiz_build(passes), occlusion(passes), cones(passes), ptp(passes),
+          displaced(passes), status(passes) {
+        glCreateBuffers(1, &counters);
+        glNamedBufferStorage(counters, sh::kCounterCount * sizeof(std::uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        check_gl("CullPipeline setup");
+    }
+    ~Impl() {
+        glDeleteBuffers(1, &counters);
+        glDeleteTextures(1, &hiz.texture);
+        if (timer_queries[0]) glDeleteQueries(PassClock::kMaxMarks, timer_queries);
+    }
+    PatchRenderer renderer;  // first: makes the context current before the passes bind to it
+    PassContext passes;
+    FrustumPass frustum;
+    HiZBuildPass hiz_build;
+    OcclusionPass occlusion;
+    BackpatchConePass cones;
+    BackpatchPtpPass ptp;
+    DisplacedPass displaced;
+    CullStatusPass status;
+    HiZTexture hiz;  // of the framebuffer's size; recreated when it changes
+    GLuint counters = 0;
+    GLuint timer_queries[PassClock::kMaxMarks] = {};
+    bool primed = false;  // statuses valid (else the next frame tags the even patches)
+
+    // Tags the even-indexed patches visible, the others not (seed 000 §3's first frame).
+    void prime_statuses() {
+        std::vector<std::uint32_t> words(renderer.patch_count());
+        for (std::size_t p = 0; p < words.size(); p += 2) words[p] = sh::kStatusVisible;
+        renderer.set_flag_words(words);
+        primed = true;
+    }
+
+    void ensure_hiz() {
+        if (hiz.texture && hiz.width == renderer.width() && hiz.height == renderer.height()) return;
+        glDeleteTextures(1, &hiz.texture);
+        hiz = create_hiz_texture(renderer.width(), renderer.height());
+    }
+};
+
+CullPipeline::CullPipeline(const GlContext& ctx) : impl_((ctx.make_current(), std::make_unique<Impl>(ctx))) {}
 CullPipeline::CullPipeline(CullPipeline&&) noexcept = default;
 CullPipeline& CullPipeline::operator=(CullPipeline&&) noexcept = default;
 CullPipeline::~CullPipeline() = default;
 
 void CullPipeline::set_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes) {
     impl_->renderer.set_patches(patches, attributes);
-    impl_->culler.use_patch_buffer(impl_->renderer.patch_buffer(), impl_->renderer.patch_count());
+    impl_->primed = false;
 }
 
 void CullPipeline::update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes) {
     impl_->renderer.update_patches(patches, attributes);
-    // Same buffer name and count: the culler keeps reading it. Re-pointing only checks the size.
-    impl_->culler.use_patch_buffer(impl_->renderer.patch_buffer(), impl_->renderer.patch_count());
 }
 
 std::size_t CullPipeline::patch_count() const { return impl_->renderer.patch_count(); }
+void CullPipeline::reset_visibility() { impl_->primed = false; }
 
 Vec3 eye_of_view(const Mat4& view) {
     Mat4 inverse;
@@ -47,50 +123,120 @@ Vec3 eye_of_view(const Mat4& view) {
 
 FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     Impl& m = *impl_;
-    FrameParams frame = params.frame;
-    frame.backpatch_culled = nullptr;
-    frame.backpatch_buffer = 0;
-    const bool backpatch = (static_cast<std::uint32_t>(frame.cull) & kFlagBackPatch) != 0;
+    PatchRenderer& r = m.renderer;
+    const FrameParams& frame = params.frame;
+    const RenderParams& rp = frame.render;
+    std::uint32_t tests = static_cast<std::uint32_t>(frame.cull) & sh::kCullReasonMask;
+    const bool two_pass = (tests & sh::kCullOcclusion) != 0;
     TimingMethod method = frame.timing;
-    if (method == TimingMethod::automatic) method = m.software ? TimingMethod::wall_clock : TimingMethod::timer_query;
+    if (method == TimingMethod::automatic) method = m.passes.is_software() ? TimingMethod::wall_clock : TimingMethod::timer_query;
 
-    double backpatch_ms = 0;
-    if (backpatch && m.renderer.patch_count() > 0) {
-        const RenderParams& rp = frame.render;
-        const Mat4 object_to_clip = rp.projection * rp.view;
-        const Vec3 eye = eye_of_view(rp.view);
-        const float alpha = clip_space_eye_alpha(rp.projection);
-        if (method == TimingMethod::wall_clock) {
-            glFinish();
-            const auto start = std::chrono::steady_clock::now();
-            m.culler.cull(params.backpatch, object_to_clip, eye, alpha, params.ptp_rule);
-            glFinish();
-            backpatch_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        } else if (method == TimingMethod::timer_query) {
-            if (!m.timer_query) glCreateQueries(GL_TIME_ELAPSED, 1, &m.timer_query);
-            glBeginQuery(GL_TIME_ELAPSED, m.timer_query);
-            m.culler.cull(params.backpatch, object_to_clip, eye, alpha, params.ptp_rule);
-            glEndQuery(GL_TIME_ELAPSED);
-        } else {
-            m.culler.cull(params.backpatch, object_to_clip, eye, alpha, params.ptp_rule);
+    // What the draw displaces decides what the tests may assume (gl_renderer.h): with a map and
+    // without margins every patch is displaced by an unknown amount, so nothing may be culled.
+    const bool displacing = rp.displace && r.displaces();
+    PatchBuffers chain = r.patch_buffers();
+    if (!displacing) chain.margins = 0;  // drawn undisplaced: every patch is its base patch
+    if (displacing && !chain.margins) tests = 0;
+    const std::uint32_t ranges = displacing ? r.range_buffer() : 0;
+
+    FrameStats stats;
+    stats.patches = r.patch_count();
+    stats.two_pass = two_pass;
+    stats.timing = method;
+    const Mat4 object_to_clip = rp.projection * rp.view;
+    const Vec3 eye = eye_of_view(rp.view);
+
+    if (!m.primed) m.prime_statuses();
+    glClearNamedBufferData(m.counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    PassClock clock(method, m.timer_queries);
+    clock.mark();
+    // The flag chain (gl_passes.h), in three timed parts: begin + frustum, back-patch, the rest.
+    auto run_chain = [&](const HiZTexture* hiz) {
+        m.status.begin(chain);
+        if (tests & sh::kCullFrustum)
+            m.frustum.run(chain, make_frustum_planes(object_to_clip, ClipDepth::zero_to_one));
+        clock.mark();
+        if (tests & sh::kCullBackPatch) {
+            if (params.backpatch == BackpatchMethod::ptp)
+                m.ptp.run(chain, object_to_clip, clip_space_eye_alpha(rp.projection), params.ptp_rule);
+            else
+                m.cones.run(chain, params.backpatch, eye);
         }
-        frame.backpatch_buffer = m.culler.flag_buffer();
+        clock.mark();
+        if (hiz) m.occlusion.run(chain, object_to_clip, *hiz, false);  // the frustum pass ran first when asked
+        if (ranges && (tests & (sh::kCullFrustum | sh::kCullOcclusion))) {
+            const DisplacedCullView view = make_displaced_cull_view(rp.view, rp.projection, ClipDepth::zero_to_one);
+            m.displaced.run(chain, ranges, params.bound, params.cone, view, hiz, true);
+        }
+        m.status.end(chain, m.counters);
+        clock.mark();
+    };
+    if (two_pass) {
+        // 1. occluders + patches tagged visible.
+        r.begin_frame(rp);
+        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
+        clock.mark();
+        // 2. Hi-Z from that depth.
+        m.ensure_hiz();
+        m.hiz_build.run(r.depth_texture(), m.hiz);
+        clock.mark();
+        // 3. test every patch, update statuses.
+        run_chain(&m.hiz);
+        // 4. newly visible patches (seed 000 §3.1: skipped when aggressive).
+        if (!frame.aggressive) r.draw_selected(sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass);
+        clock.mark();
+    } else {
+        run_chain(nullptr);
+        r.begin_frame(rp);
+        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
+        clock.mark();
     }
-    FrameStats stats = m.renderer.render_frame(frame);
-    if (backpatch && method == TimingMethod::timer_query && m.timer_query && m.renderer.patch_count() > 0) {
-        GLuint64 ns = 0;
-        glGetQueryObjectui64v(m.timer_query, GL_QUERY_RESULT, &ns);
-        backpatch_ms = static_cast<double>(ns) * 1e-6;
+    check_gl("render_frame");
+
+    std::uint32_t c[sh::kCounterCount] = {};
+    glGetNamedBufferSubData(m.counters, 0, sizeof c, c);
+    check_gl("render_frame counters");
+    stats.frustum_culled = c[sh::kCounterFrustum];
+    stats.backpatch_culled = c[sh::kCounterBackPatch];
+    stats.occlusion_culled = c[sh::kCounterOcclusion];
+    stats.displaced_occlusion_culled = c[sh::kCounterDisplacedOcclusion];
+    stats.visible = c[sh::kCounterVisible];
+    stats.newly_visible = c[sh::kCounterNewlyVisible];
+    if (two_pass) {
+        stats.pass1_drawn = c[sh::kCounterWasVisible];
+        stats.pass2_drawn = frame.aggressive ? 0 : stats.newly_visible;
+    } else {
+        stats.pass1_drawn = stats.visible;
     }
-    detail::check_gl("CullPipeline::render_frame");
-    stats.backpatch_ms = backpatch_ms;
-    stats.cull_ms += backpatch_ms;
-    stats.total_ms += backpatch_ms;
+    const std::vector<double> ms = clock.intervals();
+    if (!ms.empty()) {
+        // Two-pass marks: pass1 | hiz | chain A | back-patch | chain B | pass2; one pass: chain A |
+        // back-patch | chain B | pass1.
+        const std::size_t chain_first = two_pass ? 2 : 0;
+        stats.cull_ms = ms[chain_first] + ms[chain_first + 1] + ms[chain_first + 2];
+        stats.backpatch_ms = ms[chain_first + 1];
+        if (two_pass) {
+            stats.pass1_ms = ms[0];
+            stats.hiz_ms = ms[1];
+            stats.pass2_ms = ms[5];
+        } else {
+            stats.pass1_ms = ms[3];
+        }
+        for (double t : ms) stats.total_ms += t;
+    }
     return stats;
+}
+
+std::vector<float> CullPipeline::read_hiz() const {
+    if (!impl_->hiz.texture) throw Error("GL: read_hiz: no two-pass frame yet");
+    return read_hiz_texture(impl_->hiz);
+}
+int CullPipeline::hiz_levels() const {
+    return impl_->hiz.texture ? HiZPyramid::level_count(impl_->hiz.width, impl_->hiz.height) : 0;
 }
 
 PatchRenderer& CullPipeline::renderer() { return impl_->renderer; }
 const PatchRenderer& CullPipeline::renderer() const { return impl_->renderer; }
-BackpatchCuller& CullPipeline::culler() { return impl_->culler; }
+PassContext& CullPipeline::passes() { return impl_->passes; }
 
 }  // namespace patchcull::gl

@@ -1,7 +1,7 @@
 // PatchRenderer (patchcull/gl_renderer.h): buffers, programs, the tessellated draw into an
-// off-screen framebuffer, triangle occluders, the GPU frustum pass and read-backs. GL 4.5 direct
-// state access. The Hi-Z build, the combined cull pass and the frame pipeline are in
-// occlusion_pipeline.cpp; the shared internals in renderer_internal.h.
+// off-screen framebuffer, triangle occluders, the status image and read-backs. GL 4.5 direct
+// state access. It draws only: the cull passes are gl_passes.h's, chained by CullPipeline
+// (cull_pipeline.cpp). The shared internals are in renderer_internal.h.
 #include <epoxy/gl.h>
 #include <stb_image_write.h>
 
@@ -32,39 +32,26 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
                                                                       {"patch.frag.glsl", GL_FRAGMENT_SHADER}};
     m.draw_program = link_program(patch_stages, "patch");
     m.mark_program = link_program(patch_stages, "patch (mark front)", "#define PATCHCULL_MARK_FRONT 1\n");
-    // Mesa's software rasterizers round GLSL fma() twice; the cull passes then compute it exactly
-    // in double precision (shaders/exact_fma.h) so that decisions equal the CPU kernels'. On other
-    // drivers native fma() is checked once below.
-    m.fma_via_double = ctx.is_software();
-    m.is_software = ctx.is_software();
-    m.link_cull_programs();
     m.draw_loc.locate(m.draw_program);
     m.mark_loc.locate(m.mark_program);
-    m.hiz_program = link_program({{"hiz_build.comp.glsl", GL_COMPUTE_SHADER}}, "hiz_build");
-    const GLuint hp = m.hiz_program;
-    m.hiz_loc = {glGetUniformLocation(hp, "u_from_depth"), glGetUniformLocation(hp, "u_source_level"),
-                 glGetUniformLocation(hp, "u_source_size"), glGetUniformLocation(hp, "u_out_size")};
     m.occluder_program =
         link_program({{"occluder.vert.glsl", GL_VERTEX_SHADER}, {"occluder.frag.glsl", GL_FRAGMENT_SHADER}}, "occluder");
     m.occluder_loc = {glGetUniformLocation(m.occluder_program, "u_object_to_clip"),
                       glGetUniformLocation(m.occluder_program, "u_eye")};
 
     glCreateVertexArrays(1, &m.vao);
-    GLuint buffers[12];
-    glCreateBuffers(12, buffers);
+    GLuint buffers[10];
+    glCreateBuffers(10, buffers);
     m.control_points = buffers[0];
     m.cull_flags = buffers[1];
     m.max_displacement = buffers[2];
     m.texcoords = buffers[3];
-    m.plane_values = buffers[4];
-    m.backpatch_flags = buffers[5];
-    m.counters = buffers[6];
-    m.occluder_vertices = buffers[7];
-    m.tangents = buffers[8];
-    m.drawn_marks = buffers[9];
-    m.front_marks = buffers[10];
-    m.tess_scale = buffers[11];
-    upload(m.counters, sh::kCounterCount * sizeof(std::uint32_t), nullptr);
+    m.ranges = buffers[4];
+    m.occluder_vertices = buffers[5];
+    m.tangents = buffers[6];
+    m.drawn_marks = buffers[7];
+    m.front_marks = buffers[8];
+    m.tess_scale = buffers[9];
     upload(m.occluder_vertices, 0, nullptr);
     glCreateFramebuffers(1, &m.fbo);
     glCreateFramebuffers(1, &m.vis_fbo);
@@ -72,38 +59,6 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
     set_displacement_map(DisplacementMap{});
     m.resize(256, 256);
     check_gl("PatchRenderer setup");
-    if (!m.fma_via_double && !native_fma_rounds_once()) {
-        m.fma_via_double = true;
-        m.link_cull_programs();
-    }
-}
-
-// Start-up check of GLSL fma() on a GPU: hand-made planes make the frustum pass report exactly
-// fma(a, b, c) for cases where a*b + c lies just off the midpoint between two floats, so that any
-// second rounding (through float or double) gives the wrong neighbour (tests/gl frustum_gpu_test
-// does the same on more cases).
-bool PatchRenderer::native_fma_rounds_once() {
-    const float a = std::ldexp(1.0f + std::ldexp(1.0f, -23), -24);
-    const float b = 1.0f - std::ldexp(1.0f, -23);
-    const float c = 1.0f + std::ldexp(1.0f, -23);
-    const float a_values[6] = {a, -a, 2 * a, a / 2, -2 * a, 0.75f};
-    FrustumPlanes planes;
-    for (int q = 0; q < 6; ++q) {
-        planes.rows[q] = {1, 0, 0, a_values[q]};
-        planes.normal_length[q] = 0;
-    }
-    const float bc[4][2] = {{b, c}, {b, -c}, {-b, -c}, {std::ldexp(b, 9), std::ldexp(c, 9)}};
-    std::vector<BezierPatch> probe(4);
-    for (int p = 0; p < 4; ++p)
-        for (Vec4& cp : probe[p].cp) cp = {bc[p][1], 0, 0, bc[p][0]};
-    set_patches(probe);
-    std::vector<float> values;
-    cull_frustum(planes, &values);
-    set_patches(std::vector<BezierPatch>{});
-    for (int p = 0; p < 4; ++p)
-        for (int q = 0; q < 6; ++q)
-            if (values[6 * p + q] != std::fma(a_values[q], bc[p][0], bc[p][1])) return false;
-    return true;
 }
 
 PatchRenderer::PatchRenderer(PatchRenderer&&) noexcept = default;
@@ -129,7 +84,14 @@ void PatchRenderer::update_patches(const std::vector<BezierPatch>& patches, cons
 
 std::size_t PatchRenderer::patch_count() const { return impl_->count; }
 std::uint32_t PatchRenderer::patch_buffer() const { return impl_->control_points; }
-bool PatchRenderer::fma_via_double() const { return impl_->fma_via_double; }
+std::uint32_t PatchRenderer::flag_buffer() const { return impl_->cull_flags; }
+std::uint32_t PatchRenderer::margin_buffer() const { return impl_->has_max_displacement ? impl_->max_displacement : 0; }
+std::uint32_t PatchRenderer::range_buffer() const { return impl_->has_ranges ? impl_->ranges : 0; }
+std::uint32_t PatchRenderer::depth_texture() const { return impl_->depth; }
+PatchBuffers PatchRenderer::patch_buffers() const {
+    return {impl_->control_points, impl_->cull_flags, margin_buffer(), 0, impl_->count};
+}
+bool PatchRenderer::displaces() const { return impl_->has_displacement_map; }
 
 void PatchRenderer::set_displacement_map(const DisplacementMap& map) {
     Impl& m = *impl_;
@@ -155,14 +117,12 @@ void PatchRenderer::set_displacement_map(const DisplacementMap& map) {
 
 void PatchRenderer::clear_cull_flags() {
     glClearNamedBufferData(impl_->cull_flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-    impl_->primed = false;
     check_gl("clear_cull_flags");
 }
 
 void PatchRenderer::set_cull_flags(const std::uint8_t* culled) {
     std::vector<std::uint32_t> flags(impl_->count);
     for (std::size_t p = 0; p < flags.size(); ++p) flags[p] = culled[p] ? sh::kCullFrustum : 0u;
-    impl_->primed = false;
     if (!flags.empty())
         glNamedBufferSubData(impl_->cull_flags, 0, static_cast<GLsizeiptr>(flags.size() * sizeof(std::uint32_t)),
                              flags.data());
@@ -179,46 +139,45 @@ std::vector<std::uint32_t> PatchRenderer::read_cull_flags() const {
     return flags;
 }
 
-void PatchRenderer::cull_frustum(const FrustumPlanes& planes, std::vector<float>* plane_values) {
-    Impl& m = *impl_;
-    if (m.count == 0) {
-        if (plane_values) plane_values->clear();
-        return;
-    }
-    const std::size_t groups = (m.count + sh::kCullGroupSize - 1) / sh::kCullGroupSize;
-    if (groups > 65535) throw Error("GL: cull_frustum: more than 65535 * 64 patches");
-    if (plane_values) upload(m.plane_values, 6 * m.count * sizeof(float), nullptr);
-    const GLuint fp = m.frustum_program;
-    glProgramUniform4fv(fp, m.frustum_loc.rows, 6, &planes.rows[0].x);
-    glProgramUniform1fv(fp, m.frustum_loc.normal_length, 6, planes.normal_length);
-    glProgramUniform1ui(fp, m.frustum_loc.patch_count, static_cast<GLuint>(m.count));
-    glProgramUniform1i(fp, m.frustum_loc.has_displacement, m.has_max_displacement ? 1 : 0);
-    glProgramUniform1i(fp, m.frustum_loc.write_plane_values, plane_values ? 1 : 0);
-    glUseProgram(fp);
-    m.bind_buffers();
-    glDispatchCompute(static_cast<GLuint>(groups), 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    glUseProgram(0);
-    m.primed = false;
-    if (plane_values) {
-        plane_values->resize(6 * m.count);
-        glGetNamedBufferSubData(m.plane_values, 0, static_cast<GLsizeiptr>(plane_values->size() * sizeof(float)),
-                                plane_values->data());
-        upload(m.plane_values, 0, nullptr);
-    }
-    check_gl("cull_frustum");
+void PatchRenderer::set_flag_words(const std::vector<std::uint32_t>& words) {
+    if (words.size() != impl_->count)
+        throw Error("GL: set_flag_words: " + std::to_string(words.size()) + " words for " +
+                    std::to_string(impl_->count) + " patches");
+    if (!words.empty())
+        glNamedBufferSubData(impl_->cull_flags, 0, static_cast<GLsizeiptr>(words.size() * sizeof(std::uint32_t)),
+                             words.data());
+    check_gl("set_flag_words");
 }
 
 void PatchRenderer::render(const RenderParams& params) {
+    begin_frame(params);
+    draw_selected(params.use_cull_flags ? sh::kDrawMaskUnculled : 0u, params.use_cull_flags ? sh::kDrawValueUnculled : 0u);
+}
+
+void PatchRenderer::begin_frame(const RenderParams& params) {
     Impl& m = *impl_;
     m.resize(params.width, params.height);
     const Mat4 object_to_clip = params.projection * params.view;
-    const int level = m.set_draw_uniforms(params, object_to_clip, sh::kColorPatch, true);
+    m.frame_level = m.set_draw_uniforms(params, object_to_clip, sh::kColorPatch, true);
     m.begin_target(m.fbo, m.width, m.height);
     m.draw_occluders();
-    m.draw_patches(level, params.use_cull_flags ? sh::kCullReasonMask : 0u, 0u);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-    check_gl("render");
+    check_gl("begin_frame");
+}
+
+void PatchRenderer::draw_selected(std::uint32_t mask, std::uint32_t value) {
+    Impl& m = *impl_;
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m.fbo);
+    glViewport(0, 0, m.width, m.height);
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    m.draw_patches(m.frame_level, mask, value);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    check_gl("draw_selected");
 }
 
 namespace {

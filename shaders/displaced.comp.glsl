@@ -1,4 +1,5 @@
-// Displaced-patch cull pass (seed 000 §4.2), one invocation per patch: the GPU twin of
+// Displaced-patch cull pass (DisplacedPass, src/gl/displaced_pass.cpp; seed 000 §4.2), one
+// invocation per patch: the GPU twin of
 // cull_displaced_frustum and cull_displaced_occlusion (include/patchcull/displaced_bounds.h,
 // src/core/displaced_bounds.cpp). The bound (caf or oobb, u_bound_kind) and its decisions are
 // displaced_bounds.h (the GLSL one in shaders/); the cone kind is fixed at compile time by
@@ -7,15 +8,20 @@
 // patch's 36 cross products; the build validates the con variant, and every function is validated
 // whichever kind is picked, since all are defined).
 // Per patch: the bound, then the frustum test and, when u_occlusion, hiz.h's steps 5-9 on the
-// bound's rectangle (displaced_bound_hiz_decision). Writes the flag word (kBindingCullFlags):
-// kCullFrustum, kCullOcclusion or 0, the renderer's reason bits (status bits 0).
+// bound's rectangle (displaced_bound_hiz_decision). A link of the flag chain (flag_chain.h):
+// patches culled earlier are skipped, and with only_displaced so are patches whose range is
+// (0, 0) (the frustum and occlusion passes test those); a culled patch gets kCullFrustum or
+// kCullOcclusion.
 #version 450 core
 #include "shared.h"
+#include "pass_params.h"
 #include "displaced_shared.h"
 #include "backpatch_shared.h"
 #include "exact_fma.h"
 #include "backpatch_exact.h"
+#define u_zero displaced.zero
 #include "backpatch_cones.h"
+#include "flag_chain.h"
 
 #ifndef PC_DISPLACED_CONE
 #define PC_DISPLACED_CONE 2
@@ -26,9 +32,6 @@ layout(local_size_x = kDisplacedGroupSize) in;
 layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
     vec4 control_points[];  // patch p's point k at 16p + k (patch.h order)
 };
-layout(std430, binding = kBindingCullFlags) writeonly buffer CullFlags {
-    uint cull_flags[];
-};
 layout(std430, binding = kBindingDisplacementRanges) readonly buffer Ranges {
     vec2 ranges[];  // (d_min, d_max) per patch, read when u_has_ranges
 };
@@ -36,32 +39,21 @@ layout(std430, binding = kBindingDisplacedBounds) writeonly buffer Bounds {
     float bound_values[];  // kDisplacedBoundValues per patch, written when u_write_bounds
 };
 
-uniform uint u_patch_count;
-uniform uint u_first_patch;  // dispatches cover patches from here (large sets take several)
-uniform bool u_has_ranges;
-uniform bool u_write_bounds;
-uniform uint u_bound_kind;   // kDisplacedBoundOobb or kDisplacedBoundCaf
-uniform bool u_occlusion;    // also the Hi-Z test (else frustum only)
-uniform bool u_view_valid;   // DisplacedCullView::valid: false = every bound invalid, nothing culled
-
-// DisplacedCullView.
-uniform mat4 u_object_to_view;  // column-major: u_object_to_view[c][r] = V(r, c)
-uniform vec4 u_abs_row_z;       // |V(2, c)|
-uniform vec3 u_axis_unit[3];
-uniform float u_axis_length[3];
-uniform vec4 u_proj;            // P00, P02, P11, P12
-uniform vec2 u_proj_z;          // P22, P23
-uniform vec4 u_view_planes[6];  // make_frustum_planes(projection).rows
-
-// displaced_bounds.h's constants, from the C++ values.
-uniform float u_delta_slack;    // kDisplacedDeltaSlack
-uniform float u_ext_scale;      // kDisplacedExtScale
-uniform float u_frame_pad;      // kDisplacedFramePad
-uniform float u_depth_safety;   // kDisplacedDepthSafety
-
-// Hi-Z pyramid of a W x H depth buffer (hiz.h's levels in the lower-left part of each mip level).
-uniform ivec2 u_screen;
-uniform int u_hiz_levels;
+// displaced_bounds.h's and hiz_box_test.h's names (pass_params.h's DisplacedParams).
+#define u_bound_kind displaced.bound_kind
+#define u_object_to_view displaced.object_to_view
+#define u_abs_row_z displaced.abs_row_z
+#define u_axis_unit displaced.axis_unit
+#define u_axis_length displaced.axis_length
+#define u_proj displaced.proj
+#define u_proj_z displaced.proj_z
+#define u_view_planes displaced.view_planes
+#define u_delta_slack displaced.constants.x
+#define u_ext_scale displaced.constants.y
+#define u_frame_pad displaced.constants.z
+#define u_depth_safety displaced.constants.w
+#define u_screen ivec2(displaced.screen_width, displaced.screen_height)
+#define u_hiz_levels displaced.hiz_levels
 layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 
 #include "displaced_bounds.h"
@@ -92,32 +84,33 @@ uint pc_hiz_decision(PcDisplacedBound b) {
 }
 
 void main() {
-    const uint p = u_first_patch + gl_GlobalInvocationID.x;
-    if (p >= u_patch_count) return;
+    const uint p = displaced.first_patch + gl_GlobalInvocationID.x;
+    if (gl_GlobalInvocationID.x >= displaced.patch_count || pc_chain_culled(p)) return;
     vec4 P[16];
     for (int k = 0; k < 16; ++k) P[k] = control_points[16u * p + uint(k)];
-    const vec2 range = u_has_ranges ? ranges[p] : vec2(0.0);
+    const vec2 range = displaced.has_ranges != 0u ? ranges[p] : vec2(0.0);
+    const bool has_displacement = range.x != 0.0 || range.y != 0.0;
+    if (displaced.only_displaced != 0u && !has_displacement) return;
     PcDisplacedBound bound = pc_invalid_bound();
-    if (u_view_valid) {
+    if (displaced.view_valid != 0u) {
         // bound_of: nothing to displace, no cone (the bound does not depend on it then).
-        const bool displaced = range.x != 0.0 || range.y != 0.0;
         PcCone cone;
         cone.axis = vec3(0.0);
         cone.cos_angle = 0.0;
         cone.sin_angle = 1.0;
         cone.valid = false;
-        if (displaced) cone = pc_displaced_cone(P);
+        if (has_displacement) cone = pc_displaced_cone(P);
         bound = pc_displaced_bound_with_cone(P, range, cone, u_bound_kind);
     }
-    uint word = 0u;
-    if (u_occlusion) {
+    uint reason = 0u;
+    if (displaced.occlusion != 0u) {
         const uint decision = pc_hiz_decision(bound);
-        word = decision == kPcHiZFrustumCulled ? kCullFrustum : decision == kPcHiZOccluded ? kCullOcclusion : 0u;
+        reason = decision == kPcHiZFrustumCulled ? kCullFrustum : decision == kPcHiZOccluded ? kCullOcclusion : 0u;
     } else if (pc_bound_outside_frustum(bound)) {
-        word = kCullFrustum;
+        reason = kCullFrustum;
     }
-    cull_flags[p] = word;
-    if (u_write_bounds) {
+    if (reason != 0u) pc_chain_cull(p, reason);
+    if (displaced.write_bounds != 0u) {
         const uint o = kDisplacedBoundValues * p;
         bound_values[o] = bound.ndc_xmin;
         bound_values[o + 1u] = bound.ndc_xmax;

@@ -1,4 +1,4 @@
-// ptp back-patch cull pass (seed 001 §3-6): the GPU twin of cull_ptp_scalar
+// ptp back-patch cull pass (BackpatchPtpPass, src/gl/backpatch_ptp_pass.cpp; seed 001 §3-6): the GPU twin of cull_ptp_scalar
 // (include/patchcull/backpatch.h, src/core/ptp.cpp) with seed 001 §6's parallel scheme:
 // kPtpLanes = 16 invocations per patch, kPtpPatchesPerGroup = 8 patches per work group.
 //
@@ -19,36 +19,36 @@
 // 4. the 64 t and thr go to shared memory and are counted by a parallel reduction: lane i counts
 //    how many of t[4i .. 4i+3] satisfy the rule (ncnt: t < -thr, pcnt: t <= -thr; NaN satisfies
 //    neither), then a tree sum over the 16 lanes; culled when all 64 do (as the CPU).
-// Writes kCullBackPatch or 0 to the back-patch flag word; the 64 t and then the 64 thr to
-// kBindingPtpPlanes (128 floats per patch) on request (tests). The host skips the dispatch (and clears the flags) when ptp_clip_rows would
+// A link of the flag chain (flag_chain.h): patches culled earlier and displaced ones (margin > 0)
+// take part in the barriers but are neither counted nor written; a culled patch gets
+// kCullBackPatch. The 64 t and then the 64 thr go to kBindingPtpPlanes (128 floats per patch) on
+// request (tests). The host skips the dispatch (and clears the flags) when ptp_clip_rows would
 // return false (alpha or det(object_to_clip) zero or not finite).
 #version 450 core
 #include "shared.h"
+#include "pass_params.h"
 #include "backpatch_shared.h"
 #include "exact_fma.h"
 #include "ptp_schedule.h"
+#include "flag_chain.h"
 
 layout(local_size_x = kPtpLanes, local_size_y = kPtpPatchesPerGroup) in;
 
 layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
     vec4 control_points[];  // patch p's point k at 16p + k (patch.h order)
 };
-layout(std430, binding = kBindingBackPatchFlags) writeonly buffer BackPatchFlags {
-    uint backpatch_flags[];
-};
 layout(std430, binding = kBindingPtpPlanes) writeonly buffer PtpPlanes {
     float ptp_planes[];  // 128 per patch (t[64], thr[64]), written only when u_write_planes
 };
 
-uniform vec4 u_rows[3];  // rows x, y, w of s * object_to_clip (ptp.cpp: s = sign(alpha) sign(det))
-uniform uint u_patch_count;
-uniform uint u_first_patch;  // dispatches cover patches from here (large sets take several)
-uniform bool u_pcnt;     // PtpRule::pcnt (else ncnt)
-uniform bool u_write_planes;
-// Always 0.0 (the host sets it): the accumulators start from this run-time zero, not from a
-// literal, because Mesa folds `x + 0.0` into x even in precise code, which turns the CPU's
-// fma(w, v, +0) = +0 for v = -0 into -0 (measured on llvmpipe: the sign of zero t differed).
-uniform float u_zero;
+// Parameter names (pass_params.h's BackpatchPtpParams). u_zero is always 0.0 (the host sets it):
+// the accumulators start from this run-time zero, not from a literal, because Mesa folds `x + 0.0`
+// into x even in precise code, which turns the CPU's fma(w, v, +0) = +0 for v = -0 into -0
+// (measured on llvmpipe: the sign of zero t differed).
+#define u_rows ptp.rows
+#define u_pcnt (ptp.pcnt != 0u)
+#define u_write_planes (ptp.write_planes != 0u)
+#define u_zero ptp.zero
 
 shared vec4 s_object[kPtpPatchesPerGroup][16];
 shared float s_x[kPtpPatchesPerGroup][16];
@@ -75,8 +75,10 @@ void sync_shared() {
 
 void main() {
     const uint lane = gl_LocalInvocationID.x, slot = gl_LocalInvocationID.y;
-    const uint p = u_first_patch + gl_WorkGroupID.x * kPtpPatchesPerGroup + slot;
-    const bool in_range = p < u_patch_count;  // inactive slots still take part in every barrier
+    const uint index = gl_WorkGroupID.x * kPtpPatchesPerGroup + slot;
+    const uint p = ptp.first_patch + index;
+    // Inactive slots (past the range, culled earlier, displaced) still take part in every barrier.
+    const bool in_range = index < ptp.patch_count && !pc_chain_culled(p) && pc_margin(p, ptp.has_margins) == 0.0;
 
     // 1. Clip transform of control point `lane`: v = r.x X; v = fma(r.y, Y, v); ... (ptp.cpp step 1).
     {
@@ -214,7 +216,7 @@ void main() {
         sync_shared();
     }
     if (!in_range) return;
-    if (lane == 0u) backpatch_flags[p] = s_count[slot][0] == 64u ? kCullBackPatch : 0u;
+    if (lane == 0u && s_count[slot][0] == 64u) pc_chain_cull(p, kCullBackPatch);
     if (u_write_planes)
         for (uint i = 0u; i < 4u; ++i) {
             ptp_planes[128u * p + 4u * lane + i] = s_t[slot][4u * lane + i];

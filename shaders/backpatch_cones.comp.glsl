@@ -1,0 +1,60 @@
+// Cone back-patch cull pass (BackpatchConePass, src/gl/backpatch_cones_pass.cpp), one invocation
+// per patch: the GPU twin of cull_tcone_scalar and cull_ncone_scalar (include/patchcull/backpatch.h,
+// src/core/backpatch_cones.cpp). TCONE (default): the Sederberg & Meyers cone of the tangent and
+// bitangent control vectors; NCONE (compiled with PATCHCULL_NCONE): the cone of the 36 control
+// vectors of the normal patch (Shirman & Abi-Ezzi). The cones and the test are backpatch_cones.h,
+// the operation-by-operation mirror of src/core/cones_internal.h.
+// Per patch: the cone, the control-point sphere and the perspective back-facing test; rational
+// patches (any w != 1) are never culled. A link of the flag chain (flag_chain.h): patches culled
+// earlier are skipped, and so are displaced ones (margin > 0: a displaced surface is not bounded by
+// the base patch's normals, Loop, Niessner & Eisenacher §8); a culled patch gets kCullBackPatch.
+#version 450 core
+#include "shared.h"
+#include "pass_params.h"
+#include "backpatch_shared.h"
+#include "exact_fma.h"
+#include "backpatch_exact.h"
+#define u_zero cones.zero
+#include "backpatch_cones.h"
+#include "flag_chain.h"
+
+#ifdef PATCHCULL_NCONE
+#define PC_PASS_CONE pc_normal_cone
+#else
+#define PC_PASS_CONE pc_tangent_cone
+#endif
+
+layout(local_size_x = kConeGroupSize) in;
+
+layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
+    vec4 control_points[];  // patch p's point k at 16p + k (patch.h order)
+};
+layout(std430, binding = kBindingConeValues) writeonly buffer ConeValues {
+    float cone_values[];  // kConeValues per patch, written only when write_cones
+};
+
+void main() {
+    const uint p = cones.first_patch + gl_GlobalInvocationID.x;
+    if (gl_GlobalInvocationID.x >= cones.patch_count || pc_chain_culled(p)) return;
+    if (pc_margin(p, cones.has_margins) > 0.0) return;
+    vec4 P[16];
+    for (int k = 0; k < 16; ++k) P[k] = control_points[16u * p + uint(k)];
+    const PcCone cone = PC_PASS_CONE(P);
+    const PcSphere sphere = pc_sphere_of_points(P);
+    if (pc_is_polynomial(P) && pc_back_facing(cone, sphere, cones.eye.xyz)) pc_chain_cull(p, kCullBackPatch);
+    if (cones.write_cones != 0u) {
+        const uint o = kConeValues * p;
+        cone_values[o] = cone.axis.x;
+        cone_values[o + 1u] = cone.axis.y;
+        cone_values[o + 2u] = cone.axis.z;
+        cone_values[o + 3u] = cone.cos_angle;
+        cone_values[o + 4u] = cone.sin_angle;
+        cone_values[o + 5u] = cone.valid ? 1.0 : 0.0;
+        cone_values[o + 6u] = sphere.center.x;
+        cone_values[o + 7u] = sphere.center.y;
+        cone_values[o + 8u] = sphere.center.z;
+        cone_values[o + 9u] = sphere.radius;
+        cone_values[o + 10u] = 0.0;
+        cone_values[o + 11u] = 0.0;
+    }
+}

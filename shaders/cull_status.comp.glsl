@@ -1,0 +1,57 @@
+// Cull status pass (CullStatusPass, src/gl/cull_status_pass.cpp): the two ends of the flag chain
+// (include/patchcull/gl_passes.h), one invocation per patch.
+// - kStatusBegin: clears the reason bits (kCullReasonMask) of every patch of the range and keeps
+//   its status bits, so the frame's test passes start from "nothing culled" while the first
+//   drawing pass still sees last frame's statuses.
+// - kStatusEnd: turns the reasons the tests left into the temporal status of Niessner & Loop's
+//   two-pass pipeline (seed 000 §3): a patch no test culled gets kStatusVisible, plus
+//   kStatusNewlyVisible when its word lacked kStatusVisible (it was not drawn in the first pass);
+//   a culled patch keeps its reason alone. It adds the counts to the caller's counter buffer
+//   (kBindingCullCounters, kCounterCount uints, cleared by the caller): one atomic add per work
+//   group and counter, from shared-memory sums.
+#version 450 core
+#include "shared.h"
+#include "pass_params.h"
+#include "flag_chain.h"
+
+layout(local_size_x = kCullGroupSize) in;
+
+layout(std430, binding = kBindingCullCounters) buffer CullCounters {
+    uint counters[];
+};
+
+shared uint s_counts[kCounterCount];
+
+void main() {
+    const uint index = gl_GlobalInvocationID.x;
+    const uint p = status.first_patch + index;
+    const bool in_range = index < status.patch_count;
+    if (status.mode == kStatusBegin) {
+        if (in_range) cull_flags[p] &= ~kCullReasonMask;
+        return;
+    }
+    if (gl_LocalInvocationIndex < kCounterCount) s_counts[gl_LocalInvocationIndex] = 0u;
+    barrier();
+    if (in_range) {
+        const uint old_word = cull_flags[p];
+        const uint reason = old_word & kCullReasonMask;
+        const bool was_visible = (old_word & kStatusVisible) != 0u;
+        uint word = reason;
+        if (reason == 0u) word = kStatusVisible | (was_visible ? 0u : kStatusNewlyVisible);
+        cull_flags[p] = word;
+        if (was_visible) atomicAdd(s_counts[kCounterWasVisible], 1u);
+        if (reason == kCullFrustum) atomicAdd(s_counts[kCounterFrustum], 1u);
+        if (reason == kCullBackPatch) atomicAdd(s_counts[kCounterBackPatch], 1u);
+        if (reason == kCullOcclusion) {
+            atomicAdd(s_counts[kCounterOcclusion], 1u);
+            if (pc_margin(p, status.has_margins) > 0.0) atomicAdd(s_counts[kCounterDisplacedOcclusion], 1u);
+        }
+        if (reason == 0u) {
+            atomicAdd(s_counts[kCounterVisible], 1u);
+            if (!was_visible) atomicAdd(s_counts[kCounterNewlyVisible], 1u);
+        }
+    }
+    barrier();
+    if (gl_LocalInvocationIndex < kCounterCount && s_counts[gl_LocalInvocationIndex] != 0u)
+        atomicAdd(counters[gl_LocalInvocationIndex], s_counts[gl_LocalInvocationIndex]);
+}

@@ -1,0 +1,25 @@
+// shaders/flag_chain.h (GLSL only; include after shared.h): the flag chain of the cull passes
+// (include/patchcull/gl_passes.h, "The flag chain"). Every test pass reads and writes the
+// caller's flag buffer (kBindingCullFlags, one uint per patch); a patch whose reason bits
+// (kCullReasonMask) are set was culled by an earlier pass of the frame and is skipped, so each
+// patch ends with the reason of the first test that culled it, and the later, costlier tests only
+// see the survivors. Status bits (kStatusVisible, kStatusNewlyVisible) are left alone; only the
+// status pass (cull_status.comp.glsl) writes them.
+// The optional margin buffer (kBindingMaxDisplacement, float per patch, >= 0) marks displaced
+// patches: margin > 0.
+
+layout(std430, binding = kBindingCullFlags) buffer CullFlags {
+    uint cull_flags[];  // each invocation reads and writes its own patch's word only
+};
+layout(std430, binding = kBindingMaxDisplacement) readonly buffer MaxDisplacement {
+    float max_displacement[];
+};
+
+// True when an earlier pass of the chain culled patch p.
+bool pc_chain_culled(uint p) { return (cull_flags[p] & kCullReasonMask) != 0u; }
+
+// Culls patch p with `reason` (its status bits kept).
+void pc_chain_cull(uint p, uint reason) { cull_flags[p] = (cull_flags[p] & ~kCullReasonMask) | reason; }
+
+// Patch p's displacement margin, 0 without a margin buffer.
+float pc_margin(uint p, uint has_margins) { return has_margins != 0u ? max_displacement[p] : 0.0; }

@@ -1,0 +1,34 @@
+// Frustum cull pass (FrustumPass, src/gl/frustum_pass.cpp), one invocation per patch: the GPU twin
+// of cull_frustum_scalar (include/patchcull/frustum.h, src/core/frustum.cpp). Same arithmetic,
+// operation by operation, so the decisions are identical (the test itself is shaders/frustum_test.h,
+// shared with occlusion.comp.glsl). A link of the flag chain (gl_passes.h): a patch that an earlier
+// pass of the frame culled is left as it is; otherwise a culled patch gets the reason kCullFrustum.
+#version 450 core
+#include "shared.h"
+#include "pass_params.h"
+#include "exact_fma.h"
+#include "flag_chain.h"
+
+layout(local_size_x = kCullGroupSize) in;
+
+layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
+    vec4 control_points[];
+};
+layout(std430, binding = kBindingPlaneValues) writeonly buffer PlaneValues {
+    float plane_values[];  // 6 per patch, written only when write_plane_values
+};
+
+// frustum_test.h's names.
+#define u_plane_rows frustum.plane_rows
+#define u_plane_normal_length frustum.plane_normal_length
+#include "frustum_test.h"
+
+void main() {
+    const uint p = frustum.first_patch + gl_GlobalInvocationID.x;
+    if (gl_GlobalInvocationID.x >= frustum.patch_count || pc_chain_culled(p)) return;
+    const float d = pc_margin(p, frustum.has_margins);
+    float mx[6];
+    if (pc_frustum_culled(p, d, mx)) pc_chain_cull(p, kCullFrustum);
+    if (frustum.write_plane_values != 0u)
+        for (int q = 0; q < 6; ++q) plane_values[6u * p + uint(q)] = mx[q];
+}

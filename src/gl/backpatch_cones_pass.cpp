@@ -1,0 +1,39 @@
+// BackpatchConePass (patchcull/gl_passes.h): cull_tcone_scalar and cull_ncone_scalar on the GPU,
+// shaders/backpatch_cones.comp.glsl (ncone compiled with PATCHCULL_NCONE).
+#include "backpatch_shared.h"
+#include "pass_common.h"
+
+namespace patchcull::gl {
+
+struct BackpatchConePass::Impl {
+    explicit Impl(PassContext::Impl& c) : context(c) {}
+    PassContext::Impl& context;
+    detail::ParamBlock block;
+};
+
+BackpatchConePass::BackpatchConePass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
+BackpatchConePass::BackpatchConePass(BackpatchConePass&&) noexcept = default;
+BackpatchConePass& BackpatchConePass::operator=(BackpatchConePass&&) noexcept = default;
+BackpatchConePass::~BackpatchConePass() = default;
+
+void BackpatchConePass::run(const PatchBuffers& patches, BackpatchMethod method, Vec3 eye, std::uint32_t cone_values) {
+    if (method == BackpatchMethod::ptp) throw Error("GL: BackpatchConePass: ptp is BackpatchPtpPass's");
+    detail::check_patch_buffers("BackpatchConePass", patches);
+    if (cone_values)
+        detail::check_buffer_size("BackpatchConePass", "cone-value", cone_values,
+                                  (patches.first + patches.count) * backpatch_shared::kConeValues * sizeof(float));
+    if (patches.count == 0) return;
+    pp::BackpatchConeParams params;
+    params.eye = {eye.x, eye.y, eye.z, 1.0f};
+    params.has_margins = patches.margins ? 1u : 0u;
+    params.write_cones = cone_values ? 1u : 0u;
+    params.zero = 0.0f;
+    const bool ncone = method == BackpatchMethod::ncone;
+    glUseProgram(impl_->context.program("backpatch_cones.comp.glsl", ncone ? "#define PATCHCULL_NCONE 1\n" : ""));
+    detail::bind_patch_buffers(patches);
+    if (cone_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, backpatch_shared::kBindingConeValues, cone_values);
+    detail::dispatch_patches(impl_->block, params, patches.first, patches.count, backpatch_shared::kConeGroupSize);
+    detail::finish_pass("BackpatchConePass");
+}
+
+}  // namespace patchcull::gl

@@ -1,0 +1,46 @@
+// CullStatusPass (patchcull/gl_passes.h): the two ends of the flag chain,
+// shaders/cull_status.comp.glsl.
+#include "pass_common.h"
+
+namespace patchcull::gl {
+
+struct CullStatusPass::Impl {
+    explicit Impl(PassContext::Impl& c) : context(c) {}
+    ~Impl() { glDeleteBuffers(1, &scratch_counters); }
+    PassContext::Impl& context;
+    detail::ParamBlock block;
+    GLuint scratch_counters = 0;  // bound when the caller counts nothing
+
+    void run(const PatchBuffers& patches, pp::uint mode, GLuint counters) {
+        detail::check_patch_buffers("CullStatusPass", patches);
+        if (counters) detail::check_buffer_size("CullStatusPass", "counter", counters, shared::kCounterCount * 4);
+        if (patches.count == 0) return;
+        if (!counters) {
+            if (!scratch_counters) {
+                glCreateBuffers(1, &scratch_counters);
+                glNamedBufferStorage(scratch_counters, shared::kCounterCount * 4, nullptr, 0);
+            }
+            counters = scratch_counters;
+        }
+        pp::CullStatusParams params;
+        params.mode = mode;
+        params.has_margins = patches.margins ? 1u : 0u;
+        glUseProgram(context.program("cull_status.comp.glsl"));
+        detail::bind_patch_buffers(patches);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCullCounters, counters);
+        detail::dispatch_patches(block, params, patches.first, patches.count, shared::kCullGroupSize);
+        detail::finish_pass("CullStatusPass");
+    }
+};
+
+CullStatusPass::CullStatusPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
+CullStatusPass::CullStatusPass(CullStatusPass&&) noexcept = default;
+CullStatusPass& CullStatusPass::operator=(CullStatusPass&&) noexcept = default;
+CullStatusPass::~CullStatusPass() = default;
+
+void CullStatusPass::begin(const PatchBuffers& patches) { impl_->run(patches, shared::kStatusBegin, 0); }
+void CullStatusPass::end(const PatchBuffers& patches, std::uint32_t counters) {
+    impl_->run(patches, shared::kStatusEnd, counters);
+}
+
+}  // namespace patchcull::gl

@@ -1,0 +1,34 @@
+// FrustumPass (patchcull/gl_passes.h): cull_frustum_scalar on the GPU, shaders/frustum.comp.glsl.
+#include "pass_common.h"
+
+namespace patchcull::gl {
+
+struct FrustumPass::Impl {
+    explicit Impl(PassContext::Impl& c) : context(c) {}
+    PassContext::Impl& context;
+    detail::ParamBlock block;
+};
+
+FrustumPass::FrustumPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
+FrustumPass::FrustumPass(FrustumPass&&) noexcept = default;
+FrustumPass& FrustumPass::operator=(FrustumPass&&) noexcept = default;
+FrustumPass::~FrustumPass() = default;
+
+void FrustumPass::run(const PatchBuffers& patches, const FrustumPlanes& planes, std::uint32_t plane_values) {
+    detail::check_patch_buffers("FrustumPass", patches);
+    if (plane_values)
+        detail::check_buffer_size("FrustumPass", "plane-value", plane_values,
+                                  (patches.first + patches.count) * 6 * sizeof(float));
+    if (patches.count == 0) return;
+    pp::FrustumParams params;
+    detail::store_planes(planes, params.plane_rows, params.plane_normal_length);
+    params.has_margins = patches.margins ? 1u : 0u;
+    params.write_plane_values = plane_values ? 1u : 0u;
+    glUseProgram(impl_->context.program("frustum.comp.glsl"));
+    detail::bind_patch_buffers(patches);
+    if (plane_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingPlaneValues, plane_values);
+    detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kCullGroupSize);
+    detail::finish_pass("FrustumPass");
+}
+
+}  // namespace patchcull::gl

@@ -1,0 +1,48 @@
+// HiZBuildPass (patchcull/gl_passes.h): seed 000 §4.1's pyramid, shaders/hiz_build.comp.glsl,
+// one dispatch per level.
+#include "pass_common.h"
+
+namespace patchcull::gl {
+
+struct HiZBuildPass::Impl {
+    explicit Impl(PassContext::Impl& c) : context(c) {}
+    PassContext::Impl& context;
+    detail::ParamBlock block;
+};
+
+HiZBuildPass::HiZBuildPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
+HiZBuildPass::HiZBuildPass(HiZBuildPass&&) noexcept = default;
+HiZBuildPass& HiZBuildPass::operator=(HiZBuildPass&&) noexcept = default;
+HiZBuildPass::~HiZBuildPass() = default;
+
+void HiZBuildPass::run(std::uint32_t depth_texture, const HiZTexture& hiz) {
+    if (!glIsTexture(depth_texture)) throw Error("GL: HiZBuildPass: " + std::to_string(depth_texture) + " is not a texture");
+    if (!glIsTexture(hiz.texture) || hiz.width < 1 || hiz.height < 1)
+        throw Error("GL: HiZBuildPass: no Hi-Z texture (create_hiz_texture)");
+    glUseProgram(impl_->context.program("hiz_build.comp.glsl"));
+    glBindTextureUnit(shared::kTextureUnitDepth, depth_texture);
+    glBindTextureUnit(shared::kTextureUnitHiZ, hiz.texture);
+    const int levels = HiZPyramid::level_count(hiz.width, hiz.height);
+    pp::HiZBuildParams params;
+    int source_w = hiz.width, source_h = hiz.height;
+    for (int l = 0; l < levels; ++l) {
+        const int out_w = (source_w + 1) / 2, out_h = (source_h + 1) / 2;
+        params.from_depth = l == 0 ? 1u : 0u;
+        params.source_level = l == 0 ? 0 : l - 1;
+        params.source_width = source_w;
+        params.source_height = source_h;
+        params.out_width = out_w;
+        params.out_height = out_h;
+        impl_->block.upload(params);
+        glBindImageTexture(shared::kImageUnitHiZOut, hiz.texture, l, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glDispatchCompute((static_cast<GLuint>(out_w) + shared::kHiZGroupSize - 1) / shared::kHiZGroupSize,
+                          (static_cast<GLuint>(out_h) + shared::kHiZGroupSize - 1) / shared::kHiZGroupSize, 1);
+        // The next level reads this one.
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        source_w = out_w;
+        source_h = out_h;
+    }
+    detail::finish_pass("HiZBuildPass");
+}
+
+}  // namespace patchcull::gl

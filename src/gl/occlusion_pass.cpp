@@ -1,0 +1,40 @@
+// OcclusionPass (patchcull/gl_passes.h): cull_occlusion_scalar on the GPU against a Hi-Z
+// pyramid, shaders/occlusion.comp.glsl.
+#include "pass_common.h"
+
+namespace patchcull::gl {
+
+struct OcclusionPass::Impl {
+    explicit Impl(PassContext::Impl& c) : context(c) {}
+    PassContext::Impl& context;
+    detail::ParamBlock block;
+};
+
+OcclusionPass::OcclusionPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
+OcclusionPass::OcclusionPass(OcclusionPass&&) noexcept = default;
+OcclusionPass& OcclusionPass::operator=(OcclusionPass&&) noexcept = default;
+OcclusionPass::~OcclusionPass() = default;
+
+void OcclusionPass::run(const PatchBuffers& patches, const Mat4& object_to_clip, const HiZTexture& hiz,
+                        bool with_frustum) {
+    detail::check_patch_buffers("OcclusionPass", patches);
+    if (!glIsTexture(hiz.texture) || hiz.width < 1 || hiz.height < 1)
+        throw Error("GL: OcclusionPass: no Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
+    if (patches.count == 0) return;
+    pp::OcclusionParams params;
+    std::copy_n(object_to_clip.m, 16, params.object_to_clip);
+    detail::store_planes(make_frustum_planes(object_to_clip, ClipDepth::zero_to_one), params.plane_rows,
+                         params.plane_normal_length);
+    params.has_margins = patches.margins ? 1u : 0u;
+    params.with_frustum = with_frustum ? 1u : 0u;
+    params.screen_width = hiz.width;
+    params.screen_height = hiz.height;
+    params.hiz_levels = HiZPyramid::level_count(hiz.width, hiz.height);
+    glUseProgram(impl_->context.program("occlusion.comp.glsl"));
+    detail::bind_patch_buffers(patches);
+    glBindTextureUnit(shared::kTextureUnitHiZ, hiz.texture);
+    detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kCullGroupSize);
+    detail::finish_pass("OcclusionPass");
+}
+
+}  // namespace patchcull::gl

@@ -1,0 +1,87 @@
+// What the cull passes (patchcull/gl_passes.h) share, not a public header: the PassContext's
+// program cache and fma mode, the parameter-block upload, and the one rule for splitting a patch
+// range into dispatches.
+#pragma once
+
+#include <epoxy/gl.h>
+
+#include <cstddef>
+#include <map>
+#include <string>
+
+#include "gl_util.h"
+#include "pass_params.h"
+#include "patchcull/gl_passes.h"
+#include "shared.h"
+
+namespace patchcull::gl {
+
+namespace pp = pass_params;
+
+struct PassContext::Impl {
+    bool fma_via_double = false;
+    bool software = false;
+    std::map<std::string, GLuint> programs;  // key: shader name + "\n" + defines
+    GLuint probe_in = 0, probe_out = 0;
+    ~Impl();
+    /// The program of compute shader `shader` with `defines` (lines "#define X 1\n"), plus
+    /// PATCHCULL_FMA_VIA_DOUBLE when fma_via_double; compiled on first use.
+    GLuint program(const char* shader, const std::string& defines = {});
+};
+
+namespace detail {
+
+/// Throws unless the buffers of `patches` exist and hold its range (control points 256 bytes per
+/// patch, flags and margins 4 bytes per patch). `who` starts the message.
+void check_patch_buffers(const char* who, const PatchBuffers& patches);
+/// Throws unless buffer is a buffer of at least bytes bytes.
+void check_buffer_size(const char* who, const char* what, GLuint buffer, std::size_t bytes);
+
+/// A pass's parameter block: a small uniform buffer, uploaded whole before each dispatch and bound
+/// at kUniformPassParams.
+class ParamBlock {
+public:
+    ParamBlock();
+    ~ParamBlock();
+    ParamBlock(const ParamBlock&) = delete;
+    ParamBlock& operator=(const ParamBlock&) = delete;
+    template <class Params>
+    void upload(const Params& params) {
+        if (!buffer_) create(sizeof(Params));
+        glNamedBufferSubData(buffer_, 0, sizeof(Params), &params);
+        glBindBufferBase(GL_UNIFORM_BUFFER, shared::kUniformPassParams, buffer_);
+    }
+
+private:
+    void create(std::size_t size);
+    GLuint buffer_ = 0;
+};
+
+/// The rule for large ranges: a range of `count` patches, `patches_per_group` per work group, is
+/// covered by dispatches of at most 65535 work groups (the GL minimum of the x count); before
+/// each, params.first_patch and params.patch_count are set to its sub-range (first + offset) and
+/// the block is uploaded.
+template <class Params>
+void dispatch_patches(ParamBlock& block, Params& params, std::size_t first, std::size_t count,
+                      std::size_t patches_per_group) {
+    const std::size_t per_dispatch = 65535 * patches_per_group;
+    for (std::size_t offset = 0; offset < count; offset += per_dispatch) {
+        const std::size_t n = std::min(per_dispatch, count - offset);
+        params.first_patch = static_cast<pp::uint>(first + offset);
+        params.patch_count = static_cast<pp::uint>(n);
+        block.upload(params);
+        glDispatchCompute(static_cast<GLuint>((n + patches_per_group - 1) / patches_per_group), 1, 1);
+    }
+}
+
+/// Binds the chain's buffers (control points, flags, margins when given).
+void bind_patch_buffers(const PatchBuffers& patches);
+
+/// The end of every run(): no program, the barrier of the state contract, GL error check.
+void finish_pass(const char* who);
+
+/// Copies a FrustumPlanes into a parameter block's plane_rows / plane_normal_length.
+void store_planes(const FrustumPlanes& planes, pp::vec4 rows[6], pp::vec4 normal_length[2]);
+
+}  // namespace detail
+}  // namespace patchcull::gl
