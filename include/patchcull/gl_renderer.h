@@ -276,6 +276,10 @@ public:
     /// Writes the flag words (patch_count() values, else throws), e.g. a pipeline's first-frame
     /// statuses.
     void set_flag_words(const std::vector<std::uint32_t>& words);
+    /// Counts the times the flag words were replaced from the CPU (set_patches, clear_cull_flags,
+    /// set_cull_flags, set_flag_words; not update_patches or GPU passes): a pipeline that sees it
+    /// change starts again from a first frame.
+    std::uint64_t flag_generation() const;
 
     // ---- occluders ---------------------------------------------------------------------------
     /// Sets the triangle-mesh occluders (seed 000 §3), replacing the previous ones: triangle t has

@@ -81,14 +81,16 @@ struct CullPipeline::Impl {
     HiZTexture hiz;  // of the framebuffer's size; recreated when it changes
     GLuint counters = 0;
     GLuint timer_queries[PassClock::kMaxMarks] = {};
-    bool primed = false;  // statuses valid (else the next frame tags the even patches)
+    // The renderer's flag_generation when the statuses were primed; another value (the flags were
+    // replaced, or reset_visibility) makes the next frame a first frame.
+    std::uint64_t primed_generation = ~std::uint64_t{0};
 
     // Tags the even-indexed patches visible, the others not (seed 000 §3's first frame).
     void prime_statuses() {
         std::vector<std::uint32_t> words(renderer.patch_count());
         for (std::size_t p = 0; p < words.size(); p += 2) words[p] = sh::kStatusVisible;
         renderer.set_flag_words(words);
-        primed = true;
+        primed_generation = renderer.flag_generation();
     }
 
     void ensure_hiz() {
@@ -105,7 +107,6 @@ CullPipeline::~CullPipeline() = default;
 
 void CullPipeline::set_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes) {
     impl_->renderer.set_patches(patches, attributes);
-    impl_->primed = false;
 }
 
 void CullPipeline::update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes) {
@@ -113,7 +114,7 @@ void CullPipeline::update_patches(const std::vector<BezierPatch>& patches, const
 }
 
 std::size_t CullPipeline::patch_count() const { return impl_->renderer.patch_count(); }
-void CullPipeline::reset_visibility() { impl_->primed = false; }
+void CullPipeline::reset_visibility() { impl_->primed_generation = ~std::uint64_t{0}; }
 
 Vec3 eye_of_view(const Mat4& view) {
     Mat4 inverse;
@@ -146,7 +147,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     const Mat4 object_to_clip = rp.projection * rp.view;
     const Vec3 eye = eye_of_view(rp.view);
 
-    if (!m.primed) m.prime_statuses();
+    if (m.primed_generation != r.flag_generation()) m.prime_statuses();
     glClearNamedBufferData(m.counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
     PassClock clock(method, m.timer_queries);
     clock.mark();
@@ -163,10 +164,15 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
                 m.cones.run(chain, params.backpatch, eye);
         }
         clock.mark();
-        if (hiz) m.occlusion.run(chain, object_to_clip, *hiz, false);  // the frustum pass ran first when asked
+        // The frustum pass ran first when the mode has it: the occlusion pass only tests Hi-Z.
+        const HiZTexture* occluding = (tests & sh::kCullOcclusion) ? hiz : nullptr;
+        if (occluding) m.occlusion.run(chain, object_to_clip, *occluding, false);
         if (ranges && (tests & (sh::kCullFrustum | sh::kCullOcclusion))) {
+            // Its own frustum test belongs to the frustum mode; without it, Hi-Z only is not
+            // available for bounds, so the displaced pass runs when either test is asked for and
+            // applies the bound's frustum test too (a bound outside the frustum is invisible).
             const DisplacedCullView view = make_displaced_cull_view(rp.view, rp.projection, ClipDepth::zero_to_one);
-            m.displaced.run(chain, ranges, params.bound, params.cone, view, hiz, true);
+            m.displaced.run(chain, ranges, params.bound, params.cone, view, occluding, true);
         }
         m.status.end(chain, m.counters);
         clock.mark();
@@ -214,7 +220,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         // back-patch | chain B | pass1.
         const std::size_t chain_first = two_pass ? 2 : 0;
         stats.cull_ms = ms[chain_first] + ms[chain_first + 1] + ms[chain_first + 2];
-        stats.backpatch_ms = ms[chain_first + 1];
+        if (tests & sh::kCullBackPatch) stats.backpatch_ms = ms[chain_first + 1];
         if (two_pass) {
             stats.pass1_ms = ms[0];
             stats.hiz_ms = ms[1];

@@ -92,6 +92,7 @@ PatchBuffers PatchRenderer::patch_buffers() const {
     return {impl_->control_points, impl_->cull_flags, margin_buffer(), 0, impl_->count};
 }
 bool PatchRenderer::displaces() const { return impl_->has_displacement_map; }
+std::uint64_t PatchRenderer::flag_generation() const { return impl_->flag_generation; }
 
 void PatchRenderer::set_displacement_map(const DisplacementMap& map) {
     Impl& m = *impl_;
@@ -117,12 +118,14 @@ void PatchRenderer::set_displacement_map(const DisplacementMap& map) {
 
 void PatchRenderer::clear_cull_flags() {
     glClearNamedBufferData(impl_->cull_flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    ++impl_->flag_generation;
     check_gl("clear_cull_flags");
 }
 
 void PatchRenderer::set_cull_flags(const std::uint8_t* culled) {
     std::vector<std::uint32_t> flags(impl_->count);
     for (std::size_t p = 0; p < flags.size(); ++p) flags[p] = culled[p] ? sh::kCullFrustum : 0u;
+    ++impl_->flag_generation;
     if (!flags.empty())
         glNamedBufferSubData(impl_->cull_flags, 0, static_cast<GLsizeiptr>(flags.size() * sizeof(std::uint32_t)),
                              flags.data());
@@ -146,6 +149,7 @@ void PatchRenderer::set_flag_words(const std::vector<std::uint32_t>& words) {
     if (!words.empty())
         glNamedBufferSubData(impl_->cull_flags, 0, static_cast<GLsizeiptr>(words.size() * sizeof(std::uint32_t)),
                              words.data());
+    ++impl_->flag_generation;
     check_gl("set_flag_words");
 }
 

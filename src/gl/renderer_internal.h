@@ -45,6 +45,7 @@ struct PatchRenderer::Impl {
     bool has_ranges = false;
     bool has_tangents = false;  // the tangent buffer holds kTangentVec4s vec4 per patch
     int frame_level = 1;        // begin_frame's effective tessellation level
+    std::uint64_t flag_generation = 0;  // PatchRenderer::flag_generation
     GLuint fbo = 0, color = 0, ids = 0, depth = 0;
     int width = 0, height = 0;
     std::size_t count = 0;
@@ -152,6 +153,7 @@ struct PatchRenderer::Impl {
         if (!keep_flags) {
             upload(cull_flags, n * sizeof(std::uint32_t), nullptr);
             glClearNamedBufferData(cull_flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+            ++flag_generation;
         }
         // Margins: given, or the ranges' max |D|.
         std::vector<float> margins = a.max_displacement;

@@ -101,7 +101,7 @@ TEST(GpuFrustumCull, SameDecisionsAsCpuKernelOnRandomInputs) {
         r.set_patches(c.patches, attributes);
         const FrustumPlanes planes = make_frustum_planes(c.object_to_clip, ClipDepth::zero_to_one);
         std::vector<float> gpu_values;
-        r.cull_frustum(planes, &gpu_values);
+        test::cull_frustum(r, planes, &gpu_values);
         const std::vector<std::uint32_t> gpu = r.read_cull_flags();
 
         const PatchBatch batch = make_batch(c.patches);
@@ -169,7 +169,7 @@ TEST(GpuFrustumCull, MultiplyAddIsRoundedOnceOnHardCases) {
     PatchRenderer r(test::context());
     r.set_patches(patches);
     std::vector<float> values;
-    r.cull_frustum(planes, &values);
+    test::cull_frustum(r, planes, &values);
     ASSERT_EQ(values.size(), 6 * patches.size());
     std::size_t wrong = 0;
     for (std::size_t p = 0; p < patches.size(); ++p)
@@ -179,14 +179,14 @@ TEST(GpuFrustumCull, MultiplyAddIsRoundedOnceOnHardCases) {
                 ADD_FAILURE() << "fma(" << a_values[q] << ", " << bc[p].first << ", " << bc[p].second << "): GPU "
                               << values[6 * p + q] << " expected " << expected;
         }
-    EXPECT_EQ(wrong, 0u) << (r.fma_via_double() ? "double-precision emulation" : "native GLSL fma");
+    EXPECT_EQ(wrong, 0u) << (test::passes().fma_via_double() ? "double-precision emulation" : "native GLSL fma");
     const auto flags = r.read_cull_flags();
     std::vector<std::uint8_t> cpu(patches.size());
     cull_frustum_scalar(make_batch(patches).view(), nullptr, planes, cpu.data());
     for (std::size_t p = 0; p < patches.size(); ++p) ASSERT_EQ(flags[p] != 0, cpu[p] != 0) << "patch " << p;
 }
 
-TEST(GpuFrustumCull, MarginIsUsedAndFlagsAreOverwritten) {
+TEST(GpuFrustumCull, MarginIsUsedAndBeginClearsStaleReasons) {
     // A patch just outside the left plane: culled without margin, kept with a margin larger than
     // its distance.
     Camera cam;  // at (0,0,5) looking at the origin
@@ -197,7 +197,7 @@ TEST(GpuFrustumCull, MarginIsUsedAndFlagsAreOverwritten) {
     r.set_patches({patch, patch}, test::margins_only({0.0f, 10.0f}));
     const std::uint8_t stale[2] = {0, 1};
     r.set_cull_flags(stale);
-    r.cull_frustum(make_frustum_planes(vp, ClipDepth::zero_to_one));
+    test::cull_frustum(r, make_frustum_planes(vp, ClipDepth::zero_to_one));
     const auto flags = r.read_cull_flags();
     EXPECT_EQ(flags[0], 1u);
     EXPECT_EQ(flags[1], 0u);
@@ -232,7 +232,7 @@ void strict_views(PatchRenderer& r, const std::vector<BezierPatch>& patches, con
         const std::vector<std::uint32_t> reference = r.read_ids();
 
         const FrustumPlanes planes = make_frustum_planes(cam.view_projection(), ClipDepth::zero_to_one);
-        r.cull_frustum(planes);
+        test::cull_frustum(r, planes);
         const std::vector<std::uint32_t> flags = r.read_cull_flags();
         params.use_cull_flags = true;
         r.render(params);

@@ -9,6 +9,8 @@
 #include <utility>
 #include <vector>
 
+#include "patchcull/gl_passes.h"
+#include "patchcull/gl_pipeline.h"
 #include "patchcull/gl_renderer.h"
 #include "patchcull/mesh.h"
 #include "patchcull/patch.h"
@@ -22,6 +24,33 @@ inline GlContext& context() {
     static GlContext ctx = GlContext::create_headless();
     return ctx;
 }
+
+/// The process's pass context (on context()) and passes, for tests that run one pass on a
+/// renderer's buffers.
+inline PassContext& passes() {
+    context().make_current();
+    static PassContext p;
+    return p;
+}
+
+/// A GL buffer of `bytes` bytes (zeroed), deleted at scope end.
+class ScratchBuffer {
+public:
+    explicit ScratchBuffer(std::size_t bytes);
+    ~ScratchBuffer();
+    ScratchBuffer(const ScratchBuffer&) = delete;
+    ScratchBuffer& operator=(const ScratchBuffer&) = delete;
+    std::uint32_t name() const { return name_; }
+    std::vector<float> read_floats(std::size_t count) const;
+
+private:
+    std::uint32_t name_ = 0;
+};
+
+/// The frustum pass on the renderer's whole set as a chain of its own: reasons cleared
+/// (CullStatusPass::begin), then FrustumPass; plane_values (optional) receives the 6 maxima per
+/// patch.
+void cull_frustum(PatchRenderer& r, const FrustumPlanes& planes, std::vector<float>* plane_values = nullptr);
 
 /// Attributes with only the cull margins set.
 inline PatchAttributes margins_only(std::vector<float> max_displacement) {

@@ -4,6 +4,7 @@
 // makes the same decisions as cull_occlusion_scalar, patch by patch, on the same matrix: the teapot
 // with triangle occluders from several cameras, random (rational, eye-straddling) patches, and
 // NPOT / odd framebuffer sizes.
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -66,14 +67,42 @@ void add_wall(std::vector<Vec3>& v, std::vector<std::uint32_t>& idx, Vec3 at, Ve
     for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) idx.push_back(base + i);
 }
 
+// The GPU pyramid of a renderer's last frame: HiZBuildPass on its depth texture into a texture of
+// the framebuffer's size (recreated when the size changes).
+class GpuPyramid {
+public:
+    ~GpuPyramid() { release(); }
+    const HiZTexture& build(PatchRenderer& r) {
+        if (hiz_.width != r.width() || hiz_.height != r.height()) {
+            release();
+            hiz_ = create_hiz_texture(r.width(), r.height());
+        }
+        pass_.run(r.depth_texture(), hiz_);
+        return hiz_;
+    }
+    const HiZTexture& texture() const { return hiz_; }
+
+private:
+    void release() {
+        if (hiz_.texture) glDeleteTextures(1, &hiz_.texture);
+        hiz_ = {};
+    }
+    HiZBuildPass pass_{test::passes()};
+    HiZTexture hiz_;
+};
+
+GpuPyramid& gpu_pyramid() {
+    static GpuPyramid p;
+    return p;
+}
+
 // Compares the GPU pyramid with the CPU one built from the read-back depth; returns the CPU one.
 HiZPyramid check_pyramid(PatchRenderer& r, const char* what) {
     const std::vector<float> depth = depth_bottom_up(r);
     HiZPyramid cpu;
     cpu.build(depth.data(), r.width(), r.height());
-    r.build_hiz();
-    const std::vector<float> gpu = r.read_hiz();
-    EXPECT_EQ(r.hiz_levels(), cpu.levels()) << what;
+    const std::vector<float> gpu = read_hiz_texture(gpu_pyramid().build(r));
+    EXPECT_EQ(HiZPyramid::level_count(r.width(), r.height()), cpu.levels()) << what;
     EXPECT_EQ(gpu.size(), cpu.size()) << what;
     if (gpu.size() == cpu.size()) {
         std::size_t differ = 0;
@@ -92,13 +121,18 @@ struct DecisionCounts {
     std::size_t frustum = 0, occluded = 0, visible = 0, mismatched = 0;
 };
 
-// GPU cull_occlusion vs cull_occlusion_scalar on the same pyramid and matrix.
+// OcclusionPass (with the frustum test, as the CPU kernel) in a chain of its own on the renderer's
+// buffers, statuses updated, vs cull_occlusion_scalar on the same pyramid and matrix.
 DecisionCounts compare_decisions(PatchRenderer& r, const std::vector<BezierPatch>& patches, const Mat4& m,
                                  const HiZPyramid& cpu_hiz, const char* what) {
     const PatchBatch batch = make_batch(patches);
     std::vector<std::uint8_t> cpu(patches.size(), 0xEE);
     cull_occlusion_scalar(batch.view(), m, ClipDepth::zero_to_one, cpu_hiz, cpu.data());
-    r.cull_occlusion(m, CullMode::all);
+    static CullStatusPass status(test::passes());
+    static OcclusionPass occlusion(test::passes());
+    status.begin(r.patch_buffers());
+    occlusion.run(r.patch_buffers(), m, gpu_pyramid().texture(), true);
+    status.end(r.patch_buffers(), 0);
     const std::vector<std::uint32_t> words = r.read_cull_flags();
     DecisionCounts n;
     for (std::size_t p = 0; p < patches.size(); ++p) {
@@ -240,18 +274,25 @@ TEST(GpuHiZ, DecisionsEqualCpuOnRandomPatches) {
     EXPECT_GT(total.visible, 100u);
 }
 
-TEST(GpuHiZ, CullOcclusionNeedsAPyramidOfTheFramebufferSize) {
+TEST(GpuHiZ, PassesRefuseMissingPyramidsAndBadSizes) {
     PatchRenderer r(test::context());
     r.set_patches(teapot_patches());
     RenderParams p = params_for(teapot_camera(test::control_point_bounds(teapot_patches()), {0, -1, 0.3f}, 2.5f), 64, 64);
     r.render(p);
-    EXPECT_THROW(r.cull_occlusion(p.projection * p.view, CullMode::occlusion), patchcull::Error);
-    EXPECT_THROW(r.read_hiz(), patchcull::Error);
-    r.build_hiz();
-    EXPECT_NO_THROW(r.cull_occlusion(p.projection * p.view, CullMode::occlusion));
-    EXPECT_EQ(r.read_hiz().size(), HiZPyramid(64, 64).size());
-    p.width = 80;
-    r.render(p);  // resized: the pyramid is stale
-    EXPECT_THROW(r.cull_occlusion(p.projection * p.view, CullMode::all), patchcull::Error);
-    EXPECT_NO_THROW(r.cull_occlusion(p.projection * p.view, CullMode::frustum));
+    OcclusionPass occlusion(test::passes());
+    HiZBuildPass build(test::passes());
+    EXPECT_THROW(occlusion.run(r.patch_buffers(), p.projection * p.view, HiZTexture{}), patchcull::Error);
+    EXPECT_THROW(read_hiz_texture(HiZTexture{}), patchcull::Error);
+    EXPECT_THROW(create_hiz_texture(0, 64), patchcull::Error);
+    EXPECT_THROW(create_hiz_texture(64, 8193), patchcull::Error);
+    HiZTexture hiz = create_hiz_texture(64, 64);
+    EXPECT_THROW(build.run(0, hiz), patchcull::Error);  // no depth texture
+    build.run(r.depth_texture(), hiz);
+    EXPECT_NO_THROW(occlusion.run(r.patch_buffers(), p.projection * p.view, hiz));
+    EXPECT_EQ(read_hiz_texture(hiz).size(), HiZPyramid(64, 64).size());
+    // A flag buffer too small for the range is refused, not overrun.
+    PatchBuffers past_the_end = r.patch_buffers();
+    past_the_end.first = 1;
+    EXPECT_THROW(occlusion.run(past_the_end, p.projection * p.view, hiz), patchcull::Error);
+    glDeleteTextures(1, &hiz.texture);
 }
