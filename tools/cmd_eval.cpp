@@ -1,11 +1,11 @@
-// `patchcull eval ...`: the papers' evaluations, a subcommand group: `eval occlusion` (here) and
-// `eval displaced` (tools/eval_displaced.cpp).
+// `patchcull eval ...`: the papers' evaluations, a subcommand group: `eval occlusion` (here),
+// `eval displaced` (tools/eval_displaced.cpp) and `eval temporal` (tools/eval_temporal.cpp).
 //
 // `eval occlusion MODEL [--split N] [--views N] --json` reproduces seed 000 §6.2 for non-displaced
 // models (culling within one object): views that contain the whole object (camera.h, contain
 // mode); on each view the pipeline (seed 000 §3, cull mode occlusion) runs on the static model from
-// a first frame until its visible set is stable (two consecutive frames tag the same patches
-// visible; at most --max-frames frames), and the occluded fraction of that frame is recorded. Every
+// a first frame until its visible set is stable (converge_frame, eval_temporal.h: two consecutive
+// frames tag the same patches visible; at most --max-frames frames), and the occluded fraction of that frame is recorded. Every
 // final frame is compared with the unculled render (false culls). For comparison with seed 000's
 // back-patch figures it also reports the GPU tcone/ncone back-patch cull fractions of each view.
 // Output (--json): {"model","scheme","split","patches","views","size","tess","seed",
@@ -22,6 +22,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "eval_displaced.h"
+#include "eval_temporal.h"
 #include "patchcull/error.h"
 #include "patchcull/gl_backpatch.h"
 #include "render_support.h"
@@ -40,12 +41,6 @@ struct OcclusionOptions {
     int max_frames = 8;
     bool json = false;
 };
-
-std::vector<bool> visible_set(const std::vector<std::uint32_t>& flags) {
-    std::vector<bool> visible(flags.size());
-    for (std::size_t p = 0; p < flags.size(); ++p) visible[p] = (flags[p] & gl::kStatusVisible) != 0;
-    return visible;
-}
 
 double fraction_culled(const std::vector<std::uint8_t>& culled) {
     if (culled.empty()) return 0;
@@ -80,20 +75,10 @@ int run_occlusion(const OcclusionOptions& o) {
         params.frame.render = render_params(camera, width, height, o.tess, model.closed);
         params.frame.cull = gl::CullMode::occlusion;
         params.frame.timing = gl::TimingMethod::off;
-        pipeline.reset_visibility();
-        gl::FrameStats stats;
-        std::vector<bool> previous;
-        bool stable = false;
-        int frames = 0;
-        while (frames < o.max_frames && !stable) {
-            stats = pipeline.render_frame(params);
-            ++frames;
-            std::vector<bool> visible = visible_set(pipeline.renderer().read_cull_flags());
-            stable = visible == previous;
-            previous = std::move(visible);
-        }
-        if (!stable) ++unstable;
-        frames_sum += frames;
+        const ConvergedFrame converged = converge_frame(pipeline, params, o.max_frames);
+        const gl::FrameStats& stats = converged.stats;
+        if (!converged.stable) ++unstable;
+        frames_sum += converged.frames;
         const double occluded = double(stats.occlusion_culled) / double(std::max<std::size_t>(patches, 1));
         occluded_sum += occluded;
         occluded_min = std::min(occluded_min, occluded);
@@ -146,7 +131,7 @@ int run_occlusion(const OcclusionOptions& o) {
 }  // namespace
 
 Runner add_eval_command(CLI::App& app) {
-    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion, eval displaced)");
+    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion, eval displaced, eval temporal)");
     // At most one; none is reported by the runner ("eval: expected a subcommand ..."), which names
     // the command, unlike CLI11's own message.
     eval->require_subcommand(0, 1);
@@ -178,10 +163,35 @@ Runner add_eval_command(CLI::App& app) {
     add_size_option(*displaced_command, "--size", displaced->size, "framebuffer size");
     add_int_option(*displaced_command, "--tess", displaced->tess, 1, 64, "uniform tessellation level");
     displaced_command->add_flag("--json", displaced->json, "print one JSON object");
-    return [command, occlusion, displaced_command, displaced]() {
+
+    auto temporal = std::make_shared<TemporalEvalOptions>();
+    CLI::App* temporal_command = eval->add_subcommand(
+        "temporal", "Seed 000 Fig. 9 right: occluded fraction of the running pipeline against the camera's rotation speed");
+    add_text_option(*temporal_command, "MODEL", temporal->model, "OBJ control mesh, or 'teapot'")->required();
+    add_choice_option(*temporal_command, "--scheme", temporal->scheme, {"acc", "osd"},
+                      "Catmull-Clark to Bezier scheme");
+    temporal_command
+        ->add_option_function<std::string>(
+            "--speeds",
+            [temporal](const std::string& text) {
+                parse_speeds("--speeds", text);  // throws naming --speeds
+                temporal->speeds = text;
+            },
+            "camera rotation speeds in degrees per frame, comma-separated (1.." + std::to_string(kMaxSpeeds) +
+                " values in 0..180)")
+        ->type_name("LIST")
+        ->default_str(temporal->speeds);
+    add_int_option(*temporal_command, "--frames", temporal->frames, 2, 10000,
+                   "frames per speed (frame 0 primes the statuses)");
+    add_size_option(*temporal_command, "--size", temporal->size, "framebuffer size");
+    add_int_option(*temporal_command, "--tess", temporal->tess, 1, 64, "uniform tessellation level");
+    temporal_command->add_flag("--json", temporal->json, "print one JSON object");
+    return [command, occlusion, displaced_command, displaced, temporal_command, temporal]() {
         if (command->parsed()) return run_occlusion(*occlusion);
         if (displaced_command->parsed()) return run_displaced_eval(*displaced);
-        throw Error("eval: expected a subcommand: occlusion or displaced (e.g. patchcull eval occlusion MODEL --json)");
+        if (temporal_command->parsed()) return run_temporal_eval(*temporal);
+        throw Error("eval: expected a subcommand: occlusion, displaced or temporal (e.g. patchcull eval occlusion MODEL "
+                    "--json)");
     };
 }
 

@@ -2,7 +2,7 @@
 // back-patch pass) over an animated scene and a moving camera, optionally verified frame by frame
 // against the unculled render (compare_frames: a patch visible unculled but culled is a false
 // cull). Output (--json), one object:
-//   {"model","patches","size":[w,h],"tess","cull","backpatch","aggressive","verified",
+//   {"model","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
 //    "frames":[{"frame","pass1_drawn","pass2_drawn","frustum_culled","backpatch_culled",
 //               "occlusion_culled","visible","newly_visible","ms":{"pass1","hiz","cull","pass2",
 //               "total"[,"reference"]},"false_culls"[,"false_culled_patches":[indices]]}],
@@ -10,7 +10,9 @@
 // Without --verify nothing is compared: every false_culls is 0 and "verified" is false. Patch
 // indices are positions in the scene's pose (instances in order, each in its model's order).
 // "backpatch" is "off" when no back-patch test ran (--cull none/frustum/occlusion, or `all` on a
-// scene with an open surface, see applicable_cull_mode).
+// scene with an open surface, see applicable_cull_mode). "tess_mode" is "uniform" (--tess on every
+// patch) or "adaptive" (--tess-mode adaptive: tessellation by distance, seed 000 §6.3, "tess" is
+// the maximum; render_support.h's resolve_tess_mode gives the reference distance).
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -34,6 +36,7 @@ Runner add_render_command(CLI::App& app) {
         std::string cull = "all";
         std::string backpatch = "tcone";
         int tess = 8;
+        TessOptions tess_options;
         std::string size = "640x360";
         bool aggressive = false;
         bool verify = false;
@@ -50,7 +53,8 @@ Runner add_render_command(CLI::App& app) {
                       "cull tests of the pipeline");
     add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
                       "back-patch test of backpatch/all");
-    add_int_option(*command, "--tess", state->tess, 1, 64, "uniform tessellation level");
+    add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
+    add_tess_options(*command, state->tess_options);
     add_size_option(*command, "--size", state->size, "framebuffer size");
     command->add_flag("--aggressive", state->aggressive, "skip the second pass (seed 000 §3.1; not conservative)");
     command->add_flag("--verify", state->verify,
@@ -63,6 +67,7 @@ Runner add_render_command(CLI::App& app) {
         const gl::CullMode cull = parse_cull_mode_option("--cull", state->cull);
         const gl::BackpatchMethod backpatch = parse_backpatch_method("--backpatch", state->backpatch);
         const Scene scene = load_scene(state->model, state->scheme, state->split);
+        const TessMode tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         // Back-patch culling is conservative only on closed surfaces (both sides are drawn, and
         // through an opening the inside of a patch that faces away shows): `all` leaves it out
         // for a scene with an open model; an explicit `backpatch` keeps it, with a warning, so
@@ -89,6 +94,7 @@ Runner add_render_command(CLI::App& app) {
             gl::PipelineParams params;
             params.frame.render =
                 render_params(cameras[static_cast<std::size_t>(f)], width, height, state->tess, one_sided);
+            apply_tess_mode(tess_mode, params.frame.render);
             params.frame.cull = applied;
             params.frame.aggressive = state->aggressive;
             params.backpatch = backpatch;
@@ -137,6 +143,7 @@ Runner add_render_command(CLI::App& app) {
             out["patches"] = scene.patch_count();
             out["size"] = {width, height};
             out["tess"] = state->tess;
+            out["tess_mode"] = tess_mode.adaptive ? "adaptive" : "uniform";
             out["cull"] = gl::cull_mode_name(cull);
             out["backpatch"] = backpatch_applied ? gl::backpatch_method_name(backpatch) : "off";
             out["aggressive"] = state->aggressive;

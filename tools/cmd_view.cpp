@@ -4,6 +4,7 @@
 // colour image is blitted to the window and swapped in; the camera path loops until the window
 // is closed (or Escape), or stops after --frames frames. --screenshot writes the window's content
 // after the last frame (tests run it under xvfb-run and compare it with `render --out`).
+// --tess-mode / --tess-distance as `render` (render_support.h: TessOptions).
 #include <cstdio>
 #include <memory>
 
@@ -24,6 +25,7 @@ Runner add_view_command(CLI::App& app) {
         std::string cull = "all";
         std::string backpatch = "tcone";
         int tess = 8;
+        TessOptions tess_options;
         std::string size = "960x540";
         std::string screenshot;
     };
@@ -38,7 +40,8 @@ Runner add_view_command(CLI::App& app) {
                       "cull tests of the pipeline");
     add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
                       "back-patch test of backpatch/all");
-    add_int_option(*command, "--tess", state->tess, 1, 64, "uniform tessellation level");
+    add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
+    add_tess_options(*command, state->tess_options);
     add_size_option(*command, "--size", state->size, "window size");
     add_output_file_option(*command, "--screenshot", state->screenshot,
                            "after the last frame, write the window's content as a PNG");
@@ -50,6 +53,7 @@ Runner add_view_command(CLI::App& app) {
         if (!state->screenshot.empty() && state->frames == 0)
             throw Error("--screenshot: needs --frames N (the last frame is the one saved)");
         const Scene scene = load_scene(state->model, state->scheme, state->split);
+        const TessMode tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         const gl::CullMode applied = applicable_cull_mode(scene, cull, "view");
 
         gl::GlContext context = gl::GlContext::create_window(width, height, "patchcull view: " + scene.name);
@@ -70,6 +74,7 @@ Runner add_view_command(CLI::App& app) {
             gl::PipelineParams params;
             params.frame.render = render_params(cameras[static_cast<std::size_t>(f % lap)], width, height, state->tess,
                                                 scene_is_one_sided(scene));
+            apply_tess_mode(tess_mode, params.frame.render);
             params.frame.cull = applied;
             params.backpatch = backpatch;
             const gl::FrameStats stats = pipeline.render_frame(params);

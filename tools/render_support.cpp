@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iostream>
 
+#include "cli_options.h"
 #include "commands.h"
 #include "patchcull/error.h"
 
@@ -79,6 +81,38 @@ gl::CullMode applicable_cull_mode(const Scene& scene, gl::CullMode requested, co
         return requested;
     }
     return requested;
+}
+
+void add_tess_options(CLI::App& command, TessOptions& options) {
+    add_choice_option(command, "--tess-mode", options.mode, {"uniform", "adaptive"},
+                      "uniform: --tess everywhere; adaptive: by distance (seed 000 §6.3), --tess the maximum");
+    CLI::Option* distance = command.add_option_function<std::string>(
+        "--tess-distance",
+        [&options](const std::string& text) {
+            const float d = static_cast<float>(parse_real("--tess-distance", text, 0, 1e9));
+            // > 0 after rounding to float as well (1e-50 parses but is 0 as a float).
+            if (!(d > 0)) throw Error("--tess-distance: expected a distance > 0, got " + quote_input(text));
+            options.distance = d;
+        },
+        "adaptive: distance from the eye that gets the full --tess level (default: the camera path's eye-to-target "
+        "distance)");
+    distance->type_name("REAL >0");
+}
+
+float camera_path_eye_distance(const CameraPath& path) { return std::hypot(path.distance, path.height); }
+
+TessMode resolve_tess_mode(const TessOptions& options, const CameraPath& path) {
+    TessMode mode;
+    mode.adaptive = options.mode == "adaptive";
+    if (options.distance > 0 && !mode.adaptive)
+        throw Error("--tess-distance: needs --tess-mode adaptive (uniform tessellation has no reference distance)");
+    mode.reference_distance = options.distance > 0 ? options.distance : camera_path_eye_distance(path);
+    return mode;
+}
+
+void apply_tess_mode(const TessMode& mode, gl::RenderParams& params) {
+    params.adaptive_tess = mode.adaptive;
+    params.tess_reference_distance = mode.reference_distance;
 }
 
 gl::BackpatchMethod parse_backpatch_method(const std::string& flag, const std::string& text) {

@@ -11,6 +11,10 @@
 #include "patchcull/default_scene.h"
 #include "patchcull/gl_pipeline.h"
 
+namespace CLI {
+class App;
+}
+
 namespace patchcull::cli {
 
 /// Seconds of animation between two frames of a sequence (frames are 1/12 s apart: a visible
@@ -53,6 +57,32 @@ Scene load_scene(const std::string& model, const std::string& scheme_text, int s
 /// the back-patch test, and an explicit `backpatch` keeps it with a one-line warning on stderr
 /// (prefixed with command).
 gl::CullMode applicable_cull_mode(const Scene& scene, gl::CullMode requested, const std::string& command);
+
+/// --tess-mode uniform|adaptive and --tess-distance D of `render` and `view` (as parsed).
+struct TessOptions {
+    std::string mode = "uniform";
+    float distance = 0;  ///< 0: not given (add_tess_options refuses 0 itself)
+};
+/// Registers --tess-mode (uniform|adaptive) and --tess-distance (a finite number > 0, at most
+/// 1e9; parse errors name the flag) on command.
+void add_tess_options(CLI::App& command, TessOptions& options);
+
+/// The tessellation of a run (seed 000 §6.3's adaptive case): uniform (--tess everywhere), or
+/// adaptive by distance (gl::RenderParams::adaptive_tess: level --tess at reference_distance from
+/// the eye and nearer, proportionally less farther away, at least 1).
+struct TessMode {
+    bool adaptive = false;
+    float reference_distance = 1;
+};
+/// Resolves the options for a scene seen along path: the reference distance is --tess-distance,
+/// or by default the camera path's eye-to-target distance (camera_path_eye_distance), so that the
+/// surface at the centre of the orbit gets the full level. Throws patchcull::Error naming
+/// --tess-distance when it is given without --tess-mode adaptive.
+TessMode resolve_tess_mode(const TessOptions& options, const CameraPath& path);
+/// Sets params.adaptive_tess and params.tess_reference_distance from mode.
+void apply_tess_mode(const TessMode& mode, gl::RenderParams& params);
+/// Distance from every eye of path to its target: sqrt(distance^2 + height^2).
+float camera_path_eye_distance(const CameraPath& path);
 
 /// "tcone", "ncone", "ptp" -> method; throws patchcull::Error naming flag otherwise.
 gl::BackpatchMethod parse_backpatch_method(const std::string& flag, const std::string& text);
