@@ -263,9 +263,10 @@ public:
     void begin(const PatchBuffers& patches);
     /// Reasons -> statuses: a patch with no reason gets kStatusVisible (plus kStatusNewlyVisible
     /// when it lacked kStatusVisible), a culled one its reason alone. Adds the counts (shared.h's
-    /// kCounter*; kCounterDisplacedOcclusion needs the margins) to counters (kCounterCount uints;
-    /// 0 = not counted).
-    void end(const PatchBuffers& patches, std::uint32_t counters);
+    /// kCounter*; kCounterDisplacedOcclusion needs the margins) to counters (kCounterCount uints
+    /// from byte counters_offset, a multiple of GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT; 0 = not
+    /// counted).
+    void end(const PatchBuffers& patches, std::uint32_t counters, std::size_t counters_offset = 0);
 
 private:
     struct Impl;

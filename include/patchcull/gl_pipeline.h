@@ -58,6 +58,21 @@ struct FrameParams {
     TimingMethod timing = TimingMethod::automatic;
 };
 
+/// One object of the patch set: the patches [first, first + count), culled or not this frame.
+/// An object with cull = false is drawn whole (its flag words get kStatusVisible), its tests are
+/// not run: the per-object switch of seed 000 §6.3 (culling an object costs more than it saves
+/// when it is small on screen or almost all visible).
+struct ObjectRange {
+    std::size_t first = 0;
+    std::size_t count = 0;
+    bool cull = true;
+};
+
+/// Counts of one object in a frame (FrameStats::objects), as FrameStats's.
+struct ObjectStats {
+    std::size_t patches = 0, frustum_culled = 0, backpatch_culled = 0, occlusion_culled = 0, visible = 0;
+};
+
 /// Parameters of one pipeline frame: the frame and the choice of each test.
 struct PipelineParams {
     FrameParams frame;
@@ -67,6 +82,10 @@ struct PipelineParams {
     /// displacement_ranges and a displacement map is set).
     DisplacedBoundKind bound = DisplacedBoundKind::caf;
     NormalConeKind cone = NormalConeKind::acon;
+    /// The objects (disjoint ranges, in any order, within the set), or empty: one object of every
+    /// patch, culled. Patches outside every range are drawn unculled. Throws when a range leaves
+    /// the set or two overlap.
+    std::vector<ObjectRange> objects;
 };
 
 /// What one frame did. Counts are patches; each patch has exactly one of: frustum_culled,
@@ -91,6 +110,9 @@ struct FrameStats {
     /// Of cull_ms: the back-patch pass alone (0 when the mode has no back-patch test).
     double backpatch_ms = 0;
     TimingMethod timing = TimingMethod::off;  ///< the method used (never automatic)
+    /// Per object of PipelineParams::objects, in its order (one entry for the whole set when it
+    /// is empty). An object not culled this frame counts all its patches visible.
+    std::vector<ObjectStats> objects;
 };
 
 /// A PatchRenderer and the cull passes of gl_passes.h on its buffers.

@@ -2,7 +2,9 @@
 // gl_passes.h chained through the renderer's flag buffer.
 #include <epoxy/gl.h>
 
+#include <algorithm>
 #include <chrono>
+#include <string>
 #include <vector>
 
 #include "patchcull/error.h"
@@ -61,7 +63,11 @@ struct CullPipeline::Impl {
         : renderer(ctx), frustum(passes), hiz_build(passes), occlusion(passes), cones(passes), ptp(passes),
           displaced(passes), status(passes) {
         glCreateBuffers(1, &counters);
-        glNamedBufferStorage(counters, sh::kCounterCount * sizeof(std::uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        GLint alignment = 16;
+        glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &alignment);
+        const std::size_t bytes = sh::kCounterCount * sizeof(std::uint32_t);
+        const std::size_t a = static_cast<std::size_t>(std::max(alignment, 1));
+        counter_stride = (bytes + a - 1) / a * a;
         check_gl("CullPipeline setup");
     }
     ~Impl() {
@@ -79,7 +85,9 @@ struct CullPipeline::Impl {
     DisplacedPass displaced;
     CullStatusPass status;
     HiZTexture hiz;  // of the framebuffer's size; recreated when it changes
-    GLuint counters = 0;
+    GLuint counters = 0;             // kCounterCount uints per object (+ one slot for the rest)
+    std::size_t counter_stride = 0;  // bytes between slots (the SSBO offset alignment)
+    std::size_t counter_slots = 0;   // slots allocated
     GLuint timer_queries[PassClock::kMaxMarks] = {};
     // The renderer's flag_generation when the statuses were primed; another value (the flags were
     // replaced, or reset_visibility) makes the next frame a first frame.
@@ -91,6 +99,14 @@ struct CullPipeline::Impl {
         for (std::size_t p = 0; p < words.size(); p += 2) words[p] = sh::kStatusVisible;
         renderer.set_flag_words(words);
         primed_generation = renderer.flag_generation();
+    }
+
+    void ensure_counter_slots(std::size_t slots) {
+        if (slots > counter_slots) {
+            glNamedBufferData(counters, static_cast<GLsizeiptr>(slots * counter_stride), nullptr, GL_DYNAMIC_READ);
+            counter_slots = slots;
+        }
+        glClearNamedBufferData(counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
     }
 
     void ensure_hiz() {
@@ -147,34 +163,64 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     const Mat4 object_to_clip = rp.projection * rp.view;
     const Vec3 eye = eye_of_view(rp.view);
 
+    // The objects, and the ranges between them (drawn unculled, counted in the last slot).
+    const std::size_t count = r.patch_count();
+    std::vector<ObjectRange> objects = params.objects;
+    if (objects.empty()) objects.push_back({0, count, true});
+    std::vector<ObjectRange> sorted = objects;
+    std::sort(sorted.begin(), sorted.end(), [](const ObjectRange& a, const ObjectRange& b) { return a.first < b.first; });
+    std::vector<ObjectRange> gaps;
+    std::size_t covered = 0;
+    for (const ObjectRange& o : sorted) {
+        if (o.first > count || o.count > count - o.first)
+            throw Error("render_frame: object [" + std::to_string(o.first) + ", +" + std::to_string(o.count) +
+                        ") leaves the set of " + std::to_string(count) + " patches");
+        if (o.first < covered) throw Error("render_frame: objects overlap at patch " + std::to_string(o.first));
+        if (o.first > covered) gaps.push_back({covered, o.first - covered, false});
+        covered = o.first + o.count;
+    }
+    if (covered < count) gaps.push_back({covered, count - covered, false});
+    auto range_of = [&chain](const ObjectRange& o) {
+        PatchBuffers b = chain;
+        b.first = o.first;
+        b.count = o.count;
+        return b;
+    };
+
     if (m.primed_generation != r.flag_generation()) m.prime_statuses();
-    glClearNamedBufferData(m.counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    m.ensure_counter_slots(objects.size() + 1);
     PassClock clock(method, m.timer_queries);
     clock.mark();
-    // The flag chain (gl_passes.h), in three timed parts: begin + frustum, back-patch, the rest.
+    // The flag chain (gl_passes.h) per culled object, in three timed parts: begin + frustum,
+    // back-patch, the rest.
     auto run_chain = [&](const HiZTexture* hiz) {
         m.status.begin(chain);
-        if (tests & sh::kCullFrustum)
-            m.frustum.run(chain, make_frustum_planes(object_to_clip, ClipDepth::zero_to_one));
+        const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
+        for (const ObjectRange& o : objects)
+            if (o.cull && (tests & sh::kCullFrustum)) m.frustum.run(range_of(o), planes);
         clock.mark();
-        if (tests & sh::kCullBackPatch) {
+        for (const ObjectRange& o : objects) {
+            if (!o.cull || !(tests & sh::kCullBackPatch)) continue;
             if (params.backpatch == BackpatchMethod::ptp)
-                m.ptp.run(chain, object_to_clip, clip_space_eye_alpha(rp.projection), params.ptp_rule);
+                m.ptp.run(range_of(o), object_to_clip, clip_space_eye_alpha(rp.projection), params.ptp_rule);
             else
-                m.cones.run(chain, params.backpatch, eye);
+                m.cones.run(range_of(o), params.backpatch, eye);
         }
         clock.mark();
         // The frustum pass ran first when the mode has it: the occlusion pass only tests Hi-Z.
         const HiZTexture* occluding = (tests & sh::kCullOcclusion) ? hiz : nullptr;
-        if (occluding) m.occlusion.run(chain, object_to_clip, *occluding, false);
-        if (ranges && (tests & (sh::kCullFrustum | sh::kCullOcclusion))) {
-            // Its own frustum test belongs to the frustum mode; without it, Hi-Z only is not
-            // available for bounds, so the displaced pass runs when either test is asked for and
-            // applies the bound's frustum test too (a bound outside the frustum is invisible).
-            const DisplacedCullView view = make_displaced_cull_view(rp.view, rp.projection, ClipDepth::zero_to_one);
-            m.displaced.run(chain, ranges, params.bound, params.cone, view, occluding, true);
+        // The displaced pass runs when either test is asked for, with the bound's frustum test
+        // too (a bound outside the frustum is invisible), against the pyramid when occluding.
+        const bool bounds = ranges && (tests & (sh::kCullFrustum | sh::kCullOcclusion));
+        const DisplacedCullView view =
+            bounds ? make_displaced_cull_view(rp.view, rp.projection, ClipDepth::zero_to_one) : DisplacedCullView{};
+        for (const ObjectRange& o : objects) {
+            if (!o.cull) continue;
+            if (occluding) m.occlusion.run(range_of(o), object_to_clip, *occluding, false);
+            if (bounds) m.displaced.run(range_of(o), ranges, params.bound, params.cone, view, occluding, true);
         }
-        m.status.end(chain, m.counters);
+        for (std::size_t i = 0; i < objects.size(); ++i) m.status.end(range_of(objects[i]), m.counters, i * m.counter_stride);
+        for (const ObjectRange& g : gaps) m.status.end(range_of(g), m.counters, objects.size() * m.counter_stride);
         clock.mark();
     };
     if (two_pass) {
@@ -199,9 +245,22 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     }
     check_gl("render_frame");
 
-    std::uint32_t c[sh::kCounterCount] = {};
-    glGetNamedBufferSubData(m.counters, 0, sizeof c, c);
+    std::vector<std::uint32_t> slots((objects.size() + 1) * m.counter_stride / sizeof(std::uint32_t));
+    glGetNamedBufferSubData(m.counters, 0, static_cast<GLsizeiptr>(slots.size() * sizeof(std::uint32_t)), slots.data());
     check_gl("render_frame counters");
+    std::uint32_t c[sh::kCounterCount] = {};
+    for (std::size_t i = 0; i <= objects.size(); ++i) {
+        const std::uint32_t* slot = slots.data() + i * m.counter_stride / sizeof(std::uint32_t);
+        for (std::uint32_t k = 0; k < sh::kCounterCount; ++k) c[k] += slot[k];
+        if (i == objects.size()) break;
+        ObjectStats o;
+        o.patches = objects[i].count;
+        o.frustum_culled = slot[sh::kCounterFrustum];
+        o.backpatch_culled = slot[sh::kCounterBackPatch];
+        o.occlusion_culled = slot[sh::kCounterOcclusion];
+        o.visible = slot[sh::kCounterVisible];
+        stats.objects.push_back(o);
+    }
     stats.frustum_culled = c[sh::kCounterFrustum];
     stats.backpatch_culled = c[sh::kCounterBackPatch];
     stats.occlusion_culled = c[sh::kCounterOcclusion];

@@ -11,9 +11,10 @@ struct CullStatusPass::Impl {
     detail::ParamBlock block;
     GLuint scratch_counters = 0;  // bound when the caller counts nothing
 
-    void run(const PatchBuffers& patches, pp::uint mode, GLuint counters) {
+    void run(const PatchBuffers& patches, pp::uint mode, GLuint counters, std::size_t offset) {
         detail::check_patch_buffers("CullStatusPass", patches);
-        if (counters) detail::check_buffer_size("CullStatusPass", "counter", counters, shared::kCounterCount * 4);
+        if (counters)
+            detail::check_buffer_size("CullStatusPass", "counter", counters, offset + shared::kCounterCount * 4);
         if (patches.count == 0) return;
         if (!counters) {
             if (!scratch_counters) {
@@ -21,13 +22,15 @@ struct CullStatusPass::Impl {
                 glNamedBufferStorage(scratch_counters, shared::kCounterCount * 4, nullptr, 0);
             }
             counters = scratch_counters;
+            offset = 0;
         }
         pp::CullStatusParams params;
         params.mode = mode;
         params.has_margins = patches.margins ? 1u : 0u;
         glUseProgram(context.program("cull_status.comp.glsl"));
         detail::bind_patch_buffers(patches);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCullCounters, counters);
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, shared::kBindingCullCounters, counters,
+                          static_cast<GLintptr>(offset), shared::kCounterCount * 4);
         detail::dispatch_patches(block, params, patches.first, patches.count, shared::kCullGroupSize);
         detail::finish_pass("CullStatusPass");
     }
@@ -38,9 +41,9 @@ CullStatusPass::CullStatusPass(CullStatusPass&&) noexcept = default;
 CullStatusPass& CullStatusPass::operator=(CullStatusPass&&) noexcept = default;
 CullStatusPass::~CullStatusPass() = default;
 
-void CullStatusPass::begin(const PatchBuffers& patches) { impl_->run(patches, shared::kStatusBegin, 0); }
-void CullStatusPass::end(const PatchBuffers& patches, std::uint32_t counters) {
-    impl_->run(patches, shared::kStatusEnd, counters);
+void CullStatusPass::begin(const PatchBuffers& patches) { impl_->run(patches, shared::kStatusBegin, 0, 0); }
+void CullStatusPass::end(const PatchBuffers& patches, std::uint32_t counters, std::size_t counters_offset) {
+    impl_->run(patches, shared::kStatusEnd, counters, counters_offset);
 }
 
 }  // namespace patchcull::gl

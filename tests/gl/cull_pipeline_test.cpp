@@ -1,5 +1,5 @@
-// CullPipeline (patchcull/gl_pipeline.h): the GPU back-patch pass wired into seed 000 §3's frame
-// through the back-patch hook. For tcone, ncone and ptp: the frame culls exactly the patches the
+// CullPipeline (patchcull/gl_pipeline.h): the GPU back-patch pass in seed 000 §3's frame (the flag
+// chain of gl_passes.h), and the per-object switch (PipelineParams::objects). For tcone, ncone and ptp: the frame culls exactly the patches the
 // CPU scalar kernel culls (every patch is inside the frustum), the final id buffer equals the
 // unculled render's (no false cull), and after update_patches the pass reads the new pose.
 // Small: BigGuy (1450 patches; a closed surface, as back-patch culling requires), 64x64, level 2.
@@ -138,4 +138,57 @@ TEST(CullPipeline, ModesWithoutBackPatchRunNoPass) {
         EXPECT_EQ(s.backpatch_culled, 0u) << cull_mode_name(mode);
         EXPECT_EQ(s.backpatch_ms, 0.0) << cull_mode_name(mode);
     }
+}
+
+TEST(CullPipeline, ObjectsSwitchCullingPerRangeAndCountApart) {
+    // Three copies of BigGuy side by side as three objects: the middle one not culled. Its
+    // patches are all drawn and counted visible, the others are culled as one set would be; the
+    // per-object counts add up to the frame's; patches outside every object are drawn unculled.
+    const std::vector<BezierPatch>& one = bigguy();
+    const Bounds b = test::control_point_bounds(one);
+    const float step = 1.2f * length(b.max - b.min);
+    std::vector<BezierPatch> three;
+    for (int c = 0; c < 3; ++c)
+        for (BezierPatch patch : one) {
+            for (Vec4& q : patch.cp) q = homogeneous(cartesian(q) + Vec3{step * static_cast<float>(c - 1), 0, 0}, q.w);
+            three.push_back(patch);
+        }
+    CullPipeline& p = pipeline();
+    p.set_patches(three);
+    const std::size_t n = one.size();
+    PipelineParams params;
+    params.frame.render = params_for(orbit_sequence(test::control_point_bounds(three), 1, 0.0f)[0]);
+    params.frame.render.discard_back_facing = true;
+    params.frame.cull = CullMode::all;
+    params.objects = {{0, n, true}, {n, n, false}, {2 * n, n, true}};
+    p.render_frame(params);  // first frame
+    const FrameStats s = p.render_frame(params);
+    ASSERT_EQ(s.objects.size(), 3u);
+    std::size_t frustum = 0, back = 0, occluded = 0, visible = 0;
+    for (const ObjectStats& o : s.objects) {
+        EXPECT_EQ(o.patches, n);
+        EXPECT_EQ(o.frustum_culled + o.backpatch_culled + o.occlusion_culled + o.visible, n);
+        frustum += o.frustum_culled;
+        back += o.backpatch_culled;
+        occluded += o.occlusion_culled;
+        visible += o.visible;
+    }
+    EXPECT_EQ(s.objects[1].visible, n);  // not culled: all drawn
+    EXPECT_GT(s.objects[0].backpatch_culled + s.objects[2].backpatch_culled, n / 4);
+    EXPECT_EQ(frustum, s.frustum_culled);
+    EXPECT_EQ(back, s.backpatch_culled);
+    EXPECT_EQ(occluded, s.occlusion_culled);
+    EXPECT_EQ(visible, s.visible);
+    const std::vector<std::uint32_t> words = p.renderer().read_cull_flags();
+    for (std::size_t i = n; i < 2 * n; ++i) ASSERT_EQ(words[i], kStatusVisible) << "patch " << i;
+    // Patches between objects: drawn, not tested.
+    params.objects = {{0, n, true}, {2 * n, n, true}};
+    const FrameStats gap = p.render_frame(params);
+    EXPECT_EQ(gap.objects.size(), 2u);
+    EXPECT_GE(gap.visible, n);
+    // Ranges that leave the set or overlap are refused.
+    params.objects = {{0, n + 1, true}, {n, n, true}};
+    EXPECT_THROW(p.render_frame(params), patchcull::Error);
+    params.objects = {{2 * n, n + 1, true}};
+    EXPECT_THROW(p.render_frame(params), patchcull::Error);
 }
