@@ -69,7 +69,8 @@ int run_demo(const DemoOptions& options) {
 
     pipeline.set_patches(poses[0], attributes[0]);
     renderer.set_occluders(scene.occluder_vertices, scene.occluder_indices);
-    std::printf("patchcull default scene: 3 BigGuy + 3 MonsterFrog (ACC, animated), %zu patches, %zu occluder "
+    renderer.set_displacement_map(scene.displacement);  // the frogs are displaced (seed 000 §6)
+    std::printf("patchcull default scene: 3 BigGuy + 3 displaced MonsterFrog (ACC, animated), %zu patches, %zu occluder "
                 "triangles;\n%d frames along the camera path, %dx%d, tessellation level %d; %s (%s).\n",
                 patches, renderer.occluder_triangle_count(), options.frames, width, height, options.tess,
                 context.renderer().c_str(), context.is_software() ? "software: wall-clock pass times" : "GPU timer queries");

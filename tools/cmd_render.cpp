@@ -3,8 +3,10 @@
 // against the unculled render (compare_frames: a patch visible unculled but culled is a false
 // cull). Output (--json), one object:
 //   {"model","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
+//    "displace","displace_scale","displaced_patches","bound","cone",
 //    "frames":[{"frame","pass1_drawn","pass2_drawn","frustum_culled","backpatch_culled",
-//               "occlusion_culled","visible","newly_visible","ms":{"pass1","hiz","cull","pass2",
+//               "occlusion_culled","displaced_occlusion_culled","visible","newly_visible",
+//               "ms":{"pass1","hiz","cull","pass2",
 //               "total"[,"reference"]},"false_culls"[,"false_culled_patches":[indices]]}],
 //    "false_culls"}
 // Without --verify nothing is compared: every false_culls is 0 and "verified" is false. Patch
@@ -12,7 +14,12 @@
 // "backpatch" is "off" when no back-patch test ran (--cull none/frustum/occlusion, or `all` on a
 // scene with an open surface, see applicable_cull_mode). "tess_mode" is "uniform" (--tess on every
 // patch) or "adaptive" (--tess-mode adaptive: tessellation by distance, seed 000 §6.3, "tess" is
-// the maximum; render_support.h's resolve_tess_mode gives the reference distance).
+// the maximum; render_support.h's resolve_tess_mode gives the reference distance). "displace" is
+// the scene's map ("none", "procedural" or the PNG path; the default scene displaces its
+// MonsterFrogs), "displaced_patches" the patches with a nonzero displacement range; displaced
+// patches are culled by the frustum and the running pipeline's Hi-Z with the bound ("caf" or
+// "oobb") and cone ("full", "acon", "con") of seed 000 §4.2, and never by back-patch tests;
+// "displaced_occlusion_culled" counts those of "occlusion_culled" that are displaced.
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -37,6 +44,7 @@ Runner add_render_command(CLI::App& app) {
         std::string backpatch = "tcone";
         int tess = 8;
         TessOptions tess_options;
+        DisplaceOptions displace;
         std::string size = "640x360";
         bool aggressive = false;
         bool verify = false;
@@ -55,6 +63,7 @@ Runner add_render_command(CLI::App& app) {
                       "back-patch test of backpatch/all");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
+    add_displace_options(*command, state->displace);
     add_size_option(*command, "--size", state->size, "framebuffer size");
     command->add_flag("--aggressive", state->aggressive, "skip the second pass (seed 000 §3.1; not conservative)");
     command->add_flag("--verify", state->verify,
@@ -66,7 +75,8 @@ Runner add_render_command(CLI::App& app) {
         parse_size("--size", state->size, width, height);
         const gl::CullMode cull = parse_cull_mode_option("--cull", state->cull);
         const gl::BackpatchMethod backpatch = parse_backpatch_method("--backpatch", state->backpatch);
-        const Scene scene = load_scene(state->model, state->scheme, state->split);
+        Scene scene = load_scene(state->model, state->scheme, state->split);
+        apply_displace_options(state->displace, scene);
         const TessMode tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         // Back-patch culling is conservative only on closed surfaces (both sides are drawn, and
         // through an opening the inside of a patch that faces away shows): `all` leaves it out
@@ -81,6 +91,7 @@ Runner add_render_command(CLI::App& app) {
         ScenePoser poser(scene);
         const std::vector<BezierPatch>& first_pose = poser.pose(0);  // before pose_attributes reads it
         pipeline.set_patches(first_pose, pose_attributes(poser));
+        pipeline.renderer().set_displacement_map(scene.displacement);
         pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
         const std::vector<Camera> cameras = scene.camera_path(state->frames, float(width) / float(height));
 
@@ -98,6 +109,8 @@ Runner add_render_command(CLI::App& app) {
             params.frame.cull = applied;
             params.frame.aggressive = state->aggressive;
             params.backpatch = backpatch;
+            params.bound = displace_bound(state->displace);
+            params.cone = displace_cone(state->displace);
             const gl::FrameStats stats = pipeline.render_frame(params);
             const bool last = f + 1 == state->frames;
             if (last && !state->out.empty()) pipeline.renderer().write_color_png(state->out);
@@ -121,6 +134,7 @@ Runner add_render_command(CLI::App& app) {
                               {"frustum_culled", stats.frustum_culled},
                               {"backpatch_culled", stats.backpatch_culled},
                               {"occlusion_culled", stats.occlusion_culled},
+                              {"displaced_occlusion_culled", stats.displaced_occlusion_culled},
                               {"visible", stats.visible},
                               {"newly_visible", stats.newly_visible},
                               {"ms", ms},
@@ -128,11 +142,11 @@ Runner add_render_command(CLI::App& app) {
                               {"depth_ties", depth_ties}});
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
             if (!state->json) {
-                std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu; "
-                            "ms pass1 %.1f hiz %.1f cull %.1f pass2 %.1f",
+                std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
+                            "(displaced %zu); ms pass1 %.1f hiz %.1f cull %.1f pass2 %.1f",
                             f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
-                            stats.backpatch_culled, stats.occlusion_culled, stats.pass1_ms, stats.hiz_ms,
-                            stats.cull_ms, stats.pass2_ms);
+                            stats.backpatch_culled, stats.occlusion_culled, stats.displaced_occlusion_culled,
+                            stats.pass1_ms, stats.hiz_ms, stats.cull_ms, stats.pass2_ms);
                 if (state->verify) std::printf("; false culls %zu", false_culls);
                 std::printf("\n");
             }
@@ -148,6 +162,11 @@ Runner add_render_command(CLI::App& app) {
             out["backpatch"] = backpatch_applied ? gl::backpatch_method_name(backpatch) : "off";
             out["aggressive"] = state->aggressive;
             out["verified"] = state->verify;
+            out["displace"] = scene.displacement_name;
+            out["displace_scale"] = scene.displacement.empty() ? 0.0f : scene.displacement.scale;
+            out["displaced_patches"] = displaced_patch_count(poser);
+            out["bound"] = state->displace.bound;
+            out["cone"] = state->displace.cone;
             out["renderer"] = context.renderer();
             out["frames"] = frames;
             out["false_culls"] = total_false;

@@ -26,6 +26,7 @@ Runner add_view_command(CLI::App& app) {
         std::string backpatch = "tcone";
         int tess = 8;
         TessOptions tess_options;
+        DisplaceOptions displace;
         std::string size = "960x540";
         std::string screenshot;
     };
@@ -42,6 +43,7 @@ Runner add_view_command(CLI::App& app) {
                       "back-patch test of backpatch/all");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
+    add_displace_options(*command, state->displace);
     add_size_option(*command, "--size", state->size, "window size");
     add_output_file_option(*command, "--screenshot", state->screenshot,
                            "after the last frame, write the window's content as a PNG");
@@ -52,7 +54,8 @@ Runner add_view_command(CLI::App& app) {
         const gl::BackpatchMethod backpatch = parse_backpatch_method("--backpatch", state->backpatch);
         if (!state->screenshot.empty() && state->frames == 0)
             throw Error("--screenshot: needs --frames N (the last frame is the one saved)");
-        const Scene scene = load_scene(state->model, state->scheme, state->split);
+        Scene scene = load_scene(state->model, state->scheme, state->split);
+        apply_displace_options(state->displace, scene);
         const TessMode tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         const gl::CullMode applied = applicable_cull_mode(scene, cull, "view");
 
@@ -61,6 +64,7 @@ Runner add_view_command(CLI::App& app) {
         ScenePoser poser(scene);
         const std::vector<BezierPatch>& first_pose = poser.pose(0);  // before pose_attributes reads it
         pipeline.set_patches(first_pose, pose_attributes(poser));
+        pipeline.renderer().set_displacement_map(scene.displacement);
         pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
         // One lap of the camera path, repeated (the same cameras as `render --frames lap`).
         const int lap = state->frames > 0 ? state->frames : 72;
@@ -77,14 +81,18 @@ Runner add_view_command(CLI::App& app) {
             apply_tess_mode(tess_mode, params.frame.render);
             params.frame.cull = applied;
             params.backpatch = backpatch;
+            params.bound = displace_bound(state->displace);
+            params.cone = displace_cone(state->displace);
             const gl::FrameStats stats = pipeline.render_frame(params);
             pipeline.renderer().blit_color_to_window(width, height);
             const bool last = state->frames > 0 && f + 1 == state->frames;
             if (last && !state->screenshot.empty()) context.write_window_png(state->screenshot);
             context.swap_buffers();
-            std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu; %.1f ms\n", f,
-                        stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
-                        stats.backpatch_culled, stats.occlusion_culled, stats.total_ms);
+            std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
+                        "(displaced %zu); %.1f ms\n",
+                        f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
+                        stats.backpatch_culled, stats.occlusion_culled, stats.displaced_occlusion_culled,
+                        stats.total_ms);
         }
         return 0;
     };

@@ -9,6 +9,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "patchcull/error.h"
+#include "patchcull/image.h"
 
 namespace patchcull::cli {
 
@@ -55,6 +56,10 @@ gl::PatchAttributes pose_attributes(const ScenePoser& poser) {
     attributes.tangent_index = poser.tangent_index();
     attributes.tangents = poser.tangents();
     attributes.depth = poser.depth();
+    if (!poser.displacement_ranges().empty()) {
+        attributes.texcoords = poser.texcoords();
+        attributes.displacement_ranges = poser.displacement_ranges();
+    }
     return attributes;
 }
 
@@ -97,6 +102,52 @@ void add_tess_options(CLI::App& command, TessOptions& options) {
         "adaptive: distance from the eye that gets the full --tess level (default: the camera path's eye-to-target "
         "distance)");
     distance->type_name("REAL >0");
+}
+
+void add_displace_options(CLI::App& command, DisplaceOptions& options) {
+    CLI::Option* displace = add_text_option(
+        command, "--displace", options.displace,
+        "displacement map of every object: 'none', 'procedural' or a PNG height map (default: the scene's own; the "
+        "default scene displaces its MonsterFrogs)");
+    add_float_option(command, "--displace-scale", options.scale, 0, 1,
+                     "displacement of a full height step, in character heights (default 0.02)")
+        ->needs(displace);
+    add_choice_option(command, "--bound", options.bound, {"caf", "oobb"},
+                      "bound of displaced patches (seed 000 §4.2: camera-aligned frustum, or object-oriented box)");
+    add_choice_option(command, "--cone", options.cone, {"full", "acon", "con"},
+                      "normal cone of displaced patches' bounds (full, ACoN, CoN)");
+}
+
+void apply_displace_options(const DisplaceOptions& options, Scene& scene) {
+    if (options.displace.empty()) return;
+    if (options.displace == "none") {
+        scene.displacement = {};
+        scene.displacement_name = "none";
+        for (SceneInstance& instance : scene.instances) instance.displaced = false;
+        return;
+    }
+    const float scale = options.scale >= 0 ? options.scale : 0.02f;
+    if (!(scale > 0)) throw Error("--displace-scale: must be > 0 with --displace " + quote_input(options.displace));
+    scene.displacement = options.displace == "procedural" ? make_procedural_displacement(512, scale)
+                                                         : load_displacement_png(options.displace, scale);
+    scene.displacement_name = options.displace;
+    for (SceneInstance& instance : scene.instances) instance.displaced = true;
+}
+
+std::size_t displaced_patch_count(const ScenePoser& poser) {
+    const std::vector<DisplacementRange>& ranges = poser.displacement_ranges();
+    return static_cast<std::size_t>(std::count_if(ranges.begin(), ranges.end(), [](const DisplacementRange& r) {
+        return r.d_min != 0 || r.d_max != 0;
+    }));
+}
+
+DisplacedBoundKind displace_bound(const DisplaceOptions& options) {
+    return options.bound == "oobb" ? DisplacedBoundKind::oobb : DisplacedBoundKind::caf;
+}
+
+NormalConeKind displace_cone(const DisplaceOptions& options) {
+    if (options.cone == "full") return NormalConeKind::full;
+    return options.cone == "con" ? NormalConeKind::con : NormalConeKind::acon;
 }
 
 float camera_path_eye_distance(const CameraPath& path) { return std::hypot(path.distance, path.height); }

@@ -44,7 +44,8 @@ gl::FrameCapture capture_culled_frame(const gl::PatchRenderer& renderer);
 /// Compares the renderer's current framebuffer (a culled frame) with a reference.
 gl::FrameComparison compare_with_reference(const gl::PatchRenderer& renderer, const ReferenceFrame& reference);
 
-/// The renderer's attributes of the poser's last pose: its ACC tangent patches (shading normals).
+/// The renderer's attributes of the poser's last pose: its ACC tangent patches (shading normals),
+/// refinement depths, and for a displaced scene the texcoords and displacement ranges.
 gl::PatchAttributes pose_attributes(const ScenePoser& poser);
 
 /// The scene of a MODEL argument: "default" (the default scene; split must be 0) or a model
@@ -83,6 +84,28 @@ TessMode resolve_tess_mode(const TessOptions& options, const CameraPath& path);
 void apply_tess_mode(const TessMode& mode, gl::RenderParams& params);
 /// Distance from every eye of path to its target: sqrt(distance^2 + height^2).
 float camera_path_eye_distance(const CameraPath& path);
+
+/// --displace, --displace-scale, --bound and --cone of `render` and `view` (seed 000 §4.2, §6):
+/// displaced patches tested against the frustum and the running pipeline's Hi-Z with the chosen
+/// bound (gl_passes.h's DisplacedPass inside CullPipeline::render_frame).
+struct DisplaceOptions {
+    std::string displace;      ///< "" (the scene's own), "none", "procedural" or a PNG path
+    float scale = -1;          ///< world units (a character is 1 high); < 0: not given (0.02)
+    std::string bound = "caf";
+    std::string cone = "acon";
+};
+/// Registers the four options (--displace-scale needs --displace; parse errors name the flag).
+void add_displace_options(CLI::App& command, DisplaceOptions& options);
+/// Applies --displace to the scene: "none" removes its displacement, "procedural" or a PNG
+/// displaces every instance with that map (make_procedural_displacement(512, scale) or
+/// load_displacement_png), scale --displace-scale or 0.02; "" keeps the scene's own (the default
+/// scene's MonsterFrogs). Throws patchcull::Error naming the flag or file.
+void apply_displace_options(const DisplaceOptions& options, Scene& scene);
+/// Patches of the poser's scene with a nonzero displacement range.
+std::size_t displaced_patch_count(const ScenePoser& poser);
+/// --bound and --cone as the pipeline's enums.
+DisplacedBoundKind displace_bound(const DisplaceOptions& options);
+NormalConeKind displace_cone(const DisplaceOptions& options);
 
 /// "tcone", "ncone", "ptp" -> method; throws patchcull::Error naming flag otherwise.
 gl::BackpatchMethod parse_backpatch_method(const std::string& flag, const std::string& text);

@@ -13,6 +13,7 @@
 // y-up, the built-in teapot as z-up.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -20,6 +21,7 @@
 
 #include "patchcull/animation.h"
 #include "patchcull/camera.h"
+#include "patchcull/displacement.h"
 #include "patchcull/math.h"
 #include "patchcull/mesh.h"
 #include "patchcull/patch.h"
@@ -32,6 +34,7 @@ struct SceneInstance {
     std::size_t model = 0;   ///< index into Scene::models
     Mat4 object_to_world;    ///< affine: the model's object space -> world
     float time_offset = 0;   ///< seconds added to the scene time, so copies move out of step
+    bool displaced = false;  ///< displaced by Scene::displacement (when it is not empty)
 };
 
 /// A camera circling a target: at frame f the eye is at angle start + f * step (degrees, about
@@ -56,6 +59,12 @@ struct Scene {
     std::vector<Vec3> occluder_vertices;
     std::vector<std::uint32_t> occluder_indices;
     AnimationParams animation;  ///< applied to every subdivision model (the teapot stays rigid)
+    /// The height map of the displaced instances (displacement.h: D = scale * (h - midlevel) along
+    /// the unit normal, in world units), sampled at each patch's corner texcoords (PatchInfo::uv);
+    /// empty: nothing is displaced. displacement_name says where it came from ("procedural", a
+    /// PNG path, or "none").
+    DisplacementMap displacement;
+    std::string displacement_name = "none";
     CameraPath camera;
 
     /// Total patch count over the instances (the size of pose()'s output).
@@ -66,10 +75,15 @@ struct Scene {
 
 /// The built-in default scene: three BigGuys and three MonsterFrogs (`scheme`; ACC: 1450 and 1292 patches
 /// each, 8226 in all) on a 12 x 12 ground quad with a long low wall in front of them and two
-/// pillars between them (20 occluder triangles); the camera circles the group at 3.2 units,
-/// 25 degrees over 6 frames (4 degrees per frame from -12). Throws patchcull::Error when a
-/// shipped model cannot be read (PATCHCULL_DATA_DIR as in shipped_model_path).
+/// pillars between them (20 occluder triangles); the camera circles the group at 2.3 units, 5
+/// degrees per frame from -20. The MonsterFrogs are displaced, as the characters of Niessner &
+/// Loop's scenes are (seed 000 §6): by make_procedural_displacement(512, kDefaultSceneDisplaceScale),
+/// a smooth bump field of +-1.5% of a BigGuy's height along the normal, at the frogs' own
+/// texcoords; the BigGuys are not. Throws patchcull::Error when a shipped model cannot be read
+/// (PATCHCULL_DATA_DIR as in shipped_model_path).
 Scene make_default_scene(Scheme scheme = Scheme::acc);
+/// The default scene's displacement scale (world units: a BigGuy is 1 high).
+inline constexpr float kDefaultSceneDisplaceScale = 0.03f;
 
 /// A scene of one model (as load_model returns it): scaled to height 1, standing on the ground
 /// at the origin, with a ground quad as the only occluder, and a camera path like
@@ -92,6 +106,11 @@ public:
     const std::vector<TangentPatches>& tangents() const { return tangents_; }
     /// PatchInfo::depth of each patch of the last pose (for gl::PatchAttributes::depth).
     const std::vector<std::uint8_t>& depth() const { return depth_; }
+    /// Corner texcoords (PatchInfo::uv) and displacement range of each patch of pose(), fixed for
+    /// the scene (computed at construction from Scene::displacement: (0, 0) for instances that are
+    /// not displaced); both empty when the scene has no displacement.
+    const std::vector<std::array<Vec2, 4>>& texcoords() const { return texcoords_; }
+    const std::vector<DisplacementRange>& displacement_ranges() const { return ranges_; }
 
 private:
     const Scene* scene_;
@@ -101,6 +120,8 @@ private:
     std::vector<std::int32_t> tangent_index_;
     std::vector<TangentPatches> tangents_;
     std::vector<std::uint8_t> depth_;
+    std::vector<std::array<Vec2, 4>> texcoords_;
+    std::vector<DisplacementRange> ranges_;
 };
 
 }  // namespace patchcull

@@ -134,9 +134,13 @@ Scene make_default_scene(Scheme scheme) {
     float offset = 0;
     for (const Placement& p : placements) {
         const Mat4& standing = p.model == 0 ? bigguy : frog;
-        scene.instances.push_back({p.model, translation(p.position) * rotation_y(p.yaw_degrees) * standing, offset});
+        const bool displaced = p.model == 1;  // the frogs
+        scene.instances.push_back(
+            {p.model, translation(p.position) * rotation_y(p.yaw_degrees) * standing, offset, displaced});
         offset += 0.37f;
     }
+    scene.displacement = make_procedural_displacement(512, kDefaultSceneDisplaceScale);
+    scene.displacement_name = "procedural";
     add_ground(scene, 6.0f);
     add_box(scene, {-2.6f, 0, 0.75f}, {0.9f, 0.42f, 0.9f});  // low wall in front of the front row
     add_box(scene, {-0.45f, 0, -0.85f}, {-0.2f, 1.5f, -0.6f});  // pillar between the rows
@@ -175,7 +179,16 @@ Scene make_model_scene(LoadedModel model, float degrees_per_frame) {
     return scene;
 }
 
-ScenePoser::ScenePoser(const Scene& scene) : scene_(&scene) {}
+ScenePoser::ScenePoser(const Scene& scene) : scene_(&scene) {
+    if (scene.displacement.empty()) return;
+    for (const SceneInstance& instance : scene.instances) {
+        const PatchFrame& rest = scene.models.at(instance.model).rest;
+        for (const PatchInfo& info : rest.info) {
+            texcoords_.push_back({info.uv[0], info.uv[1], info.uv[2], info.uv[3]});
+            ranges_.push_back(instance.displaced ? scene.displacement.patch_range(info.uv) : DisplacementRange{});
+        }
+    }
+}
 
 const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
     const Scene& scene = *scene_;
