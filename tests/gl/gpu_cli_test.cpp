@@ -184,7 +184,7 @@ TEST(GpuCli, BadRenderFlagsAreOneLineErrors) {
 }
 
 // eval displaced (seed 000 Table 1): six rows with the contract's keys, no false culls against
-// the unculled displaced render, and the nesting that is a theorem: a CAF with a cone lies inside
+// the unculled displaced render (converged depth and running pipeline), and the nesting that is a theorem: a CAF with a cone lies inside
 // the CAF without one (DisplacedBounds.CafWithAConeLiesInsideTheFullCaf), so per view it culls
 // at least as much (a smaller rectangle reads a finer Hi-Z level, whose max is not larger).
 TEST(GpuCli, EvalDisplacedGivesSixRowsWithoutFalseCulls) {
@@ -194,8 +194,15 @@ TEST(GpuCli, EvalDisplacedGivesSixRowsWithoutFalseCulls) {
     ASSERT_EQ(j["rows"].size(), 6u);
     std::map<std::string, double> rate;
     for (const auto& row : j["rows"]) {
-        for (const char* key : {"bound", "cone", "cull_rate", "false_culls"}) ASSERT_TRUE(row.contains(key)) << row.dump();
+        for (const char* key : {"bound", "cone", "cull_rate", "false_culls", "pipeline_cull_rate", "pipeline_frames",
+                                "pipeline_false_culls"})
+            ASSERT_TRUE(row.contains(key)) << row.dump();
         EXPECT_EQ(row["false_culls"], 0) << row.dump();
+        // The running pipeline (its own Hi-Z, displaced patches tested by their bound in the frame).
+        EXPECT_EQ(row["pipeline_false_culls"], 0) << row.dump();
+        EXPECT_GT(row["pipeline_cull_rate"].get<double>(), 0.0) << row.dump();
+        EXPECT_LE(row["pipeline_cull_rate"].get<double>(), 1.0) << row.dump();
+        EXPECT_GE(row["pipeline_frames"].get<double>(), 1.0) << row.dump();
         const double c = row["cull_rate"];
         EXPECT_GE(c, 0.0);
         EXPECT_LE(c, 1.0);
