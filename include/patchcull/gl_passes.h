@@ -54,6 +54,17 @@
 // framebuffer, viewport, depth or VAO state), does not wait for the GPU and allocates no GL
 // objects after its first run (programs are compiled on first use and cached in the PassContext).
 // Large ranges are split into dispatches of at most 65535 work groups (dispatch_patches).
+// GL errors: a run first checks that no GL error is pending (one left by the caller is reported
+// as "GL: error 0x.... pending before <pass> (left by an earlier GL call)", not blamed on the
+// pass) and checks again after its work ("GL: error 0x.... after <pass>"); glGetError is the
+// only query it makes besides buffer sizes (glGetNamedBufferParameteri64v) and names (glIs*).
+// The PassContext constructor, on a GPU (not on software rasterizers), runs the fma probe once:
+// it binds shader storage bindings 13 and 14 (backpatch_shared.h's kBindingProbeIn/Out) and a
+// program, reads one small buffer back (a wait), and leaves glUseProgram(0).
+// Depth conventions: the depth texture and the pyramid hold window depths in [0, 1] (glDepthRange
+// 0..1, GL_LOWER_LEFT, cleared to 1, depth test GL_LESS; no reversed Z: the pyramid keeps the
+// maximum). Matrices are zero-to-one clip space unless a pass takes a ClipDepth (clip_space.h:
+// FrustumPlanes and DisplacedCullView are built with one; OcclusionPass takes one).
 //
 // Threads and lifetime: a PassContext and its passes belong to the GL context current when the
 // PassContext was made; use and destroy them on that thread with that context current.
@@ -68,6 +79,7 @@
 #include <vector>
 
 #include "patchcull/backpatch.h"
+#include "patchcull/clip_space.h"
 #include "patchcull/displaced_bounds.h"
 #include "patchcull/frustum.h"
 #include "patchcull/hiz.h"
@@ -151,7 +163,8 @@ public:
     HiZBuildPass(HiZBuildPass&&) noexcept;
     HiZBuildPass& operator=(HiZBuildPass&&) noexcept;
     ~HiZBuildPass();
-    /// Builds hiz from depth_texture (DEPTH32F, at least hiz.width x hiz.height).
+    /// Builds hiz from depth_texture (DEPTH32F, at least hiz.width x hiz.height, no compare mode;
+    /// its lower-left hiz.width x hiz.height texels: the viewport the frame was drawn with).
     void run(std::uint32_t depth_texture, const HiZTexture& hiz);
 
 private:
@@ -186,7 +199,12 @@ public:
     OcclusionPass(OcclusionPass&&) noexcept;
     OcclusionPass& operator=(OcclusionPass&&) noexcept;
     ~OcclusionPass();
-    void run(const PatchBuffers& patches, const Mat4& object_to_clip, const HiZTexture& hiz, bool with_frustum = true);
+    /// depth: the convention of object_to_clip (clip_space.h; the matrix is converted with
+    /// to_zero_to_one, as the CPU kernel does). The pyramid must come from a depth buffer of
+    /// window depths in [0, 1] (glDepthRange(0, 1)), larger = farther, GL_LOWER_LEFT origin: what
+    /// GL writes for either convention's matrix under the matching glClipControl depth mode.
+    void run(const PatchBuffers& patches, const Mat4& object_to_clip, ClipDepth depth, const HiZTexture& hiz,
+             bool with_frustum = true);
 
 private:
     struct Impl;

@@ -18,6 +18,7 @@ BackpatchConePass::~BackpatchConePass() = default;
 
 void BackpatchConePass::run(const PatchBuffers& patches, BackpatchMethod method, Vec3 eye, std::uint32_t cone_values) {
     if (method == BackpatchMethod::ptp) throw Error("GL: BackpatchConePass: ptp is BackpatchPtpPass's");
+    detail::begin_pass("BackpatchConePass");
     detail::check_patch_buffers("BackpatchConePass", patches);
     if (cone_values)
         detail::check_buffer_size("BackpatchConePass", "cone-value", cone_values,

@@ -35,6 +35,7 @@ BackpatchPtpPass::~BackpatchPtpPass() = default;
 
 bool BackpatchPtpPass::run(const PatchBuffers& patches, const Mat4& object_to_clip, float alpha, PtpRule rule,
                            std::uint32_t plane_values) {
+    detail::begin_pass("BackpatchPtpPass");
     detail::check_patch_buffers("BackpatchPtpPass", patches);
     if (plane_values)
         detail::check_buffer_size("BackpatchPtpPass", "plane-value", plane_values,

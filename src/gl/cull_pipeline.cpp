@@ -216,7 +216,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
             bounds ? make_displaced_cull_view(rp.view, rp.projection, ClipDepth::zero_to_one) : DisplacedCullView{};
         for (const ObjectRange& o : objects) {
             if (!o.cull) continue;
-            if (occluding) m.occlusion.run(range_of(o), object_to_clip, *occluding, false);
+            if (occluding) m.occlusion.run(range_of(o), object_to_clip, ClipDepth::zero_to_one, *occluding, false);
             if (bounds) m.displaced.run(range_of(o), ranges, params.bound, params.cone, view, occluding, true);
         }
         for (std::size_t i = 0; i < objects.size(); ++i) m.status.end(range_of(objects[i]), m.counters, i * m.counter_stride);

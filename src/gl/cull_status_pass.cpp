@@ -12,6 +12,7 @@ struct CullStatusPass::Impl {
     GLuint scratch_counters = 0;  // bound when the caller counts nothing
 
     void run(const PatchBuffers& patches, pp::uint mode, GLuint counters, std::size_t offset) {
+        detail::begin_pass("CullStatusPass");
         detail::check_patch_buffers("CullStatusPass", patches);
         if (counters)
             detail::check_buffer_size("CullStatusPass", "counter", counters, offset + shared::kCounterCount * 4);

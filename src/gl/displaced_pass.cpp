@@ -34,6 +34,7 @@ DisplacedPass::~DisplacedPass() = default;
 void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, DisplacedBoundKind bound, NormalConeKind cone,
                         const DisplacedCullView& view, const HiZTexture* hiz, bool only_displaced, std::uint32_t bounds) {
     Impl& m = *impl_;
+    detail::begin_pass("DisplacedPass");
     detail::check_patch_buffers("DisplacedPass", patches);
     const std::size_t end = patches.first + patches.count;
     if (ranges) detail::check_buffer_size("DisplacedPass", "range", ranges, end * sizeof(DisplacementRange));

@@ -15,6 +15,7 @@ FrustumPass& FrustumPass::operator=(FrustumPass&&) noexcept = default;
 FrustumPass::~FrustumPass() = default;
 
 void FrustumPass::run(const PatchBuffers& patches, const FrustumPlanes& planes, std::uint32_t plane_values) {
+    detail::begin_pass("FrustumPass");
     detail::check_patch_buffers("FrustumPass", patches);
     if (plane_values)
         detail::check_buffer_size("FrustumPass", "plane-value", plane_values,

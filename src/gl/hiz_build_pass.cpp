@@ -16,6 +16,7 @@ HiZBuildPass& HiZBuildPass::operator=(HiZBuildPass&&) noexcept = default;
 HiZBuildPass::~HiZBuildPass() = default;
 
 void HiZBuildPass::run(std::uint32_t depth_texture, const HiZTexture& hiz) {
+    detail::begin_pass("HiZBuildPass");
     if (!glIsTexture(depth_texture)) throw Error("GL: HiZBuildPass: " + std::to_string(depth_texture) + " is not a texture");
     if (!glIsTexture(hiz.texture) || hiz.width < 1 || hiz.height < 1)
         throw Error("GL: HiZBuildPass: no Hi-Z texture (create_hiz_texture)");

@@ -15,12 +15,14 @@ OcclusionPass::OcclusionPass(OcclusionPass&&) noexcept = default;
 OcclusionPass& OcclusionPass::operator=(OcclusionPass&&) noexcept = default;
 OcclusionPass::~OcclusionPass() = default;
 
-void OcclusionPass::run(const PatchBuffers& patches, const Mat4& object_to_clip, const HiZTexture& hiz,
-                        bool with_frustum) {
+void OcclusionPass::run(const PatchBuffers& patches, const Mat4& any_object_to_clip, ClipDepth depth,
+                        const HiZTexture& hiz, bool with_frustum) {
+    detail::begin_pass("OcclusionPass");
     detail::check_patch_buffers("OcclusionPass", patches);
     if (!glIsTexture(hiz.texture) || hiz.width < 1 || hiz.height < 1)
         throw Error("GL: OcclusionPass: no Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
     if (patches.count == 0) return;
+    const Mat4 object_to_clip = to_zero_to_one(any_object_to_clip, depth);
     pp::OcclusionParams params;
     std::copy_n(object_to_clip.m, 16, params.object_to_clip);
     detail::store_planes(make_frustum_planes(object_to_clip, ClipDepth::zero_to_one), params.plane_rows,

@@ -218,6 +218,14 @@ void check_patch_buffers(const char* who, const PatchBuffers& patches) {
     if (patches.margins) check_buffer_size(who, "margin", patches.margins, end * sizeof(float));
 }
 
+void begin_pass(const char* who) {
+    const GLenum e = glGetError();
+    if (e == GL_NO_ERROR) return;
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    throw Error("GL: error " + hex(e) + " pending before " + who + " (left by an earlier GL call)");
+}
+
 void bind_patch_buffers(const PatchBuffers& patches) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingControlPoints, patches.control_points);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCullFlags, patches.flags);

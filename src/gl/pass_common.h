@@ -74,6 +74,10 @@ void dispatch_patches(ParamBlock& block, Params& params, std::size_t first, std:
     }
 }
 
+/// The start of every run(): throws when a GL error is pending (left by the caller), so that
+/// finish_pass's check reports only the pass's own.
+void begin_pass(const char* who);
+
 /// Binds the chain's buffers (control points, flags, margins when given).
 void bind_patch_buffers(const PatchBuffers& patches);
 

@@ -124,14 +124,15 @@ struct DecisionCounts {
 // OcclusionPass (with the frustum test, as the CPU kernel) in a chain of its own on the renderer's
 // buffers, statuses updated, vs cull_occlusion_scalar on the same pyramid and matrix.
 DecisionCounts compare_decisions(PatchRenderer& r, const std::vector<BezierPatch>& patches, const Mat4& m,
-                                 const HiZPyramid& cpu_hiz, const char* what) {
+                                 const HiZPyramid& cpu_hiz, const char* what,
+                                 ClipDepth depth = ClipDepth::zero_to_one) {
     const PatchBatch batch = make_batch(patches);
     std::vector<std::uint8_t> cpu(patches.size(), 0xEE);
-    cull_occlusion_scalar(batch.view(), m, ClipDepth::zero_to_one, cpu_hiz, cpu.data());
+    cull_occlusion_scalar(batch.view(), m, depth, cpu_hiz, cpu.data());
     static CullStatusPass status(test::passes());
     static OcclusionPass occlusion(test::passes());
     status.begin(r.patch_buffers());
-    occlusion.run(r.patch_buffers(), m, gpu_pyramid().texture(), true);
+    occlusion.run(r.patch_buffers(), m, depth, gpu_pyramid().texture(), true);
     status.end(r.patch_buffers(), 0);
     const std::vector<std::uint32_t> words = r.read_cull_flags();
     DecisionCounts n;
@@ -265,6 +266,12 @@ TEST(GpuHiZ, DecisionsEqualCpuOnRandomPatches) {
         const HiZPyramid cpu = check_pyramid(r, what.c_str());
         const DecisionCounts n = compare_decisions(r, patches, cam.view_projection(), cpu, what.c_str());
         EXPECT_EQ(n.mismatched, 0u) << what;
+        // The same camera as a standard OpenGL (-1..1) matrix: converted like the CPU kernel.
+        const Mat4 gl_matrix =
+            perspective(cam.fovy_radians, cam.aspect, cam.z_near, cam.z_far, ClipDepth::minus_one_to_one) * cam.view();
+        const DecisionCounts g = compare_decisions(r, patches, gl_matrix, cpu, (what + " (-1..1)").c_str(),
+                                                   ClipDepth::minus_one_to_one);
+        EXPECT_EQ(g.mismatched, 0u) << what << " (-1..1)";
         total.frustum += n.frustum;
         total.occluded += n.occluded;
         total.visible += n.visible;
@@ -281,18 +288,27 @@ TEST(GpuHiZ, PassesRefuseMissingPyramidsAndBadSizes) {
     r.render(p);
     OcclusionPass occlusion(test::passes());
     HiZBuildPass build(test::passes());
-    EXPECT_THROW(occlusion.run(r.patch_buffers(), p.projection * p.view, HiZTexture{}), patchcull::Error);
+    EXPECT_THROW(occlusion.run(r.patch_buffers(), p.projection * p.view, ClipDepth::zero_to_one, HiZTexture{}), patchcull::Error);
     EXPECT_THROW(read_hiz_texture(HiZTexture{}), patchcull::Error);
     EXPECT_THROW(create_hiz_texture(0, 64), patchcull::Error);
     EXPECT_THROW(create_hiz_texture(64, 8193), patchcull::Error);
     HiZTexture hiz = create_hiz_texture(64, 64);
     EXPECT_THROW(build.run(0, hiz), patchcull::Error);  // no depth texture
     build.run(r.depth_texture(), hiz);
-    EXPECT_NO_THROW(occlusion.run(r.patch_buffers(), p.projection * p.view, hiz));
+    EXPECT_NO_THROW(occlusion.run(r.patch_buffers(), p.projection * p.view, ClipDepth::zero_to_one, hiz));
     EXPECT_EQ(read_hiz_texture(hiz).size(), HiZPyramid(64, 64).size());
     // A flag buffer too small for the range is refused, not overrun.
     PatchBuffers past_the_end = r.patch_buffers();
     past_the_end.first = 1;
-    EXPECT_THROW(occlusion.run(past_the_end, p.projection * p.view, hiz), patchcull::Error);
+    EXPECT_THROW(occlusion.run(past_the_end, p.projection * p.view, ClipDepth::zero_to_one, hiz), patchcull::Error);
+    // A GL error the caller left pending is reported as such, not blamed on the pass.
+    glBindBuffer(GL_ARRAY_BUFFER, 0xFFFFFFu);  // not a buffer name: GL_INVALID_OPERATION
+    try {
+        occlusion.run(r.patch_buffers(), p.projection * p.view, ClipDepth::zero_to_one, hiz);
+        ADD_FAILURE() << "a pending GL error was not reported";
+    } catch (const patchcull::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("pending before OcclusionPass"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW(occlusion.run(r.patch_buffers(), p.projection * p.view, ClipDepth::zero_to_one, hiz));
     glDeleteTextures(1, &hiz.texture);
 }
