@@ -521,7 +521,7 @@ int run(const Options& options) {
         // the frustum and occlusion passes (skipped here: the teapot is open).
         status.begin(range);
         frustum.run(range, pc::make_frustum_planes(object_to_clip, pc::ClipDepth::zero_to_one));
-        occlusion.run(range, object_to_clip, hiz, false);
+        occlusion.run(range, object_to_clip, pc::ClipDepth::zero_to_one, hiz, false);
         status.end(range, counters);
         // Pass 2: the patches newly visible (passed now, not drawn in pass 1), into the same
         // colour, id and depth.
