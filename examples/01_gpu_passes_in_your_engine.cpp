@@ -26,11 +26,11 @@
 // proved nothing); 2 a setup error (bad option, no X display, no GL 4.5 core context, a shader
 // header missing), with one line on stderr. Without a screen: xvfb-run -a -s "-screen 0 1280x1024x24".
 //
-// GLSL headers: the TCS includes shaders/shared.h and shaders/patchcull_tcs.h. This program reads
-// them at run time from PATCHCULL_EXAMPLE_SHADER_DIR (the source tree's shaders/, a compile
-// definition from examples/CMakeLists.txt) and pastes them where the TCS says #include, as an
-// engine's own include system would (patchcull's build does the same, cmake/GlShaders.cmake).
-// The same shared.h is also valid C++: included here for the binding points, flag bits, draw
+// GLSL headers: the TCS includes shared.h and patchcull_tcs.h. The library ships their text
+// (gl::shipped_glsl, the files of shaders/ embedded at build time), and this program pastes it
+// where the TCS says #include, as an engine's own include system would (patchcull's build does the
+// same for its shaders, cmake/GlShaders.cmake). The same shared.h is also valid C++ (shaders/ is
+// on patchcull_gl's public include path): included here for the binding points, flag bits, draw
 // selections and counter indices.
 
 #include <epoxy/gl.h>  // GL through libepoxy, as patchcull_gl loads it; before GLFW
@@ -115,19 +115,18 @@ Options parse_options(int argc, char** argv) {
 
 // ---- the engine's shaders ---------------------------------------------------------------------
 
-// The engine's include system: each line `#include "NAME"` becomes the text of DIR/NAME.
-std::string expand_includes(const std::string& source, const std::string& dir) {
+// The engine's include system: each line `#include "NAME"` becomes the text patchcull ships for
+// NAME (gl::shipped_glsl).
+std::string expand_includes(const std::string& source) {
     std::istringstream in(source);
     std::string out, line;
     while (std::getline(in, line)) {
         const std::string directive = "#include \"";
         if (line.rfind(directive, 0) == 0 && line.size() > directive.size() + 1 && line.back() == '"') {
-            const std::string path = dir + "/" + line.substr(directive.size(), line.size() - directive.size() - 1);
-            std::ifstream file(path);
-            if (!file) setup_error("cannot read GLSL header " + path);
-            std::ostringstream text;
-            text << file.rdbuf();
-            out += text.str() + "\n";
+            const std::string name = line.substr(directive.size(), line.size() - directive.size() - 1);
+            const std::string_view text = pc::gl::shipped_glsl(name);
+            if (text.empty()) setup_error("GLSL header " + name + " is not shipped by patchcull");
+            out += std::string(text) + "\n";
         } else {
             out += line + "\n";
         }
@@ -239,10 +238,10 @@ GLuint compile(GLenum stage, const std::string& source, const char* name) {
     return shader;
 }
 
-GLuint link_patch_program(const std::string& shader_dir) {
+GLuint link_patch_program() {
     const GLuint program = glCreateProgram();
     const GLuint stages[] = {compile(GL_VERTEX_SHADER, kVertexShader, "vertex"),
-                             compile(GL_TESS_CONTROL_SHADER, expand_includes(kControlShader, shader_dir), "control"),
+                             compile(GL_TESS_CONTROL_SHADER, expand_includes(kControlShader), "control"),
                              compile(GL_TESS_EVALUATION_SHADER, kEvaluationShader, "evaluation"),
                              compile(GL_FRAGMENT_SHADER, kFragmentShader, "fragment")};
     for (GLuint s : stages) glAttachShader(program, s);
@@ -470,7 +469,7 @@ int run(const Options& options) {
         setup_error("GL: the framebuffer is incomplete");
 
     // 4. The engine's patch program, its TCS with patchcull_tcs.h.
-    r.program = link_patch_program(PATCHCULL_EXAMPLE_SHADER_DIR);
+    r.program = link_patch_program();
     r.loc_level = glGetUniformLocation(r.program, "u_level");
     r.loc_mask = glGetUniformLocation(r.program, "u_draw_mask");
     r.loc_value = glGetUniformLocation(r.program, "u_draw_value");

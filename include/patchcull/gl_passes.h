@@ -76,6 +76,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "patchcull/backpatch.h"
@@ -92,6 +93,13 @@ namespace patchcull::gl {
 enum class BackpatchMethod { tcone, ncone, ptp };
 /// "tcone", "ncone", "ptp" (the `patchcull cull` method names).
 const char* backpatch_method_name(BackpatchMethod method);
+
+/// The text of a GLSL header shipped for an engine's own shaders, embedded in the library:
+/// "shared.h" (the constants shared by C++ and GLSL: bindings, flag bits, draw selections,
+/// counters; C++ code includes the same file from shaders/, on patchcull_gl's public include
+/// path) and "patchcull_tcs.h" (the TCS include, shaders/patchcull_tcs.h). Paste it in place of
+/// the #include line (or register it with your include mechanism). Empty for any other name.
+std::string_view shipped_glsl(std::string_view name);
 
 /// The arithmetic the probe evaluates (tests, start-up check): pc_fma(a, b, c), pc_div(a, b),
 /// pc_sqrt(a), and the correction steps alone from a given guess: pc_div_from(a, b, guess = c),

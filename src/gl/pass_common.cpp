@@ -128,6 +128,12 @@ std::vector<float> PassContext::probe(BackpatchProbe op, const std::vector<Vec3>
     return out;
 }
 
+std::string_view shipped_glsl(std::string_view name) {
+    if (name != "shared.h" && name != "patchcull_tcs.h") return {};
+    const char* text = find_shader_source(name);
+    return text ? std::string_view(text) : std::string_view();
+}
+
 const char* backpatch_method_name(BackpatchMethod method) {
     switch (method) {
         case BackpatchMethod::tcone: return "tcone";

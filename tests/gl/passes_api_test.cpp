@@ -1,0 +1,34 @@
+// What gl_passes.h ships for an engine's own shaders: the embedded GLSL headers equal the files
+// in shaders/ byte for byte, and only those two are handed out.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "patchcull/gl_passes.h"
+#include "shared.h"  // shaders/, on patchcull_gl's public include path
+
+namespace {
+
+std::string read_source(const std::string& name) {
+    std::ifstream in(std::string(PATCHCULL_SOURCE_DIR) + "/shaders/" + name, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+}  // namespace
+
+TEST(PassesApi, ShippedGlslIsTheSourceFile) {
+    for (const char* name : {"shared.h", "patchcull_tcs.h"}) {
+        const std::string_view shipped = patchcull::gl::shipped_glsl(name);
+        ASSERT_FALSE(shipped.empty()) << name;
+        EXPECT_EQ(std::string(shipped), read_source(name)) << name;
+    }
+    EXPECT_NE(patchcull::gl::shipped_glsl("patchcull_tcs.h").find("patchcull_patch_drawn"), std::string_view::npos);
+    EXPECT_TRUE(patchcull::gl::shipped_glsl("frustum.comp.glsl").empty());  // internal, not shipped
+    EXPECT_TRUE(patchcull::gl::shipped_glsl("nonexistent.h").empty());
+    // The C++ side of the same constants.
+    EXPECT_EQ(patchcull::gl::shared::kDrawMaskFirstPass, patchcull::gl::shared::kStatusVisible);
+}
