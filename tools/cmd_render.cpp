@@ -20,6 +20,16 @@
 // patches are culled by the frustum and the running pipeline's Hi-Z with the bound ("caf" or
 // "oobb") and cone ("full", "acon", "con") of seed 000 §4.2, and never by back-patch tests;
 // "displaced_occlusion_culled" counts those of "occlusion_culled" that are displaced.
+// --cull auto (cull_auto.h: Niessner & Loop §6.3's per-object switch): each object of the scene
+// (render_support.h scene_objects: one per instance) is culled with the tests of `all` (back-patch
+// only where applicable_cull_mode allows) or drawn whole, decided per frame from the measured pass
+// costs, its recent cull rate and its tessellation factor; "cull" is "auto" and every frame gains
+//   "objects":[{"name","patches","culling":"on"|"off","break_even","cull_rate"}]
+// (break_even: x = (RT0 + CT) / (RT - RT0) at the object's tess factor, null until the costs are
+// measured or when there is no tessellation cost to save; cull_rate: the object's average rate the
+// decision used, null until measured). Without --json a line per frame says how many objects are
+// culled, and why each is on or off.
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -28,11 +38,30 @@
 
 #include "cli_options.h"
 #include "commands.h"
+#include "cull_auto.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
+namespace {
+
+// A number of the objects array: null when not known (NaN) or infinite.
+nlohmann::json number_or_null(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
+
+nlohmann::json auto_objects_json(const std::vector<SceneObject>& objects,
+                                 const std::vector<CullAutoPolicy::Decision>& decisions) {
+    nlohmann::json out = nlohmann::json::array();
+    for (std::size_t i = 0; i < objects.size(); ++i)
+        out.push_back({{"name", objects[i].name},
+                       {"patches", objects[i].range.count},
+                       {"culling", decisions[i].cull ? "on" : "off"},
+                       {"break_even", number_or_null(decisions[i].break_even)},
+                       {"cull_rate", number_or_null(decisions[i].cull_rate)}});
+    return out;
+}
+
+}  // namespace
 
 Runner add_render_command(CLI::App& app) {
     struct State {
@@ -57,8 +86,8 @@ Runner add_render_command(CLI::App& app) {
     add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 1, 1000, "number of frames");
-    add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all"},
-                      "cull tests of the pipeline");
+    add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all", "auto"},
+                      "cull tests of the pipeline (auto: all, per object where it pays, seed 000 §6.3)");
     add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
                       "back-patch test of backpatch/all");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
@@ -73,7 +102,8 @@ Runner add_render_command(CLI::App& app) {
     return [state]() {
         int width = 0, height = 0;
         parse_size("--size", state->size, width, height);
-        const gl::CullMode cull = parse_cull_mode_option("--cull", state->cull);
+        const bool automatic = state->cull == "auto";
+        const gl::CullMode cull = automatic ? gl::CullMode::all : parse_cull_mode_option("--cull", state->cull);
         const gl::BackpatchMethod backpatch = parse_backpatch_method("--backpatch", state->backpatch);
         Scene scene = load_scene(state->model, state->scheme, state->split);
         apply_displace_options(state->displace, scene);
@@ -94,13 +124,20 @@ Runner add_render_command(CLI::App& app) {
         pipeline.renderer().set_displacement_map(scene.displacement);
         pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
         const std::vector<Camera> cameras = scene.camera_path(state->frames, float(width) / float(height));
+        const std::vector<SceneObject> objects = scene_objects(scene);
+        std::vector<gl::ObjectRange> ranges;
+        for (const SceneObject& o : objects) ranges.push_back(o.range);
+        std::vector<std::string> names;
+        for (const SceneObject& o : objects) names.push_back(o.name);
+        CullAutoPolicy policy(ranges, scene.patch_count());
 
+        const std::vector<BezierPatch>* pose = &first_pose;
         nlohmann::json frames = nlohmann::json::array();
         std::size_t total_false = 0;
         for (int f = 0; f < state->frames; ++f) {
             if (f > 0) {
-                const std::vector<BezierPatch>& patches = poser.pose(f * kSecondsPerFrame);
-                pipeline.update_patches(patches, pose_attributes(poser));
+                pose = &poser.pose(f * kSecondsPerFrame);
+                pipeline.update_patches(*pose, pose_attributes(poser));
             }
             gl::PipelineParams params;
             params.frame.render =
@@ -111,7 +148,13 @@ Runner add_render_command(CLI::App& app) {
             params.backpatch = backpatch;
             params.bound = displace_bound(state->displace);
             params.cone = displace_cone(state->displace);
+            if (automatic) {
+                policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
+                params.objects = policy.objects();
+                params.frame.cull = policy.frame_cull_mode(applied);
+            }
             const gl::FrameStats stats = pipeline.render_frame(params);
+            if (automatic) policy.observe(stats);
             const bool last = f + 1 == state->frames;
             if (last && !state->out.empty()) pipeline.renderer().write_color_png(state->out);
             nlohmann::json ms = {{"pass1", stats.pass1_ms}, {"hiz", stats.hiz_ms}, {"cull", stats.cull_ms},
@@ -141,6 +184,7 @@ Runner add_render_command(CLI::App& app) {
                               {"false_culls", false_culls},
                               {"depth_ties", depth_ties}});
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
+            if (automatic) frames.back()["objects"] = auto_objects_json(objects, policy.decisions());
             if (!state->json) {
                 std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
                             "(displaced %zu); ms pass1 %.1f hiz %.1f cull %.1f pass2 %.1f",
@@ -149,6 +193,7 @@ Runner add_render_command(CLI::App& app) {
                             stats.pass1_ms, stats.hiz_ms, stats.cull_ms, stats.pass2_ms);
                 if (state->verify) std::printf("; false culls %zu", false_culls);
                 std::printf("\n");
+                if (automatic) std::printf("%s\n", auto_summary_line(names, policy.decisions()).c_str());
             }
         }
         if (state->json) {
@@ -158,7 +203,7 @@ Runner add_render_command(CLI::App& app) {
             out["size"] = {width, height};
             out["tess"] = state->tess;
             out["tess_mode"] = tess_mode.adaptive ? "adaptive" : "uniform";
-            out["cull"] = gl::cull_mode_name(cull);
+            out["cull"] = automatic ? "auto" : gl::cull_mode_name(cull);
             out["backpatch"] = backpatch_applied ? gl::backpatch_method_name(backpatch) : "off";
             out["aggressive"] = state->aggressive;
             out["verified"] = state->verify;

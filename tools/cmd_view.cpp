@@ -4,12 +4,15 @@
 // colour image is blitted to the window and swapped in; the camera path loops until the window
 // is closed (or Escape), or stops after --frames frames. --screenshot writes the window's content
 // after the last frame (tests run it under xvfb-run and compare it with `render --out`).
-// --tess-mode / --tess-distance as `render` (render_support.h: TessOptions).
+// --tess-mode / --tess-distance as `render` (render_support.h: TessOptions). --cull auto as
+// `render` (cull_auto.h: per object and frame, culled where it pays); each frame's line is then
+// followed by the policy's summary line.
 #include <cstdio>
 #include <memory>
 
 #include "cli_options.h"
 #include "commands.h"
+#include "cull_auto.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
 #include "render_support.h"
@@ -37,8 +40,8 @@ Runner add_view_command(CLI::App& app) {
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 0, 1000000,
                    "stop after N frames (0: loop until the window is closed)");
-    add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all"},
-                      "cull tests of the pipeline");
+    add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all", "auto"},
+                      "cull tests of the pipeline (auto: all, per object where it pays, seed 000 §6.3)");
     add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
                       "back-patch test of backpatch/all");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
@@ -50,7 +53,8 @@ Runner add_view_command(CLI::App& app) {
     return [state]() {
         int width = 0, height = 0;
         parse_size("--size", state->size, width, height);
-        const gl::CullMode cull = parse_cull_mode_option("--cull", state->cull);
+        const bool automatic = state->cull == "auto";
+        const gl::CullMode cull = automatic ? gl::CullMode::all : parse_cull_mode_option("--cull", state->cull);
         const gl::BackpatchMethod backpatch = parse_backpatch_method("--backpatch", state->backpatch);
         if (!state->screenshot.empty() && state->frames == 0)
             throw Error("--screenshot: needs --frames N (the last frame is the one saved)");
@@ -69,11 +73,16 @@ Runner add_view_command(CLI::App& app) {
         // One lap of the camera path, repeated (the same cameras as `render --frames lap`).
         const int lap = state->frames > 0 ? state->frames : 72;
         const std::vector<Camera> cameras = scene.camera_path(lap, float(width) / float(height));
+        std::vector<gl::ObjectRange> ranges;
+        std::vector<std::string> names;
+        for (const SceneObject& o : scene_objects(scene)) ranges.push_back(o.range), names.push_back(o.name);
+        CullAutoPolicy policy(ranges, scene.patch_count());
+        const std::vector<BezierPatch>* pose = &first_pose;
         for (int f = 0; state->frames == 0 || f < state->frames; ++f) {
             if (!context.window_open()) break;
             if (f > 0) {
-                const std::vector<BezierPatch>& patches = poser.pose(f * kSecondsPerFrame);
-                pipeline.update_patches(patches, pose_attributes(poser));
+                pose = &poser.pose(f * kSecondsPerFrame);
+                pipeline.update_patches(*pose, pose_attributes(poser));
             }
             gl::PipelineParams params;
             params.frame.render = render_params(cameras[static_cast<std::size_t>(f % lap)], width, height, state->tess,
@@ -83,7 +92,13 @@ Runner add_view_command(CLI::App& app) {
             params.backpatch = backpatch;
             params.bound = displace_bound(state->displace);
             params.cone = displace_cone(state->displace);
+            if (automatic) {
+                policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
+                params.objects = policy.objects();
+                params.frame.cull = policy.frame_cull_mode(applied);
+            }
             const gl::FrameStats stats = pipeline.render_frame(params);
+            if (automatic) policy.observe(stats);
             pipeline.renderer().blit_color_to_window(width, height);
             const bool last = state->frames > 0 && f + 1 == state->frames;
             if (last && !state->screenshot.empty()) context.write_window_png(state->screenshot);
@@ -93,6 +108,7 @@ Runner add_view_command(CLI::App& app) {
                         f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
                         stats.backpatch_culled, stats.occlusion_culled, stats.displaced_occlusion_culled,
                         stats.total_ms);
+            if (automatic) std::printf("%s\n", auto_summary_line(names, policy.decisions()).c_str());
         }
         return 0;
     };

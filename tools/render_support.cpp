@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
+#include <string>
 
 #include "cli_options.h"
 #include "commands.h"
@@ -72,6 +74,24 @@ Scene load_scene(const std::string& model, const std::string& scheme_text, int s
     for (const LoadedModel& m : scene.models)
         print_warnings(m.warnings);
     return scene;
+}
+
+std::vector<SceneObject> scene_objects(const Scene& scene) {
+    std::vector<SceneObject> objects;
+    std::vector<std::size_t> copies(scene.models.size(), 0);
+    std::size_t first = 0;
+    for (const SceneInstance& instance : scene.instances) {
+        const LoadedModel& model = scene.models.at(instance.model);
+        SceneObject o;
+        // LoadedModel::name is the OBJ path (or "teapot"): its file name without the extension.
+        o.name = std::filesystem::path(model.name).stem().string() + "#" + std::to_string(copies[instance.model]++);
+        o.range.first = first;
+        o.range.count = model.rest.patches.size();
+        o.range.cull = true;
+        first += o.range.count;
+        objects.push_back(std::move(o));
+    }
+    return objects;
 }
 
 gl::CullMode applicable_cull_mode(const Scene& scene, gl::CullMode requested, const std::string& command) {

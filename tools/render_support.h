@@ -53,6 +53,17 @@ gl::PatchAttributes pose_attributes(const ScenePoser& poser);
 /// Throws patchcull::Error naming the flag or file.
 Scene load_scene(const std::string& model, const std::string& scheme_text, int split);
 
+/// One object of a scene for PipelineParams::objects: an instance's patches in the pose
+/// (ScenePoser's order: instance by instance, each in its model's order).
+struct SceneObject {
+    /// The model's file name without extension, '#', the instance's number among that model's
+    /// instances from 0 ("bigguy#0", "monsterfrog#2", "teapot#0").
+    std::string name;
+    gl::ObjectRange range;  ///< first patch, patch count; cull = true
+};
+/// The scene's objects, one per instance, in instance order (their ranges tile [0, patch_count())).
+std::vector<SceneObject> scene_objects(const Scene& scene);
+
 /// The tests of `requested` that are conservative on scene: back-patch culling only when every
 /// model is a closed surface (LoadedModel::closed). For a scene with an open model, `all` drops
 /// the back-patch test, and an explicit `backpatch` keeps it with a one-line warning on stderr

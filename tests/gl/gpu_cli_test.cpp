@@ -239,7 +239,7 @@ TEST(GpuCli, MainJobWritesFrameAndCullImages) {
     EXPECT_TRUE(is_png(dir + "/frame.png"));
     EXPECT_TRUE(is_png(dir + "/cull.png"));
     for (const char* method : {"none (reference)", "frustum", "backpatch tcone", "backpatch ncone", "backpatch ptp",
-                               "occlusion", "all (tcone)"})
+                               "occlusion", "all (tcone)", "auto (tcone)", "(objects culled per frame: "})
         EXPECT_NE(r.out.find(method), std::string::npos) << method << " missing from\n" << r.out;
     EXPECT_NE(r.out.find("in total: 0 (must be 0)"), std::string::npos) << r.out;
 }

@@ -1,0 +1,285 @@
+// `--cull auto` (tools/cull_auto.h, Niessner & Loop §6.3's per-object switch): the policy class
+// alone, with given costs and cull rates (tools/cull_auto.cpp is compiled into this suite; no GL),
+// and through `render`: the JSON shape of the objects array, 0 false culls under --verify, bad
+// values exit 2. The CLI runs use the default scene at 96x54, level 4, a few frames.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/cli_test_util.h"
+#include "cull_auto.h"
+#include "patchcull/error.h"
+
+using namespace patchcull;
+using patchcull::cli::CullAutoPolicy;
+
+namespace {
+
+// Two objects of 100 patches each in a set of 200.
+std::vector<gl::ObjectRange> two_objects() { return {{0, 100, true}, {100, 100, true}}; }
+
+// Costs with tess(t) = tess_at_8 at t = 8 (tess_unit = tess_at_8 / (c0 + 64)), per patch.
+CullAutoPolicy::Costs costs(double issue, double cull, double tess_at_8, double hiz, double c0 = 10) {
+    CullAutoPolicy::Costs c;
+    c.issue_ms = issue;
+    c.cull_ms = cull;
+    c.tess_unit_ms = tess_at_8 / (c0 + 64);
+    c.hiz_ms = hiz;
+    return c;
+}
+
+// A frame without timing (the costs stay as set) in which the culled objects culled `culled` patches.
+gl::FrameStats untimed_frame(const std::vector<std::size_t>& culled) {
+    gl::FrameStats s;
+    s.patches = 200;
+    s.two_pass = true;
+    s.timing = gl::TimingMethod::off;
+    for (std::size_t c : culled) {
+        gl::ObjectStats o;
+        o.patches = 100;
+        o.occlusion_culled = c;
+        o.visible = 100 - c;
+        s.objects.push_back(o);
+    }
+    return s;
+}
+
+const std::vector<double> kLevel8 = {8, 8};
+
+}  // namespace
+
+TEST(CullAutoPolicy, CullsWhereTheRateExceedsTheBreakEvenAndStopsWhenTheCostsSayItCannotPay) {
+    CullAutoPolicy policy(two_objects(), 200);
+    // x = (issue + cull) / tess = (1 + 2) / 10 = 0.3 at level 8.
+    policy.set_costs(costs(0.001, 0.002, 0.010, 0.0));
+    // Until a rate is measured, both objects are probed.
+    auto d = policy.decide(kLevel8);
+    EXPECT_TRUE(d[0].cull && d[0].probe);
+    EXPECT_TRUE(d[1].cull && d[1].probe);
+    EXPECT_NEAR(d[0].break_even, 0.3, 1e-12);
+    policy.observe(untimed_frame({50, 10}));  // rates 0.5 and 0.1
+    d = policy.decide(kLevel8);
+    EXPECT_TRUE(d[0].cull);
+    EXPECT_FALSE(d[0].probe);
+    EXPECT_EQ(d[0].reason, "rate 0.50 > break-even 0.30");
+    EXPECT_FALSE(d[1].cull);
+    EXPECT_EQ(d[1].reason, "rate 0.10 <= break-even 0.30");
+    EXPECT_NEAR(d[1].cull_rate, 0.1, 1e-12);
+    EXPECT_EQ(policy.culled_objects(), 1u);
+    const std::vector<gl::ObjectRange> ranges = policy.objects();
+    ASSERT_EQ(ranges.size(), 2u);
+    EXPECT_TRUE(ranges[0].cull);
+    EXPECT_FALSE(ranges[1].cull);
+    EXPECT_EQ(ranges[1].first, 100u);
+    EXPECT_EQ(policy.frame_cull_mode(gl::CullMode::all), gl::CullMode::all);
+    policy.observe(untimed_frame({50, 0}));
+
+    // Tessellation four times cheaper: x = 3 / 2.5 = 1.2, no rate can pay.
+    policy.set_costs(costs(0.001, 0.002, 0.0025, 0.0));
+    d = policy.decide(kLevel8);
+    EXPECT_FALSE(d[0].cull);
+    EXPECT_FALSE(d[1].cull);
+    EXPECT_EQ(d[0].reason, "tess factor 8.0: break-even 1.20 >= 1, culling cannot pay");
+    EXPECT_EQ(policy.frame_cull_mode(gl::CullMode::all), gl::CullMode::none);
+    policy.observe(untimed_frame({0, 0}));
+}
+
+TEST(CullAutoPolicy, AnObjectSwitchedOffIsProbedAfterTheInterval) {
+    CullAutoPolicy::Config config;
+    config.probe_interval = 4;
+    CullAutoPolicy policy(two_objects(), 200, config);
+    policy.set_costs(costs(0.001, 0.002, 0.010, 0.0));
+    policy.decide(kLevel8);
+    policy.observe(untimed_frame({50, 10}));  // frame 0: object 1 culled (rate 0.1)
+    int probed_at = -1;
+    for (int frame = 1; frame <= 6 && probed_at < 0; ++frame) {
+        const auto& d = policy.decide(kLevel8);
+        if (d[1].cull) {
+            EXPECT_TRUE(d[1].probe);
+            EXPECT_EQ(d[1].reason.rfind("probe: rate 0.10 <= break-even 0.30", 0), 0u) << d[1].reason;
+            probed_at = frame;
+        }
+        policy.observe(untimed_frame({50, 40}));
+    }
+    EXPECT_EQ(probed_at, 4);
+    // The probe measured 0.4: its rate replaces the stale one, and the object stays on.
+    const auto& d = policy.decide(kLevel8);
+    EXPECT_TRUE(d[1].cull);
+    EXPECT_FALSE(d[1].probe);
+    EXPECT_NEAR(d[1].cull_rate, 0.4, 1e-12);
+}
+
+TEST(CullAutoPolicy, TheFrameRuleTurnsEverythingOffWhenTheHiZBuildCostsMoreThanTheSaving) {
+    CullAutoPolicy policy(two_objects(), 200);
+    // Object 0 saves 100 * (0.5 * 0.010 - 0.003) = 0.2 ms; the Hi-Z build and pass 2's issue of
+    // object 1's patches cost 1 + 100 * 0.001 = 1.1 ms.
+    policy.set_costs(costs(0.001, 0.002, 0.010, 1.0));
+    policy.decide(kLevel8);
+    policy.observe(untimed_frame({50, 10}));
+    const auto& d = policy.decide(kLevel8);
+    EXPECT_FALSE(d[0].cull);
+    EXPECT_NE(d[0].reason.find("rate 0.50 > break-even 0.30; the frame would save 0.20 ms <= 1.10 ms"), std::string::npos)
+        << d[0].reason;
+    EXPECT_EQ(policy.frame_cull_mode(gl::CullMode::all), gl::CullMode::none);
+    policy.observe(untimed_frame({0, 0}));
+    // A cheap Hi-Z build: object 0 pays again.
+    policy.set_costs(costs(0.001, 0.002, 0.010, 0.05));
+    EXPECT_TRUE(policy.decide(kLevel8)[0].cull);
+}
+
+TEST(CullAutoPolicy, ALowTessFactorAtTheCentroidTurnsAnObjectOff) {
+    // Adaptive tessellation: object 0 at distance 1 from the eye, object 1 at distance 8; level 8
+    // at the reference distance 1: factors 8 and 1.
+    std::vector<BezierPatch> patches(2);
+    for (int k = 0; k < kPatchPoints; ++k) {
+        patches[0].cp[k] = {0, 0, -1, 1};
+        patches[1].cp[k] = {0, 0, -8, 1};
+    }
+    const std::vector<gl::ObjectRange> objects = {{0, 1, true}, {1, 1, true}};
+    const std::vector<double> factors = cli::object_tess_factors(patches, objects, Vec3{0, 0, 0}, 8, true, 1.0f);
+    ASSERT_EQ(factors.size(), 2u);
+    EXPECT_NEAR(factors[0], 8.0, 1e-6);
+    EXPECT_NEAR(factors[1], 1.0, 1e-6);
+    EXPECT_EQ(cli::object_tess_factors(patches, objects, Vec3{0, 0, 0}, 8, false, 1.0f), kLevel8);
+
+    CullAutoPolicy policy(objects, 2);
+    policy.set_costs(costs(0.001, 0.002, 0.010, 0.0));  // tess(8) = 0.010, tess(1) = 0.010 * 11 / 74
+    policy.decide(factors);
+    gl::FrameStats s = untimed_frame({});
+    s.patches = 2;
+    s.objects = {{1, 0, 0, 1, 0}, {1, 0, 0, 1, 0}};  // each fully occluded: rate 1
+    policy.observe(s);
+    const auto& d = policy.decide(factors);
+    EXPECT_TRUE(d[0].cull) << d[0].reason;
+    EXPECT_FALSE(d[1].cull);
+    EXPECT_FALSE(d[1].probe);
+    EXPECT_NEAR(d[1].break_even, 0.003 / (0.010 * 11.0 / 74.0), 1e-9);
+    EXPECT_EQ(d[1].reason.rfind("tess factor 1.0: break-even 2.02 >= 1", 0), 0u) << d[1].reason;
+}
+
+TEST(CullAutoPolicy, CostsComeFromThePassTimesAndTheFirstFrameIsIgnored) {
+    CullAutoPolicy policy(two_objects(), 200);
+    const double issue = 0.001, tess = 0.02, cull = 0.003, hiz = 0.5;
+    // Two-pass frames with both objects culled; pass 1 draws 150, pass 2 draws 10 patches.
+    auto timed = [&](double extra) {
+        gl::FrameStats s = untimed_frame({40, 40});
+        s.timing = gl::TimingMethod::wall_clock;
+        s.pass1_drawn = 150;
+        s.pass2_drawn = 10;
+        s.pass1_ms = 200 * issue + 150 * tess + extra;
+        s.pass2_ms = 200 * issue + 10 * tess + extra;
+        s.cull_ms = 200 * cull + extra;
+        s.hiz_ms = hiz + extra;
+        return s;
+    };
+    for (int f = 0; f < 3; ++f) {
+        const auto& d = policy.decide(kLevel8);
+        EXPECT_TRUE(d[0].cull && d[0].probe) << "frame " << f << ": " << d[0].reason;
+        EXPECT_EQ(d[0].reason, "probe: costs not measured yet");
+        EXPECT_TRUE(std::isnan(d[0].break_even));
+        policy.observe(timed(f == 0 ? 1000.0 : 0.0));  // frame 0: compilation, ignored
+    }
+    ASSERT_TRUE(policy.costs_ready());
+    EXPECT_NEAR(policy.costs().issue_ms, issue, 1e-12);
+    EXPECT_NEAR(policy.costs().cull_ms, cull, 1e-12);
+    EXPECT_NEAR(policy.costs().hiz_ms, hiz, 1e-12);
+    EXPECT_NEAR(policy.tess_cost_ms(8), tess, 1e-12);
+    const auto& d = policy.decide(kLevel8);
+    EXPECT_NEAR(d[0].break_even, (issue + cull) / tess, 1e-9);
+    EXPECT_EQ(d[0].reason, "rate 0.40 > break-even 0.20");
+    EXPECT_TRUE(d[0].cull);
+}
+
+TEST(CullAutoPolicy, MisuseAndBadRangesThrow) {
+    EXPECT_THROW(CullAutoPolicy({{150, 100, true}}, 200), Error);
+    CullAutoPolicy::Config bad;
+    bad.probe_interval = 0;
+    EXPECT_THROW(CullAutoPolicy(two_objects(), 200, bad), Error);
+    CullAutoPolicy policy(two_objects(), 200);
+    EXPECT_THROW(policy.observe(untimed_frame({0, 0})), std::logic_error);
+    EXPECT_THROW(policy.decide({8}), std::logic_error);
+    policy.decide(kLevel8);
+    EXPECT_THROW(policy.decide(kLevel8), std::logic_error);
+    EXPECT_THROW(policy.observe(untimed_frame({0})), std::logic_error);
+}
+
+// ---- through the CLI ------------------------------------------------------------------------
+
+namespace {
+const std::string kSmallAuto = "render default --size 96x54 --tess 4 --frames 4 --cull auto ";
+}  // namespace
+
+TEST(CullAutoCli, JsonHasTheObjectsOfEveryFrameAndVerifiesWithoutFalseCulls) {
+    const cli_test::CliRun r = cli_test::run(kSmallAuto + "--verify --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["cull"], "auto");
+    EXPECT_EQ(j["verified"], true);
+    EXPECT_EQ(j["false_culls"], 0);
+    ASSERT_EQ(j["frames"].size(), 4u);
+    const std::set<std::string> keys = {"name", "patches", "culling", "break_even", "cull_rate"};
+    std::size_t culled = 0;
+    for (const auto& frame : j["frames"]) {
+        EXPECT_EQ(frame["false_culls"], 0) << frame.dump();
+        ASSERT_TRUE(frame.contains("objects")) << frame.dump();
+        const auto& objects = frame["objects"];
+        ASSERT_EQ(objects.size(), 6u);
+        std::size_t patches = 0;
+        for (const auto& o : objects) {
+            std::set<std::string> got;
+            for (const auto& item : o.items()) got.insert(item.key());
+            EXPECT_EQ(got, keys) << o.dump();
+            EXPECT_TRUE(o["culling"] == "on" || o["culling"] == "off") << o.dump();
+            EXPECT_TRUE(o["break_even"].is_null() || o["break_even"].is_number()) << o.dump();
+            EXPECT_TRUE(o["cull_rate"].is_null() || o["cull_rate"].is_number()) << o.dump();
+            patches += o["patches"].get<std::size_t>();
+        }
+        EXPECT_EQ(patches, j["patches"].get<std::size_t>());
+        culled += frame["frustum_culled"].get<std::size_t>() + frame["occlusion_culled"].get<std::size_t>();
+    }
+    // Names in instance order; frame 0 probes every object (nothing measured yet).
+    const auto& first = j["frames"][0]["objects"];
+    EXPECT_EQ(first[0]["name"], "bigguy#0");
+    EXPECT_EQ(first[1]["name"], "monsterfrog#0");
+    EXPECT_EQ(first[5]["name"], "monsterfrog#2");
+    EXPECT_EQ(first[0]["patches"], 1450);
+    for (const auto& o : first) {
+        EXPECT_EQ(o["culling"], "on");
+        EXPECT_TRUE(o["break_even"].is_null());
+        EXPECT_TRUE(o["cull_rate"].is_null());
+    }
+    EXPECT_TRUE(j["frames"][1]["objects"][0]["cull_rate"].is_number());
+    // Something was culled, so the verification compared culled frames.
+    EXPECT_GT(culled, 0u);
+
+    // Other modes keep their frames as they were.
+    const cli_test::CliRun all = cli_test::run("render default --size 96x54 --tess 4 --frames 1 --cull all --json");
+    ASSERT_EQ(all.status, 0) << all.err;
+    EXPECT_FALSE(nlohmann::json::parse(all.out)["frames"][0].contains("objects"));
+}
+
+TEST(CullAutoCli, TextOutputHasOneAutoLinePerFrame) {
+    const cli_test::CliRun r = cli_test::run(kSmallAuto);
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::size_t lines = 0;
+    for (std::size_t at = r.out.find("auto: culling "); at != std::string::npos; at = r.out.find("auto: culling ", at + 1))
+        ++lines;
+    EXPECT_EQ(lines, 4u) << r.out;
+    EXPECT_NE(r.out.find("auto: culling 6 of 6 objects: bigguy#0 on (probe: costs not measured yet)"), std::string::npos)
+        << r.out;
+}
+
+TEST(CullAutoCli, BadValuesAreOneLineErrors) {
+    for (const char* command : {"render default --frames 1 --size 8x8 ", "view default --frames 1 --size 8x8 "}) {
+        const std::string c = command;
+        cli_test::expect_one_line_error(cli_test::run(c + "--cull automatic"), "--cull");
+        cli_test::expect_one_line_error(cli_test::run(c + "--cull Auto"), "--cull");
+        cli_test::expect_one_line_error(cli_test::run(c + "--cull ''"), "--cull");
+    }
+}
