@@ -25,8 +25,8 @@ namespace {
 
 // The frog standing on the ground, displaced by a procedural map (3% of its height), a wall
 // hiding its lower half from the first cameras.
-Scene displaced_frog_scene() {
-    Scene scene = make_model_scene(load_model(shipped_model_path("monsterfrog.obj"), Scheme::acc, 0), 20.0f);
+Scene displaced_frog_scene(Scheme scheme = Scheme::acc) {
+    Scene scene = make_model_scene(load_model(shipped_model_path("monsterfrog.obj"), scheme, 0), 20.0f);
     scene.displacement = make_procedural_displacement(128, 0.03f);
     scene.displacement_name = "procedural";
     scene.instances[0].displaced = true;
@@ -108,6 +108,35 @@ TEST(DisplacedPipeline, StrictForEveryBoundAndConeThroughAnAnimatedSequence) {
         }
     }
     EXPECT_GT(displaced_occluded_all, 100u);  // the wall and the frog itself hide displaced patches
+}
+
+TEST(DisplacedPipeline, StrictWithOsdPatchesOfMixedDepth) {
+    // OpenSubdiv's adaptive patches (several refinement depths, watertight by the depth scale of
+    // the tessellation level), displaced, animated: caf/acon, every frame without a false cull.
+    const Scene scene = displaced_frog_scene(Scheme::osd);
+    const std::vector<Camera> cameras = scene.camera_path(3, 1.0f);
+    CullPipeline pipeline(test::context());
+    PatchRenderer& r = pipeline.renderer();
+    r.set_displacement_map(scene.displacement);
+    r.set_occluders(scene.occluder_vertices, scene.occluder_indices);
+    ScenePoser poser(scene);
+    pipeline.set_patches(poser.pose(0), attributes_of(poser));
+    std::size_t displaced_occluded = 0;
+    for (std::size_t f = 0; f < cameras.size(); ++f) {
+        if (f > 0) pipeline.update_patches(poser.pose(0.25f * static_cast<float>(f)), attributes_of(poser));
+        PipelineParams pp;
+        pp.frame.render = params_of(cameras[f]);
+        pp.frame.render.tess_level = 2;  // times 2^(D - depth) per patch
+        const FrameStats s = pipeline.render_frame(pp);
+        const FrameCapture culled{r.read_ids(), r.read_depth(), r.read_drawn_patches()};
+        RenderParams unculled = pp.frame.render;
+        unculled.use_cull_flags = false;
+        r.render(unculled);
+        const FrameCapture reference{r.read_ids(), r.read_depth(), r.mark_front_patches(unculled)};
+        EXPECT_TRUE(compare_frames(reference, culled).false_culled.empty()) << "osd frame " << f;
+        displaced_occluded += s.displaced_occlusion_culled;
+    }
+    EXPECT_GT(displaced_occluded, 100u);
 }
 
 TEST(DisplacedPipeline, UndisplacedObjectsOfADisplacedSceneKeepEveryTest) {
