@@ -60,6 +60,19 @@ RenderParams params_of(const Camera& camera) {
     return p;
 }
 
+// One pipeline frame, then the unculled render of the same frame: the false culls (per patch, the
+// front set against the drawn set).
+std::vector<std::uint32_t> false_culls_of_frame(CullPipeline& pipeline, const PipelineParams& pp, FrameStats& stats) {
+    PatchRenderer& r = pipeline.renderer();
+    stats = pipeline.render_frame(pp);
+    const FrameCapture culled{r.read_ids(), r.read_depth(), r.read_drawn_patches()};
+    RenderParams unculled = pp.frame.render;
+    unculled.use_cull_flags = false;
+    r.render(unculled);
+    const FrameCapture reference{r.read_ids(), r.read_depth(), r.mark_front_patches(unculled)};
+    return compare_frames(reference, culled).false_culled;
+}
+
 }  // namespace
 
 TEST(DisplacedPipeline, StrictForEveryBoundAndConeThroughAnAnimatedSequence) {
@@ -87,16 +100,11 @@ TEST(DisplacedPipeline, StrictForEveryBoundAndConeThroughAnAnimatedSequence) {
                 pp.frame.cull = CullMode::all;
                 pp.bound = bound;
                 pp.cone = cone;
-                const FrameStats s = pipeline.render_frame(pp);
-                const FrameCapture culled{r.read_ids(), r.read_depth(), r.read_drawn_patches()};
-                RenderParams unculled = pp.frame.render;
-                unculled.use_cull_flags = false;
-                r.render(unculled);
-                const FrameCapture reference{r.read_ids(), r.read_depth(), r.mark_front_patches(unculled)};
-                const FrameComparison cmp = compare_frames(reference, culled);
-                EXPECT_TRUE(cmp.false_culled.empty())
-                    << combo << " frame " << f << ": " << cmp.false_culled.size() << " false culls, first patch "
-                    << (cmp.false_culled.empty() ? 0u : cmp.false_culled[0]);
+                FrameStats s;
+                const std::vector<std::uint32_t> false_culled = false_culls_of_frame(pipeline, pp, s);
+                EXPECT_TRUE(false_culled.empty()) << combo << " frame " << f << ": " << false_culled.size()
+                                                  << " false culls, first patch "
+                                                  << (false_culled.empty() ? 0u : false_culled[0]);
                 EXPECT_EQ(s.backpatch_culled, 0u) << combo << ": every patch of the frog is displaced";
                 EXPECT_LE(s.displaced_occlusion_culled, s.occlusion_culled);
                 displaced_occluded += s.displaced_occlusion_culled;
@@ -127,13 +135,8 @@ TEST(DisplacedPipeline, StrictWithOsdPatchesOfMixedDepth) {
         PipelineParams pp;
         pp.frame.render = params_of(cameras[f]);
         pp.frame.render.tess_level = 2;  // times 2^(D - depth) per patch
-        const FrameStats s = pipeline.render_frame(pp);
-        const FrameCapture culled{r.read_ids(), r.read_depth(), r.read_drawn_patches()};
-        RenderParams unculled = pp.frame.render;
-        unculled.use_cull_flags = false;
-        r.render(unculled);
-        const FrameCapture reference{r.read_ids(), r.read_depth(), r.mark_front_patches(unculled)};
-        EXPECT_TRUE(compare_frames(reference, culled).false_culled.empty()) << "osd frame " << f;
+        FrameStats s;
+        EXPECT_TRUE(false_culls_of_frame(pipeline, pp, s).empty()) << "osd frame " << f;
         displaced_occluded += s.displaced_occlusion_culled;
     }
     EXPECT_GT(displaced_occluded, 100u);
