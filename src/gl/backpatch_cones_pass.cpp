@@ -5,10 +5,8 @@
 
 namespace patchcull::gl {
 
-struct BackpatchConePass::Impl {
-    explicit Impl(PassContext::Impl& c) : context(c) {}
-    PassContext::Impl& context;
-    detail::ParamBlock block;
+struct BackpatchConePass::Impl : detail::PassState {
+    using PassState::PassState;
 };
 
 BackpatchConePass::BackpatchConePass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}

@@ -22,10 +22,8 @@ bool ptp_rows(const Mat4& object_to_clip, float alpha, pp::vec4 rows[3]) {
 
 }  // namespace
 
-struct BackpatchPtpPass::Impl {
-    explicit Impl(PassContext::Impl& c) : context(c) {}
-    PassContext::Impl& context;
-    detail::ParamBlock block;
+struct BackpatchPtpPass::Impl : detail::PassState {
+    using PassState::PassState;
 };
 
 BackpatchPtpPass::BackpatchPtpPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}

@@ -3,10 +3,8 @@
 
 namespace patchcull::gl {
 
-struct FrustumPass::Impl {
-    explicit Impl(PassContext::Impl& c) : context(c) {}
-    PassContext::Impl& context;
-    detail::ParamBlock block;
+struct FrustumPass::Impl : detail::PassState {
+    using PassState::PassState;
 };
 
 FrustumPass::FrustumPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}

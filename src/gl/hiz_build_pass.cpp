@@ -4,10 +4,8 @@
 
 namespace patchcull::gl {
 
-struct HiZBuildPass::Impl {
-    explicit Impl(PassContext::Impl& c) : context(c) {}
-    PassContext::Impl& context;
-    detail::ParamBlock block;
+struct HiZBuildPass::Impl : detail::PassState {
+    using PassState::PassState;
 };
 
 HiZBuildPass::HiZBuildPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}

@@ -4,10 +4,8 @@
 
 namespace patchcull::gl {
 
-struct OcclusionPass::Impl {
-    explicit Impl(PassContext::Impl& c) : context(c) {}
-    PassContext::Impl& context;
-    detail::ParamBlock block;
+struct OcclusionPass::Impl : detail::PassState {
+    using PassState::PassState;
 };
 
 OcclusionPass::OcclusionPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}

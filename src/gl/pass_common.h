@@ -57,6 +57,13 @@ private:
     GLuint buffer_ = 0;
 };
 
+/// What every pass keeps: its context's program cache and its parameter block.
+struct PassState {
+    explicit PassState(PassContext::Impl& c) : context(c) {}
+    PassContext::Impl& context;
+    ParamBlock block;
+};
+
 /// The rule for large ranges: a range of `count` patches, `patches_per_group` per work group, is
 /// covered by dispatches of at most 65535 work groups (the GL minimum of the x count); before
 /// each, params.first_patch and params.patch_count are set to its sub-range (first + offset) and
