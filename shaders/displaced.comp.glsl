@@ -75,7 +75,7 @@ PcCone pc_displaced_cone(vec4 P[16]) {
 }
 
 /// hiz_decision of displaced_bounds.cpp: frustum, then hiz.h steps 5-9 on a projected bound
-/// (hiz_box_test.h, shared with cull_occlusion.comp.glsl).
+/// (hiz_box_test.h, shared with occlusion.comp.glsl).
 uint pc_hiz_decision(PcDisplacedBound b) {
     if (pc_bound_outside_frustum(b)) return kPcHiZFrustumCulled;
     if (b.status != kPcBoundProjected) return kPcHiZVisible;

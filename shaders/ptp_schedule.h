@@ -2,7 +2,7 @@
 // src/core/ptp_schedule.h's kSchedule (itself built from src/core/ptp_table.inc) by
 // tests/gl/backpatch_gpu_test.cpp, which fails when this file differs: do not edit. Regenerate:
 //   PATCHCULL_WRITE_PTP_GLSL=1 <build>/tests/patchcull_gl_tests --gtest_filter=BackpatchGpu.PtpScheduleHeader*
-// Used by cull_ptp.comp.glsl; the meaning of each array is that of ptp_schedule.h's Schedule:
+// Used by backpatch_ptp.comp.glsl; the meaning of each array is that of ptp_schedule.h's Schedule:
 // - kPtpPairs[q] = a | b << 8: the point pairs (a < b) whose 2x2 minors (of (a, b - a)) are shared;
 // - kPtpSteps[s] = pair | third << 8 and kPtpStepWeights[s] (float bits, the table weight with the
 //   permutation sign folded in): acc = fma(weight, cross4Z from the pair's minors and point third, acc);

@@ -1,14 +1,16 @@
 // patchcull/gl_displaced.h: GPU culling of displaced patches (library patchcull_gl): the bounds of
 // displaced_bounds.h (seed 000 §4.2's camera-aligned frustum `caf`, Munkberg et al.'s `oobb`, each
 // with the cone `full`, `acon` or `con`) and their frustum and Hi-Z occlusion decisions, in a
-// compute shader that mirrors src/core/displaced_bounds.cpp operation by operation.
+// compute shader that mirrors src/core/displaced_bounds.cpp operation by operation: gl_passes.h's
+// DisplacedPass over buffers and a Hi-Z texture that DisplacedCuller owns, with read-backs (tests,
+// tools). In a frame, CullPipeline runs the same pass on the renderer's buffers.
 //
-// Shaders: shaders/cull_displaced.comp.glsl (one invocation per patch; one program per cone kind,
+// Shaders: shaders/displaced.comp.glsl (one invocation per patch; one program per cone kind,
 // compiled on first use: on llvmpipe without a warm shader cache, with the exact double-precision
 // fma, about 3 s for `full`, 5 s for `acon` and 10 s for `con`, mostly the cone code),
 // shaders/displaced_bounds.h (the bound arithmetic), the cones of shaders/backpatch_cones.h (the
 // mirror of src/core/cones_internal.h that BackpatchCuller's tcone / ncone use) and the Hi-Z
-// steps 5-9 of cull_occlusion.comp.glsl.
+// steps 5-9 of occlusion.comp.glsl (shaders/hiz_box_test.h).
 //
 // Buffers and textures (bindings of shaders/shared.h and shaders/displaced_shared.h):
 // - control points, kBindingControlPoints (0): vec4 cp[16 * patch_count], patch p's point k at
@@ -16,14 +18,12 @@
 //   (use_patch_buffer, e.g. PatchRenderer::patch_buffer()).
 // - displacement ranges, kBindingDisplacementRanges (8): vec2 (d_min, d_max) per patch, uploaded by
 //   set_ranges; without ranges every patch is undisplaced (the CPU kernels' ranges = null).
-// - flags, kBindingCullFlags (1), flag_buffer(): uint per patch, written whole by every cull call:
-//   kFlagFrustum (1) = outside the view volume, kFlagOcclusion (4) = behind the Hi-Z pyramid
-//   (cull_occlusion only), 0 = kept; status bits 8-9 are 0. These are the reason bits of the
-//   renderer's flag word (gl_renderer.h): a TCS that draws iff (word & kFlagReasonMask) == 0 draws
-//   exactly the kept patches. (PatchRenderer does not take an external flag buffer yet: copy it,
-//   or read it back and use set_cull_flags.)
-// - Hi-Z pyramid: an R32F texture on kTextureUnitHiZ (2) whose mip level l holds hiz.h's level l
-//   in its lower-left W_l x H_l texels, the layout PatchRenderer builds; set_hiz uploads a CPU
+// - flags, kBindingCullFlags (1), flag_buffer(): uint per patch, cleared and written by every
+//   cull call: kFlagFrustum (1) = outside the view volume, kFlagOcclusion (4) = behind the Hi-Z
+//   pyramid (cull_occlusion only), 0 = kept; status bits 8-9 are 0 (the reason bits of the flag
+//   word, gl_renderer.h).
+// - Hi-Z pyramid: an R32F texture on kTextureUnitHiZ (2) of create_hiz_texture's layout (mip
+//   level l holds hiz.h's level l in its lower-left W_l x H_l texels); set_hiz uploads a CPU
 //   HiZPyramid into the culler's own texture of that layout.
 // - diagnostics, kBindingDisplacedBounds (9): float [8 * patch_count], per patch the bound
 //   (ndc_xmin, ndc_xmax, ndc_ymin, ndc_ymax, depth_near, depth_far, status, 0), written only when

@@ -75,7 +75,7 @@ std::string ptp_schedule_glsl() {
          "// src/core/ptp_schedule.h's kSchedule (itself built from src/core/ptp_table.inc) by\n"
          "// tests/gl/backpatch_gpu_test.cpp, which fails when this file differs: do not edit. Regenerate:\n"
          "//   PATCHCULL_WRITE_PTP_GLSL=1 <build>/tests/patchcull_gl_tests --gtest_filter=BackpatchGpu.PtpScheduleHeader*\n"
-         "// Used by cull_ptp.comp.glsl; the meaning of each array is that of ptp_schedule.h's Schedule:\n"
+         "// Used by backpatch_ptp.comp.glsl; the meaning of each array is that of ptp_schedule.h's Schedule:\n"
          "// - kPtpPairs[q] = a | b << 8: the point pairs (a < b) whose 2x2 minors (of (a, b - a)) are shared;\n"
          "// - kPtpSteps[s] = pair | third << 8 and kPtpStepWeights[s] (float bits, the table weight with the\n"
          "//   permutation sign folded in): acc = fma(weight, cross4Z from the pair's minors and point third, acc);\n"

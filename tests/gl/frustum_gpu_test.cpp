@@ -1,4 +1,4 @@
-// The GPU frustum pass (shaders/cull_frustum.comp.glsl) against the CPU reference kernel
+// The GPU frustum pass (FrustumPass, shaders/frustum.comp.glsl) against the CPU reference kernel
 // cull_frustum_scalar, and the strict test of DESIGN.md: with GPU frustum culling on, the patch-id
 // buffer is identical to the unculled render's at the same resolution and tessellation level.
 #include <gtest/gtest.h>

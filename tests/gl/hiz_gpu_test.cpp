@@ -1,6 +1,6 @@
 // The GPU Hi-Z pipeline against its CPU mirror (include/patchcull/hiz.h): on the same depth buffer
 // (rendered by GL, read back) the compute-built pyramid (shaders/hiz_build.comp.glsl) is
-// bit-identical to HiZPyramid::build, and the combined cull pass (shaders/cull_occlusion.comp.glsl)
+// bit-identical to HiZPyramid::build, and the combined cull pass (shaders/occlusion.comp.glsl, OcclusionPass)
 // makes the same decisions as cull_occlusion_scalar, patch by patch, on the same matrix: the teapot
 // with triangle occluders from several cameras, random (rational, eye-straddling) patches, and
 // NPOT / odd framebuffer sizes.
