@@ -4,34 +4,62 @@
 // program, draws with its own tessellation shaders, and calls only the passes. This is what an
 // engine does to adopt them (docs/ENGINE.md explains each piece).
 //
-// Per frame it runs Niessner & Loop's two-pass occlusion-culling frame ("Patch-Based Occlusion
-// Culling for Hardware Tessellation", §3, the sequence gl_pipeline.h describes):
+// The scene has three objects in one patch buffer, each a range [first, first + count) that the
+// passes are given separately (PatchBuffers::first/count), each drawn under its own rule:
+//   teapot   the Utah teapot split twice (512 patches): an OPEN surface (the lid sits loose in the
+//            rim), drawn two-sided, never back-patch tested;
+//   bigguy   BigGuy (data/models, ACC patches through patchcull's import layer): a CLOSED,
+//            outward-oriented surface, drawn ONE-SIDED by the exact surface (below) and
+//            back-patch tested (Loop, Niessner & Eisenacher, "Effective Back-Patch Culling for
+//            Hardware Tessellation": tcone, ncone or ptp);
+//   frog     MonsterFrog, DISPLACED by a height map in our TES along the unit normal of the
+//            patch's own derivatives, drawn two-sided, tested by its displaced bound (Niessner &
+//            Loop, "Patch-Based Occlusion Culling for Hardware Tessellation", §4.2: caf or oobb,
+//            cone full, acon or con) instead of its control points.
+//
+// Per frame it runs seed 000's two-pass occlusion-culling frame (§3, the order of gl_pipeline.h):
 //   1. draw the patches tagged visible by the previous frame     (kDrawMaskFirstPass)
 //   2. build the Hi-Z pyramid from that depth buffer             (HiZBuildPass)
-//   3. the flag chain: CullStatusPass::begin, FrustumPass, OcclusionPass, CullStatusPass::end
+//   3. the flag chain on one flag buffer: CullStatusPass::begin; FrustumPass (all, with the
+//      displacement margins); BackpatchConePass or BackpatchPtpPass (bigguy); OcclusionPass (all;
+//      it skips displaced patches); DisplacedPass (frog, against the same pyramid);
+//      CullStatusPass::end per object (its own counter slot)
 //   4. draw the patches that became visible in step 3            (kDrawMaskSecondPass)
 // and then checks the result: the final id buffer must equal the id buffer of its own unculled
-// draw (every patch, selection (0, 0)) of the same camera. The model is the Utah teapot split
-// twice (512 patches), an OPEN surface drawn two-sided, so back-patch culling (BackpatchConePass,
-// Loop, Niessner & Eisenacher, "Effective Back-Patch Culling for Hardware Tessellation") is not
-// run: it is conservative only for closed surfaces drawn one-sided (docs/ENGINE.md).
+// draw (every patch, selection (0, 0)) of the same camera.
+//
+// The one-sided rule (the lesson for an engine): back-patch culling is conservative only when a
+// closed surface contributes exactly the points whose EXACT tangent plane faces the eye. Hardware
+// back-face culling of the tessellated triangles is not that: a secant triangle can face the eye
+// where the surface does not, and a crack between patches shows the inside. So our fragment
+// shader re-evaluates the patch at the fragment's (u, v) and discards it unless
+// cos(du x dv, eye - p) > kFrontFacingMinCosine (shared.h), as patchcull's own
+// shaders/patch.frag.glsl does (README.md, "What contributes a pixel"). Open and displaced
+// surfaces are drawn two-sided and must never be given to a back-patch pass.
 //
 // Usage: 01_gpu_passes_in_your_engine [--frames N] [--size WxH] [--aggressive]
+//            [--backpatch tcone|ncone|ptp] [--bound caf|oobb] [--cone full|acon|con] [--backpatch-open]
 //   --frames N    frames per camera position (3 positions, the camera moving), N in 1..1000, default 4
 //   --size WxH    framebuffer (and window) size, each in 1..8192, default 320x240
 //   --aggressive  skip pass 2 (seed 000 §3.1's aggressive variant: newly visible patches appear a
 //                 frame late). NOT conservative: shows that the check catches missing patches.
-// Prints one line per frame (patches culled per reason, from the counters; whether the ids match).
-// Exit status: 0 every frame matched; 1 a frame did not (or the run culled nothing, so the check
-// proved nothing); 2 a setup error (bad option, no X display, no GL 4.5 core context, a shader
-// header missing), with one line on stderr. Without a screen: xvfb-run -a -s "-screen 0 1280x1024x24".
+//   --backpatch   the back-patch test of bigguy (default tcone; ptp with the ncnt rule)
+//   --bound, --cone  the displaced bound of the frog and its cone of normals (default caf, acon)
+//   --backpatch-open  give the open teapot to the back-patch pass too. NOT conservative (from
+//                 above, the inside of its far side shows through the lid gap): shows that the
+//                 check catches a back-patch test on a surface it does not hold for.
+// Prints one line per frame (patches culled per reason and pass, from the counters; whether the
+// ids match). Exit status: 0 every frame matched; 1 a frame did not, or a cull pass culled nothing
+// over the run (the check would prove nothing about it); 2 a setup error (bad option, no X
+// display, no GL 4.5 core context, a model file missing), with one line on stderr. Without a
+// screen: xvfb-run -a -s "-screen 0 1280x1024x24".
 //
-// GLSL headers: the TCS includes shared.h and patchcull_tcs.h. The library ships their text
-// (gl::shipped_glsl, the files of shaders/ embedded at build time), and this program pastes it
-// where the TCS says #include, as an engine's own include system would (patchcull's build does the
-// same for its shaders, cmake/GlShaders.cmake). The same shared.h is also valid C++ (shaders/ is
-// on patchcull_gl's public include path): included here for the binding points, flag bits, draw
-// selections and counter indices.
+// GLSL headers: our shaders include shared.h, and the TCS patchcull_tcs.h. The library ships
+// their text (gl::shipped_glsl, the files of shaders/ embedded at build time), and this program
+// pastes it where a shader says #include, as an engine's own include system would (with one
+// header of its own, the patch evaluation shared by the TES and the fragment shader). The same
+// shared.h is also valid C++ (shaders/ is on patchcull_gl's public include path): included here
+// for the binding points, flag bits, draw selections and counter indices.
 
 #include <epoxy/gl.h>  // GL through libepoxy, as patchcull_gl loads it; before GLFW
 #define GLFW_INCLUDE_NONE
@@ -43,16 +71,19 @@
 #include <cstdint>
 #include <cstdio>
 #include <exception>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "patchcull/backpatch.h"
+#include "patchcull/displaced_bounds.h"
+#include "patchcull/displacement.h"
 #include "patchcull/error.h"
 #include "patchcull/frustum.h"
 #include "patchcull/gl_passes.h"
 #include "patchcull/math.h"
 #include "patchcull/patch.h"
+#include "patchcull/scene.h"
 #include "patchcull/teapot.h"
 #include "shared.h"  // shaders/shared.h: C++ and GLSL at once
 
@@ -86,9 +117,16 @@ struct Options {
     int frames = 4;  // per camera position
     int width = 320, height = 240;
     bool aggressive = false;
+    bool backpatch_open = false;
+    pc::gl::BackpatchMethod backpatch = pc::gl::BackpatchMethod::tcone;
+    pc::DisplacedBoundKind bound = pc::DisplacedBoundKind::caf;
+    pc::NormalConeKind cone = pc::NormalConeKind::acon;
 };
 
 Options parse_options(int argc, char** argv) {
+    const std::string usage =
+        "(usage: [--frames N] [--size WxH] [--aggressive] [--backpatch tcone|ncone|ptp] [--bound caf|oobb] "
+        "[--cone full|acon|con] [--backpatch-open])";
     Options o;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
@@ -96,18 +134,32 @@ Options parse_options(int argc, char** argv) {
             o.aggressive = true;
             continue;
         }
-        if (flag != "--frames" && flag != "--size")
-            setup_error("unknown option " + pc::quote_input(flag) + " (usage: [--frames N] [--size WxH] [--aggressive])");
+        if (flag == "--backpatch-open") {
+            o.backpatch_open = true;
+            continue;
+        }
+        if (flag != "--frames" && flag != "--size" && flag != "--backpatch" && flag != "--bound" && flag != "--cone")
+            setup_error("unknown option " + pc::quote_input(flag) + " " + usage);
         if (i + 1 >= argc) setup_error(flag + ": missing value");
         const std::string value = argv[++i];
         if (flag == "--frames") {
             if (!parse_int(value, 1, 1000, o.frames))
                 setup_error("--frames: expected an integer in 1..1000, got " + pc::quote_input(value));
-        } else {
+        } else if (flag == "--size") {
             const std::size_t x = value.find('x');
             if (x == std::string::npos || !parse_int(value.substr(0, x), 1, 8192, o.width) ||
                 !parse_int(value.substr(x + 1), 1, 8192, o.height))
                 setup_error("--size: expected WIDTHxHEIGHT, each in 1..8192, got " + pc::quote_input(value));
+        } else if (flag == "--backpatch") {
+            if (value == "tcone") o.backpatch = pc::gl::BackpatchMethod::tcone;
+            else if (value == "ncone") o.backpatch = pc::gl::BackpatchMethod::ncone;
+            else if (value == "ptp") o.backpatch = pc::gl::BackpatchMethod::ptp;
+            else setup_error("--backpatch: expected tcone, ncone or ptp, got " + pc::quote_input(value));
+        } else if (flag == "--bound") {
+            if (!pc::parse_displaced_bound(value.c_str(), o.bound))
+                setup_error("--bound: expected caf or oobb, got " + pc::quote_input(value));
+        } else if (!pc::parse_normal_cone(value.c_str(), o.cone)) {
+            setup_error("--cone: expected full, acon or con, got " + pc::quote_input(value));
         }
     }
     return o;
@@ -115,8 +167,36 @@ Options parse_options(int argc, char** argv) {
 
 // ---- the engine's shaders ---------------------------------------------------------------------
 
-// The engine's include system: each line `#include "NAME"` becomes the text patchcull ships for
-// NAME (gl::shipped_glsl).
+// Our own header, shared by the TES and the fragment shader: the bicubic rational Bezier patch at
+// (u, v), control point (i, j) (i along u) at cp[4 j + i], its point p and derivatives pu, pv.
+// du x dv of THIS evaluation is the normal that both the displacement (seed 000 §4.2's bounds
+// assume it) and the one-sided test (the back-patch tests decide on it) use.
+const char* const kPatchEvalGlsl = R"(
+void bernstein(float t, out vec4 b, out vec4 db) {
+    float s = 1.0 - t;
+    b = vec4(s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t);
+    db = vec4(-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t);
+}
+void evaluate_patch(vec4 cp[16], vec2 uv, out vec3 p, out vec3 pu, out vec3 pv) {
+    vec4 bu, dbu, bv, dbv;
+    bernstein(uv.x, bu, dbu);
+    bernstein(uv.y, bv, dbv);
+    vec4 h = vec4(0.0), hu = vec4(0.0), hv = vec4(0.0);
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            vec4 c = cp[4 * j + i];
+            h += bu[i] * bv[j] * c;
+            hu += dbu[i] * bv[j] * c;
+            hv += bu[i] * dbv[j] * c;
+        }
+    p = h.xyz / h.w;
+    pu = (hu.xyz - p * hu.w) / h.w;
+    pv = (hv.xyz - p * hv.w) / h.w;
+}
+)";
+
+// The engine's include system: each line `#include "NAME"` becomes our own header or the text
+// patchcull ships for NAME (gl::shipped_glsl).
 std::string expand_includes(const std::string& source) {
     std::istringstream in(source);
     std::string out, line;
@@ -124,7 +204,7 @@ std::string expand_includes(const std::string& source) {
         const std::string directive = "#include \"";
         if (line.rfind(directive, 0) == 0 && line.size() > directive.size() + 1 && line.back() == '"') {
             const std::string name = line.substr(directive.size(), line.size() - directive.size() - 1);
-            const std::string_view text = pc::gl::shipped_glsl(name);
+            const std::string_view text = name == "example_patch_eval.glsl" ? kPatchEvalGlsl : pc::gl::shipped_glsl(name);
             if (text.empty()) setup_error("GLSL header " + name + " is not shipped by patchcull");
             out += std::string(text) + "\n";
         } else {
@@ -172,49 +252,77 @@ void main() {
 }
 )";
 
-// Bicubic rational Bezier evaluation, control point (i, j) (i along u) at tcs_point[4 j + i].
+// Evaluation and displacement. A patch with margin > 0 (the frog's) is displaced by
+// D(s, t) = scale * (h(s, t) - midlevel) along the UNIT normal of its own derivatives, (s, t)
+// bilinear in its corner texcoords (patchcull/displacement.h): what DisplacedPass bounds, with
+// |D| <= margin and D in its range. The height map is sampled as DisplacementMap::sample is
+// defined: bilinear, GL_REPEAT, no mipmaps (a mip level averages texels the range never saw).
+// Where du x dv = 0 the point stays on the base patch, as the bounds assume.
 const char* const kEvaluationShader = R"(#version 450 core
+#include "shared.h"
+#include "example_patch_eval.glsl"
 layout(quads, equal_spacing, ccw) in;
+layout(std430, binding = kBindingMaxDisplacement) readonly buffer Margins { float margins[]; };
+layout(std430, binding = kBindingPatchTexcoords) readonly buffer Texcoords { vec2 texcoords[]; };  // 4 per patch
+layout(binding = kTextureUnitDisplacement) uniform sampler2D u_height;
 uniform mat4 u_object_to_clip;
+uniform float u_displacement_scale;
+uniform float u_displacement_midlevel;
 in vec4 tcs_point[];
 patch in uint tcs_patch;
 out vec3 tes_position;
 out vec3 tes_normal;
+out vec2 tes_uv;
 flat out uint tes_patch;
-void bernstein(float t, out vec4 b, out vec4 db) {
-    float s = 1.0 - t;
-    b = vec4(s * s * s, 3.0 * t * s * s, 3.0 * t * t * s, t * t * t);
-    db = vec4(-3.0 * s * s, 3.0 * s * s - 6.0 * t * s, 6.0 * t * s - 3.0 * t * t, 3.0 * t * t);
-}
 void main() {
-    vec4 bu, dbu, bv, dbv;
-    bernstein(gl_TessCoord.x, bu, dbu);
-    bernstein(gl_TessCoord.y, bv, dbv);
-    vec4 h = vec4(0.0), hu = vec4(0.0), hv = vec4(0.0);
-    for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) {
-            vec4 c = tcs_point[4 * j + i];
-            h += bu[i] * bv[j] * c;
-            hu += dbu[i] * bv[j] * c;
-            hv += bu[i] * dbv[j] * c;
-        }
-    vec3 p = h.xyz / h.w;
+    vec4 cp[16];
+    for (int k = 0; k < 16; ++k) cp[k] = tcs_point[k];
+    vec3 p, pu, pv;
+    evaluate_patch(cp, gl_TessCoord.xy, p, pu, pv);
+    vec3 n = cross(pu, pv);  // zero where degenerate
+    float len = length(n);
+    if (margins[tcs_patch] > 0.0 && len > 0.0) {
+        uint b = 4u * tcs_patch;
+        vec2 st = mix(mix(texcoords[b], texcoords[b + 1u], gl_TessCoord.x),
+                      mix(texcoords[b + 2u], texcoords[b + 3u], gl_TessCoord.x), gl_TessCoord.y);
+        float d = u_displacement_scale * (textureLod(u_height, st, 0.0).r - u_displacement_midlevel);
+        p += (d / len) * n;
+    }
     tes_position = p;
-    tes_normal = cross((hu.xyz - p * hu.w) / h.w, (hv.xyz - p * hv.w) / h.w);  // zero where degenerate
+    tes_normal = n;
+    tes_uv = gl_TessCoord.xy;
     tes_patch = tcs_patch;
     gl_Position = u_object_to_clip * vec4(p, 1.0);
 }
 )";
 
-// Colour (shaded two-sided: the teapot is open) and the patch id, p + 1 (0 = background).
+// Colour and the patch id, p + 1 (0 = background). The patches in u_one_sided (the closed,
+// back-patch-tested object) follow the one-sided rule: the fragment re-evaluates the EXACT patch at
+// its (u, v) and is discarded unless the tangent plane there faces the eye by more than
+// kFrontFacingMinCosine. This is the visibility the back-patch tests decide on, independent of the
+// tessellation (README.md, "What contributes a pixel"; patchcull's shaders/patch.frag.glsl). The
+// others (the open teapot, the displaced frog) are drawn two-sided.
 const char* const kFragmentShader = R"(#version 450 core
+#include "shared.h"
+#include "example_patch_eval.glsl"
+layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints { vec4 control_points[]; };
 uniform vec3 u_eye;
+uniform uvec2 u_one_sided;  // patches [x, y) are one-sided
 in vec3 tes_position;
 in vec3 tes_normal;
+in vec2 tes_uv;
 flat in uint tes_patch;
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out uint out_id;
 void main() {
+    if (tes_patch >= u_one_sided.x && tes_patch < u_one_sided.y) {
+        vec4 cp[16];
+        for (int k = 0; k < 16; ++k) cp[k] = control_points[16u * tes_patch + uint(k)];
+        vec3 p, pu, pv;
+        evaluate_patch(cp, clamp(tes_uv, 0.0, 1.0), p, pu, pv);  // interpolation may leave [0, 1] by an ulp
+        vec3 n = cross(pu, pv), to_eye = u_eye - p;
+        if (!(dot(n, to_eye) > kFrontFacingMinCosine * length(n) * length(to_eye))) discard;
+    }
     float len = length(tes_normal);
     float facing = len > 0.0 ? abs(dot(tes_normal / len, normalize(u_eye - tes_position))) : 1.0;
     vec3 hue = 0.4 + 0.6 * fract(vec3(0.37, 0.61, 0.83) * float(tes_patch % 97u));
@@ -242,8 +350,8 @@ GLuint link_patch_program() {
     const GLuint program = glCreateProgram();
     const GLuint stages[] = {compile(GL_VERTEX_SHADER, kVertexShader, "vertex"),
                              compile(GL_TESS_CONTROL_SHADER, expand_includes(kControlShader), "control"),
-                             compile(GL_TESS_EVALUATION_SHADER, kEvaluationShader, "evaluation"),
-                             compile(GL_FRAGMENT_SHADER, kFragmentShader, "fragment")};
+                             compile(GL_TESS_EVALUATION_SHADER, expand_includes(kEvaluationShader), "evaluation"),
+                             compile(GL_FRAGMENT_SHADER, expand_includes(kFragmentShader), "fragment")};
     for (GLuint s : stages) glAttachShader(program, s);
     glLinkProgram(program);
     for (GLuint s : stages) glDeleteShader(s);
@@ -255,15 +363,92 @@ GLuint link_patch_program() {
 
 // ---- the engine's scene ------------------------------------------------------------------------
 
-// The teapot's 32 patches, each split twice (4^2 children): 512 patches, in patch.h's layout.
-std::vector<pc::BezierPatch> make_patches() {
-    std::vector<pc::BezierPatch> patches = pc::teapot_patches();
-    for (int level = 0; level < 2; ++level) {
-        std::vector<pc::BezierPatch> children(patches.size() * 4);
-        for (std::size_t i = 0; i < patches.size(); ++i) pc::split_patch(patches[i], &children[4 * i]);
-        patches.swap(children);
+// One object: its range of the patch buffer and how it is drawn and culled.
+struct Object {
+    const char* name;
+    std::size_t first = 0, count = 0;
+    pc::gl::PatchBuffers range(const pc::gl::PatchBuffers& all) const {
+        pc::gl::PatchBuffers r = all;
+        r.first = first;
+        r.count = count;
+        return r;
     }
-    return patches;
+};
+
+// The scene in world space (z up): patches (patch.h's layout), 4 corner texcoords per patch, and
+// per patch the margin max |D| (0 = not displaced) and the range (d_min, d_max) of DisplacedPass.
+struct Scene {
+    std::vector<pc::BezierPatch> patches;
+    std::vector<pc::Vec2> texcoords;
+    std::vector<float> margins;
+    std::vector<pc::Vec2> ranges;
+    pc::DisplacementMap height_map;
+    Object teapot{"teapot"}, bigguy{"bigguy"}, frog{"frog"};
+};
+
+// Appends patches moved by p -> scale * R (p - base) + position, R a PROPER rotation (y up -> z
+// up, then a turn of yaw degrees about z): a reflection would turn a closed surface inside out,
+// and its back-patch tests and one-sided drawing with it. Homogeneous points (w x, w y, w z, w)
+// move as w (scale * R (x - base) + position).
+void add_patches(Scene& s, const std::vector<pc::BezierPatch>& patches, bool y_up, pc::Vec3 base, float scale,
+                 float yaw_degrees, pc::Vec3 position) {
+    const float a = yaw_degrees * 3.14159265f / 180, c = std::cos(a), sn = std::sin(a);
+    for (pc::BezierPatch patch : patches) {
+        for (pc::Vec4& q : patch.cp) {
+            const pc::Vec3 p = (pc::Vec3{q.x, q.y, q.z} * (1 / q.w) - base) * scale;
+            const pc::Vec3 up = y_up ? pc::Vec3{p.x, -p.z, p.y} : p;
+            const pc::Vec3 w = pc::Vec3{c * up.x - sn * up.y, sn * up.x + c * up.y, up.z} + position;
+            q = {w.x * q.w, w.y * q.w, w.z * q.w, q.w};
+        }
+        s.patches.push_back(patch);
+    }
+}
+
+// A shipped OBJ model (ACC patches: patchcull's import layer), standing on z = 0 at position,
+// height units tall.
+pc::LoadedModel add_model(Scene& s, Object& o, const char* file, float height, float yaw, pc::Vec3 position) {
+    pc::LoadedModel model = pc::load_model(pc::shipped_model_path(file), pc::Scheme::acc, 0);
+    const pc::Bounds b = pc::patch_bounds(model.rest);  // y up
+    const pc::Vec3 base{0.5f * (b.min.x + b.max.x), b.min.y, 0.5f * (b.min.z + b.max.z)};
+    o.first = s.patches.size();
+    o.count = model.rest.patches.size();
+    add_patches(s, model.rest.patches, true, base, height / (b.max.y - b.min.y), yaw, position);
+    return model;
+}
+
+Scene make_scene() {
+    Scene s;
+    // The teapot's 32 patches, each split twice (4^2 children), in its own z-up frame.
+    std::vector<pc::BezierPatch> teapot = pc::teapot_patches();
+    for (int level = 0; level < 2; ++level) {
+        std::vector<pc::BezierPatch> children(teapot.size() * 4);
+        for (std::size_t i = 0; i < teapot.size(); ++i) pc::split_patch(teapot[i], &children[4 * i]);
+        teapot.swap(children);
+    }
+    s.teapot.count = teapot.size();
+    add_patches(s, teapot, false, {0, 0, 0}, 1, 0, {0, 0, 0});
+    // BigGuy beside the teapot. Back-patch culling needs a closed, outward-oriented surface:
+    // load_model reports it (LoadedModel::closed) after orienting it outward.
+    const pc::LoadedModel bigguy = add_model(s, s.bigguy, "bigguy.obj", 4.0f, 200, {0.5f, -5.0f, 0});
+    if (!bigguy.closed) setup_error("bigguy.obj: not a closed surface (the back-patch tests need one)");
+    // MonsterFrog behind the teapot (seen from the first camera), displaced.
+    const pc::LoadedModel frog = add_model(s, s.frog, "monsterfrog.obj", 2.6f, 30, {-5.5f, 2.2f, 0});
+    const std::size_t n = s.patches.size();
+    s.texcoords.assign(4 * n, pc::Vec2{});
+    s.margins.assign(n, 0.0f);
+    s.ranges.assign(n, pc::Vec2{});
+    // The height map: patchcull's procedural one; D = scale (h - 1/2), |D| <= 3% of the frog's height.
+    s.height_map = pc::make_procedural_displacement(256, 0.16f);
+    for (std::size_t i = 0; i < s.frog.count; ++i) {
+        const pc::PatchInfo& info = frog.rest.info[i];
+        const std::size_t p = s.frog.first + i;
+        for (int k = 0; k < 4; ++k) s.texcoords[4 * p + k] = info.uv[k];
+        // Seed 002's per-patch bound of D over every texel the patch can sample (displacement.h).
+        const pc::DisplacementRange r = s.height_map.patch_range(info.uv);
+        s.margins[p] = r.max_abs();
+        s.ranges[p] = {r.d_min, r.d_max};
+    }
+    return s;
 }
 
 struct View {
@@ -271,24 +456,26 @@ struct View {
     pc::Vec3 eye;
 };
 
-// Three camera positions (the teapot is z-up, about 6 x 4 x 3 units around (0.2, 0, 1.5)), each
-// orbiting 4 degrees per frame: whole in view from the side (its far half occluded by the near
-// one); close to the spout (parts leave the frustum); steep from above (the lid hides the inside).
+// Three camera positions, each orbiting 4 degrees per frame: the whole scene from the side (the
+// teapot hides part of the frog, every object hides its own far half); close to the teapot's
+// spout (most of the scene leaves the frustum); steep from above, behind BigGuy.
 View camera(int frame, int frames_per_position, float aspect) {
     struct Position {
         float azimuth, elevation, distance;
+        pc::Vec3 target;
     };
-    const Position positions[] = {{20, 15, 9}, {-10, 10, 3.5f}, {140, 60, 7}};
+    const Position positions[] = {{15, 12, 13, {-1.5f, -1.2f, 1.3f}},
+                                  {-10, 10, 3.5f, {0.2f, 0, 1.5f}},
+                                  {-120, 55, 12, {-1.5f, -2.0f, 1.0f}}};
     const Position& p = positions[frame / frames_per_position];
     const float deg = 3.14159265f / 180;
     const float azimuth = (p.azimuth + 4.0f * static_cast<float>(frame % frames_per_position)) * deg;
     const float elevation = p.elevation * deg;
-    const pc::Vec3 target{0.2f, 0, 1.5f};
-    const pc::Vec3 eye = target + pc::Vec3{std::cos(elevation) * std::cos(azimuth),
-                                           std::cos(elevation) * std::sin(azimuth), std::sin(elevation)} * p.distance;
+    const pc::Vec3 eye = p.target + pc::Vec3{std::cos(elevation) * std::cos(azimuth),
+                                             std::cos(elevation) * std::sin(azimuth), std::sin(elevation)} * p.distance;
     // patchcull's perspective() is a zero-to-one depth projection (clip_space.h), matching
     // glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) below.
-    return {pc::look_at(eye, target, {0, 0, 1}), pc::perspective(0.9f, aspect, 0.1f, 40.0f), eye};
+    return {pc::look_at(eye, p.target, {0, 0, 1}), pc::perspective(0.9f, aspect, 0.1f, 60.0f), eye};
 }
 
 // ---- the engine's renderer ---------------------------------------------------------------------
@@ -298,9 +485,11 @@ struct Renderer {
     GLuint fbo = 0, color = 0, ids = 0, depth = 0;
     GLuint vao = 0, program = 0;
     GLint loc_level = -1, loc_mask = -1, loc_value = -1, loc_object_to_clip = -1, loc_eye = -1;
-    GLuint patch_buffer = 0, flag_buffer = 0;
+    GLint loc_one_sided = -1, loc_scale = -1, loc_midlevel = -1;
+    GLuint patch_buffer = 0, flag_buffer = 0, texcoord_buffer = 0, margin_buffer = 0, height_texture = 0;
     std::size_t patch_count = 0;
-    float level = 8;
+    Object one_sided{"none"};
+    float level = 6, displacement_scale = 0, displacement_midlevel = 0.5f;
 
     // Clears the framebuffer: depth 1 (the far plane of zero-to-one depth), id 0, a grey colour.
     void clear() const {
@@ -321,7 +510,9 @@ struct Renderer {
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
         glDepthMask(GL_TRUE);
-        glDisable(GL_CULL_FACE);  // two-sided: the teapot is open
+        // No hardware face culling: the open and displaced objects are two-sided, and the closed
+        // one is made one-sided by its exact surface in the fragment shader, not by its triangles.
+        glDisable(GL_CULL_FACE);
         glUseProgram(program);
         const pc::Mat4 object_to_clip = v.projection * v.view;
         glUniformMatrix4fv(loc_object_to_clip, 1, GL_FALSE, object_to_clip.m);
@@ -329,8 +520,16 @@ struct Renderer {
         glUniform1f(loc_level, level);
         glUniform1ui(loc_mask, mask);
         glUniform1ui(loc_value, value);
+        glUniform2ui(loc_one_sided, static_cast<GLuint>(one_sided.first),
+                     static_cast<GLuint>(one_sided.first + one_sided.count));
+        glUniform1f(loc_scale, displacement_scale);
+        glUniform1f(loc_midlevel, displacement_midlevel);
         glBindVertexArray(vao);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullFlags, flag_buffer);  // read by the TCS
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, patch_buffer);  // fragment shader
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingMaxDisplacement, margin_buffer);  // TES
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchTexcoords, texcoord_buffer);  // TES
+        glBindTextureUnit(sh::kTextureUnitDisplacement, height_texture);
         glPatchParameteri(GL_PATCH_VERTICES, 16);
         // llvmpipe garbles a 4096-vertex chunk that yields more than 65536 tessellated vertices
         // (gl_renderer.h): sub-draws of at most 65536 / (level + 1)^2 patches avoid it.
@@ -362,6 +561,14 @@ void check_gl(const char* where) {
         std::snprintf(code, sizeof code, "0x%04x", e);
         setup_error(std::string("GL: error ") + code + " " + where);
     }
+}
+
+template <class T>
+GLuint make_buffer(const std::vector<T>& data, GLbitfield flags = 0) {
+    GLuint buffer = 0;
+    glCreateBuffers(1, &buffer);
+    glNamedBufferStorage(buffer, static_cast<GLsizeiptr>(data.size() * sizeof(T)), data.data(), flags);
+    return buffer;
 }
 
 // ---- the check ---------------------------------------------------------------------------------
@@ -404,7 +611,17 @@ std::vector<std::uint32_t> read_words(GLuint buffer, std::size_t count) {
     return words;
 }
 
+// What the counters of one frame say, per object slot (CullStatusPass::end adds each object's
+// counts to its own slot of kCounterCount uints).
+struct Counts {
+    std::uint32_t slot[3][sh::kCounterCount] = {};
+    std::uint32_t total(std::uint32_t counter) const { return slot[0][counter] + slot[1][counter] + slot[2][counter]; }
+};
+
 int run(const Options& options) {
+    // 0. The engine's scene (a model file missing is a setup error before any window opens).
+    const Scene scene = make_scene();
+
     // 1. The engine's window and context: GLFW, OpenGL 4.5 core (no patchcull GlContext).
     glfwSetErrorCallback(remember_glfw_error);
     if (!glfwInit()) setup_error("GLFW: cannot start: " + g_glfw_error + " (no X display? run under xvfb-run)");
@@ -420,32 +637,51 @@ int run(const Options& options) {
     if (epoxy_gl_version() < 45) setup_error("GL: the context is not OpenGL 4.5");
 
     // 2. The engine's buffers. Patch buffer: 16 vec4 per patch, patch p's point k at 16 p + k
-    //    (BezierPatch's memory layout). Flag buffer: one uint per patch. Counters: kCounterCount
-    //    uints, cleared by the engine before each frame, added to by CullStatusPass::end.
-    const std::vector<pc::BezierPatch> patches = make_patches();
+    //    (BezierPatch's memory layout). Flag buffer: one uint per patch. Margins (float) and
+    //    displacement ranges (vec2) per patch, for the passes and our TES; corner texcoords (4
+    //    vec2 per patch) for our TES. Counters: one slot of kCounterCount uints per object, at
+    //    offsets that are multiples of GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, cleared by the
+    //    engine before each frame, added to by CullStatusPass::end.
+    const std::size_t n = scene.patches.size();
     Renderer r;
     r.width = options.width;
     r.height = options.height;
-    r.patch_count = patches.size();
-    GLuint counters = 0;
-    glCreateBuffers(1, &r.patch_buffer);
-    glNamedBufferStorage(r.patch_buffer, static_cast<GLsizeiptr>(patches.size() * sizeof(pc::BezierPatch)),
-                         patches.data(), 0);
-    glCreateBuffers(1, &r.flag_buffer);
+    r.patch_count = n;
+    r.one_sided = scene.bigguy;
+    r.displacement_scale = scene.height_map.scale;
+    r.displacement_midlevel = scene.height_map.midlevel;
+    r.patch_buffer = make_buffer(scene.patches);
+    r.texcoord_buffer = make_buffer(scene.texcoords);
+    r.margin_buffer = make_buffer(scene.margins);
+    const GLuint range_buffer = make_buffer(scene.ranges);
     // First frame: no previous frame tagged anything, so tag the even-indexed patches visible
     // (as CullPipeline does; seed 000 §3): pass 1 draws half, pass 2 the rest of what shows.
-    std::vector<std::uint32_t> words(patches.size(), 0);
-    for (std::size_t p = 0; p < words.size(); p += 2) words[p] = sh::kStatusVisible;
-    glNamedBufferStorage(r.flag_buffer, static_cast<GLsizeiptr>(words.size() * sizeof(std::uint32_t)), words.data(),
-                         GL_DYNAMIC_STORAGE_BIT);
+    std::vector<std::uint32_t> words(n, 0);
+    for (std::size_t p = 0; p < n; p += 2) words[p] = sh::kStatusVisible;
+    r.flag_buffer = make_buffer(words, GL_DYNAMIC_STORAGE_BIT);
+    GLint alignment = 1;
+    glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &alignment);
+    const std::size_t slot_bytes = sh::kCounterCount * sizeof(std::uint32_t);
+    const std::size_t stride = (slot_bytes + alignment - 1) / alignment * alignment;
+    GLuint counters = 0;
     glCreateBuffers(1, &counters);
-    glNamedBufferStorage(counters, sh::kCounterCount * sizeof(std::uint32_t), nullptr, GL_DYNAMIC_STORAGE_BIT);
-    // The draw reads control points as vertex attribute 0 from the same buffer.
+    glNamedBufferStorage(counters, static_cast<GLsizeiptr>(3 * stride), nullptr, GL_DYNAMIC_STORAGE_BIT);
+    // The draw reads control points as vertex attribute 0 from the patch buffer.
     glCreateVertexArrays(1, &r.vao);
     glVertexArrayVertexBuffer(r.vao, 0, r.patch_buffer, 0, sizeof(pc::Vec4));
     glEnableVertexArrayAttrib(r.vao, 0);
     glVertexArrayAttribFormat(r.vao, 0, 4, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(r.vao, 0, 0);
+    // The height map: R32F, bilinear, GL_REPEAT, row 0 at t = 0 (displacement.h), one level.
+    const pc::DisplacementMap& map = scene.height_map;
+    glCreateTextures(GL_TEXTURE_2D, 1, &r.height_texture);
+    glTextureStorage2D(r.height_texture, 1, GL_R32F, map.width, map.height);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTextureSubImage2D(r.height_texture, 0, 0, 0, map.width, map.height, GL_RED, GL_FLOAT, map.texels.data());
+    glTextureParameteri(r.height_texture, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTextureParameteri(r.height_texture, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    glTextureParameteri(r.height_texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(r.height_texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
 
     // 3. The engine's framebuffer: colour, R32UI ids and a DEPTH32F depth texture (the Hi-Z
     //    input: no compare mode, nearest filtering) of the same size.
@@ -475,30 +711,45 @@ int run(const Options& options) {
     r.loc_value = glGetUniformLocation(r.program, "u_draw_value");
     r.loc_object_to_clip = glGetUniformLocation(r.program, "u_object_to_clip");
     r.loc_eye = glGetUniformLocation(r.program, "u_eye");
+    r.loc_one_sided = glGetUniformLocation(r.program, "u_one_sided");
+    r.loc_scale = glGetUniformLocation(r.program, "u_displacement_scale");
+    r.loc_midlevel = glGetUniformLocation(r.program, "u_displacement_midlevel");
     check_gl("in setup");
 
     // 5. The passes, on the context current now. The Hi-Z pyramid texture is ours too.
     pc::gl::PassContext passes;
     pc::gl::CullStatusPass status(passes);
     pc::gl::FrustumPass frustum(passes);
+    pc::gl::BackpatchConePass cones(passes);
+    pc::gl::BackpatchPtpPass ptp(passes);
     pc::gl::OcclusionPass occlusion(passes);
+    pc::gl::DisplacedPass displaced(passes);
     pc::gl::HiZBuildPass hiz_build(passes);
     const pc::gl::HiZTexture hiz = pc::gl::create_hiz_texture(r.width, r.height);
-    // The patches the passes cover: the whole buffer, no displacement margins (none displaced).
-    const pc::gl::PatchBuffers range{r.patch_buffer, r.flag_buffer, 0, 0, patches.size()};
+    // All patches, with the margin buffer: the passes then know the displaced ones (margin > 0):
+    // FrustumPass moves their control points out by the margin, OcclusionPass and the back-patch
+    // passes skip them. Each object is a range of these buffers.
+    const pc::gl::PatchBuffers all{r.patch_buffer, r.flag_buffer, r.margin_buffer, 0, n};
+    const Object* const objects[3] = {&scene.teapot, &scene.bigguy, &scene.frog};
 
-    std::printf("%s, %zu patches, %dx%d, tessellation level %g, %d frames at 3 camera positions\n",
-                reinterpret_cast<const char*>(glGetString(GL_RENDERER)), patches.size(), r.width, r.height,
-                static_cast<double>(r.level), 3 * options.frames);
+    const char* const backpatch_name = pc::gl::backpatch_method_name(options.backpatch);
+    char bound_name[32];
+    std::snprintf(bound_name, sizeof bound_name, "%s/%s", pc::displaced_bound_name(options.bound),
+                  pc::normal_cone_name(options.cone));
+    std::printf("%s, %zu patches (teapot %zu two-sided, bigguy %zu one-sided, frog %zu displaced), %dx%d, "
+                "tessellation level %g, back-patch %s, displaced bound %s, %d frames at 3 camera positions\n",
+                reinterpret_cast<const char*>(glGetString(GL_RENDERER)), n, scene.teapot.count, scene.bigguy.count,
+                scene.frog.count, r.width, r.height, static_cast<double>(r.level), backpatch_name, bound_name,
+                3 * options.frames);
     const float aspect = static_cast<float>(r.width) / static_cast<float>(r.height);
     int mismatched = 0;
-    std::size_t total_frustum = 0, total_occlusion = 0;
+    std::size_t total_frustum = 0, total_backpatch = 0, total_occlusion = 0, total_displaced = 0;
     const int frames = 3 * options.frames;
     for (int f = 0; f < frames && !glfwWindowShouldClose(window); ++f) {
         const View v = camera(f, options.frames, aspect);
-        const pc::Mat4 object_to_clip = v.projection * v.view;
+        const pc::Mat4 object_to_clip = v.projection * v.view;  // the scene is in world space: model = I
         // For the check only: which patches pass 1 draws (the statuses of the previous frame).
-        const std::vector<std::uint32_t> words_before = read_words(r.flag_buffer, patches.size());
+        const std::vector<std::uint32_t> words_before = read_words(r.flag_buffer, n);
         glClearNamedBufferData(counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
         // ---- the culled frame: seed 000 §3's two passes ----
@@ -507,30 +758,46 @@ int run(const Options& options) {
         r.draw(v, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
         // Hi-Z pyramid of pass 1's depth (max per texel: a conservative occluder depth).
         hiz_build.run(r.depth, hiz);
-        // The flag chain, on every patch: clear the reasons, frustum test, Hi-Z test (frustum
-        // already done: with_frustum = false), then reasons -> statuses and counts. State
-        // contract (gl_passes.h): each run() binds its program, its parameter block (a uniform
-        // buffer at kUniformPassParams = 0), our buffers at kBindingControlPoints (0),
-        // kBindingCullFlags (1) and kBindingCullCounters (6), the textures at kTextureUnitDepth
-        // (1) / kTextureUnitHiZ (2) and the image unit kImageUnitHiZOut (0); it leaves those
-        // bindings as it set them and glUseProgram(0), touches no framebuffer, viewport, depth or
-        // VAO state, and ends with glMemoryBarrier(SSBO | texture fetch | image | buffer update),
-        // so the next pass, the TCS of pass 2 and our read-backs see its writes: no barrier of
-        // ours is needed. A closed surface drawn one-sided would add BackpatchConePass between
-        // the frustum and occlusion passes (skipped here: the teapot is open).
-        status.begin(range);
-        frustum.run(range, pc::make_frustum_planes(object_to_clip, pc::ClipDepth::zero_to_one));
-        occlusion.run(range, object_to_clip, pc::ClipDepth::zero_to_one, hiz, false);
-        status.end(range, counters);
+        // The flag chain. Each pass skips the patches an earlier one culled and writes its own
+        // reason into those it culls. State contract (gl_passes.h): each run() binds its program,
+        // its parameter block (a uniform buffer at kUniformPassParams = 0), our buffers at
+        // their bindings (control points 0, flags 1, margins 2, counters 6, ranges 8), the
+        // textures at kTextureUnitDepth (1) / kTextureUnitHiZ (2) and the image unit
+        // kImageUnitHiZOut (0); it leaves those bindings as it set them and glUseProgram(0),
+        // touches no framebuffer, viewport, depth or VAO state, and ends with
+        // glMemoryBarrier(SSBO | texture fetch | image | buffer update), so the next pass, the
+        // TCS of pass 2 and our read-backs see its writes: no barrier of ours is needed.
+        status.begin(all);
+        frustum.run(all, pc::make_frustum_planes(object_to_clip, pc::ClipDepth::zero_to_one));
+        // Back-patch: ONLY the closed, one-sided object (on the open teapot the inside of a patch
+        // that faces away shows through the lid gap; a displaced patch's normals are not the
+        // base patch's). The eye is in the patches' space (world here).
+        for (const Object* o : {&scene.bigguy, options.backpatch_open ? &scene.teapot : nullptr}) {
+            if (!o) continue;
+            if (options.backpatch == pc::gl::BackpatchMethod::ptp)
+                ptp.run(o->range(all), object_to_clip, pc::clip_space_eye_alpha(v.projection), pc::PtpRule::ncnt);
+            else
+                cones.run(o->range(all), options.backpatch, v.eye);
+        }
+        // Hi-Z test of the control-point boxes (the frustum already done: with_frustum = false).
+        occlusion.run(all, object_to_clip, pc::ClipDepth::zero_to_one, hiz, false);
+        // The frog's displaced bounds against the frustum and the same pyramid (only_displaced:
+        // a patch whose range is (0, 0) was left to the passes above).
+        const pc::DisplacedCullView cull_view =
+            pc::make_displaced_cull_view(v.view, v.projection, pc::ClipDepth::zero_to_one);
+        displaced.run(scene.frog.range(all), range_buffer, options.bound, options.cone, cull_view, &hiz, true);
+        // Reasons -> statuses, counted per object.
+        for (std::size_t o = 0; o < 3; ++o) status.end(objects[o]->range(all), counters, o * stride);
         // Pass 2: the patches newly visible (passed now, not drawn in pass 1), into the same
         // colour, id and depth.
         if (!options.aggressive) r.draw(v, sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass);
 
-        std::uint32_t c[sh::kCounterCount] = {};
-        glGetNamedBufferSubData(counters, 0, sizeof c, c);
+        Counts c;
+        for (std::size_t o = 0; o < 3; ++o)
+            glGetNamedBufferSubData(counters, static_cast<GLintptr>(o * stride), slot_bytes, c.slot[o]);
         const std::vector<std::uint32_t> ids = r.read<std::uint32_t>(r.ids, GL_RED_INTEGER, GL_UNSIGNED_INT);
         const std::vector<float> depth = r.read<float>(r.depth, GL_DEPTH_COMPONENT, GL_FLOAT);
-        const std::vector<std::uint32_t> words_after = read_words(r.flag_buffer, patches.size());
+        const std::vector<std::uint32_t> words_after = read_words(r.flag_buffer, n);
         // Show the culled frame.
         int fb_width = 0, fb_height = 0;
         glfwGetFramebufferSize(window, &fb_width, &fb_height);
@@ -547,24 +814,36 @@ int run(const Options& options) {
         const Comparison cmp = compare(ids, depth, ref_ids, ref_depth, words_before, words_after, options.aggressive);
         const bool ok = cmp.differing == 0;
         mismatched += ok ? 0 : 1;
-        total_frustum += c[sh::kCounterFrustum];
-        total_occlusion += c[sh::kCounterOcclusion];
+        // Who culled what: back-patch reasons come only from the back-patch pass (bigguy);
+        // kCounterDisplacedOcclusion counts the displaced patches culled by Hi-Z, which only
+        // DisplacedPass tests (OcclusionPass skips them); the rest of the occlusion count is
+        // OcclusionPass's. A displaced patch's frustum cull is FrustumPass's (with its margin) or
+        // DisplacedPass's (its bound).
+        const std::uint32_t displaced_hiz = c.total(sh::kCounterDisplacedOcclusion);
+        const std::uint32_t occlusion_hiz = c.total(sh::kCounterOcclusion) - displaced_hiz;
+        total_frustum += c.total(sh::kCounterFrustum);
+        total_backpatch += c.total(sh::kCounterBackPatch);
+        total_occlusion += occlusion_hiz;
+        total_displaced += displaced_hiz;
         std::string verdict = ok ? "ids match" : "IDS DIFFER in " + std::to_string(cmp.differing) + " pixels";
         if (cmp.ties) verdict += " (" + std::to_string(cmp.ties) + " exact depth-tie pixels, both patches drawn)";
-        std::printf("frame %d (camera %d): culled frustum %u, back-patch %u (not run), occlusion %u; "
+        std::printf("frame %d (camera %d): culled frustum %u (teapot %u, bigguy %u, frog %u), back-patch %u "
+                    "(bigguy %u), occlusion %u (teapot %u, bigguy %u), displaced occlusion %u (frog); "
                     "drawn pass 1 %u, pass 2 %u%s; %s\n",
-                    f, f / options.frames, c[sh::kCounterFrustum], c[sh::kCounterBackPatch],
-                    c[sh::kCounterOcclusion], c[sh::kCounterWasVisible], c[sh::kCounterNewlyVisible],
+                    f, f / options.frames, c.total(sh::kCounterFrustum), c.slot[0][sh::kCounterFrustum],
+                    c.slot[1][sh::kCounterFrustum], c.slot[2][sh::kCounterFrustum], c.total(sh::kCounterBackPatch),
+                    c.slot[1][sh::kCounterBackPatch], occlusion_hiz, c.slot[0][sh::kCounterOcclusion], c.slot[1][sh::kCounterOcclusion], displaced_hiz,
+                    c.total(sh::kCounterWasVisible), c.total(sh::kCounterNewlyVisible),
                     options.aggressive ? " (skipped: --aggressive)" : "", verdict.c_str());
         std::fflush(stdout);
         glfwSwapBuffers(window);
         glfwPollEvents();
     }
 
-    GLuint textures[] = {r.color, r.ids, r.depth, hiz.texture};
-    glDeleteTextures(4, textures);
-    GLuint buffers[] = {r.patch_buffer, r.flag_buffer, counters};
-    glDeleteBuffers(3, buffers);
+    GLuint textures[] = {r.color, r.ids, r.depth, r.height_texture, hiz.texture};
+    glDeleteTextures(5, textures);
+    GLuint buffers[] = {r.patch_buffer, r.flag_buffer, r.texcoord_buffer, r.margin_buffer, range_buffer, counters};
+    glDeleteBuffers(6, buffers);
     glDeleteFramebuffers(1, &r.fbo);
     glDeleteVertexArrays(1, &r.vao);
     glDeleteProgram(r.program);
@@ -573,13 +852,23 @@ int run(const Options& options) {
         std::printf("FAILED: %d of %d frames differ from the unculled draw\n", mismatched, frames);
         return 1;
     }
-    if (total_frustum == 0 || total_occlusion == 0) {
-        std::printf("FAILED: the run culled nothing by %s, so the check proved nothing\n",
-                    total_frustum == 0 ? "the frustum" : "occlusion");
-        return 1;
-    }
-    std::printf("all %d frames match the unculled draw (%zu frustum-, %zu occlusion-culled patch-frames)\n", frames,
-                total_frustum, total_occlusion);
+    // Each cull pass must have culled something, or the check says nothing about it.
+    const struct {
+        std::size_t count;
+        std::string pass;
+    } culled[] = {{total_frustum, "FrustumPass"},
+                  {total_backpatch, std::string("the back-patch pass (") + backpatch_name + ")"},
+                  {total_occlusion, "OcclusionPass"},
+                  {total_displaced, std::string("DisplacedPass (") + bound_name + ")"}};
+    for (const auto& pass : culled)
+        if (pass.count == 0) {
+            std::printf("FAILED: %s culled nothing over the run, so the check proved nothing about it\n",
+                        pass.pass.c_str());
+            return 1;
+        }
+    std::printf("all %d frames match the unculled draw (patch-frames culled: %zu frustum, %zu back-patch %s, "
+                "%zu occlusion, %zu displaced occlusion %s)\n",
+                frames, total_frustum, total_backpatch, backpatch_name, total_occlusion, total_displaced, bound_name);
     return 0;
 }
 
@@ -592,7 +881,7 @@ int main(int argc, char** argv) {
         status = run(options);
     } catch (const SetupError& e) {
         std::fprintf(stderr, "%s\n", pc::printable_line(e.message).c_str());
-    } catch (const std::exception& e) {  // patchcull::Error from a pass: one line
+    } catch (const std::exception& e) {  // patchcull::Error from the import layer or a pass: one line
         std::fprintf(stderr, "%s\n", pc::printable_line(e.what()).c_str());
     }
     glfwTerminate();  // after every GL object and pass is gone
