@@ -23,11 +23,13 @@ using namespace patchcull::gl;
 
 namespace {
 
-// The frog standing on the ground, displaced by a procedural map (3% of its height), a wall
-// hiding its lower half from the first cameras.
+// The frog standing on the ground, displaced by a procedural map of +-10% of its height (a strong
+// displacement: with a few percent, bounds shrunk to 1% of the true ranges still pass the strict
+// check, see StrictCheckCatchesBoundsTooSmall), a wall hiding its lower half from the first
+// cameras.
 Scene displaced_frog_scene(Scheme scheme = Scheme::acc) {
     Scene scene = make_model_scene(load_model(shipped_model_path("monsterfrog.obj"), scheme, 0), 20.0f);
-    scene.displacement = make_procedural_displacement(128, 0.03f);
+    scene.displacement = make_procedural_displacement(128, 0.2f);
     scene.displacement_name = "procedural";
     scene.instances[0].displaced = true;
     const auto base = static_cast<std::uint32_t>(scene.occluder_vertices.size());
@@ -40,13 +42,19 @@ Scene displaced_frog_scene(Scheme scheme = Scheme::acc) {
     return scene;
 }
 
-PatchAttributes attributes_of(const ScenePoser& poser) {
+// range_scale < 1: bounds deliberately too small (the mutation the strict check must catch); the
+// drawn surface keeps the map's full displacement (the TES displaces every patch with margin > 0).
+PatchAttributes attributes_of(const ScenePoser& poser, float range_scale = 1.0f) {
     PatchAttributes a;
     a.tangent_index = poser.tangent_index();
     a.tangents = poser.tangents();
     a.depth = poser.depth();
     a.texcoords = poser.texcoords();
     a.displacement_ranges = poser.displacement_ranges();
+    for (DisplacementRange& r : a.displacement_ranges) {
+        r.d_min *= range_scale;
+        r.d_max *= range_scale;
+    }
     return a;
 }
 
@@ -116,6 +124,27 @@ TEST(DisplacedPipeline, StrictForEveryBoundAndConeThroughAnAnimatedSequence) {
         }
     }
     EXPECT_GT(displaced_occluded_all, 100u);  // the wall and the frog itself hide displaced patches
+}
+
+TEST(DisplacedPipeline, StrictCheckCatchesBoundsTooSmall) {
+    // The same sequence with every range shrunk to 1%: the bounds no longer hold the displaced
+    // surface, and the comparison with the unculled render must find the patches culled wrongly.
+    const Scene scene = displaced_frog_scene();
+    const std::vector<Camera> cameras = scene.camera_path(4, 1.0f);
+    CullPipeline pipeline(test::context());
+    pipeline.renderer().set_displacement_map(scene.displacement);
+    pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
+    ScenePoser poser(scene);
+    pipeline.set_patches(poser.pose(0), attributes_of(poser, 0.01f));
+    std::size_t false_culls = 0;
+    for (std::size_t f = 0; f < cameras.size(); ++f) {
+        if (f > 0) pipeline.update_patches(poser.pose(0.25f * static_cast<float>(f)), attributes_of(poser, 0.01f));
+        PipelineParams pp;
+        pp.frame.render = params_of(cameras[f]);
+        FrameStats s;
+        false_culls += false_culls_of_frame(pipeline, pp, s).size();
+    }
+    EXPECT_GT(false_culls, 0u) << "bounds 100x too small went unnoticed: the strict test would be vacuous";
 }
 
 TEST(DisplacedPipeline, StrictWithOsdPatchesOfMixedDepth) {
