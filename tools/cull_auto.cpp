@@ -80,12 +80,14 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
             d.break_even = break_even(d.tess_factor);
             const long since = frame_ - o.last_culled;
             if (!(d.break_even < 1)) {
-                // No rate can pay: not even probed (seed 000 §6.3: low tess factor, no culling).
-                d.cull = false;
+                // No rate can pay (seed 000 §6.3: low tess factor, no culling). Probed only rarely:
+                // the issue and cull costs are measured in two-pass frames alone.
                 d.reason = std::isinf(d.break_even)
                                ? format("tess factor %.1f: no measured tessellation cost to save", d.tess_factor)
                                : format("tess factor %.1f: break-even %.2f >= 1, culling cannot pay", d.tess_factor,
                                         d.break_even);
+                d.cull = d.probe = since >= 4L * config_.probe_interval;
+                if (d.probe) d.reason = "probe (costs): " + d.reason;
             } else if (std::isnan(o.rate)) {
                 d.cull = d.probe = true;
                 d.reason = "probe: no cull rate yet";

@@ -45,7 +45,9 @@
 //      tess_unit measured from the frames' drawn patches weighted by their objects' (c0 + t^2).
 //      With uniform tessellation every object has the frame's t, so c0 cancels out. When x >= 1
 //      at the object's t, no cull rate can pay (seed 000: a model small on screen, or at a low
-//      tess factor, is not culled): off, and not probed.
+//      tess factor, is not culled): off, probed only every 4 * Config::probe_interval frames, which
+//      refreshes the issue and cull costs (measured in two-pass frames only; tess is also measured
+//      in the one-pass frames).
 // Frame rule (beyond the seed's per-object rule): the pipeline's second pass issues every patch of
 // the set, and the Hi-Z build runs once, as soon as one object is culled; a frame with no object
 // culled runs as --cull none (one pass, no Hi-Z). So when no object is probed, the objects whose
@@ -77,7 +79,7 @@ public:
         /// Weight of the newest frame in the cost averages, in (0, 1].
         double cost_weight = 0.25;
         /// c0 of tess(t) = tess_unit * (c0 + t^2), >= 0 (only matters when the objects' factors differ).
-        double tess_cost_offset = 10;
+        double tess_cost_offset = 4;
         /// Two-pass frames whose times are averaged before the costs are used (>= 1; the first
         /// two-pass frame, compilation, is not one of them).
         int cost_frames = 2;

@@ -25,7 +25,8 @@ namespace {
 std::vector<gl::ObjectRange> two_objects() { return {{0, 100, true}, {100, 100, true}}; }
 
 // Costs with tess(t) = tess_at_8 at t = 8 (tess_unit = tess_at_8 / (c0 + 64)), per patch.
-CullAutoPolicy::Costs costs(double issue, double cull, double tess_at_8, double hiz, double c0 = 10) {
+CullAutoPolicy::Costs costs(double issue, double cull, double tess_at_8, double hiz,
+                            double c0 = CullAutoPolicy::Config{}.tess_cost_offset) {
     CullAutoPolicy::Costs c;
     c.issue_ms = issue;
     c.cull_ms = cull;
@@ -115,6 +116,27 @@ TEST(CullAutoPolicy, AnObjectSwitchedOffIsProbedAfterTheInterval) {
     EXPECT_NEAR(d[1].cull_rate, 0.4, 1e-12);
 }
 
+TEST(CullAutoPolicy, ObjectsThatCannotPayAreProbedOnlyEveryFourIntervals) {
+    CullAutoPolicy::Config config;
+    config.probe_interval = 2;
+    CullAutoPolicy policy(two_objects(), 200, config);
+    policy.set_costs(costs(0.001, 0.002, 0.010, 0.0));
+    policy.decide(kLevel8);
+    policy.observe(untimed_frame({50, 10}));  // frame 0: both culled
+    policy.set_costs(costs(0.001, 0.002, 0.002, 0.0));  // x = 1.5
+    std::vector<int> probes;
+    for (int frame = 1; frame <= 9; ++frame) {
+        const auto& d = policy.decide(kLevel8);
+        EXPECT_EQ(d[0].cull, d[0].probe);
+        if (d[0].cull) {
+            probes.push_back(frame);
+            EXPECT_EQ(d[0].reason, "probe (costs): tess factor 8.0: break-even 1.50 >= 1, culling cannot pay");
+        }
+        policy.observe(untimed_frame({50, 10}));
+    }
+    EXPECT_EQ(probes, (std::vector<int>{8}));
+}
+
 TEST(CullAutoPolicy, TheFrameRuleTurnsEverythingOffWhenTheHiZBuildCostsMoreThanTheSaving) {
     CullAutoPolicy policy(two_objects(), 200);
     // Object 0 saves 100 * (0.5 * 0.010 - 0.003) = 0.2 ms; the Hi-Z build and pass 2's issue of
@@ -148,8 +170,10 @@ TEST(CullAutoPolicy, ALowTessFactorAtTheCentroidTurnsAnObjectOff) {
     EXPECT_NEAR(factors[1], 1.0, 1e-6);
     EXPECT_EQ(cli::object_tess_factors(patches, objects, Vec3{0, 0, 0}, 8, false, 1.0f), kLevel8);
 
-    CullAutoPolicy policy(objects, 2);
-    policy.set_costs(costs(0.001, 0.002, 0.010, 0.0));  // tess(8) = 0.010, tess(1) = 0.010 * 11 / 74
+    CullAutoPolicy::Config config;
+    config.tess_cost_offset = 10;
+    CullAutoPolicy policy(objects, 2, config);
+    policy.set_costs(costs(0.001, 0.002, 0.010, 0.0, 10));  // tess(8) = 0.010, tess(1) = 0.010 * 11 / 74
     policy.decide(factors);
     gl::FrameStats s = untimed_frame({});
     s.patches = 2;
