@@ -78,7 +78,8 @@ public:
         double rate_weight = 0.5;
         /// Weight of the newest frame in the cost averages, in (0, 1].
         double cost_weight = 0.25;
-        /// c0 of tess(t) = tess_unit * (c0 + t^2), >= 0 (only matters when the objects' factors differ).
+        /// c0 of tess(t) = tess_unit * (c0 + t^2), >= 0 (only matters when the objects' factors differ;
+        /// 4: none's per-patch time on llvmpipe at levels 1-8, docs/PERFORMANCE.md).
         double tess_cost_offset = 4;
         /// Two-pass frames whose times are averaged before the costs are used (>= 1; the first
         /// two-pass frame, compilation, is not one of them).
