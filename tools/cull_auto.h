@@ -56,6 +56,10 @@
 // otherwise none is.
 // Until the costs are measured (Config::cost_frames two-pass frames after the first), every object
 // is culled ("probe").
+// Limits: issue, cull and tess_unit are averages over all patches of the set. A displaced object's
+// patches cost more to cull (DisplacedPass's bound against the frustum and the Hi-Z) and to draw
+// (the TES samples the map) than an undisplaced one's; FrameStats times whole passes, not objects,
+// so the policy does not tell them apart.
 #pragma once
 
 #include <cstddef>
