@@ -36,6 +36,13 @@ constexpr int kSize = 256;
 const CullMode kFrustumOcclusion = static_cast<CullMode>(kFlagFrustum | kFlagOcclusion);
 const CullMode kModes[] = {CullMode::none, CullMode::frustum, CullMode::occlusion, kFrustumOcclusion};
 
+// A pipeline frame with the default tests' choices (tcone, caf/acon, one object).
+PipelineParams pipeline_params(const FrameParams& frame) {
+    PipelineParams p;
+    p.frame = frame;
+    return p;
+}
+
 std::string mode_name(CullMode mode) {
     return mode == kFrustumOcclusion ? std::string("frustum+occlusion") : std::string(cull_mode_name(mode));
 }
@@ -242,7 +249,7 @@ Totals strict_frame(CullPipeline& pipeline, const std::vector<BezierPatch>& patc
     FrameParams fp;
     fp.render = params;
     fp.cull = mode;
-    const FrameStats s = pipeline.render_frame({fp});
+    const FrameStats s = pipeline.render_frame(pipeline_params(fp));
     const Frame got = read_frame(r);
     const std::vector<std::uint32_t> words = r.read_cull_flags();
     const Diff d = compare_frames(ref, got, words, &patches, occ, params, what);
@@ -431,7 +438,7 @@ TEST(OcclusionPipeline, AggressiveMissesOnlyNewlyVisibleAndRecoversAfterOneFrame
         fp.render = params;
         fp.cull = kFrustumOcclusion;
         fp.aggressive = true;
-        const FrameStats s = pipeline.render_frame({fp});
+        const FrameStats s = pipeline.render_frame(pipeline_params(fp));
         EXPECT_EQ(s.pass2_drawn, 0u);
         const std::vector<std::uint32_t> got = r.read_ids();
         const std::vector<float> got_depth = r.read_depth();
@@ -446,7 +453,7 @@ TEST(OcclusionPipeline, AggressiveMissesOnlyNewlyVisibleAndRecoversAfterOneFrame
             EXPECT_NE(words[ref[i] - 1] & kStatusNewlyVisible, 0u) << "frame " << f << " pixel " << i;
         }
         // The same camera again: exact.
-        const FrameStats again = pipeline.render_frame({fp});
+        const FrameStats again = pipeline.render_frame(pipeline_params(fp));
         const Diff d = compare_frames(ref_frame, read_frame(r), r.read_cull_flags(), &rest, &occ, params,
                                       "aggressive repeat frame " + std::to_string(f));
         EXPECT_EQ(d.pixels, 0u);
@@ -607,14 +614,14 @@ TEST(OcclusionPipeline, TimingMethodsAndStatusImage) {
     FrameParams fp;
     fp.render = params_for(camera_at(b, {0.3f, 0.35f, -1}, 2.4f));
     fp.cull = kFrustumOcclusion;
-    FrameStats s = pipeline.render_frame({fp});
+    FrameStats s = pipeline.render_frame(pipeline_params(fp));
     EXPECT_EQ(s.timing, test::context().is_software() ? TimingMethod::wall_clock : TimingMethod::timer_query);
     EXPECT_GT(s.pass1_ms, 0.0);
     EXPECT_GT(s.total_ms, 0.0);
     EXPECT_NEAR(s.total_ms, s.pass1_ms + s.hiz_ms + s.cull_ms + s.pass2_ms, 1e-6);
     for (TimingMethod m : {TimingMethod::wall_clock, TimingMethod::timer_query, TimingMethod::off}) {
         fp.timing = m;
-        s = pipeline.render_frame({fp});
+        s = pipeline.render_frame(pipeline_params(fp));
         EXPECT_EQ(s.timing, m);
         if (m == TimingMethod::off) EXPECT_EQ(s.total_ms, 0.0);
         else EXPECT_GE(s.total_ms, 0.0);
@@ -655,16 +662,16 @@ TEST(OcclusionPipeline, UpdatePatchesKeepsStatusAndChecksCount) {
     FrameParams fp;
     fp.render = params_for(camera_at(test::control_point_bounds(patches), {0.3f, 0.35f, -1}, 2.4f));
     fp.cull = kFrustumOcclusion;
-    pipeline.render_frame({fp});
+    pipeline.render_frame(pipeline_params(fp));
     const std::vector<std::uint32_t> words = r.read_cull_flags();
     r.update_patches(patches);
     EXPECT_EQ(r.read_cull_flags(), words);
-    FrameStats s = pipeline.render_frame({fp});
+    FrameStats s = pipeline.render_frame(pipeline_params(fp));
     EXPECT_EQ(s.newly_visible, 0u);  // same pose, same camera: nothing becomes visible
     EXPECT_LE(s.visible, s.pass1_drawn);  // the fuller first pass may occlude more
     EXPECT_THROW(r.update_patches(std::vector<BezierPatch>(patches.begin(), patches.end() - 1)), patchcull::Error);
     r.set_patches(patches);  // a new set: statuses start again from the even half
-    s = pipeline.render_frame({fp});
+    s = pipeline.render_frame(pipeline_params(fp));
     EXPECT_EQ(s.pass1_drawn, patches.size() / 2);
     CullMode m = CullMode::none;
     EXPECT_TRUE(parse_cull_mode("occlusion", m));
