@@ -36,6 +36,8 @@ bool CullAutoPolicy::Costs::known() const {
 CullAutoPolicy::CullAutoPolicy(std::vector<gl::ObjectRange> objects, std::size_t patch_count, Config config)
     : config_(config), patch_count_(patch_count) {
     if (config.probe_interval < 1) throw Error("cull auto: probe_interval must be >= 1");
+    if (config.max_probe_interval < config.probe_interval)
+        throw Error("cull auto: max_probe_interval must be >= probe_interval");
     if (!(config.rate_weight > 0 && config.rate_weight <= 1) || !(config.cost_weight > 0 && config.cost_weight <= 1))
         throw Error("cull auto: the average weights must be in (0, 1]");
     if (!(config.tess_cost_offset >= 0)) throw Error("cull auto: tess_cost_offset must be >= 0");
@@ -79,6 +81,7 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
         } else {
             d.break_even = break_even(d.tess_factor);
             const long since = frame_ - o.last_culled;
+            const long wait = o.wait > 0 ? o.wait : config_.probe_interval;
             if (!(d.break_even < 1)) {
                 // No rate can pay (seed 000 §6.3: low tess factor, no culling). Probed only rarely:
                 // the issue and cull costs are measured in two-pass frames alone.
@@ -86,7 +89,7 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
                                ? format("tess factor %.1f: no measured tessellation cost to save", d.tess_factor)
                                : format("tess factor %.1f: break-even %.2f >= 1, culling cannot pay", d.tess_factor,
                                         d.break_even);
-                d.cull = d.probe = since >= 4L * config_.probe_interval;
+                d.cull = d.probe = since >= 4L * wait;
                 if (d.probe) d.reason = "probe (costs): " + d.reason;
             } else if (std::isnan(o.rate)) {
                 d.cull = d.probe = true;
@@ -94,7 +97,7 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
             } else if (o.rate > d.break_even) {
                 d.cull = true;
                 d.reason = format("rate %.2f > break-even %.2f", o.rate, d.break_even);
-            } else if (since >= config_.probe_interval) {
+            } else if (since >= wait) {
                 d.cull = d.probe = true;
                 d.reason = format("probe: rate %.2f <= break-even %.2f", o.rate, d.break_even) + ", measured " +
                            std::to_string(since) + " frames ago";
@@ -106,10 +109,11 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
         any_probe = any_probe || d.probe;
     }
     if (known && any_probe) {
-        // The probe makes this a two-pass frame anyway: the objects off for half the interval come along.
-        const long half = std::max(1, config_.probe_interval / 2);
+        // The probe makes this a two-pass frame anyway: the objects off for half their interval come along.
         for (std::size_t i = 0; i < objects_.size(); ++i) {
             Decision& d = decisions_[i];
+            const long wait = objects_[i].wait > 0 ? objects_[i].wait : config_.probe_interval;
+            const long half = std::max(1L, wait / 2);
             const long since = frame_ - objects_[i].last_culled;
             if (d.cull || !(d.break_even < 1) || std::isnan(objects_[i].rate) || since < half) continue;
             d.cull = d.probe = true;
@@ -178,8 +182,15 @@ void CullAutoPolicy::observe(const gl::FrameStats& stats) {
         culled_patches += s.patches;
         const double rate =
             static_cast<double>(s.frustum_culled + s.backpatch_culled + s.occlusion_culled) / static_cast<double>(s.patches);
+        const bool retest = decisions_[i].probe && !std::isnan(o.rate);  // not its first measurement
         o.rate = decisions_[i].probe ? rate : average(o.rate, rate, config_.rate_weight);
         o.last_culled = frame_;
+        // Probe back-off: a re-test that finds the object still not paying doubles its wait.
+        const double x = decisions_[i].break_even;
+        if (retest && !std::isnan(x)) {
+            const long wait = o.wait > 0 ? o.wait : config_.probe_interval;
+            o.wait = rate > x ? config_.probe_interval : std::min<long>(2 * wait, config_.max_probe_interval);
+        }
     }
     ++frame_;
 

@@ -35,8 +35,11 @@
 //      exponential average (Config::rate_weight) over the frames it was culled in; a probe's
 //      measurement replaces the average (the old one is stale). An object switched off because its
 //      rate is below x is probed (culled for one frame, which measures its rate) once it has been
-//      off for Config::probe_interval frames; when any object is probed, every object off for at
-//      least half that long is probed in the same frame, so probes share their two-pass frames.
+//      off for its probe interval (Config::probe_interval, doubled by every probe that finds the
+//      rate still below break-even, up to Config::max_probe_interval, and reset by one that finds
+//      it above: a steady object that does not pay costs a two-pass frame ever more rarely); when
+//      any object is probed, every object off for at least half its own interval is probed in the
+//      same frame, so probes share their two-pass frames.
 //  (c) the tessellation factor t at the object's centroid (mean of its patches' corner points):
 //      uniform tessellation: the level; adaptive: clamp(level * reference / distance(eye,
 //      centroid), 1, level), as the TCS computes an edge's level (object_tess_factors). The
@@ -77,7 +80,10 @@ class CullAutoPolicy {
 public:
     struct Config {
         /// Frames an object switched off (rate below break-even) waits before it is probed (>= 1).
+        /// Each probe that finds the rate still below break-even doubles the object's wait, up to
+        /// max_probe_interval; a probe that finds it above resets the wait to probe_interval.
         int probe_interval = 8;
+        int max_probe_interval = 64;
         /// Weight of the newest frame in the cull-rate average, in (0, 1].
         double rate_weight = 0.5;
         /// Weight of the newest frame in the cost averages, in (0, 1].
@@ -151,6 +157,7 @@ private:
         gl::ObjectRange range;
         double rate = kUnknown;
         long last_culled = -1;  ///< frame index of the last frame it was culled, -1 never
+        long wait = 0;          ///< its current probe interval (0: Config::probe_interval)
     };
     Config config_;
     std::size_t patch_count_;

@@ -116,6 +116,47 @@ TEST(CullAutoPolicy, AnObjectSwitchedOffIsProbedAfterTheInterval) {
     EXPECT_NEAR(d[1].cull_rate, 0.4, 1e-12);
 }
 
+TEST(CullAutoPolicy, ProbesThatKeepFailingBackOffAndOneThatPaysResetsTheWait) {
+    // Object 1 never pays (rate 0.1 against a break-even of 0.3): probed after 4, then 8, then 16
+    // frames (max 16 here); then a probe finds 0.4 and the object stays on; switched off again it
+    // is re-tested after the base interval.
+    CullAutoPolicy::Config config;
+    config.probe_interval = 4;
+    config.max_probe_interval = 16;
+    CullAutoPolicy policy(two_objects(), 200, config);
+    policy.set_costs(costs(0.001, 0.002, 0.010, 0.0));
+    policy.decide(kLevel8);
+    policy.observe(untimed_frame({50, 10}));  // frame 0: the first measurement of object 1 (0.1)
+    std::vector<int> probes;
+    for (int frame = 1; frame <= 50; ++frame) {
+        const auto& d = policy.decide(kLevel8);
+        if (d[1].cull) {
+            EXPECT_TRUE(d[1].probe) << frame;
+            probes.push_back(frame);
+        }
+        policy.observe(untimed_frame({50, 10}));
+    }
+    EXPECT_EQ(probes, (std::vector<int>{4, 12, 28, 44}));  // waits 4, 8, 16, 16
+    // A probe that pays: the rate replaces the stale one, the object stays on, and the wait resets.
+    int frame = 51;
+    for (; frame <= 80; ++frame) {
+        const auto& d = policy.decide(kLevel8);
+        const bool probed = d[1].cull;
+        policy.observe(untimed_frame({50, probed ? 40 : 10}));
+        if (probed) break;
+    }
+    EXPECT_EQ(frame, 60);
+    EXPECT_TRUE(policy.decide(kLevel8)[1].cull);  // 0.4 > 0.3
+    policy.observe(untimed_frame({50, 10}));      // culled, measures 0.1 (averaged to 0.25): off again
+    probes.clear();
+    for (int f = 62; f <= 80; ++f) {
+        if (policy.decide(kLevel8)[1].cull) probes.push_back(f);
+        policy.observe(untimed_frame({50, 10}));
+    }
+    ASSERT_FALSE(probes.empty());
+    EXPECT_EQ(probes.front(), 65);  // the base interval again after the last culled frame (61)
+}
+
 TEST(CullAutoPolicy, ObjectsThatCannotPayAreProbedOnlyEveryFourIntervals) {
     CullAutoPolicy::Config config;
     config.probe_interval = 2;
