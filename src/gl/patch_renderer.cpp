@@ -171,14 +171,7 @@ void PatchRenderer::begin_frame(const RenderParams& params) {
 
 void PatchRenderer::draw_selected(std::uint32_t mask, std::uint32_t value) {
     Impl& m = *impl_;
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m.fbo);
-    glViewport(0, 0, m.width, m.height);
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);
-    glDisable(GL_BLEND);
+    m.bind_target(m.fbo, m.width, m.height);
     m.draw_patches(m.frame_level, mask, value);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     check_gl("draw_selected");
@@ -211,14 +204,11 @@ std::vector<std::uint8_t> PatchRenderer::mark_front_patches(const RenderParams& 
     const Mat4 object_to_clip = params.projection * params.view;
     const int level = m.set_draw_uniforms(params, object_to_clip, sh::kColorPatch);
     glClearNamedBufferData(m.front_marks, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, m.fbo);
-    glViewport(0, 0, m.width, m.height);
-    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-    glEnable(GL_DEPTH_TEST);
+    m.bind_target(m.fbo, m.width, m.height);
+    // The mark-front pass: fragments exactly at the front depth, nothing written.
     glDepthFunc(GL_EQUAL);
     glDepthMask(GL_FALSE);
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    glDisable(GL_CULL_FACE);
     m.draw_patches(level, params.use_cull_flags ? sh::kCullReasonMask : 0u, 0u, true);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);

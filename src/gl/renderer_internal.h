@@ -227,8 +227,9 @@ struct PatchRenderer::Impl {
         return level;
     }
 
-    // Binds target (fbo, or vis_fbo) with the fixed-function state of every draw and clears it.
-    void begin_target(GLuint target, int w, int h) {
+    // Binds target (fbo, or vis_fbo) with the fixed-function state of every draw: zero-to-one
+    // clip depth, depth test GL_LESS with writes, no face culling, no blending.
+    void bind_target(GLuint target, int w, int h) {
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target);
         glViewport(0, 0, w, h);
         glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
@@ -237,6 +238,11 @@ struct PatchRenderer::Impl {
         glDepthMask(GL_TRUE);
         glDisable(GL_CULL_FACE);
         glDisable(GL_BLEND);
+    }
+
+    // bind_target, then clears it (colour dark grey, id 0, depth 1).
+    void begin_target(GLuint target, int w, int h) {
+        bind_target(target, w, h);
         const float background[4] = {0.12f, 0.12f, 0.14f, 1.0f};
         const GLuint no_id[4] = {sh::kIdBackground, 0, 0, 0};
         const float far_depth = 1.0f;
