@@ -32,14 +32,44 @@ namespace patchcull {
 /// One placed copy of a model.
 struct SceneInstance {
     std::size_t model = 0;   ///< index into Scene::models
-    Mat4 object_to_world;    ///< affine: the model's object space -> world
+    Mat4 object_to_world;    ///< affine: the model's object space -> world, at scene time -time_offset
     float time_offset = 0;   ///< seconds added to the scene time, so copies move out of step
     bool displaced = false;  ///< displaced by Scene::displacement (when it is not empty)
+    /// Unique among the scene's instances, e.g. "bigguy#3" (every scene builder and the scene
+    /// file reader set it; per-object statistics and scene cells name instances by it).
+    std::string name;
+    /// True: Scene::animation deforms the control mesh (at scene time t + time_offset). False:
+    /// rigid, the model's rest patches every frame (the teapot is always rigid).
+    bool deforms = true;
+    /// Rigid motion in world units per second (see instance_to_world); zero: it stays in place.
+    Vec3 velocity{0, 0, 0};
 };
 
-/// A camera circling a target: at frame f the eye is at angle start + f * step (degrees, about
-/// the world y axis, angle 0 on +z) at horizontal distance `distance` and height `height` above
-/// the target, looking at the target.
+/// The instance's transform at scene time t:
+/// translation(velocity * (t + time_offset)) * object_to_world. Affine (the w row is kept, so
+/// homogeneous control points map exactly as by object_to_world); the linear part is
+/// object_to_world's. Computed in float, the translation added to column 3.
+Mat4 instance_to_world(const SceneInstance& instance, float time_seconds);
+
+/// A triangle-mesh object of the environment: triangles [first_triangle, first_triangle +
+/// triangle_count) of Scene::occluder_indices (3 indices each). Drawn and occluding.
+struct EnvironmentObject {
+    std::string name;  ///< unique among the scene's environment objects, e.g. "ground", "wall"
+    std::uint32_t first_triangle = 0, triangle_count = 0;
+    /// Drawn with back faces culled: every triangle is counter-clockwise seen from its front, and
+    /// nothing is visible from behind (closed outward solids: boxes, buildings; the ground seen
+    /// from above). False: drawn two-sided.
+    bool one_sided = false;
+};
+
+/// The camera path of a scene: an orbit (walk == false) or a straight walk (walk == true).
+/// Orbit: at frame f the eye is at angle start + f * step (degrees, about the world y axis,
+/// angle 0 on +z) at horizontal distance `distance` and height `height` above the target,
+/// looking at the target.
+/// Walk: at frame f the eye is at walk_start + f * walk_step, looking along walk_direction
+/// (target = eye + walk_direction; the up vector is +y, so walk_direction must not be vertical).
+/// distance and height are not used by a walk's cameras; the walk scenes set them to a typical
+/// viewing distance (hypot(distance, height) is the CLI's default adaptive-tessellation distance).
 struct CameraPath {
     Vec3 target{0, 0, 0};
     float distance = 5;
@@ -49,6 +79,31 @@ struct CameraPath {
     float fovy_radians = 1.0471976f;  ///< 60 degrees
     float z_near = 0.05f;
     float z_far = 50;
+    bool walk = false;
+    Vec3 walk_start{0, 0, 0};      ///< eye at frame 0 (walk)
+    Vec3 walk_step{0, 0, 0};       ///< eye movement per frame (walk)
+    Vec3 walk_direction{0, 0, -1}; ///< look direction, any non-zero length (walk)
+};
+
+/// A cell of a cell-and-portal scene (a room of the `building` scene; read by issue 12's portal
+/// traversal). The cells' boxes tile the interior: neighbouring rooms' boxes meet at the
+/// mid-plane of the wall between them, so every eye inside the building (doorways included) is
+/// in at least one box.
+struct SceneCell {
+    std::string name;
+    Bounds box;                             ///< world-space box of the cell
+    std::vector<std::size_t> instances;     ///< indices into Scene::instances standing in the cell
+    /// Indices into Scene::environment of the objects that bound or fill the cell: its floor,
+    /// ceiling and wall pieces (a wall between two cells is listed in both).
+    std::vector<std::size_t> environment;
+};
+
+/// An opening between two cells (a door or window rectangle), in the mid-plane of its wall.
+struct ScenePortal {
+    std::size_t cell_a = 0, cell_b = 0;  ///< indices into Scene::cells, different
+    /// The rectangle's corners, in order around it, counter-clockwise seen from cell_a (its
+    /// normal by the right-hand rule points into cell_a).
+    Vec3 corners[4];
 };
 
 struct Scene {
@@ -58,7 +113,10 @@ struct Scene {
     /// Triangle occluders (world space), for PatchRenderer::set_occluders.
     std::vector<Vec3> occluder_vertices;
     std::vector<std::uint32_t> occluder_indices;
-    AnimationParams animation;  ///< applied to every subdivision model (the teapot stays rigid)
+    /// The occluder triangles grouped into objects: their ranges tile occluder_indices exactly,
+    /// in order (object k starts where object k-1 ends; the first starts at triangle 0).
+    std::vector<EnvironmentObject> environment;
+    AnimationParams animation;  ///< applied to every deforming subdivision instance
     /// The height map of the displaced instances (displacement.h: D = scale * (h - midlevel) along
     /// the unit normal, in world units), sampled at each patch's corner texcoords (PatchInfo::uv);
     /// empty: nothing is displaced. displacement_name says where it came from ("procedural", a
@@ -66,10 +124,13 @@ struct Scene {
     DisplacementMap displacement;
     std::string displacement_name = "none";
     CameraPath camera;
+    /// Cells and portals (the `building` scene, scene files with "cells"); both empty elsewhere.
+    std::vector<SceneCell> cells;
+    std::vector<ScenePortal> portals;
 
     /// Total patch count over the instances (the size of pose()'s output).
     std::size_t patch_count() const;
-    /// Cameras of frames 0 .. frames-1 along `camera` (aspect = width / height).
+    /// Cameras of frames 0 .. frames-1 along `camera` (aspect = width / height), orbit or walk.
     std::vector<Camera> camera_path(int frames, float aspect) const;
 };
 
@@ -81,6 +142,9 @@ struct Scene {
 /// a smooth bump field of +-1.5% of a BigGuy's height along the normal, at the frogs' own
 /// texcoords; the BigGuys are not. Throws patchcull::Error when a shipped model cannot be read
 /// (PATCHCULL_DATA_DIR as in shipped_model_path).
+/// Names: instances "bigguy#0".."bigguy#2", "monsterfrog#0".."monsterfrog#2" (in placement
+/// order, BigGuy first); environment "ground" (one-sided, front +y), "wall", "pillar#0",
+/// "pillar#1" (boxes, one-sided, counter-clockwise outward). Every instance deforms, none moves.
 Scene make_default_scene(Scheme scheme = Scheme::acc);
 /// The default scene's displacement scale (world units: a BigGuy is 1 high).
 inline constexpr float kDefaultSceneDisplaceScale = 0.03f;
@@ -88,11 +152,79 @@ inline constexpr float kDefaultSceneDisplaceScale = 0.03f;
 /// A scene of one model (as load_model returns it): scaled to height 1, standing on the ground
 /// at the origin, with a ground quad as the only occluder, and a camera path like
 /// orbit_sequence's (the whole model in view, 30 degrees above the horizon, `degrees_per_frame`
-/// per frame).
+/// per frame). Names: the instance is the model file's stem + "#0" ("teapot#0"), the
+/// environment object "ground".
 Scene make_model_scene(LoadedModel model, float degrees_per_frame = 5.0f);
+
+/// Parameters of the `city` scene. Lengths in character heights (a BigGuy is 1 high).
+struct CityParams {
+    int blocks_x = 6, blocks_z = 6;  ///< blocks (one box building each), 1..64 per axis
+    float block_size = 8;            ///< side of a block's square footprint
+    float street_width = 4;          ///< streets run between the blocks and around the grid
+    float min_height = 3, max_height = 14;  ///< building heights, uniform in between
+    int characters = 220;            ///< BigGuys and MonsterFrogs (alternating), 0..100000
+    float rigid_fraction = 0.25f;    ///< share of characters that do not deform
+    float walking_fraction = 0.35f;  ///< share that walk along their street (velocity)
+    float walk_seconds = 10;         ///< walkers stay in their street and out of the camera's corridor this long
+    int phases = 6;                  ///< distinct animation time offsets (1..64), k * 0.37 s
+    unsigned seed = 11;              ///< placement, heights and choices (std::mt19937)
+    int camera_street = -1;          ///< index of the z street the camera walks; -1: the middle one
+};
+
+/// The built-in `city` scene (issue 11): a blocks_x x blocks_z grid of box buildings (heights
+/// uniform in [min_height, max_height], each one EnvironmentObject "building#i", one-sided,
+/// counter-clockwise outward) separated by streets, on one ground quad ("ground", one-sided,
+/// front +y) that covers the grid and its outer streets. `characters` BigGuys and MonsterFrogs
+/// (alternating; `scheme`, ACC by default) stand in the streets at random yaw: a rigid_fraction
+/// of them rigid, a walking_fraction walking along their street at 0.3-0.7 units per second,
+/// facing their way; the MonsterFrogs displaced by the default scene's procedural map
+/// (kDefaultSceneDisplaceScale); time offsets from `phases` values k * 0.37 s (so ScenePoser
+/// shares one deformation per model and phase). Over [0, walk_seconds] no character comes within
+/// its animated reach (over one animation period, any yaw) plus 0.1 of a building on x or z,
+/// leaves the grid, or enters the camera's corridor (0.6 either side of its line); characters
+/// start apart. The camera walks down the middle of z street camera_street (streets 0..blocks_x
+/// from -x) from the grid's +z edge towards -z at eye height 0.8 (a character is 1 high), 0.15
+/// units per frame, looking down the street (60 degrees): buildings hide the parallel streets,
+/// the characters behind the camera are outside the view. Names: "bigguy#k" / "monsterfrog#k"
+/// (counted per model). The default makes 220 characters, about 300k ACC patches.
+/// Throws patchcull::Error for parameters out of range, when the characters do not fit, or when
+/// a shipped model cannot be read.
+Scene make_city_scene(Scheme scheme = Scheme::acc, const CityParams& params = {});
+
+/// Parameters of the `building` scene.
+struct BuildingParams {
+    int rooms_x = 3, rooms_z = 3;     ///< a grid of square rooms, 1..16 per axis
+    float room_size = 6;              ///< inner side of a room (wall centre to wall centre)
+    float wall_height = 2.5f;
+    float wall_thickness = 0.2f;
+    int characters_per_room = 9;      ///< 0..64, placed on a jittered grid in each room
+    unsigned seed = 5;
+};
+
+/// The built-in `building` scene (issue 11, read by issue 12's cells and portals): a
+/// rooms_x x rooms_z grid of rooms under one ceiling. Every wall is built from closed boxes
+/// around its openings (one EnvironmentObject per box: "wall#k", one-sided, counter-clockwise
+/// outward); each room has a floor slab and a ceiling slab ("floor#i", "ceiling#i", boxes).
+/// Neighbouring rooms are joined by a door (1 x 2, in the walls between rooms of one column, and
+/// every second wall between columns) or a window (1.2 wide, 1.0-1.8 high, the other walls
+/// between columns); the outer walls are closed. The cells are the rooms ("room#i" for room
+/// (i % rooms_x, i / rooms_x)), the portals the doors and windows. Characters (BigGuys and
+/// MonsterFrogs, `scheme`, the frogs displaced as in the default scene, every third one rigid)
+/// stand in the rooms, away from the walls and from the camera's corridor. The camera walks from
+/// the south room of the middle column (largest z) north through its doors at eye height 0.9,
+/// 0.08 units per frame. The default makes 81 characters, about 110k ACC patches.
+/// Throws patchcull::Error for parameters out of range, or when a shipped model cannot be read.
+Scene make_building_scene(Scheme scheme = Scheme::acc, const BuildingParams& params = {});
+
+/// A built-in scene by name: "default", "city" or "building" (default parameters). Throws
+/// patchcull::Error("unknown scene '...' (default, city or building)") for any other name.
+Scene make_builtin_scene(const std::string& name, Scheme scheme = Scheme::acc);
 
 /// Evaluates a scene's patches at a time (animation, then each instance's transform), keeping
 /// its storage between calls (no allocation after the first pose of the same scene).
+/// Instances that share a model and an effective time (time_seconds + time_offset, compared as
+/// floats; every rigid instance of a model shares its rest frame) share one deformation and one
+/// patch evaluation per pose() call: a city of 220 characters in 6 phases evaluates 12 frames.
 class ScenePoser {
 public:
     explicit ScenePoser(const Scene& scene);
@@ -116,6 +248,11 @@ private:
     const Scene* scene_;
     std::vector<Vec3> positions_;
     PatchFrame frame_;
+    std::vector<std::size_t> first_patch_;    ///< per instance: its first patch in pose()'s output
+    std::vector<std::size_t> first_tangent_;  ///< per instance: its first entry of tangents()
+    std::vector<std::size_t> order_;          ///< instances sorted by (model, effective time)
+    std::vector<float> times_;                ///< per instance: effective time (rest: -inf)
+    std::vector<std::size_t> tangent_counts_; ///< per model: patches with tangent patches
     std::vector<BezierPatch> patches_;
     std::vector<std::int32_t> tangent_index_;
     std::vector<TangentPatches> tangents_;

@@ -4,13 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <limits>
 
 #include "patchcull/error.h"
+#include "scene_builder.h"
 
 namespace patchcull {
-namespace {
-
-constexpr float kPi = 3.14159265358979f;
+namespace detail {
 
 Mat4 translation(Vec3 t) {
     Mat4 m;
@@ -26,7 +27,6 @@ Mat4 scaling(float s) {
     return m;
 }
 
-// Rotation about the world y axis by `degrees` (counter-clockwise seen from +y).
 Mat4 rotation_y(float degrees) {
     const float a = degrees * kPi / 180.0f;
     Mat4 m;
@@ -37,7 +37,6 @@ Mat4 rotation_y(float degrees) {
     return m;
 }
 
-// The built-in teapot is z-up: (x, y, z) -> (x, z, -y) stands it on the y = 0 plane.
 Mat4 teapot_to_y_up() {
     Mat4 m;
     m.at(1, 1) = 0;
@@ -55,8 +54,6 @@ Bounds transformed_bounds(const PatchFrame& frame, const Mat4& m) {
     return compute_bounds(points);
 }
 
-// Object space -> "standing" space: y-up, scaled to height `height`, centred on x = z = 0, feet at
-// y = 0 (from the control points at rest, which bound the surface).
 Mat4 standing_transform(const LoadedModel& model, float height) {
     const Mat4 up = model.subdiv ? Mat4{} : teapot_to_y_up();
     const Bounds b = transformed_bounds(model.rest, up);
@@ -67,29 +64,91 @@ Mat4 standing_transform(const LoadedModel& model, float height) {
     return scaling(s) * translation(-base) * up;
 }
 
-// An axis-aligned box [lo, hi] as 12 triangles.
-void add_box(Scene& scene, Vec3 lo, Vec3 hi) {
+void add_triangles(Scene& scene, std::string name, const std::vector<Vec3>& vertices,
+                   const std::vector<std::uint32_t>& indices, bool one_sided) {
     const auto base = static_cast<std::uint32_t>(scene.occluder_vertices.size());
+    EnvironmentObject object;
+    object.name = std::move(name);
+    object.first_triangle = static_cast<std::uint32_t>(scene.occluder_indices.size() / 3);
+    object.triangle_count = static_cast<std::uint32_t>(indices.size() / 3);
+    object.one_sided = one_sided;
+    scene.occluder_vertices.insert(scene.occluder_vertices.end(), vertices.begin(), vertices.end());
+    for (std::uint32_t i : indices) scene.occluder_indices.push_back(base + i);
+    scene.environment.push_back(std::move(object));
+}
+
+void add_box(Scene& scene, std::string name, Vec3 lo, Vec3 hi) {
+    std::vector<Vec3> vertices;
     for (int i = 0; i < 8; ++i)
-        scene.occluder_vertices.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-    // Faces as corner quads (bit 0 = x, bit 1 = y, bit 2 = z); the renderer draws both sides.
-    const std::uint32_t quads[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
-                                       {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+        vertices.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+    // Faces as corner quads (bit 0 = x, bit 1 = y, bit 2 = z), each counter-clockwise seen from
+    // outside: -x, +x, -y, +y, -z, +z (tests check the signed volume is the box's).
+    const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                       {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    std::vector<std::uint32_t> indices;
     for (const auto& q : quads)
-        for (int k : {0, 1, 2, 0, 2, 3}) scene.occluder_indices.push_back(base + q[k]);
+        for (int k : {0, 1, 2, 0, 2, 3}) indices.push_back(q[k]);
+    add_triangles(scene, std::move(name), vertices, indices, true);
+}
+
+void add_quad(Scene& scene, std::string name, const Vec3 corners[4], bool one_sided) {
+    add_triangles(scene, std::move(name), {corners[0], corners[1], corners[2], corners[3]}, {0, 1, 2, 0, 2, 3},
+                  one_sided);
 }
 
 void add_ground(Scene& scene, float half_size) {
-    const auto base = static_cast<std::uint32_t>(scene.occluder_vertices.size());
-    // Slightly below y = 0, so that feet resting on the ground are not tied with it in depth.
     const float y = -0.002f;
-    for (Vec3 p : {Vec3{-half_size, y, -half_size}, Vec3{half_size, y, -half_size}, Vec3{half_size, y, half_size},
-                   Vec3{-half_size, y, half_size}})
-        scene.occluder_vertices.push_back(p);
-    for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) scene.occluder_indices.push_back(base + i);
+    const float h = half_size;
+    // Counter-clockwise seen from +y.
+    const Vec3 corners[4] = {{-h, y, -h}, {-h, y, h}, {h, y, h}, {h, y, -h}};
+    add_quad(scene, "ground", corners, true);
 }
 
-}  // namespace
+void load_characters(Scene& scene, Scheme scheme) {
+    scene.models.push_back(load_model(shipped_model_path("bigguy.obj"), scheme, 0));
+    scene.models.push_back(load_model(shipped_model_path("monsterfrog.obj"), scheme, 0));
+}
+
+float animated_reach(const LoadedModel& model, const Mat4& standing, const AnimationParams& animation, int samples) {
+    float reach = 0;
+    auto measure = [&](const PatchFrame& frame) {
+        for (const BezierPatch& p : frame.patches)
+            for (const Vec4& c : p.cp) {
+                const Vec3 q = cartesian(standing * c);
+                reach = std::max(reach, std::hypot(q.x, q.z));
+            }
+    };
+    measure(model.rest);
+    if (!model.subdiv) return reach;
+    std::vector<Vec3> positions;
+    PatchFrame frame;
+    for (int k = 0; k < samples; ++k) {
+        animate(model.subdiv->mesh.positions, animation.period_seconds * static_cast<float>(k) / static_cast<float>(samples),
+                animation, positions);
+        evaluate_frame(model, positions, frame);
+        measure(frame);
+    }
+    return reach;
+}
+
+}  // namespace detail
+
+using namespace detail;
+
+Mat4 instance_to_world(const SceneInstance& instance, float time_seconds) {
+    const float t = time_seconds + instance.time_offset;
+    Mat4 m = instance.object_to_world;
+    // translation(v * t) * M adds (v * t) * M's w row to each column's xyz: for an affine M the
+    // w row is (0, 0, 0, 1), so only column 3 moves.
+    const Vec3 d = instance.velocity * t;
+    for (int c = 0; c < 4; ++c) {
+        const float w = m.at(3, c);
+        m.at(0, c) += d.x * w;
+        m.at(1, c) += d.y * w;
+        m.at(2, c) += d.z * w;
+    }
+    return m;
+}
 
 std::size_t Scene::patch_count() const {
     std::size_t n = 0;
@@ -100,10 +159,15 @@ std::size_t Scene::patch_count() const {
 std::vector<Camera> Scene::camera_path(int frames, float aspect) const {
     std::vector<Camera> cameras;
     for (int f = 0; f < frames; ++f) {
-        const float a = (camera.start_degrees + f * camera.degrees_per_frame) * kPi / 180.0f;
         Camera cam;
-        cam.eye = camera.target + Vec3{camera.distance * std::sin(a), camera.height, camera.distance * std::cos(a)};
-        cam.target = camera.target;
+        if (camera.walk) {
+            cam.eye = camera.walk_start + camera.walk_step * static_cast<float>(f);
+            cam.target = cam.eye + camera.walk_direction;
+        } else {
+            const float a = (camera.start_degrees + f * camera.degrees_per_frame) * kPi / 180.0f;
+            cam.eye = camera.target + Vec3{camera.distance * std::sin(a), camera.height, camera.distance * std::cos(a)};
+            cam.target = camera.target;
+        }
         cam.fovy_radians = camera.fovy_radians;
         cam.aspect = aspect;
         cam.z_near = camera.z_near;
@@ -116,8 +180,7 @@ std::vector<Camera> Scene::camera_path(int frames, float aspect) const {
 Scene make_default_scene(Scheme scheme) {
     Scene scene;
     scene.name = "default";
-    scene.models.push_back(load_model(shipped_model_path("bigguy.obj"), scheme, 0));
-    scene.models.push_back(load_model(shipped_model_path("monsterfrog.obj"), scheme, 0));
+    load_characters(scene, scheme);
     const Mat4 bigguy = standing_transform(scene.models[0], 1.0f);
     const Mat4 frog = standing_transform(scene.models[1], 0.6f);  // a frog is lower than BigGuy
     // Two loose rows facing the camera's side (+z); the front row partly hides the back row,
@@ -132,19 +195,24 @@ Scene make_default_scene(Scheme scheme) {
         {1, {-0.7f, 0, -0.1f}, 35}, {0, {0.6f, 0, 0.0f}, 0},    {1, {1.9f, 0, 0.2f}, -40},
     };
     float offset = 0;
+    int copies[2] = {0, 0};
     for (const Placement& p : placements) {
         const Mat4& standing = p.model == 0 ? bigguy : frog;
-        const bool displaced = p.model == 1;  // the frogs
-        scene.instances.push_back(
-            {p.model, translation(p.position) * rotation_y(p.yaw_degrees) * standing, offset, displaced});
+        SceneInstance instance;
+        instance.model = p.model;
+        instance.object_to_world = translation(p.position) * rotation_y(p.yaw_degrees) * standing;
+        instance.time_offset = offset;
+        instance.displaced = p.model == 1;  // the frogs
+        instance.name = std::string(p.model == 0 ? "bigguy#" : "monsterfrog#") + std::to_string(copies[p.model]++);
+        scene.instances.push_back(std::move(instance));
         offset += 0.37f;
     }
     scene.displacement = make_procedural_displacement(512, kDefaultSceneDisplaceScale);
     scene.displacement_name = "procedural";
     add_ground(scene, 6.0f);
-    add_box(scene, {-2.6f, 0, 0.75f}, {0.9f, 0.42f, 0.9f});  // low wall in front of the front row
-    add_box(scene, {-0.45f, 0, -0.85f}, {-0.2f, 1.5f, -0.6f});  // pillar between the rows
-    add_box(scene, {1.0f, 0, -0.75f}, {1.2f, 1.3f, -0.55f});    // a second, thinner pillar
+    add_box(scene, "wall", {-2.6f, 0, 0.75f}, {0.9f, 0.42f, 0.9f});         // low wall in front of the front row
+    add_box(scene, "pillar#0", {-0.45f, 0, -0.85f}, {-0.2f, 1.5f, -0.6f});  // pillar between the rows
+    add_box(scene, "pillar#1", {1.0f, 0, -0.75f}, {1.2f, 1.3f, -0.55f});    // a second, thinner pillar
     // Low and close, with a 45-degree vertical field of view: the wall hides the front row's legs,
     // the front row hides parts of the back row, and the frog on the right leaves the view.
     scene.camera.target = {0.3f, 0.4f, -0.5f};
@@ -163,8 +231,11 @@ Scene make_model_scene(LoadedModel model, float degrees_per_frame) {
     scene.name = model.name;
     const Mat4 standing = standing_transform(model, 1.0f);
     const Bounds b = transformed_bounds(model.rest, standing);
+    SceneInstance instance;
+    instance.object_to_world = standing;
+    instance.name = std::filesystem::path(model.name).stem().string() + "#0";
     scene.models.push_back(std::move(model));
-    scene.instances.push_back({0, standing, 0});
+    scene.instances.push_back(std::move(instance));
     add_ground(scene, 3.0f);
     // As orbit_sequence: far enough that the bounding sphere fits in the vertical field of view.
     const float radius = b.radius();
@@ -192,35 +263,77 @@ ScenePoser::ScenePoser(const Scene& scene) : scene_(&scene) {
 
 const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
     const Scene& scene = *scene_;
-    patches_.resize(scene.patch_count());
-    tangent_index_.assign(scene.patch_count(), -1);
-    depth_.assign(scene.patch_count(), 0);
-    tangents_.clear();
-    std::size_t next = 0;
-    for (const SceneInstance& instance : scene.instances) {
+    const std::size_t n = scene.instances.size();
+    // Each instance's first patch and first tangent entry (recomputed per call: cheap, and the
+    // scene may have been edited since the poser was made).
+    tangent_counts_.assign(scene.models.size(), 0);
+    for (std::size_t m = 0; m < scene.models.size(); ++m)
+        for (const PatchInfo& info : scene.models[m].rest.info) tangent_counts_[m] += info.tangent_index >= 0 ? 1 : 0;
+    first_patch_.resize(n);
+    first_tangent_.resize(n);
+    std::size_t total = 0, total_tangents = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        first_patch_[i] = total;
+        first_tangent_[i] = total_tangents;
+        total += scene.models.at(scene.instances[i].model).rest.patches.size();
+        total_tangents += tangent_counts_[scene.instances[i].model];
+    }
+    order_.resize(n);
+    times_.resize(n);
+    patches_.resize(total);
+    tangent_index_.assign(total, -1);
+    depth_.assign(total, 0);
+    tangents_.resize(total_tangents);
+    // Group the instances by (model, effective time): each group's frame is evaluated once.
+    const float rest_time = -std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i < n; ++i) {
+        const SceneInstance& instance = scene.instances[i];
+        const bool animated = instance.deforms && scene.models.at(instance.model).subdiv.has_value();
+        times_[i] = animated ? time_seconds + instance.time_offset : rest_time;
+        order_[i] = i;
+    }
+    std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) {
+        const std::size_t ma = scene.instances[a].model, mb = scene.instances[b].model;
+        if (ma != mb) return ma < mb;
+        if (times_[a] != times_[b]) return times_[a] < times_[b];
+        return a < b;
+    });
+    const PatchFrame* frame = nullptr;
+    std::size_t frame_model = 0;
+    float frame_time = 0;
+    for (std::size_t i : order_) {
+        const SceneInstance& instance = scene.instances[i];
         const LoadedModel& model = scene.models.at(instance.model);
-        const PatchFrame* frame = &model.rest;
-        if (model.subdiv) {
-            animate(model.subdiv->mesh.positions, time_seconds + instance.time_offset, scene.animation, positions_);
-            evaluate_frame(model, positions_, frame_);
-            frame = &frame_;
+        if (!frame || frame_model != instance.model || !(frame_time == times_[i])) {
+            if (times_[i] == rest_time) {
+                frame = &model.rest;
+            } else {
+                animate(model.subdiv->mesh.positions, times_[i], scene.animation, positions_);
+                evaluate_frame(model, positions_, frame_);
+                frame = &frame_;
+            }
+            frame_model = instance.model;
+            frame_time = times_[i];
         }
-        // Tangent vectors map by the linear part of the affine object_to_world (w = 0).
+        const Mat4 to_world = instance_to_world(instance, time_seconds);
+        // Tangent vectors map by the linear part of the affine transform (w = 0).
         auto linear = [&](Vec3 d) {
-            const Vec4 m = instance.object_to_world * Vec4{d.x, d.y, d.z, 0.0f};
+            const Vec4 m = to_world * Vec4{d.x, d.y, d.z, 0.0f};
             return Vec3{m.x, m.y, m.z};
         };
+        std::size_t next = first_patch_[i];
+        std::size_t next_tangent = first_tangent_[i];
         for (std::size_t p = 0; p < frame->patches.size(); ++p) {
             BezierPatch& out = patches_[next];
-            for (int k = 0; k < kPatchPoints; ++k) out.cp[k] = instance.object_to_world * frame->patches[p].cp[k];
+            for (int k = 0; k < kPatchPoints; ++k) out.cp[k] = to_world * frame->patches[p].cp[k];
             depth_[next] = frame->info[p].depth;
             const std::int32_t t = frame->info[p].tangent_index;
             if (t >= 0) {
-                TangentPatches mapped;
+                TangentPatches& mapped = tangents_[next_tangent];
                 const TangentPatches& source = frame->tangents[static_cast<std::size_t>(t)];
                 for (int k = 0; k < 12; ++k) mapped.du[k] = linear(source.du[k]), mapped.dv[k] = linear(source.dv[k]);
-                tangent_index_[next] = static_cast<std::int32_t>(tangents_.size());
-                tangents_.push_back(mapped);
+                tangent_index_[next] = static_cast<std::int32_t>(next_tangent);
+                ++next_tangent;
             }
             ++next;
         }

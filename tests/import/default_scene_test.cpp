@@ -101,3 +101,130 @@ TEST(DefaultScene, ShippedCharactersAreClosedTheTeapotIsNot) {
     for (const LoadedModel& m : scene.models) EXPECT_TRUE(m.closed) << m.name;
     EXPECT_FALSE(load_model("teapot", Scheme::acc, 0).closed);
 }
+
+TEST(DefaultScene, NamesAndEnvironmentObjects) {
+    const Scene scene = make_default_scene();
+    const char* const names[] = {"bigguy#0", "monsterfrog#0", "bigguy#1", "monsterfrog#1", "bigguy#2", "monsterfrog#2"};
+    ASSERT_EQ(scene.instances.size(), 6u);
+    for (std::size_t i = 0; i < 6; ++i) {
+        EXPECT_EQ(scene.instances[i].name, names[i]);
+        EXPECT_TRUE(scene.instances[i].deforms);
+        EXPECT_EQ(length(scene.instances[i].velocity), 0.0f);
+    }
+    ASSERT_EQ(scene.environment.size(), 4u);
+    const char* const env[] = {"ground", "wall", "pillar#0", "pillar#1"};
+    std::uint32_t next = 0;
+    for (std::size_t e = 0; e < 4; ++e) {
+        const EnvironmentObject& o = scene.environment[e];
+        EXPECT_EQ(o.name, env[e]);
+        EXPECT_TRUE(o.one_sided);
+        EXPECT_EQ(o.first_triangle, next);
+        EXPECT_EQ(o.triangle_count, e == 0 ? 2u : 12u);
+        next += o.triangle_count;
+        // Counter-clockwise seen from outside: the signed volume is the box's (the ground's
+        // triangles face +y).
+        double volume = 0;
+        Vec3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
+        for (std::uint32_t t = o.first_triangle; t < next; ++t) {
+            const Vec3 a = scene.occluder_vertices[scene.occluder_indices[3 * t]];
+            const Vec3 b = scene.occluder_vertices[scene.occluder_indices[3 * t + 1]];
+            const Vec3 c = scene.occluder_vertices[scene.occluder_indices[3 * t + 2]];
+            if (e == 0) {
+                EXPECT_GT(cross(b - a, c - a).y, 0.0f);
+            }
+            volume += dot(a, cross(b, c)) / 6.0;
+            for (Vec3 p : {a, b, c})
+                lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)},
+                hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+        }
+        if (e > 0) {
+            const double box = double(hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z);
+            EXPECT_NEAR(volume, box, 1e-5 * box) << o.name;
+        }
+    }
+    EXPECT_EQ(next * 3, scene.occluder_indices.size());
+    // The model scene names its instance and ground.
+    const Scene teapot = make_model_scene(load_model("teapot", Scheme::acc, 0));
+    EXPECT_EQ(teapot.instances[0].name, "teapot#0");
+    ASSERT_EQ(teapot.environment.size(), 1u);
+    EXPECT_EQ(teapot.environment[0].name, "ground");
+}
+
+// instance_to_world moves by velocity * (t + time_offset) and keeps the linear part.
+TEST(DefaultScene, InstanceToWorldIsTheRigidMotion) {
+    SceneInstance instance;
+    instance.object_to_world.at(0, 0) = 2;
+    instance.object_to_world.at(1, 3) = 5;
+    instance.time_offset = 0.5f;
+    instance.velocity = {1, 0, -2};
+    const Mat4 m = instance_to_world(instance, 1.5f);
+    EXPECT_EQ(m.at(0, 0), 2.0f);
+    EXPECT_EQ(m.at(0, 3), 2.0f);
+    EXPECT_EQ(m.at(1, 3), 5.0f);
+    EXPECT_EQ(m.at(2, 3), -4.0f);
+    EXPECT_EQ(m.at(3, 3), 1.0f);
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(m.at(r, c), instance.object_to_world.at(r, c));
+    instance.velocity = {};
+    const Mat4 still = instance_to_world(instance, 7);
+    for (int k = 0; k < 16; ++k) EXPECT_EQ(still.m[k], instance.object_to_world.m[k]);
+}
+
+// pose() shares one evaluation per (model, effective time): its output equals evaluating every
+// instance on its own, bit for bit (patches, tangents, depth), with rigid instances at rest and
+// moving ones moved.
+TEST(DefaultScene, PoseSharesFramesAndMatchesPerInstanceEvaluation) {
+    Scene scene = make_default_scene();
+    // Copies sharing phases, a rigid one, a moving one.
+    scene.instances[1].time_offset = scene.instances[0].time_offset;
+    scene.instances[2].time_offset = scene.instances[0].time_offset;
+    scene.instances[3].deforms = false;
+    scene.instances[4].velocity = {0.5f, 0, -0.25f};
+    scene.instances.push_back(scene.instances[0]);
+    scene.instances.back().name = "bigguy#3";
+    scene.instances.back().object_to_world.at(0, 3) += 3;
+    ScenePoser poser(scene);
+    for (float t : {0.0f, 0.4f, 1.3f}) {
+        const std::vector<BezierPatch>& patches = poser.pose(t);
+        ASSERT_EQ(patches.size(), scene.patch_count());
+        std::size_t next = 0;
+        std::vector<Vec3> positions;
+        PatchFrame frame;
+        for (const SceneInstance& instance : scene.instances) {
+            const LoadedModel& model = scene.models[instance.model];
+            const PatchFrame* source = &model.rest;
+            if (instance.deforms) {
+                animate(model.subdiv->mesh.positions, t + instance.time_offset, scene.animation, positions);
+                evaluate_frame(model, positions, frame);
+                source = &frame;
+            }
+            const Mat4 m = instance_to_world(instance, t);
+            for (std::size_t p = 0; p < source->patches.size(); ++p, ++next) {
+                for (int k = 0; k < kPatchPoints; ++k) {
+                    const Vec4 expected = m * source->patches[p].cp[k];
+                    ASSERT_EQ(patches[next].cp[k].x, expected.x) << instance.name << " patch " << p;
+                    ASSERT_EQ(patches[next].cp[k].y, expected.y);
+                    ASSERT_EQ(patches[next].cp[k].z, expected.z);
+                    ASSERT_EQ(patches[next].cp[k].w, expected.w);
+                }
+                ASSERT_EQ(poser.depth()[next], source->info[p].depth);
+                const std::int32_t ti = source->info[p].tangent_index;
+                ASSERT_EQ(poser.tangent_index()[next] >= 0, ti >= 0);
+                if (ti >= 0) {
+                    const Vec3 d = source->tangents[static_cast<std::size_t>(ti)].du[3];
+                    const Vec4 e = m * Vec4{d.x, d.y, d.z, 0};
+                    const Vec3 got = poser.tangents()[static_cast<std::size_t>(poser.tangent_index()[next])].du[3];
+                    ASSERT_EQ(got.x, e.x);
+                    ASSERT_EQ(got.z, e.z);
+                }
+            }
+        }
+        // Tangent entries are in patch order, one per patch that has one.
+        std::int32_t last = -1;
+        for (std::int32_t ti : poser.tangent_index())
+            if (ti >= 0) {
+                ASSERT_EQ(ti, ++last);
+            }
+        ASSERT_EQ(static_cast<std::size_t>(last + 1), poser.tangents().size());
+    }
+}
