@@ -61,6 +61,7 @@ vec3 status_color(uint word) {
     if ((word & kCullFrustum) != 0u) return vec3(0.25, 0.45, 1.0);    // blue: frustum-culled
     if ((word & kCullBackPatch) != 0u) return vec3(0.85, 0.3, 0.9);   // magenta: back-patch-culled
     if ((word & kCullOcclusion) != 0u) return vec3(1.0, 0.2, 0.15);   // red: occlusion-culled
+    if ((word & kCullObject) != 0u) return vec3(0.1, 0.75, 0.8);      // cyan: culled with its object
     if ((word & kStatusNewlyVisible) != 0u) return vec3(1.0, 0.85, 0.1);  // yellow: newly visible
     if ((word & kStatusVisible) != 0u) return vec3(0.2, 0.85, 0.3);   // green: visible
     return vec3(0.6, 0.6, 0.6);                                        // grey: no status yet

@@ -56,6 +56,9 @@ PATCHCULL_CONST uint kImageUnitHiZOut = 0u;          // R32F Hi-Z level being wr
 PATCHCULL_CONST uint kCullFrustum = 1u;
 PATCHCULL_CONST uint kCullBackPatch = 2u;   // back-facing (a back-patch pass: tcone, ncone or ptp)
 PATCHCULL_CONST uint kCullOcclusion = 4u;   // behind the Hi-Z pyramid
+// Culled by the object level before any patch pass (object_culling.h: the object outside the
+// frustum, or a back-facing cluster of it): written by CullPipeline with a buffer clear, no pass.
+PATCHCULL_CONST uint kCullObject = 8u;
 PATCHCULL_CONST uint kCullReasonMask = 0xFFu;
 // Bits 8-9: temporal status of the two-pass pipeline (seed 000 §3), written by cull_status (end):
 // kStatusVisible = passed the latest test (drawn in the next frame's first pass); with

@@ -71,6 +71,7 @@ struct ObjectRange {
 /// Counts of one object in a frame (FrameStats::objects), as FrameStats's.
 struct ObjectStats {
     std::size_t patches = 0, frustum_culled = 0, backpatch_culled = 0, occlusion_culled = 0, visible = 0;
+    std::size_t object_culled = 0;  ///< in PipelineParams::object_culled
 };
 
 /// Parameters of one pipeline frame: the frame and the choice of each test.
@@ -86,12 +87,23 @@ struct PipelineParams {
     /// patch, culled. Patches outside every range are drawn unculled. Throws when a range leaves
     /// the set or two overlap.
     std::vector<ObjectRange> objects;
+    /// Patches culled by the object level (object_culling.h: an object outside the frustum, a
+    /// back-facing cluster) before the passes: no pass tests them and no draw issues them (no
+    /// patch work on the GPU); their flag words become kFlagObject with the status cleared, so a
+    /// span that comes back next frame is tested and drawn as newly visible. Disjoint, any order,
+    /// within the set (else render_frame throws). The caller answers for them being invisible.
+    std::vector<PatchSpan> object_culled;
+    /// Occluder triangles culled by the object level (PatchRenderer::set_culled_occluders, set at
+    /// the start of the frame; the unculled reference still draws them).
+    std::vector<TriangleSpan> culled_occluders;
 };
 
 /// What one frame did. Counts are patches; each patch has exactly one of: frustum_culled,
-/// backpatch_culled, occlusion_culled, or it passed (visible = tagged visible for the next frame).
+/// backpatch_culled, occlusion_culled, object_culled, or it passed (visible = tagged visible for
+/// the next frame).
 struct FrameStats {
     std::size_t patches = 0;
+    std::size_t object_culled = 0;   ///< in PipelineParams::object_culled (no pass ran on them)
     bool two_pass = false;           ///< the mode includes occlusion (seed 000 §3's pipeline)
     // Every pass issues all patches to the TCS (seed 000 §6.3's RT_0 cost per pass); "drawn" =
     // tessellated (levels > 0), the others get levels 0 there.

@@ -88,10 +88,22 @@ namespace patchcull::gl {
 inline constexpr std::uint32_t kFlagFrustum = 1u;        ///< culled by the view frustum
 inline constexpr std::uint32_t kFlagBackPatch = 2u;      ///< culled as back-facing (a back-patch pass)
 inline constexpr std::uint32_t kFlagOcclusion = 4u;      ///< culled behind the Hi-Z pyramid
+inline constexpr std::uint32_t kFlagObject = 8u;         ///< culled with its object (object_culling.h)
 inline constexpr std::uint32_t kFlagReasonMask = 0xFFu;  ///< bits of the cull reason
 inline constexpr std::uint32_t kStatusVisible = 0x100u;  ///< passed the latest test
 inline constexpr std::uint32_t kStatusNewlyVisible = 0x200u;  ///< ... and was not tagged visible
 inline constexpr std::uint32_t kIdOccluderBit = 0x80000000u;  ///< id of occluder triangle t: bit | t
+
+/// Patches [first, first + count) of the set (object-level culling and draws restricted to spans).
+struct PatchSpan {
+    std::size_t first = 0;
+    std::size_t count = 0;
+};
+/// Occluder triangles [first, first + count) (set_occluders' triangle order).
+struct TriangleSpan {
+    std::size_t first = 0;
+    std::size_t count = 0;
+};
 
 /// Which tests a frame runs (CullPipeline, gl_pipeline.h); the values are the flag bits a culled
 /// patch gets.
@@ -288,8 +300,19 @@ public:
     /// patches through the depth buffer and the Hi-Z pyramid. Empty vectors remove them. Throws
     /// patchcull::Error when indices.size() is not a multiple of 3, an index is out of range, or
     /// there are 2^31 triangles or more.
-    void set_occluders(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& indices);
+    /// one_sided: triangle spans drawn with back faces culled (counter-clockwise = front, as
+    /// GL's default): the environment objects that show nothing from behind (closed outward solids,
+    /// a ground seen from above), so that back-face culling them at the object level removes no
+    /// pixel (object_culling.h). The other triangles are drawn two-sided. Spans must lie within the
+    /// triangles (else throws). Clears the culled spans (set_culled_occluders).
+    void set_occluders(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& indices,
+                       const std::vector<TriangleSpan>& one_sided = {});
     std::size_t occluder_triangle_count() const;
+    /// Occluder triangles culled by the object level: begin_frame() and render() with
+    /// use_cull_flags skip them; render() without use_cull_flags (the unculled reference) draws
+    /// every triangle. Spans may overlap and come in any order; each must lie within the triangles
+    /// (else throws). An empty vector culls none.
+    void set_culled_occluders(const std::vector<TriangleSpan>& culled);
 
     // ---- drawing -----------------------------------------------------------------------------
     /// Clears the framebuffer (colour dark grey, id 0, depth 1), draws the occluders, then every
@@ -307,6 +330,9 @@ public:
     /// the first pass of seed 000 §3), as many times as needed. params.use_cull_flags is ignored.
     void begin_frame(const RenderParams& params);
     void draw_selected(std::uint32_t mask, std::uint32_t value);
+    /// draw_selected restricted to the patches of spans (disjoint, any order, within the set, else
+    /// throws): the patches of objects culled whole are never issued, so they cost no TCS work.
+    void draw_selected(std::uint32_t mask, std::uint32_t value, const std::vector<PatchSpan>& spans);
 
     /// Visualisation (seed 000 Fig. 2's statuses): renders every patch, ignoring the flags, with a
     /// colour from its flag word, and the occluders in grey, seen through `view` (its camera, size
@@ -317,6 +343,7 @@ public:
     ///   blue    frustum-culled
     ///   magenta back-patch-culled
     ///   red     occlusion-culled
+    ///   cyan    culled with its object (object level, before the patch passes)
     ///   grey    no status yet (before any test); occluders a darker neutral grey
     /// With the frame's own camera no red or magenta patch may show in front (that would be a false
     /// cull); another camera shows the culled patches. Returns RGBA8, row 0 = top. Waits.
@@ -358,6 +385,7 @@ public:
     struct Impl;
 
 private:
+    void begin_frame_drawing(const RenderParams& params, bool honour_occluder_culls);
     std::unique_ptr<Impl> impl_;
 };
 

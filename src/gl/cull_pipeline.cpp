@@ -14,7 +14,8 @@
 namespace patchcull::gl {
 
 static_assert(kFlagFrustum == sh::kCullFrustum && kFlagBackPatch == sh::kCullBackPatch &&
-              kFlagOcclusion == sh::kCullOcclusion && kFlagReasonMask == sh::kCullReasonMask);
+              kFlagOcclusion == sh::kCullOcclusion && kFlagObject == sh::kCullObject &&
+              kFlagReasonMask == sh::kCullReasonMask);
 static_assert(kStatusVisible == sh::kStatusVisible && kStatusNewlyVisible == sh::kStatusNewlyVisible);
 
 namespace {
@@ -180,31 +181,73 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         covered = o.first + o.count;
     }
     if (covered < count) gaps.push_back({covered, count - covered, false});
-    auto range_of = [&chain](const ObjectRange& o) {
+    // Object-level culls: the spans no pass or draw touches; every range runs on what is left.
+    std::vector<PatchSpan> culled = params.object_culled;
+    std::sort(culled.begin(), culled.end(), [](const PatchSpan& a, const PatchSpan& b) { return a.first < b.first; });
+    std::size_t culled_end = 0;
+    for (const PatchSpan& s : culled) {
+        if (s.first > count || s.count > count - s.first)
+            throw Error("render_frame: object-culled span [" + std::to_string(s.first) + ", +" + std::to_string(s.count) +
+                        ") leaves the set of " + std::to_string(count) + " patches");
+        if (s.first < culled_end) throw Error("render_frame: object-culled spans overlap at patch " + std::to_string(s.first));
+        culled_end = s.first + s.count;
+    }
+    // The parts of [o.first, o.first + o.count) outside every culled span, in order.
+    auto active_spans = [&culled](const ObjectRange& o) {
+        std::vector<PatchSpan> out;
+        std::size_t at = o.first;
+        const std::size_t end = o.first + o.count;
+        for (const PatchSpan& s : culled) {
+            if (s.first + s.count <= at) continue;
+            if (s.first >= end) break;
+            if (s.first > at) out.push_back({at, s.first - at});
+            at = std::max(at, s.first + s.count);
+        }
+        if (at < end) out.push_back({at, end - at});
+        return out;
+    };
+    std::vector<std::vector<PatchSpan>> object_spans, gap_spans;
+    std::vector<PatchSpan> drawn;  // every active span (the draws)
+    for (const ObjectRange& o : objects) object_spans.push_back(active_spans(o));
+    for (const ObjectRange& g : gaps) gap_spans.push_back(active_spans(g));
+    for (const auto& list : {&object_spans, &gap_spans})
+        for (const std::vector<PatchSpan>& spans : *list) drawn.insert(drawn.end(), spans.begin(), spans.end());
+    auto buffers_of = [&chain](const PatchSpan& s) {
         PatchBuffers b = chain;
-        b.first = o.first;
-        b.count = o.count;
+        b.first = s.first;
+        b.count = s.count;
         return b;
     };
 
     if (m.primed_generation != r.flag_generation()) m.prime_statuses();
+    r.set_culled_occluders(params.culled_occluders);
     m.ensure_counter_slots(objects.size() + 1);
     PassClock clock(method, m.timer_queries);
     clock.mark();
     // The flag chain (gl_passes.h) per culled object, in three timed parts: begin + frustum,
     // back-patch, the rest.
     auto run_chain = [&](const HiZTexture* hiz) {
-        m.status.begin(chain);
+        for (const PatchSpan& s : drawn) m.status.begin(buffers_of(s));
+        // The culled spans' words: kFlagObject, status cleared (a buffer clear, no pass).
+        const std::uint32_t object_word = sh::kCullObject;
+        for (const PatchSpan& s : culled)
+            if (s.count)
+                glClearNamedBufferSubData(r.flag_buffer(), GL_R32UI, static_cast<GLintptr>(s.first * sizeof(std::uint32_t)),
+                                          static_cast<GLsizeiptr>(s.count * sizeof(std::uint32_t)), GL_RED_INTEGER,
+                                          GL_UNSIGNED_INT, &object_word);
         const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
-        for (const ObjectRange& o : objects)
-            if (o.cull && (tests & sh::kCullFrustum)) m.frustum.run(range_of(o), planes);
+        for (std::size_t i = 0; i < objects.size(); ++i)
+            if (objects[i].cull && (tests & sh::kCullFrustum))
+                for (const PatchSpan& s : object_spans[i]) m.frustum.run(buffers_of(s), planes);
         clock.mark();
-        for (const ObjectRange& o : objects) {
-            if (!o.cull || !(tests & sh::kCullBackPatch)) continue;
-            if (params.backpatch == BackpatchMethod::ptp)
-                m.ptp.run(range_of(o), object_to_clip, clip_space_eye_alpha(rp.projection), params.ptp_rule);
-            else
-                m.cones.run(range_of(o), params.backpatch, eye);
+        for (std::size_t i = 0; i < objects.size(); ++i) {
+            if (!objects[i].cull || !(tests & sh::kCullBackPatch)) continue;
+            for (const PatchSpan& s : object_spans[i]) {
+                if (params.backpatch == BackpatchMethod::ptp)
+                    m.ptp.run(buffers_of(s), object_to_clip, clip_space_eye_alpha(rp.projection), params.ptp_rule);
+                else
+                    m.cones.run(buffers_of(s), params.backpatch, eye);
+            }
         }
         clock.mark();
         // The frustum pass ran first when the mode has it: the occlusion pass only tests Hi-Z.
@@ -214,19 +257,23 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         const bool bounds = ranges && (tests & (sh::kCullFrustum | sh::kCullOcclusion));
         const DisplacedCullView view =
             bounds ? make_displaced_cull_view(rp.view, rp.projection, ClipDepth::zero_to_one) : DisplacedCullView{};
-        for (const ObjectRange& o : objects) {
-            if (!o.cull) continue;
-            if (occluding) m.occlusion.run(range_of(o), object_to_clip, ClipDepth::zero_to_one, *occluding, false);
-            if (bounds) m.displaced.run(range_of(o), ranges, params.bound, params.cone, view, occluding, true);
+        for (std::size_t i = 0; i < objects.size(); ++i) {
+            if (!objects[i].cull) continue;
+            for (const PatchSpan& s : object_spans[i]) {
+                if (occluding) m.occlusion.run(buffers_of(s), object_to_clip, ClipDepth::zero_to_one, *occluding, false);
+                if (bounds) m.displaced.run(buffers_of(s), ranges, params.bound, params.cone, view, occluding, true);
+            }
         }
-        for (std::size_t i = 0; i < objects.size(); ++i) m.status.end(range_of(objects[i]), m.counters, i * m.counter_stride);
-        for (const ObjectRange& g : gaps) m.status.end(range_of(g), m.counters, objects.size() * m.counter_stride);
+        for (std::size_t i = 0; i < objects.size(); ++i)
+            for (const PatchSpan& s : object_spans[i]) m.status.end(buffers_of(s), m.counters, i * m.counter_stride);
+        for (const std::vector<PatchSpan>& spans : gap_spans)
+            for (const PatchSpan& s : spans) m.status.end(buffers_of(s), m.counters, objects.size() * m.counter_stride);
         clock.mark();
     };
     if (two_pass) {
         // 1. occluders + patches tagged visible.
         r.begin_frame(rp);
-        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
+        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, drawn);
         clock.mark();
         // 2. Hi-Z from that depth.
         m.ensure_hiz();
@@ -235,12 +282,12 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         // 3. test every patch, update statuses.
         run_chain(&m.hiz);
         // 4. newly visible patches (seed 000 §3.1: skipped when aggressive).
-        if (!frame.aggressive) r.draw_selected(sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass);
+        if (!frame.aggressive) r.draw_selected(sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass, drawn);
         clock.mark();
     } else {
         run_chain(nullptr);
         r.begin_frame(rp);
-        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
+        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, drawn);
         clock.mark();
     }
     check_gl("render_frame");
@@ -255,12 +302,15 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         if (i == objects.size()) break;
         ObjectStats o;
         o.patches = objects[i].count;
+        o.object_culled = objects[i].count;
+        for (const PatchSpan& s : object_spans[i]) o.object_culled -= s.count;
         o.frustum_culled = slot[sh::kCounterFrustum];
         o.backpatch_culled = slot[sh::kCounterBackPatch];
         o.occlusion_culled = slot[sh::kCounterOcclusion];
         o.visible = slot[sh::kCounterVisible];
         stats.objects.push_back(o);
     }
+    for (const PatchSpan& s : culled) stats.object_culled += s.count;
     stats.frustum_culled = c[sh::kCounterFrustum];
     stats.backpatch_culled = c[sh::kCounterBackPatch];
     stats.occlusion_culled = c[sh::kCounterOcclusion];

@@ -39,7 +39,7 @@ std::vector<std::uint8_t> PatchRenderer::render_status_image(const RenderParams&
     const Mat4 object_to_clip = view.projection * view.view;
     const int level = m.set_draw_uniforms(view, object_to_clip, sh::kColorStatus);
     m.begin_target(m.vis_fbo, m.vis_width, m.vis_height);
-    m.draw_occluders();
+    m.draw_occluders(false);
     m.draw_patches(level, 0u, 0u);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glProgramUniform1ui(m.draw_program, m.draw_loc.color_mode, sh::kColorPatch);

@@ -154,17 +154,19 @@ void PatchRenderer::set_flag_words(const std::vector<std::uint32_t>& words) {
 }
 
 void PatchRenderer::render(const RenderParams& params) {
-    begin_frame(params);
+    begin_frame_drawing(params, params.use_cull_flags);
     draw_selected(params.use_cull_flags ? sh::kDrawMaskUnculled : 0u, params.use_cull_flags ? sh::kDrawValueUnculled : 0u);
 }
 
-void PatchRenderer::begin_frame(const RenderParams& params) {
+void PatchRenderer::begin_frame(const RenderParams& params) { begin_frame_drawing(params, true); }
+
+void PatchRenderer::begin_frame_drawing(const RenderParams& params, bool honour_occluder_culls) {
     Impl& m = *impl_;
     m.resize(params.width, params.height);
     const Mat4 object_to_clip = params.projection * params.view;
     m.frame_level = m.set_draw_uniforms(params, object_to_clip, sh::kColorPatch, true);
     m.begin_target(m.fbo, m.width, m.height);
-    m.draw_occluders();
+    m.draw_occluders(honour_occluder_culls);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     check_gl("begin_frame");
 }
@@ -173,6 +175,24 @@ void PatchRenderer::draw_selected(std::uint32_t mask, std::uint32_t value) {
     Impl& m = *impl_;
     m.bind_target(m.fbo, m.width, m.height);
     m.draw_patches(m.frame_level, mask, value);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    check_gl("draw_selected");
+}
+
+void PatchRenderer::draw_selected(std::uint32_t mask, std::uint32_t value, const std::vector<PatchSpan>& spans) {
+    Impl& m = *impl_;
+    std::vector<PatchSpan> sorted = spans;
+    std::sort(sorted.begin(), sorted.end(), [](const PatchSpan& a, const PatchSpan& b) { return a.first < b.first; });
+    std::size_t covered = 0;
+    for (const PatchSpan& s : sorted) {
+        if (s.first > m.count || s.count > m.count - s.first)
+            throw Error("GL: draw_selected: span [" + std::to_string(s.first) + ", +" + std::to_string(s.count) +
+                        ") leaves the set of " + std::to_string(m.count) + " patches");
+        if (s.first < covered) throw Error("GL: draw_selected: spans overlap at patch " + std::to_string(s.first));
+        covered = s.first + s.count;
+    }
+    m.bind_target(m.fbo, m.width, m.height);
+    m.draw_patches(m.frame_level, mask, value, false, &sorted);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     check_gl("draw_selected");
 }
@@ -221,7 +241,29 @@ std::vector<std::uint8_t> PatchRenderer::mark_front_patches(const RenderParams& 
 
 // ---- occluders ---------------------------------------------------------------------------------
 
-void PatchRenderer::set_occluders(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& indices) {
+namespace {
+
+// Sets flags[t] = 1 for the triangles of spans (each within triangles, else throws naming what).
+void mark_triangle_spans(const std::vector<TriangleSpan>& spans, std::size_t triangles, const char* what,
+                         std::vector<std::uint8_t>& flags) {
+    flags.assign(triangles, 0);
+    for (const TriangleSpan& s : spans) {
+        if (s.first > triangles || s.count > triangles - s.first)
+            throw Error(std::string("GL: ") + what + ": triangle span [" + std::to_string(s.first) + ", +" +
+                        std::to_string(s.count) + ") leaves the " + std::to_string(triangles) + " occluder triangles");
+        std::fill(flags.begin() + static_cast<std::ptrdiff_t>(s.first),
+                  flags.begin() + static_cast<std::ptrdiff_t>(s.first + s.count), std::uint8_t{1});
+    }
+}
+
+}  // namespace
+
+void PatchRenderer::set_culled_occluders(const std::vector<TriangleSpan>& culled) {
+    mark_triangle_spans(culled, impl_->occluder_triangles, "set_culled_occluders", impl_->occluder_culled);
+}
+
+void PatchRenderer::set_occluders(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& indices,
+                                  const std::vector<TriangleSpan>& one_sided) {
     if (indices.size() % 3 != 0)
         throw Error("GL: set_occluders: " + std::to_string(indices.size()) + " indices is not a multiple of 3");
     if (indices.size() / 3 >= 0x80000000u) throw Error("GL: set_occluders: 2^31 triangles or more");
@@ -236,8 +278,12 @@ void PatchRenderer::set_occluders(const std::vector<Vec3>& vertices, const std::
         expanded[4 * i + 2] = v.z;
         expanded[4 * i + 3] = 1.0f;
     }
+    std::vector<std::uint8_t> sides;
+    mark_triangle_spans(one_sided, indices.size() / 3, "set_occluders", sides);
     upload(impl_->occluder_vertices, expanded.size() * sizeof(float), expanded.data());
     impl_->occluder_triangles = indices.size() / 3;
+    impl_->occluder_one_sided = std::move(sides);
+    impl_->occluder_culled.assign(impl_->occluder_triangles, 0);
     check_gl("set_occluders");
 }
 

@@ -50,6 +50,8 @@ struct PatchRenderer::Impl {
     int width = 0, height = 0;
     std::size_t count = 0;
     std::size_t occluder_triangles = 0;
+    std::vector<std::uint8_t> occluder_one_sided;  // per triangle: drawn with back faces culled
+    std::vector<std::uint8_t> occluder_culled;     // per triangle: culled by the object level
     // Status visualisation: its own colour + depth framebuffer.
     GLuint vis_fbo = 0, vis_color = 0, vis_depth = 0;
     int vis_width = 0, vis_height = 0;
@@ -251,19 +253,48 @@ struct PatchRenderer::Impl {
         glClearNamedFramebufferfv(target, GL_DEPTH, 0, &far_depth);
     }
 
-    void draw_occluders() {
+    // Draws the occluders: the two-sided triangles, then the one-sided ones with back faces
+    // culled (counter-clockwise front); honour_culls skips the triangles of set_culled_occluders.
+    void draw_occluders(bool honour_culls) {
         if (occluder_triangles == 0) return;
+        std::vector<GLint> firsts[2];
+        std::vector<GLsizei> counts[2];
+        for (std::size_t t = 0; t < occluder_triangles;) {
+            const bool skip = honour_culls && occluder_culled[t];
+            const std::uint8_t side = occluder_one_sided[t];
+            std::size_t end = t + 1;
+            while (end < occluder_triangles && (honour_culls && occluder_culled[end]) == skip &&
+                   occluder_one_sided[end] == side)
+                ++end;
+            if (!skip) {
+                firsts[side].push_back(static_cast<GLint>(3 * t));
+                counts[side].push_back(static_cast<GLsizei>(3 * (end - t)));
+            }
+            t = end;
+        }
         glUseProgram(occluder_program);
         glBindVertexArray(vao);
         bind_buffers();
-        glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(3 * occluder_triangles));
+        for (int side = 0; side < 2; ++side) {
+            if (firsts[side].empty()) continue;
+            if (side == 1) {
+                glEnable(GL_CULL_FACE);
+                glCullFace(GL_BACK);
+                glFrontFace(GL_CCW);
+            }
+            glMultiDrawArrays(GL_TRIANGLES, firsts[side].data(), counts[side].data(),
+                              static_cast<GLsizei>(firsts[side].size()));
+        }
+        glDisable(GL_CULL_FACE);
         glBindVertexArray(0);
         glUseProgram(0);
     }
 
     // Draws the patches whose flag word w has (w & mask) == value (into the bound framebuffer)
     // with the draw program, or with the mark program (mark_front: marks into front_marks).
-    void draw_patches(int level, GLuint mask, GLuint value, bool mark_front = false) {
+    // spans: only those patches (PatchSpan, validated by the caller); null: every patch.
+    void draw_patches(int level, GLuint mask, GLuint value, bool mark_front = false,
+                      const std::vector<PatchSpan>* spans = nullptr) {
         if (count == 0) return;
         const GLuint dp = mark_front ? mark_program : draw_program;
         const DrawUniforms& loc = mark_front ? mark_loc : draw_loc;
@@ -281,11 +312,15 @@ struct PatchRenderer::Impl {
         const std::size_t per_draw = std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((top + 1) * (top + 1)));
         std::vector<GLint> firsts;
         std::vector<GLsizei> counts;
-        for (std::size_t first = 0; first < count; first += per_draw) {
-            firsts.push_back(static_cast<GLint>(first * kPatchPoints));
-            counts.push_back(static_cast<GLsizei>(std::min(per_draw, count - first) * kPatchPoints));
+        const std::vector<PatchSpan> all{{0, count}};
+        for (const PatchSpan& span : spans ? *spans : all) {
+            const std::size_t end = span.first + span.count;
+            for (std::size_t first = span.first; first < end; first += per_draw) {
+                firsts.push_back(static_cast<GLint>(first * kPatchPoints));
+                counts.push_back(static_cast<GLsizei>(std::min(per_draw, end - first) * kPatchPoints));
+            }
         }
-        glMultiDrawArrays(GL_PATCHES, firsts.data(), counts.data(), static_cast<GLsizei>(firsts.size()));
+        if (!firsts.empty()) glMultiDrawArrays(GL_PATCHES, firsts.data(), counts.data(), static_cast<GLsizei>(firsts.size()));
         glBindVertexArray(0);
         glUseProgram(0);
     }

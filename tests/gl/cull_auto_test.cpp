@@ -142,7 +142,7 @@ TEST(CullAutoPolicy, ProbesThatKeepFailingBackOffAndOneThatPaysResetsTheWait) {
     for (; frame <= 80; ++frame) {
         const auto& d = policy.decide(kLevel8);
         const bool probed = d[1].cull;
-        policy.observe(untimed_frame({50, probed ? 40 : 10}));
+        policy.observe(untimed_frame({50, probed ? std::size_t{40} : std::size_t{10}}));
         if (probed) break;
     }
     EXPECT_EQ(frame, 60);
