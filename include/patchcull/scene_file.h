@@ -1,0 +1,43 @@
+// patchcull/scene_file.h: scene files, the JSON form of a Scene (patchcull/default_scene.h): placed,
+// animated subdivision characters and triangle-mesh environment objects that are drawn and
+// occlude, a displacement map, a camera path, and optional cells and portals (issue 11; the
+// object-level scenes of G. Zachmann's lecture "Advanced Visibility Computations", seed 004, and
+// of Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation", seed 000).
+// The format is documented, with a complete example, in docs/SCENE_FORMAT.md; data/scenes/ holds
+// default.json (the built-in default scene), city_small.json and building.json.
+//
+// Strict by design, like the OBJ reader: every unknown or duplicate key, wrong type, missing
+// required key, empty array where one is needed, number out of range (non-finite, beyond a
+// float, negative or zero scale, a singular or non-affine matrix), unknown name, unreadable file
+// or model is a patchcull::Error whose what() is one short line naming the file and the JSON path:
+//   "scenes/a.json: objects[3].transform: expected 16 numbers"
+//   "scenes/a.json:7:12: syntax error while parsing object key - ..." (JSON syntax: line, column)
+// Input text in messages is quoted through quote_input (patchcull/error.h).
+//
+// Float rounding: numbers are read as double and must fit a float (|x| <= FLT_MAX, else an
+// error); transforms are composed in float exactly as the built-in scenes compose them (so
+// default.json reproduces make_default_scene bit for bit). Placed models and environment
+// vertices must lie within kMaxMeshExtent of the origin and be at least kMinMeshDiagonal across
+// (scene.h's load_model limits, applied in world space): beyond them the float kernels lose
+// their guarantees, so the file is refused rather than culled wrongly.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "patchcull/default_scene.h"
+
+namespace patchcull {
+
+/// Largest scene file load_scene_file reads (a regular file; devices and FIFOs are refused).
+inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
+
+/// Reads a scene file. Paths inside it (OBJ models and environment meshes, PNG maps) are relative
+/// to the file's directory. Each (model file, scheme) pair is loaded once and shared by every
+/// object naming it (Scene::models has one entry per pair, in first-use order). Returns the
+/// scene with Scene::name from the file's "name" (default: the file name without extension),
+/// instances in file order, environment objects tiling the occluders in file order.
+/// Throws patchcull::Error (one line, file and JSON path) for any malformed input.
+Scene load_scene_file(const std::string& path);
+
+}  // namespace patchcull

@@ -1,0 +1,594 @@
+// Scene files (patchcull/scene_file.h; the format: docs/SCENE_FORMAT.md).
+//
+// The reader walks the parsed JSON with the JSON path of every value at hand, so each check can
+// name it. Objects are checked key by key against the keys their kind allows (unknown keys are
+// errors: a misspelt "displaced" must not silently leave an object undisplaced); duplicate keys,
+// which nlohmann-json would resolve silently (the last one wins), are caught while parsing by a
+// parser callback that keeps the path of the container being parsed.
+#include "patchcull/scene_file.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <map>
+#include <set>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+#include "input_file.h"
+#include "patchcull/error.h"
+#include "patchcull/image.h"
+#include "patchcull/obj.h"
+#include "scene_builder.h"
+
+namespace patchcull {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using namespace detail;
+
+std::string number_text(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", v);
+    return text;
+}
+
+std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+std::string index(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
+
+// Throws "file: path: what" (or "file: what" at the root).
+struct Reader {
+    std::string file;
+    fs::path dir;
+
+    [[noreturn]] void fail(const std::string& path, const std::string& what) const {
+        // Names from the file (model and map paths inside nested loaders' messages) are
+        // untrusted: the whole line goes through printable_line.
+        throw Error(printable_line(file + ": " + (path.empty() ? "" : path + ": ") + what));
+    }
+
+    std::string resolve(const std::string& p) const {
+        const fs::path q(p);
+        return q.is_absolute() || dir.empty() ? p : (dir / q).lexically_normal().string();
+    }
+
+    const json& object(const json& j, const std::string& path, std::initializer_list<const char*> allowed) const {
+        if (!j.is_object()) fail(path, "expected an object");
+        for (auto it = j.begin(); it != j.end(); ++it)
+            if (std::none_of(allowed.begin(), allowed.end(), [&](const char* k) { return it.key() == k; })) {
+                std::string keys;
+                for (const char* k : allowed) keys += std::string(keys.empty() ? "" : ", ") + k;
+                fail(path, "unknown key " + quote_input(it.key()) + " (expected " + keys + ")");
+            }
+        return j;
+    }
+
+    const json* find(const json& obj, const char* key) const {
+        const auto it = obj.find(key);
+        return it == obj.end() ? nullptr : &*it;
+    }
+
+    const json& require(const json& obj, const std::string& path, const char* key) const {
+        const json* j = find(obj, key);
+        if (!j) fail(path, std::string("missing required key '") + key + "'");
+        return *j;
+    }
+
+    // A number in [lo, hi] that fits a float (lo_open: > lo).
+    float number(const json& j, const std::string& path, double lo, double hi, bool lo_open = false) const {
+        if (!j.is_number()) fail(path, "expected a number");
+        const double v = j.get<double>();
+        if (!std::isfinite(v)) fail(path, "expected a finite number");
+        if (std::fabs(v) > double(FLT_MAX)) fail(path, "number " + number_text(v) + " does not fit a float");
+        if (!(lo_open ? v > lo : v >= lo) || !(v <= hi))
+            fail(path, "expected a number " + std::string(lo_open ? "> " : ">= ") + number_text(lo) +
+                           (hi < DBL_MAX ? " and <= " + number_text(hi) : "") + ", got " + number_text(v));
+        return static_cast<float>(v);
+    }
+
+    float number_or(const json& obj, const std::string& path, const char* key, float fallback, double lo, double hi,
+                    bool lo_open = false) const {
+        const json* j = find(obj, key);
+        return j ? number(*j, join(path, key), lo, hi, lo_open) : fallback;
+    }
+
+    long long integer(const json& j, const std::string& path, long long lo, long long hi) const {
+        if (!j.is_number_integer()) fail(path, "expected an integer");
+        if (j.is_number_unsigned() ? j.get<unsigned long long>() > static_cast<unsigned long long>(hi)
+                                   : (j.get<long long>() < lo || j.get<long long>() > hi))
+            fail(path, "expected an integer between " + std::to_string(lo) + " and " + std::to_string(hi));
+        return j.get<long long>();
+    }
+
+    bool boolean(const json& j, const std::string& path) const {
+        if (!j.is_boolean()) fail(path, "expected true or false");
+        return j.get<bool>();
+    }
+
+    bool boolean_or(const json& obj, const std::string& path, const char* key, bool fallback) const {
+        const json* j = find(obj, key);
+        return j ? boolean(*j, join(path, key)) : fallback;
+    }
+
+    std::string string(const json& j, const std::string& path) const {
+        if (!j.is_string()) fail(path, "expected a string");
+        const std::string s = j.get<std::string>();
+        if (s.empty()) fail(path, "expected a non-empty string");
+        return s;
+    }
+
+    // A finite coordinate: any float within kMaxMeshExtent of 0.
+    Vec3 vec3(const json& j, const std::string& path) const {
+        if (!j.is_array() || j.size() != 3) fail(path, "expected 3 numbers");
+        Vec3 v;
+        float* out = &v.x;
+        for (std::size_t k = 0; k < 3; ++k) out[k] = number(j[k], index(path, k), -kMaxMeshExtent, kMaxMeshExtent);
+        return v;
+    }
+
+    const json& array(const json& j, const std::string& path, bool non_empty) const {
+        if (!j.is_array()) fail(path, "expected an array");
+        if (non_empty && j.empty()) fail(path, "expected a non-empty array");
+        return j;
+    }
+};
+
+// Determinant of the linear (upper-left 3x3) part, in double.
+double linear_determinant(const Mat4& m) {
+    auto a = [&](int r, int c) { return double(m.at(r, c)); };
+    return a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
+           a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
+}
+
+// A transform: an object {position, yaw_degrees, scale | height} or 16 numbers row-major.
+// `standing` (objects only) gives the height form's standing transform. The result maps the
+// object's own coordinates (relative to `origin`, the loader's local frame) to world space.
+Mat4 read_transform(const Reader& r, const json& j, const std::string& path, const LoadedModel* model, DVec3 origin) {
+    if (j.is_array()) {
+        if (j.size() != 16) r.fail(path, "expected 16 numbers (a row-major 4x4 matrix) or an object");
+        Mat4 m;
+        for (int row = 0; row < 4; ++row)
+            for (int col = 0; col < 4; ++col)
+                m.at(row, col) = r.number(j[static_cast<std::size_t>(4 * row + col)], index(path, static_cast<std::size_t>(4 * row + col)),
+                                          -FLT_MAX, FLT_MAX);
+        if (m.at(3, 0) != 0 || m.at(3, 1) != 0 || m.at(3, 2) != 0 || m.at(3, 3) != 1)
+            r.fail(path, "the last row must be 0 0 0 1 (an affine matrix)");
+        const double det = linear_determinant(m);
+        if (!(std::fabs(det) > 0) || !std::isfinite(det)) r.fail(path, "the matrix is singular (a zero scale)");
+        if (origin.x != 0 || origin.y != 0 || origin.z != 0) {
+            // M * translation(origin), the new translation summed in double.
+            for (int row = 0; row < 3; ++row)
+                m.at(row, 3) = static_cast<float>(double(m.at(row, 0)) * origin.x + double(m.at(row, 1)) * origin.y +
+                                                  double(m.at(row, 2)) * origin.z + double(m.at(row, 3)));
+        }
+        return m;
+    }
+    if (model) r.object(j, path, {"position", "yaw_degrees", "scale", "height"});
+    else r.object(j, path, {"position", "yaw_degrees", "scale"});
+    const json* p = r.find(j, "position");
+    const Vec3 position = p ? r.vec3(*p, join(path, "position")) : Vec3{};
+    const float yaw = r.number_or(j, path, "yaw_degrees", 0, -1e6, 1e6);
+    const json* height = model ? r.find(j, "height") : nullptr;
+    if (height && r.find(j, "scale")) r.fail(path, "give 'height' or 'scale', not both");
+    Mat4 local;
+    if (height) {
+        const float h = r.number(*height, join(path, "height"), 0, 1e9, true);
+        try {
+            local = standing_transform(*model, h);
+        } catch (const Error& e) {
+            r.fail(join(path, "height"), e.what());
+        }
+    } else {
+        const float s = r.number_or(j, path, "scale", 1, 0, 1e9, true);
+        local = scaling(s) * translation({static_cast<float>(origin.x), static_cast<float>(origin.y), static_cast<float>(origin.z)});
+    }
+    return translation(position) * rotation_y(yaw) * local;
+}
+
+// World-space points must be finite, within kMaxMeshExtent of 0 and (together) at least
+// kMinMeshDiagonal across.
+void check_placed(const Reader& r, const std::string& path, const std::vector<Vec3>& points, const char* what) {
+    double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+    for (const Vec3& p : points) {
+        const float* c = &p.x;
+        for (int a = 0; a < 3; ++a) {
+            if (!std::isfinite(c[a]) || std::fabs(double(c[a])) > kMaxMeshExtent)
+                r.fail(path, std::string("the placed ") + what + " reaches " + number_text(c[a]) +
+                                 "; patchcull takes coordinates up to 2e+11 (the kernels work in float)");
+            lo[a] = std::min(lo[a], double(c[a]));
+            hi[a] = std::max(hi[a], double(c[a]));
+        }
+    }
+    double diagonal = 0;
+    for (int a = 0; a < 3; ++a) diagonal += (hi[a] - lo[a]) * (hi[a] - lo[a]);
+    diagonal = std::sqrt(diagonal);
+    if (!(diagonal >= kMinMeshDiagonal))
+        r.fail(path, std::string("the placed ") + what + " is " + number_text(diagonal) +
+                         " units across; patchcull takes meshes of at least 1e-06 units across (the kernels work in float)");
+}
+
+Scheme read_scheme(const Reader& r, const json& obj, const std::string& path) {
+    const json* j = r.find(obj, "scheme");
+    if (!j) return Scheme::acc;
+    const std::string text = r.string(*j, join(path, "scheme"));
+    Scheme scheme = Scheme::acc;
+    if (!parse_scheme(text, scheme)) r.fail(join(path, "scheme"), "unknown scheme " + quote_input(text) + " (acc or osd)");
+    return scheme;
+}
+
+// Parses text, catching duplicate keys (with their JSON path) and reporting syntax errors with
+// line and column.
+json parse_strict(const Reader& r, const std::string& text) {
+    struct Frame {
+        bool array;
+        std::size_t next = 0;
+        std::string path, key;
+        std::set<std::string> keys;
+    };
+    std::vector<Frame> frames;
+    auto child_path = [&]() -> std::string {
+        if (frames.empty()) return "";
+        Frame& parent = frames.back();
+        return parent.array ? index(parent.path, parent.next++) : join(parent.path, parent.key);
+    };
+    const json::parser_callback_t callback = [&](int, json::parse_event_t event, json& parsed) {
+        switch (event) {
+        case json::parse_event_t::object_start:
+        case json::parse_event_t::array_start: {
+            std::string path = child_path();
+            frames.push_back({event == json::parse_event_t::array_start, 0, std::move(path), {}, {}});
+            break;
+        }
+        case json::parse_event_t::object_end:
+        case json::parse_event_t::array_end:
+            if (!frames.empty()) frames.pop_back();
+            break;
+        case json::parse_event_t::key:
+            if (!frames.empty()) {
+                Frame& f = frames.back();
+                f.key = parsed.is_string() ? parsed.get<std::string>() : std::string();
+                if (!f.keys.insert(f.key).second) r.fail(f.path, "duplicate key " + quote_input(f.key));
+            }
+            break;
+        case json::parse_event_t::value:
+            if (!frames.empty() && frames.back().array) ++frames.back().next;
+            break;
+        }
+        return true;
+    };
+    try {
+        return json::parse(text, callback);
+    } catch (const json::parse_error& e) {
+        // Line and column of the byte nlohmann stopped at (e.byte counts from 1).
+        const std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
+        std::size_t line = 1, column = 1;
+        for (std::size_t i = 0; i < end; ++i) {
+            if (text[i] == '\n') ++line, column = 1;
+            else ++column;
+        }
+        std::string what = e.what();
+        const std::size_t colon = what.find(": ", what.find("column"));
+        what = colon != std::string::npos ? what.substr(colon + 2) : what.substr(std::min(what.size(), what.find(']') + 1));
+        throw Error(printable_line(r.file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + what, 300));
+    } catch (const json::exception& e) {
+        // E.g. out_of_range.406, a number beyond a double (nlohmann-json gives no position).
+        std::string what = e.what();
+        what = what.substr(std::min(what.size(), what.find("] ") == std::string::npos ? 0 : what.find("] ") + 2));
+        throw Error(printable_line(r.file + ": invalid JSON: " + what, 300));
+    }
+}
+
+struct ModelKey {
+    std::string file;  // canonical path, or the built-in name
+    Scheme scheme;
+    bool operator<(const ModelKey& o) const { return file != o.file ? file < o.file : scheme < o.scheme; }
+};
+
+}  // namespace
+
+Scene load_scene_file(const std::string& path) {
+    Reader r{path, fs::path(path).parent_path()};
+    const std::string problem = detail::input_file_problem(path, kMaxSceneFileBytes, "scene");
+    if (!problem.empty()) r.fail("", problem);
+    std::ifstream in(path, std::ios::binary);
+    if (!in) r.fail("", "cannot open file");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) r.fail("", "cannot read the file");
+    const json root = parse_strict(r, text);
+    r.object(root, "", {"name", "objects", "environment", "displacement", "animation", "camera", "cells", "portals"});
+
+    Scene scene;
+    const json* name = r.find(root, "name");
+    scene.name = name ? r.string(*name, "name") : fs::path(path).stem().string();
+
+    // Animation and displacement first: objects refer to them.
+    if (const json* a = r.find(root, "animation")) {
+        r.object(*a, "animation", {"bend_radians", "twist_radians", "breathe_amplitude", "period_seconds"});
+        scene.animation.bend_radians = r.number_or(*a, "animation", "bend_radians", scene.animation.bend_radians, -10, 10);
+        scene.animation.twist_radians = r.number_or(*a, "animation", "twist_radians", scene.animation.twist_radians, -10, 10);
+        scene.animation.breathe_amplitude =
+            r.number_or(*a, "animation", "breathe_amplitude", scene.animation.breathe_amplitude, 0, 0.5);
+        scene.animation.period_seconds =
+            r.number_or(*a, "animation", "period_seconds", scene.animation.period_seconds, 0, 1e6, true);
+    }
+    if (const json* d = r.find(root, "displacement")) {
+        r.object(*d, "displacement", {"map", "scale", "size", "seed"});
+        const std::string map = r.string(r.require(*d, "displacement", "map"), "displacement.map");
+        if (map == "none") {
+            for (const char* key : {"scale", "size", "seed"})
+                if (r.find(*d, key)) r.fail(join("displacement", key), "not used with map 'none'");
+        } else {
+            const float scale = r.number(r.require(*d, "displacement", "scale"), "displacement.scale", 0, 1e6, true);
+            if (map == "procedural") {
+                const json* size = r.find(*d, "size");
+                const json* seed = r.find(*d, "seed");
+                const int n = size ? static_cast<int>(r.integer(*size, "displacement.size", 1, 4096)) : 512;
+                const auto s = seed ? static_cast<std::uint32_t>(r.integer(*seed, "displacement.seed", 0, 4294967295LL)) : 7u;
+                scene.displacement = make_procedural_displacement(n, scale, s);
+            } else {
+                for (const char* key : {"size", "seed"})
+                    if (r.find(*d, key)) r.fail(join("displacement", key), "only for map 'procedural'");
+                try {
+                    scene.displacement = load_displacement_png(r.resolve(map), scale);
+                } catch (const Error& e) {
+                    r.fail("displacement.map", e.what());
+                }
+            }
+            scene.displacement_name = map == "procedural" ? map : r.resolve(map);
+        }
+    }
+
+    // Objects.
+    std::map<ModelKey, std::size_t> loaded;
+    std::map<std::string, std::size_t> instance_names;
+    std::vector<std::size_t> copies;
+    const json& objects = r.array(r.require(root, "", "objects"), "objects", true);
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        const std::string p = index("objects", i);
+        const json& o = r.object(objects[i], p, {"name", "model", "scheme", "transform", "animation", "displaced"});
+        const std::string spec = r.string(r.require(o, p, "model"), join(p, "model"));
+        const Scheme scheme = read_scheme(r, o, p);
+        std::string file;
+        if (spec == "bigguy" || spec == "monsterfrog") file = shipped_model_path(spec + ".obj");
+        else if (spec == "teapot") file = "teapot";
+        else file = r.resolve(spec);
+        ModelKey key{file, spec == "teapot" ? Scheme::acc : scheme};
+        if (spec != "teapot") {
+            std::error_code ec;
+            const fs::path canonical = fs::weakly_canonical(file, ec);
+            if (!ec) key.file = canonical.string();
+        }
+        auto found = loaded.find(key);
+        if (found == loaded.end()) {
+            try {
+                scene.models.push_back(load_model(file, key.scheme, 0));
+            } catch (const Error& e) {
+                r.fail(join(p, "model"), e.what());
+            }
+            found = loaded.emplace(key, scene.models.size() - 1).first;
+            copies.push_back(0);
+        }
+        const LoadedModel& model = scene.models[found->second];
+        SceneInstance instance;
+        instance.model = found->second;
+        const json* t = r.find(o, "transform");
+        instance.object_to_world = t ? read_transform(r, *t, join(p, "transform"), &model, model.origin)
+                                     : read_transform(r, json::object(), join(p, "transform"), &model, model.origin);
+        if (const json* a = r.find(o, "animation")) {
+            const std::string ap = join(p, "animation");
+            r.object(*a, ap, {"deform", "time_offset", "velocity"});
+            instance.deforms = r.boolean_or(*a, ap, "deform", true);
+            instance.time_offset = r.number_or(*a, ap, "time_offset", 0, -1e6, 1e6);
+            if (const json* v = r.find(*a, "velocity")) {
+                instance.velocity = r.vec3(*v, join(ap, "velocity"));
+                if (length(instance.velocity) > 1e6f) r.fail(join(ap, "velocity"), "expected a speed of at most 1e6 units per second");
+            }
+        }
+        instance.displaced = r.boolean_or(o, p, "displaced", false);
+        if (instance.displaced && scene.displacement.empty())
+            r.fail(join(p, "displaced"), "true, but the scene has no displacement map (\"displacement\")");
+        // The placed model's control points at rest (which bound the surface) must fit the limits.
+        std::vector<Vec3> points;
+        points.reserve(model.rest.patches.size() * kPatchPoints);
+        for (const BezierPatch& patch : model.rest.patches)
+            for (const Vec4& c : patch.cp) points.push_back(cartesian(instance.object_to_world * c));
+        check_placed(r, join(p, "transform"), points, "model");
+        const json* n = r.find(o, "name");
+        instance.name = n ? r.string(*n, join(p, "name"))
+                          : fs::path(model.name).stem().string() + "#" + std::to_string(copies[instance.model]);
+        ++copies[instance.model];
+        if (!instance_names.emplace(instance.name, i).second)
+            r.fail(join(p, "name"), "duplicate object name " + quote_input(instance.name) + " (also objects[" +
+                                        std::to_string(instance_names[instance.name]) + "])");
+        scene.instances.push_back(std::move(instance));
+    }
+
+    // Environment objects.
+    std::map<std::string, std::size_t> environment_names;
+    if (const json* env = r.find(root, "environment")) {
+        r.array(*env, "environment", false);
+        for (std::size_t i = 0; i < env->size(); ++i) {
+            const std::string p = index("environment", i);
+            const json& e = r.object((*env)[i], p, {"name", "box", "quad", "obj", "transform", "one_sided"});
+            const int kinds = (r.find(e, "box") ? 1 : 0) + (r.find(e, "quad") ? 1 : 0) + (r.find(e, "obj") ? 1 : 0);
+            if (kinds != 1) r.fail(p, "expected exactly one of 'box', 'quad' or 'obj'");
+            std::vector<DVec3> local;  // before the transform
+            std::vector<std::uint32_t> indices;
+            DVec3 origin{};
+            bool one_sided = false;
+            if (const json* box = r.find(e, "box")) {
+                const std::string bp = join(p, "box");
+                r.object(*box, bp, {"min", "max"});
+                const Vec3 lo = r.vec3(r.require(*box, bp, "min"), join(bp, "min"));
+                const Vec3 hi = r.vec3(r.require(*box, bp, "max"), join(bp, "max"));
+                if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
+                    r.fail(bp, "max must be greater than min on every axis (a flat or empty box)");
+                Scene tmp;
+                add_box(tmp, "", lo, hi);
+                for (const Vec3& v : tmp.occluder_vertices) local.push_back({v.x, v.y, v.z});
+                indices = tmp.occluder_indices;
+                one_sided = true;
+            } else if (const json* quad = r.find(e, "quad")) {
+                const std::string qp = join(p, "quad");
+                if (!quad->is_array() || quad->size() != 4) r.fail(qp, "expected 4 corners");
+                Vec3 c[4];
+                for (std::size_t k = 0; k < 4; ++k) c[k] = r.vec3((*quad)[k], index(qp, k));
+                const float area = length(cross(c[1] - c[0], c[2] - c[0])) + length(cross(c[2] - c[0], c[3] - c[0]));
+                if (!(area > 0)) r.fail(qp, "the corners span no area");
+                for (const Vec3& v : c) local.push_back({v.x, v.y, v.z});
+                indices = {0, 1, 2, 0, 2, 3};
+            } else {
+                const std::string file = r.resolve(r.string(*r.find(e, "obj"), join(p, "obj")));
+                ControlMesh mesh;
+                try {
+                    mesh = load_obj(file);
+                } catch (const Error& err) {
+                    r.fail(join(p, "obj"), err.what());
+                }
+                if (mesh.face_count() == 0) r.fail(join(p, "obj"), file + ": the mesh has no faces");
+                for (const Vec3& v : mesh.positions) local.push_back({v.x, v.y, v.z});
+                origin = mesh.origin;
+                for (std::size_t f = 0; f < mesh.face_count(); ++f) {
+                    const std::uint32_t first = mesh.face_offsets[f];
+                    for (std::uint32_t k = 1; k + 1 < mesh.face_size(f); ++k)
+                        for (std::uint32_t c : {first, first + k, first + k + 1}) indices.push_back(mesh.face_vertices[c]);
+                }
+            }
+            one_sided = r.boolean_or(e, p, "one_sided", one_sided);
+            // The transform maps the object's coordinates (an OBJ's own, with its local frame's
+            // origin added back) to world space, in double.
+            const json* t = r.find(e, "transform");
+            const Mat4 m = t ? read_transform(r, *t, join(p, "transform"), nullptr, {}) : Mat4{};
+            const double det = linear_determinant(m);
+            if (!(std::fabs(det) > 0)) r.fail(join(p, "transform"), "the transform is singular (a zero scale)");
+            std::vector<Vec3> world;
+            world.reserve(local.size());
+            for (const DVec3& v : local) {
+                const double x = v.x + origin.x, y = v.y + origin.y, z = v.z + origin.z;
+                double w[3];
+                for (int row = 0; row < 3; ++row)
+                    w[row] = double(m.at(row, 0)) * x + double(m.at(row, 1)) * y + double(m.at(row, 2)) * z + double(m.at(row, 3));
+                for (double& c : w)
+                    if (!(std::fabs(c) <= double(FLT_MAX))) c = INFINITY;  // reported by check_placed
+                world.push_back({static_cast<float>(w[0]), static_cast<float>(w[1]), static_cast<float>(w[2])});
+            }
+            check_placed(r, t ? join(p, "transform") : p, world, "environment object");
+            // A mirroring transform turns counter-clockwise into clockwise: flip the triangles back.
+            if (det < 0)
+                for (std::size_t k = 0; k + 2 < indices.size(); k += 3) std::swap(indices[k + 1], indices[k + 2]);
+            const json* n = r.find(e, "name");
+            const std::string object_name = n ? r.string(*n, join(p, "name")) : "environment#" + std::to_string(i);
+            if (!environment_names.emplace(object_name, i).second)
+                r.fail(join(p, "name"), "duplicate environment name " + quote_input(object_name) + " (also environment[" +
+                                            std::to_string(environment_names[object_name]) + "])");
+            add_triangles(scene, object_name, world, indices, one_sided);
+        }
+    }
+
+    // Camera.
+    {
+        const json& c = r.object(r.require(root, "", "camera"), "camera", {"orbit", "walk", "fovy_degrees", "z_near", "z_far"});
+        const json* orbit = r.find(c, "orbit");
+        const json* walk = r.find(c, "walk");
+        if ((orbit ? 1 : 0) + (walk ? 1 : 0) != 1) r.fail("camera", "expected exactly one of 'orbit' or 'walk'");
+        CameraPath& cam = scene.camera;
+        if (orbit) {
+            r.object(*orbit, "camera.orbit", {"target", "distance", "height", "start_degrees", "degrees_per_frame"});
+            const json* target = r.find(*orbit, "target");
+            cam.target = target ? r.vec3(*target, "camera.orbit.target") : Vec3{};
+            cam.distance = r.number(r.require(*orbit, "camera.orbit", "distance"), "camera.orbit.distance", 0, kMaxMeshExtent, true);
+            cam.height = r.number_or(*orbit, "camera.orbit", "height", 0, -kMaxMeshExtent, kMaxMeshExtent);
+            cam.start_degrees = r.number_or(*orbit, "camera.orbit", "start_degrees", 0, -1e6, 1e6);
+            cam.degrees_per_frame = r.number_or(*orbit, "camera.orbit", "degrees_per_frame", 5, -360, 360);
+        } else {
+            r.object(*walk, "camera.walk", {"start", "step", "direction", "view_distance"});
+            cam.walk = true;
+            cam.walk_start = r.vec3(r.require(*walk, "camera.walk", "start"), "camera.walk.start");
+            cam.walk_step = r.vec3(r.require(*walk, "camera.walk", "step"), "camera.walk.step");
+            cam.walk_direction = r.vec3(r.require(*walk, "camera.walk", "direction"), "camera.walk.direction");
+            const Vec3 d = cam.walk_direction;
+            if (!(std::hypot(d.x, d.z) > 1e-6f * std::fabs(d.y)) || !(length(d) > 0))
+                r.fail("camera.walk.direction", "expected a direction that is not zero or vertical");
+            cam.distance = r.number_or(*walk, "camera.walk", "view_distance", 5, 0, kMaxMeshExtent, true);
+            cam.height = 0;
+            cam.target = cam.walk_start + cam.walk_direction;
+        }
+        const float fovy = r.number_or(c, "camera", "fovy_degrees", 60, 0, 179, true);
+        cam.fovy_radians = fovy * kPi / 180.0f;
+        cam.z_near = r.number_or(c, "camera", "z_near", 0.05f, 0, kMaxMeshExtent, true);
+        cam.z_far = r.number_or(c, "camera", "z_far", 50, 0, 1e30, true);
+        if (!(cam.z_far > cam.z_near)) r.fail("camera.z_far", "must be greater than z_near");
+    }
+
+    // Cells and portals.
+    std::map<std::string, std::size_t> cell_names;
+    if (const json* cells = r.find(root, "cells")) {
+        r.array(*cells, "cells", false);
+        for (std::size_t i = 0; i < cells->size(); ++i) {
+            const std::string p = index("cells", i);
+            const json& c = r.object((*cells)[i], p, {"name", "min", "max", "objects", "environment"});
+            SceneCell cell;
+            cell.name = r.string(r.require(c, p, "name"), join(p, "name"));
+            if (!cell_names.emplace(cell.name, i).second)
+                r.fail(join(p, "name"), "duplicate cell name " + quote_input(cell.name));
+            cell.box.min = r.vec3(r.require(c, p, "min"), join(p, "min"));
+            cell.box.max = r.vec3(r.require(c, p, "max"), join(p, "max"));
+            if (!(cell.box.max.x > cell.box.min.x && cell.box.max.y > cell.box.min.y && cell.box.max.z > cell.box.min.z))
+                r.fail(p, "max must be greater than min on every axis");
+            auto names = [&](const char* key, const std::map<std::string, std::size_t>& known, const char* what,
+                             std::vector<std::size_t>& out) {
+                const json* list = r.find(c, key);
+                if (!list) return;
+                const std::string lp = join(p, key);
+                r.array(*list, lp, false);
+                for (std::size_t k = 0; k < list->size(); ++k) {
+                    const std::string n = r.string((*list)[k], index(lp, k));
+                    const auto it = known.find(n);
+                    if (it == known.end()) r.fail(index(lp, k), std::string("no ") + what + " named " + quote_input(n));
+                    if (std::find(out.begin(), out.end(), it->second) != out.end())
+                        r.fail(index(lp, k), quote_input(n) + " is listed twice");
+                    out.push_back(it->second);
+                }
+            };
+            names("objects", instance_names, "object", cell.instances);
+            names("environment", environment_names, "environment object", cell.environment);
+            scene.cells.push_back(std::move(cell));
+        }
+    }
+    if (const json* portals = r.find(root, "portals")) {
+        r.array(*portals, "portals", false);
+        if (!portals->empty() && scene.cells.empty()) r.fail("portals", "portals need cells (\"cells\")");
+        for (std::size_t i = 0; i < portals->size(); ++i) {
+            const std::string p = index("portals", i);
+            const json& o = r.object((*portals)[i], p, {"cells", "corners"});
+            const json& pair = r.require(o, p, "cells");
+            if (!pair.is_array() || pair.size() != 2) r.fail(join(p, "cells"), "expected 2 cell names");
+            ScenePortal portal;
+            std::size_t* ends[2] = {&portal.cell_a, &portal.cell_b};
+            for (std::size_t k = 0; k < 2; ++k) {
+                const std::string n = r.string(pair[k], index(join(p, "cells"), k));
+                const auto it = cell_names.find(n);
+                if (it == cell_names.end()) r.fail(index(join(p, "cells"), k), "no cell named " + quote_input(n));
+                *ends[k] = it->second;
+            }
+            if (portal.cell_a == portal.cell_b) r.fail(join(p, "cells"), "a portal joins two different cells");
+            const json& corners = r.require(o, p, "corners");
+            if (!corners.is_array() || corners.size() != 4) r.fail(join(p, "corners"), "expected 4 corners");
+            for (std::size_t k = 0; k < 4; ++k) portal.corners[k] = r.vec3(corners[k], index(join(p, "corners"), k));
+            const Vec3* c = portal.corners;
+            if (!(length(cross(c[1] - c[0], c[2] - c[0])) + length(cross(c[2] - c[0], c[3] - c[0])) > 0))
+                r.fail(join(p, "corners"), "the corners span no area");
+            scene.portals.push_back(portal);
+        }
+    }
+    return scene;
+}
+
+}  // namespace patchcull
