@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -237,6 +238,30 @@ TEST(SceneFile, ShippedCityAndBuildingFiles) {
         const Vec3 n = cross(p.corners[1] - p.corners[0], p.corners[2] - p.corners[0]);
         EXPECT_GT(dot(n, building.cells[p.cell_a].box.center() - centre), 0.0f);
     }
+}
+
+// The complete example of docs/SCENE_FORMAT.md loads (its OBJ files stood in for by cubes).
+TEST(SceneFile, DocumentedExampleLoads) {
+    std::ifstream in(fs::path(PATCHCULL_SOURCE_DIR) / "docs" / "SCENE_FORMAT.md");
+    const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t at = doc.find("## A complete example");
+    ASSERT_NE(at, std::string::npos);
+    const std::size_t start = doc.find("```json\n", at), end = doc.find("```\n", start + 8);
+    ASSERT_NE(start, std::string::npos);
+    ASSERT_NE(end, std::string::npos);
+    const fs::path dir = temp_dir("example");
+    write(dir / "models" / "crate.obj", cube_obj());
+    write(dir / "meshes" / "statue.obj", cube_obj());
+    write(dir / "yard.json", doc.substr(start + 8, end - start - 8));
+    const Scene s = load_scene_file((dir / "yard.json").string());
+    EXPECT_EQ(s.name, "yard");
+    EXPECT_EQ(s.instances.size(), 4u);
+    EXPECT_EQ(s.models.size(), 4u);
+    EXPECT_EQ(s.instances[1].name, "monsterfrog#0");
+    EXPECT_EQ(s.environment.size(), 3u);
+    EXPECT_EQ(s.cells.size(), 2u);
+    EXPECT_EQ(s.portals.size(), 1u);
+    EXPECT_EQ(s.cells[1].instances, (std::vector<std::size_t>{0, 1, 2}));
 }
 
 TEST(SceneFile, ValidSceneSectionsAndModelsLoadedOnce) {
