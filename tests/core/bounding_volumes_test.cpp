@@ -229,6 +229,31 @@ void run_ground_truth(P3 offset, double scale, unsigned seed) {
             check_against_samples(cam, o, co, sample(rng, o, 200), "obb");
             if (::testing::Test::HasFatalFailure()) return;
         }
+        // Volumes built from point clouds, checked with the enclosed points themselves
+        // (any_point_in_clip_volume, double precision).
+        for (int i = 0; i < 20; ++i) {
+            const P3 c = random_centre(rng, cam);
+            const double s = random_size(rng, cam);
+            std::uniform_real_distribution<double> u(-1, 1);
+            std::vector<Vec3> pts;
+            const int n = 1 + i * 3;
+            for (int k = 0; k < n; ++k) pts.push_back(to_f(c + P3{u(rng), (i % 4 == 0) ? 0.0 : u(rng), u(rng)} * s));
+            const bool any_in = any_point_in_clip_volume(cam.world_to_clip, pts.data(), pts.size());
+            const bool all_in = std::all_of(pts.begin(), pts.end(), [&](Vec3 p) { return in_all_planes(cam.world_to_clip, p3(p)); });
+            std::uint32_t t = 0;
+            PlaneCullState st;
+            const Containment r[3] = {classify_sphere(cam.planes, sphere_of_points(pts.data(), pts.size()), st, t),
+                                      classify_aabb(cam.planes, aabb_of_points(pts.data(), pts.size()), st = {}, t),
+                                      classify_obb(cam.planes, obb_of_points(pts.data(), pts.size()), st = {}, t)};
+            for (Containment x : r) {
+                if (any_in) {
+                    ASSERT_NE(x, Containment::outside) << "a volume of points, one of them in the frustum, culled";
+                }
+                if (!all_in) {
+                    ASSERT_NE(x, Containment::inside) << "a volume of points, one of them outside, inside";
+                }
+            }
+        }
     }
     // The mix must exercise all three answers (else the test shows nothing).
     for (const Tally* t : {&ts, &ta, &to}) {
