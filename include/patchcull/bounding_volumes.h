@@ -94,6 +94,11 @@ Obb obb_of_aabb(const Bounds& box);
 /// the exact image of every point of the box. Empty -> empty.
 Bounds transformed_aabb(const Bounds& object_space, const Mat4& affine);
 
+/// The box grown by margin (>= 0) on every side, computed in double and rounded outwards, so it
+/// holds every point within margin (per axis) of the box exactly (a float `min - margin` rounds to
+/// nearest and can land half an ulp inside). Empty -> empty.
+Bounds grow_bounds(const Bounds& box, float margin);
+
 // ---- frustum tests ----------------------------------------------------------------------------
 
 /// Plane masking and plane coherence (seed 004): state carried per volume (or BVH node).

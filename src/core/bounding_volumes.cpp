@@ -507,6 +507,15 @@ Bounds transformed_aabb(const Bounds& b, const Mat4& m) {
     return out;
 }
 
+Bounds grow_bounds(const Bounds& b, float margin) {
+    if (empty(b)) return empty_bounds();
+    const double m = margin;
+    Bounds out;
+    out.min = {round_down(b.min.x - m), round_down(b.min.y - m), round_down(b.min.z - m)};
+    out.max = {round_up(b.max.x + m), round_up(b.max.y + m), round_up(b.max.z + m)};
+    return out;
+}
+
 // ---- frustum tests ------------------------------------------------------------------------------
 
 PATCHCULL_SCALAR_CLONES

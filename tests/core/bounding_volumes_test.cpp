@@ -552,6 +552,32 @@ TEST(BoundingVolumes, TransformedAabbHoldsTheTransformedBox) {
     EXPECT_GT(te.min.x, te.max.x);
 }
 
+TEST(BoundingVolumes, GrowBoundsRoundsOutwards) {
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<double> u(-1, 1), unit(0, 1);
+    int rounded = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const double off = i % 2 ? 1e5 : 1;
+        const Vec3 c = to_f(P3{u(rng), u(rng), u(rng)} * off);
+        const Bounds b{c, c + Vec3{float(unit(rng)), 0, float(unit(rng))}};
+        const float m = float(unit(rng) * 0.01);
+        const Bounds g = grow_bounds(b, m);
+        const float* lo = &g.min.x;
+        const float* hi = &g.max.x;
+        const float* blo = &b.min.x;
+        const float* bhi = &b.max.x;
+        for (int a = 0; a < 3; ++a) {
+            ASSERT_LE(double(lo[a]), double(blo[a]) - m);
+            ASSERT_GE(double(hi[a]), double(bhi[a]) + m);
+            ASSERT_LE(double(hi[a]) - (double(bhi[a]) + m), std::fabs(double(bhi[a]) + m) * 1.2e-7 + 1e-30);
+            if (blo[a] - m > double(blo[a]) - m) ++rounded;  // where plain float subtraction falls short
+        }
+    }
+    EXPECT_GT(rounded, 100);
+    const Bounds e = grow_bounds(aabb_of_points(nullptr, 0), 1);
+    EXPECT_GT(e.min.x, e.max.x);
+}
+
 // ---- scalar == SIMD --------------------------------------------------------------------------------
 
 void for_each_simd_target(const std::function<void()>& body) {
