@@ -156,6 +156,16 @@ inline constexpr float kDefaultSceneDisplaceScale = 0.03f;
 /// environment object "ground".
 Scene make_model_scene(LoadedModel model, float degrees_per_frame = 5.0f);
 
+/// Appends an environment object of `indices.size() / 3` triangles (3 indices each into
+/// `vertices`, world space) to Scene::occluder_vertices / occluder_indices and Scene::environment,
+/// keeping the tiling. one_sided: see EnvironmentObject (the caller vouches for the winding).
+/// Throws patchcull::Error (naming `name`) when indices are not whole triangles or one is out of range.
+void add_environment_object(Scene& scene, std::string name, const std::vector<Vec3>& vertices,
+                            const std::vector<std::uint32_t>& indices, bool one_sided);
+/// Appends an axis-aligned box [lo, hi] as a one-sided environment object: 12 triangles,
+/// counter-clockwise seen from outside.
+void add_environment_box(Scene& scene, std::string name, Vec3 lo, Vec3 hi);
+
 /// Parameters of the `city` scene. Lengths in character heights (a BigGuy is 1 high).
 struct CityParams {
     int blocks_x = 6, blocks_z = 6;  ///< blocks (one box building each), 1..64 per axis

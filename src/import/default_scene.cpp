@@ -135,6 +135,16 @@ float animated_reach(const LoadedModel& model, const Mat4& standing, const Anima
 
 using namespace detail;
 
+void add_environment_object(Scene& scene, std::string name, const std::vector<Vec3>& vertices,
+                            const std::vector<std::uint32_t>& indices, bool one_sided) {
+    if (indices.size() % 3 != 0) throw Error(name + ": " + std::to_string(indices.size()) + " indices, not whole triangles");
+    for (std::uint32_t i : indices)
+        if (i >= vertices.size()) throw Error(name + ": index " + std::to_string(i) + " beyond the " + std::to_string(vertices.size()) + " vertices");
+    add_triangles(scene, std::move(name), vertices, indices, one_sided);
+}
+
+void add_environment_box(Scene& scene, std::string name, Vec3 lo, Vec3 hi) { add_box(scene, std::move(name), lo, hi); }
+
 Mat4 instance_to_world(const SceneInstance& instance, float time_seconds) {
     const float t = time_seconds + instance.time_offset;
     Mat4 m = instance.object_to_world;

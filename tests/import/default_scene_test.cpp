@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "patchcull/default_scene.h"
+#include "patchcull/error.h"
 #include "patchcull/frustum.h"
 
 using namespace patchcull;
@@ -227,4 +228,22 @@ TEST(DefaultScene, PoseSharesFramesAndMatchesPerInstanceEvaluation) {
             }
         ASSERT_EQ(static_cast<std::size_t>(last + 1), poser.tangents().size());
     }
+}
+
+// The public environment helpers keep the tiling and check their input.
+TEST(DefaultScene, AddEnvironmentObjects) {
+    Scene scene = make_model_scene(load_model("teapot", Scheme::acc, 0));
+    add_environment_box(scene, "crate", {1, 0, 1}, {2, 1, 2});
+    add_environment_object(scene, "sign", {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {0, 1, 2}, false);
+    ASSERT_EQ(scene.environment.size(), 3u);
+    EXPECT_EQ(scene.environment[1].first_triangle, 2u);
+    EXPECT_EQ(scene.environment[1].triangle_count, 12u);
+    EXPECT_TRUE(scene.environment[1].one_sided);
+    EXPECT_EQ(scene.environment[2].first_triangle, 14u);
+    EXPECT_FALSE(scene.environment[2].one_sided);
+    EXPECT_EQ(scene.occluder_indices.size(), 15u * 3u);
+    EXPECT_EQ(scene.occluder_indices.back(), static_cast<std::uint32_t>(scene.occluder_vertices.size() - 1));
+    EXPECT_THROW(add_environment_object(scene, "bad", {{0, 0, 0}}, {0, 0, 1}, false), Error);
+    EXPECT_THROW(add_environment_object(scene, "bad", {{0, 0, 0}}, {0, 0}, false), Error);
+    EXPECT_EQ(scene.environment.size(), 3u);
 }
