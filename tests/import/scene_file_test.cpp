@@ -11,10 +11,13 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <iterator>
 #include <random>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include "patchcull/error.h"
 #include "patchcull/scene_file.h"
@@ -26,13 +29,24 @@ namespace {
 
 const fs::path kScenes = fs::path(PATCHCULL_SOURCE_DIR) / "data" / "scenes";
 
-// A fresh directory per test under the system's temp directory.
-fs::path temp_dir(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("patchcull_scene_file_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+// A fresh directory per test under the system's temp directory, named by the test and the
+// process (test runs of other build directories may run at the same time), removed at the end.
+struct TempDir {
+    fs::path path;
+    explicit TempDir(const std::string& name)
+        : path(fs::temp_directory_path() / ("patchcull_scene_file_" + name + "_" + std::to_string(::getpid()))) {
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    fs::path operator/(const std::string& p) const { return path / p; }
+    std::string string() const { return path.string(); }
+};
 
 void write(const fs::path& path, const std::string& text) {
     fs::create_directories(path.parent_path());
@@ -103,7 +117,8 @@ std::string with(std::string text, const std::string& from, const std::string& t
 class SceneFileErrors : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = temp_dir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+        temp_ = std::make_unique<TempDir>(::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ = temp_->path;
         write(dir_ / "cube.obj", cube_obj());
         ASSERT_EQ(load_error(dir_, valid_scene()), "");
     }
@@ -120,6 +135,7 @@ protected:
         EXPECT_EQ(message.substr(0, prefix.size()), prefix) << message;
         EXPECT_TRUE(is_printable_line(message)) << message;
     }
+    std::unique_ptr<TempDir> temp_;
     fs::path dir_;
 };
 
@@ -249,7 +265,7 @@ TEST(SceneFile, DocumentedExampleLoads) {
     const std::size_t start = doc.find("```json\n", at), end = doc.find("```\n", start + 8);
     ASSERT_NE(start, std::string::npos);
     ASSERT_NE(end, std::string::npos);
-    const fs::path dir = temp_dir("example");
+    const TempDir dir("example");
     write(dir / "models" / "crate.obj", cube_obj());
     write(dir / "meshes" / "statue.obj", cube_obj());
     write(dir / "yard.json", doc.substr(start + 8, end - start - 8));
@@ -265,7 +281,7 @@ TEST(SceneFile, DocumentedExampleLoads) {
 }
 
 TEST(SceneFile, ValidSceneSectionsAndModelsLoadedOnce) {
-    const fs::path dir = temp_dir("valid");
+    const TempDir dir("valid");
     write(dir / "cube.obj", cube_obj());
     write(dir / "a.json", valid_scene());
     const Scene s = load_scene_file((dir / "a.json").string());
@@ -317,7 +333,7 @@ TEST(SceneFile, ValidSceneSectionsAndModelsLoadedOnce) {
 }
 
 TEST(SceneFile, PathsAreRelativeToTheFile) {
-    const fs::path dir = temp_dir("relative");
+    const TempDir dir("relative");
     write(dir / "models" / "cube.obj", cube_obj());
     // The file in scenes/, the model named two ways from there: one model.
     std::string text = with(valid_scene(), R"("model": "cube.obj", "transform": {"position": [0)",
@@ -343,7 +359,7 @@ TEST(SceneFile, PathsAreRelativeToTheFile) {
 }
 
 TEST(SceneFile, FarFromTheOriginAndMirrored) {
-    const fs::path dir = temp_dir("far");
+    const TempDir dir("far");
     // An OBJ environment mesh at 1e5 (the OBJ reader recentres it; the file adds the origin back
     // in double), a character and a box at 1e4-1e5.
     write(dir / "far.obj", cube_obj(1e5, 2));
@@ -524,7 +540,7 @@ TEST_F(SceneFileErrors, UnreadableFilesAndModels) {
 // that names the file. std::mt19937's output is fixed by the standard: the mutants are the same
 // everywhere.
 TEST(SceneFile, MutantsLoadOrFailWithOneLine) {
-    const fs::path dir = temp_dir("mutants");
+    const TempDir dir("mutants");
     write(dir / "cube.obj", cube_obj());
     const std::string base = valid_scene();
     const char* const tokens[] = {"1e39", "-1e39", "1e-50", "nan", "-0", "0", "-1", "1e308", "99999999999999999999",
