@@ -44,6 +44,12 @@ public:
     std::size_t node_count() const { return nodes_.size(); }
     /// Longest root-to-leaf path in nodes (0 when empty).
     std::size_t depth() const { return depth_; }
+    /// Surface-area cost of the current tree relative to its root: sum over inner nodes of
+    /// area(node) / area(root) plus, over leaves, that ratio times the leaf's object count (the
+    /// expected node and object tests for a random query, the quantity the build minimises).
+    /// Refits after motion raise it; rebuild when it has grown by, say, 1.5x over the value just
+    /// after build. 0 when empty or when the root has no area, +inf when a box is unbounded.
+    double sah_cost() const;
 
     struct Options {
         bool plane_masking = true;  ///< a node's children test only the planes it straddles

@@ -174,6 +174,15 @@ void ObjectBvh::refit(const Bounds* boxes) {
     }
 }
 
+double ObjectBvh::sah_cost() const {
+    if (nodes_.empty()) return 0;
+    const double root = half_area(nodes_[0].box);
+    if (!(root > 0)) return 0;
+    double cost = 0;
+    for (const Node& node : nodes_) cost += half_area(node.box) / root * (node.count > 0 ? node.count : 1);
+    return cost;
+}
+
 void ObjectBvh::cull(const FrustumPlanes& planes, Options options, Containment* per_object, Stats& stats) {
     if (nodes_.empty()) return;
     std::size_t sp = 0;

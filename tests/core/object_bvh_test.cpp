@@ -220,6 +220,36 @@ TEST(ObjectBvh, SpecialScenes) {
     EXPECT_EQ(st.nodes_visited, 0u);
 }
 
+// Refit keeps the answers but not the quality: after objects move far, the SAH cost rises, and a
+// rebuild brings it back down.
+TEST(ObjectBvh, SahCostGrowsWithRefitAndFallsWithRebuild) {
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<float> u(-1, 1);
+    Scene s = random_scene(rng, 1000, {0, 0, 0});
+    ObjectBvh bvh;
+    bvh.build(s.boxes.data(), s.boxes.size());
+    const double built = bvh.sah_cost();
+    EXPECT_GT(built, 1.0);
+    // Every object jumps to a random place in the same area.
+    for (Bounds& b : s.boxes) {
+        const Vec3 d{200 * u(rng), 0, 200 * u(rng)};
+        const Vec3 c = b.center();
+        b.min += d - c;
+        b.max += d - c;
+    }
+    bvh.refit(s.boxes.data());
+    const double refitted = bvh.sah_cost();
+    EXPECT_GT(refitted, 2 * built);
+    std::vector<Containment> out(s.boxes.size());
+    ObjectBvh::Stats st;
+    bvh.cull(s.planes, {}, out.data(), st);
+    EXPECT_EQ(out, reference(s.planes, s.boxes));
+    bvh.build(s.boxes.data(), s.boxes.size());
+    EXPECT_LT(bvh.sah_cost(), 0.7 * refitted);
+    ObjectBvh none;
+    EXPECT_EQ(none.sah_cost(), 0);
+}
+
 // Ground truth: an object the BVH culls has no sampled point in the frustum (double precision).
 TEST(ObjectBvh, CulledObjectsHaveNoPointInTheFrustum) {
     std::mt19937 rng(3);
