@@ -2,8 +2,9 @@
 // over Highway vectors and compiled for every x86 target Highway attains; the best one the CPU
 // supports is chosen once, at the first call (HWY_DYNAMIC_DISPATCH), as in frustum_simd.cpp.
 //
-// Lanes are volumes. Spheres (4 floats) are loaded with LoadInterleaved4; AABBs (6 floats) and
-// OBBs (15 floats) with GatherIndex at their stride. The last partial group is copied to a stack
+// Lanes are volumes. Spheres (4 floats) are loaded with LoadInterleaved4; AABBs (6 floats) as 2N
+// interleaved points split into even (min) and odd (max) lanes (GatherIndex on the 1-lane scalar
+// target); OBBs (15 floats) with GatherIndex at their stride. The last partial group is copied to a stack
 // buffer whose unused lanes repeat the last volume, and only its valid results are written.
 //
 // Every operation mirrors the scalar reference in bounding_volumes.cpp operation by operation
@@ -134,9 +135,21 @@ void ClassifyAabbs(const FrustumPlanes& planes, const Bounds* boxes, std::size_t
     MakePlanes(DF(), planes, pv);
     ForEachVolumeGroup(boxes, n, out, [&](DF d, const Bounds* b, MF& outside, MF& inside) {
         const float* base = &b->min.x;
+#if HWY_TARGET == HWY_SCALAR
         const VF lx = GatherStrided<6>(d, base + 0), ly = GatherStrided<6>(d, base + 1);
         const VF lz = GatherStrided<6>(d, base + 2), hx = GatherStrided<6>(d, base + 3);
         const VF hy = GatherStrided<6>(d, base + 4), hz = GatherStrided<6>(d, base + 5);
+#else
+        // The boxes as 2N points (min, max, min, max, ...): two interleaved loads of N points,
+        // then even lanes are the mins and odd lanes the maxes.
+        const std::size_t N = hn::Lanes(d);
+        VF x0, y0, z0, x1, y1, z1;
+        hn::LoadInterleaved3(d, base, x0, y0, z0);
+        hn::LoadInterleaved3(d, base + 3 * N, x1, y1, z1);
+        const VF lx = hn::ConcatEven(d, x1, x0), hx = hn::ConcatOdd(d, x1, x0);
+        const VF ly = hn::ConcatEven(d, y1, y0), hy = hn::ConcatOdd(d, y1, y0);
+        const VF lz = hn::ConcatEven(d, z1, z0), hz = hn::ConcatOdd(d, z1, z0);
+#endif
         VF m = hn::Abs(lx);
         m = hn::Max(m, hn::Abs(ly));
         m = hn::Max(m, hn::Abs(lz));
