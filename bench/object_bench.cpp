@@ -9,7 +9,7 @@
 // second. One thread.
 //
 // Run (see docs/PERFORMANCE.md):
-//   build-bench/bench/patchcull_bench --benchmark_filter='object_' --benchmark_min_time=0.2
+//   build-bench/bench/patchcull_bench --benchmark_filter='^object_' --benchmark_min_time=0.2
 //       --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
@@ -79,7 +79,7 @@ void report_mix(benchmark::State& state, const std::vector<Containment>& out) {
 enum class Vol { kSphere, kAabb, kAabbCorners, kObb };
 enum class Impl { kSingle, kScalar, kSimd };
 
-void bm_volumes(benchmark::State& state, Vol vol, Impl impl) {
+void object_tests(benchmark::State& state, Vol vol, Impl impl) {
     const VolumeWorkload& cw = volume_workload();
     VolumeWorkload& w = const_cast<VolumeWorkload&>(cw);
     const std::size_t n = w.boxes.size();
@@ -118,16 +118,16 @@ void bm_volumes(benchmark::State& state, Vol vol, Impl impl) {
     report_mix(state, w.out);
 }
 
-BENCHMARK_CAPTURE(bm_volumes, object_sphere_single, Vol::kSphere, Impl::kSingle);
-BENCHMARK_CAPTURE(bm_volumes, object_sphere_scalar, Vol::kSphere, Impl::kScalar);
-BENCHMARK_CAPTURE(bm_volumes, object_sphere_simd, Vol::kSphere, Impl::kSimd);
-BENCHMARK_CAPTURE(bm_volumes, object_aabb_np_single, Vol::kAabb, Impl::kSingle);
-BENCHMARK_CAPTURE(bm_volumes, object_aabb_np_scalar, Vol::kAabb, Impl::kScalar);
-BENCHMARK_CAPTURE(bm_volumes, object_aabb_np_simd, Vol::kAabb, Impl::kSimd);
-BENCHMARK_CAPTURE(bm_volumes, object_aabb_corners_single, Vol::kAabbCorners, Impl::kSingle);
-BENCHMARK_CAPTURE(bm_volumes, object_obb_single, Vol::kObb, Impl::kSingle);
-BENCHMARK_CAPTURE(bm_volumes, object_obb_scalar, Vol::kObb, Impl::kScalar);
-BENCHMARK_CAPTURE(bm_volumes, object_obb_simd, Vol::kObb, Impl::kSimd);
+BENCHMARK_CAPTURE(object_tests, sphere_single, Vol::kSphere, Impl::kSingle);
+BENCHMARK_CAPTURE(object_tests, sphere_scalar, Vol::kSphere, Impl::kScalar);
+BENCHMARK_CAPTURE(object_tests, sphere_simd, Vol::kSphere, Impl::kSimd);
+BENCHMARK_CAPTURE(object_tests, aabb_np_single, Vol::kAabb, Impl::kSingle);
+BENCHMARK_CAPTURE(object_tests, aabb_np_scalar, Vol::kAabb, Impl::kScalar);
+BENCHMARK_CAPTURE(object_tests, aabb_np_simd, Vol::kAabb, Impl::kSimd);
+BENCHMARK_CAPTURE(object_tests, aabb_corners_single, Vol::kAabbCorners, Impl::kSingle);
+BENCHMARK_CAPTURE(object_tests, obb_single, Vol::kObb, Impl::kSingle);
+BENCHMARK_CAPTURE(object_tests, obb_scalar, Vol::kObb, Impl::kScalar);
+BENCHMARK_CAPTURE(object_tests, obb_simd, Vol::kObb, Impl::kSimd);
 
 // ---- BVH ---------------------------------------------------------------------------------------
 
@@ -203,7 +203,7 @@ BENCHMARK(bm_bvh_refit)->Name("object_bvh_refit")->Arg(200)->Arg(1000)->Arg(5000
 
 // One frame per iteration, cycling through the walk; the objects stay where they are (the
 // comparison is the traversal, refit is measured above).
-void bm_cull(benchmark::State& state, bool use_bvh, bool masking, bool coherence) {
+void object_cull(benchmark::State& state, bool use_bvh, bool masking, bool coherence) {
     const std::size_t n = static_cast<std::size_t>(state.range(0));
     const CityScene& s = city(n);
     ObjectBvh bvh;
@@ -237,11 +237,11 @@ void bm_cull(benchmark::State& state, bool use_bvh, bool masking, bool coherence
     report_mix(state, all);
 }
 
-BENCHMARK_CAPTURE(bm_cull, object_flat, false, false, false)->Arg(200)->Arg(2000)->Arg(5000);
-BENCHMARK_CAPTURE(bm_cull, object_flat_coherence, false, false, true)->Arg(200)->Arg(2000)->Arg(5000);
-BENCHMARK_CAPTURE(bm_cull, object_bvh, true, false, false)->Arg(200)->Arg(2000)->Arg(5000);
-BENCHMARK_CAPTURE(bm_cull, object_bvh_masking, true, true, false)->Arg(200)->Arg(2000)->Arg(5000);
-BENCHMARK_CAPTURE(bm_cull, object_bvh_coherence, true, false, true)->Arg(200)->Arg(2000)->Arg(5000);
-BENCHMARK_CAPTURE(bm_cull, object_bvh_masking_coherence, true, true, true)->Arg(200)->Arg(2000)->Arg(5000);
+BENCHMARK_CAPTURE(object_cull, flat, false, false, false)->Arg(200)->Arg(2000)->Arg(5000);
+BENCHMARK_CAPTURE(object_cull, flat_coherence, false, false, true)->Arg(200)->Arg(2000)->Arg(5000);
+BENCHMARK_CAPTURE(object_cull, bvh, true, false, false)->Arg(200)->Arg(2000)->Arg(5000);
+BENCHMARK_CAPTURE(object_cull, bvh_masking, true, true, false)->Arg(200)->Arg(2000)->Arg(5000);
+BENCHMARK_CAPTURE(object_cull, bvh_coherence, true, false, true)->Arg(200)->Arg(2000)->Arg(5000);
+BENCHMARK_CAPTURE(object_cull, bvh_masking_coherence, true, true, true)->Arg(200)->Arg(2000)->Arg(5000);
 
 }  // namespace

@@ -51,6 +51,13 @@
 #else
 #define PATCHCULL_SCALAR_CLONES
 #endif
+// The templates below must be inlined into each clone, or the FMA clone would call a shared
+// non-FMA copy that calls libm's fmaf.
+#if defined(__GNUC__) || defined(__clang__)
+#define PATCHCULL_INLINE inline __attribute__((always_inline))
+#else
+#define PATCHCULL_INLINE inline
+#endif
 
 namespace patchcull {
 namespace {
@@ -65,7 +72,7 @@ struct PlaneConst {
     float x, y, z, w, len, nlen, pthr, nthr;
 };
 
-inline PlaneConst plane_const(const FrustumPlanes& planes, int k) {
+PATCHCULL_INLINE PlaneConst plane_const(const FrustumPlanes& planes, int k) {
     PlaneConst p;
     p.x = planes.rows[k].x;
     p.y = planes.rows[k].y;
@@ -78,12 +85,12 @@ inline PlaneConst plane_const(const FrustumPlanes& planes, int k) {
     return p;
 }
 
-inline float plane_value(const PlaneConst& p, float X, float Y, float Z) {
+PATCHCULL_INLINE float plane_value(const PlaneConst& p, float X, float Y, float Z) {
     return std::fma(p.z, Z, std::fma(p.y, Y, std::fma(p.x, X, p.w)));
 }
 
 // -1: outside the plane, 1: inside it, 0: straddles it.
-inline int plane_side(const PlaneConst& p, float g, float hi, float lo) {
+PATCHCULL_INLINE int plane_side(const PlaneConst& p, float g, float hi, float lo) {
     if (std::fma(p.len, g, hi) < p.nthr) return -1;
     if (std::fma(p.nlen, g, lo) > p.pthr) return 1;
     return 0;
@@ -98,12 +105,12 @@ inline bool empty(const Obb& b) { return b.half_extents[0] < 0; }
 struct SphereTerms {
     float g;
     const Sphere* s;
-    SphereTerms(const Sphere& sphere) : s(&sphere) {
+    PATCHCULL_INLINE SphereTerms(const Sphere& sphere) : s(&sphere) {
         const Vec3 c = sphere.center;
         const float m = max_like_simd(max_like_simd(std::fabs(c.x), std::fabs(c.y)), std::fabs(c.z));
         g = std::fma(kEps, (m + m) + sphere.radius, sphere.radius);
     }
-    int side(const PlaneConst& p) const {
+    PATCHCULL_INLINE int side(const PlaneConst& p) const {
         const float v = plane_value(p, s->center.x, s->center.y, s->center.z);
         return plane_side(p, g, v, v);
     }
@@ -112,7 +119,7 @@ struct SphereTerms {
 struct AabbTerms {
     float g;
     const Bounds* b;
-    AabbTerms(const Bounds& box) : b(&box) {
+    PATCHCULL_INLINE AabbTerms(const Bounds& box) : b(&box) {
         float m = std::fabs(box.min.x);
         m = max_like_simd(m, std::fabs(box.min.y));
         m = max_like_simd(m, std::fabs(box.min.z));
@@ -123,7 +130,7 @@ struct AabbTerms {
         const float fin = (((((box.min.x + box.min.y) + box.min.z) + box.max.x) + box.max.y) + box.max.z) * 0.0f;
         g = kEps * (m + m) + fin;
     }
-    int side(const PlaneConst& p) const {
+    PATCHCULL_INLINE int side(const PlaneConst& p) const {
         const float hi = plane_value(p, p.x >= 0 ? b->max.x : b->min.x, p.y >= 0 ? b->max.y : b->min.y,
                                      p.z >= 0 ? b->max.z : b->min.z);
         const float lo = plane_value(p, p.x >= 0 ? b->min.x : b->max.x, p.y >= 0 ? b->min.y : b->max.y,
@@ -135,8 +142,8 @@ struct AabbTerms {
 struct CornerTerms {
     float g;
     const Bounds* b;
-    CornerTerms(const Bounds& box) : g(AabbTerms(box).g), b(&box) {}
-    int side(const PlaneConst& p) const {
+    PATCHCULL_INLINE CornerTerms(const Bounds& box) : g(AabbTerms(box).g), b(&box) {}
+    PATCHCULL_INLINE int side(const PlaneConst& p) const {
         float hi = -kInf, lo = kInf;
         for (int i = 0; i < 8; ++i) {
             const float v = plane_value(p, (i & 1) ? b->max.x : b->min.x, (i & 2) ? b->max.y : b->min.y,
@@ -151,14 +158,14 @@ struct CornerTerms {
 struct ObbTerms {
     float g;
     const Obb* b;
-    ObbTerms(const Obb& box) : b(&box) {
+    PATCHCULL_INLINE ObbTerms(const Obb& box) : b(&box) {
         const Vec3 c = box.center;
         const float m = max_like_simd(max_like_simd(std::fabs(c.x), std::fabs(c.y)), std::fabs(c.z));
         const float h = (box.half_extents[0] + box.half_extents[1]) + box.half_extents[2];
         const float s = m + h;
         g = kEps * (s + s);
     }
-    int side(const PlaneConst& p) const {
+    PATCHCULL_INLINE int side(const PlaneConst& p) const {
         const float v = plane_value(p, b->center.x, b->center.y, b->center.z);
         float d[3];
         for (int i = 0; i < 3; ++i) {
@@ -171,7 +178,7 @@ struct ObbTerms {
 };
 
 template <class Terms, class Volume>
-Containment classify_masked(const FrustumPlanes& planes, const Volume& volume, PlaneCullState& state,
+PATCHCULL_INLINE Containment classify_masked(const FrustumPlanes& planes, const Volume& volume, PlaneCullState& state,
                             std::uint32_t& plane_tests) {
     if (empty(volume)) return Containment::outside;
     const Terms terms(volume);
@@ -199,7 +206,7 @@ Containment classify_masked(const FrustumPlanes& planes, const Volume& volume, P
 
 // All six planes in order, no early exit (the batch kernels' reference).
 template <class Terms, class Volume>
-inline Containment classify_all(const PlaneConst pc[6], const Volume& volume) {
+PATCHCULL_INLINE Containment classify_all(const PlaneConst pc[6], const Volume& volume) {
     if (empty(volume)) return Containment::outside;
     const Terms terms(volume);
     bool out = false, in = true;
@@ -212,7 +219,7 @@ inline Containment classify_all(const PlaneConst pc[6], const Volume& volume) {
 }
 
 template <class Terms, class Volume>
-inline void classify_batch(const FrustumPlanes& planes, const Volume* v, std::size_t n, Containment* out) {
+PATCHCULL_INLINE void classify_batch(const FrustumPlanes& planes, const Volume* v, std::size_t n, Containment* out) {
     PlaneConst pc[6];
     for (int k = 0; k < 6; ++k) pc[k] = plane_const(planes, k);
     for (std::size_t i = 0; i < n; ++i) out[i] = classify_all<Terms>(pc, v[i]);
