@@ -274,7 +274,7 @@ TEST(CityScene, DefaultCityHasAtLeast200CharactersAndInteractivePatchCounts) {
     }
 }
 
-// Not a check: the pose time of the default city (run with --gtest_also_run_disabled_tests).
+// Not a check: the pose time of the default city and building (run with --gtest_also_run_disabled_tests).
 TEST(CityScene, DISABLED_PoseTime) {
     const Scene scene = make_city_scene();
     ScenePoser poser(scene);
@@ -293,6 +293,15 @@ TEST(CityScene, DISABLED_PoseTime) {
     const double ms2 = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start2).count() / frames;
     std::cout << "city: " << scene.instances.size() << " instances, " << scene.patch_count() << " patches, pose " << ms
               << " ms/frame (shared phases), " << ms2 << " ms/frame (every instance its own phase)\n";
+    const Scene building = make_building_scene();
+    ScenePoser building_poser(building);
+    building_poser.pose(0);
+    const auto start3 = std::chrono::steady_clock::now();
+    for (int f = 1; f <= frames; ++f) building_poser.pose(f * kFrameSeconds);
+    const double ms3 = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start3).count() / frames;
+    std::cout << "building: " << building.instances.size() << " instances, " << building.patch_count() << " patches, "
+              << building.environment.size() << " environment objects, " << building.occluder_indices.size() / 3
+              << " triangles, pose " << ms3 << " ms/frame\n";
 }
 
 TEST(BuildingScene, RoomsDoorsAndWindows) {
