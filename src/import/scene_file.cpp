@@ -226,6 +226,7 @@ Scheme read_scheme(const Reader& r, const json& obj, const std::string& path) {
 // Parses text, catching duplicate keys (with their JSON path) and reporting syntax errors with
 // line and column.
 json parse_strict(const Reader& r, const std::string& text) {
+    constexpr std::size_t kMaxDepth = 32;
     struct Frame {
         bool array;
         std::size_t next = 0;
@@ -242,6 +243,9 @@ json parse_strict(const Reader& r, const std::string& text) {
         switch (event) {
         case json::parse_event_t::object_start:
         case json::parse_event_t::array_start: {
+            // The format nests 6 deep; a deeper file is refused before its paths grow (each
+            // frame keeps its path: quadratic in the depth).
+            if (frames.size() >= kMaxDepth) r.fail("", "JSON nested deeper than " + std::to_string(kMaxDepth) + " levels");
             std::string path = child_path();
             frames.push_back({event == json::parse_event_t::array_start, 0, std::move(path), {}, {}});
             break;

@@ -406,6 +406,8 @@ TEST_F(SceneFileErrors, Syntax) {
     EXPECT_TRUE(is_printable_line(binary)) << binary;
     EXPECT_EQ(binary.rfind((dir_ / "a.json").string() + ":1:", 0), 0u) << binary;
     expect("[1, 2]", "expected an object");
+    // Deep nesting is refused early (quickly, without memory growing with the depth).
+    expect(std::string(200000, '[') + std::string(200000, ']'), "JSON nested deeper than 32 levels");
 }
 
 TEST_F(SceneFileErrors, UnknownAndDuplicateKeys) {
