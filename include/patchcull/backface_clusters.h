@@ -141,7 +141,10 @@ struct ClusterBuildOptions {
 /// closest to the seed's while within max_leaf_normal_angle of it, up to max_leaf triangles
 /// (normal and spatial coherence); leaves ordered by their normal's cube face then Morton order;
 /// then adjacent nodes merged bottom-up, always the pair with the largest gain
-/// T(A) + T(B) - T(C), while merge_pays holds. Zero-area triangles join any leaf.
+/// T(A) + T(B) - T(C), while merge_pays holds. Zero-area triangles join any leaf. Precisely: the
+/// grown regions are the units of merge_into_leaves (adjacent regions merged into leaves of at
+/// most max_leaf triangles while merge_pays holds), each leaf recomputed from its triangles, then
+/// build_cluster_hierarchy.
 /// Contracts: indices.size() % 3 == 0 and every index < vertices.size(), else throws
 /// patchcull::Error; max_leaf >= 1 else throws. Empty input gives an empty hierarchy.
 ClusterHierarchy build_triangle_clusters(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& indices,
@@ -184,6 +187,14 @@ BackfaceCluster make_cluster_from_planes(const ClusterPlane* planes, std::size_t
 /// is 0) on every side. Never throws.
 Bounds near_field_viewpoints(const Bounds& box);
 
+/// The lecture's cluster generation: adjacent units (in range order) merged greedily, always the
+/// pair with the largest gain T(A) + T(B) - T(C), while merge_pays holds and the merged cluster has
+/// at most options.max_leaf members; returns the merged clusters in range order (first/count
+/// exact; bounds relaxed as merge_clusters makes them: recompute each from its members for
+/// leaves). Never throws except bad_alloc.
+std::vector<BackfaceCluster> merge_into_leaves(const std::vector<BackfaceCluster>& units, const ClusterBuildOptions& options,
+                                               const Bounds& default_viewpoints);
+
 /// The hierarchy over leaves given in range order (their first/count adjacent and increasing):
 /// adjacent nodes merged bottom-up by the largest gain while merge_pays holds (tC / r and the
 /// viewpoint box U from options; an empty options.viewpoints means default_viewpoints). indices
@@ -210,10 +221,10 @@ void patch_control_planes(const BezierPatch& patch, Vec3 origin, PlaneD planes[6
 /// bounding box centre and corners. Contracts: count >= 1. Never throws.
 BackfaceCluster make_patch_cluster(const BezierPatch* patches, std::uint32_t first, std::uint32_t count);
 
-/// Patch clusters of one object, built once at rest in the object's space: leaves are runs of
-/// consecutive patches (input order) of up to max_leaf patches, cut where the next patch's mean
-/// normal leaves max_leaf_normal_angle of the run's first; then merged bottom-up as for
-/// triangles. For an object moving rigidly, test each frame with the eye moved into object
+/// Patch clusters of one object, built once at rest in the object's space: every patch a unit,
+/// adjacent units (input order) merged into leaves by merge_into_leaves (merge_pays, at most
+/// max_leaf patches; max_leaf_normal_angle is not used), each leaf recomputed from its patches'
+/// control planes; then the hierarchy as for triangles (build_cluster_hierarchy). For an object moving rigidly, test each frame with the eye moved into object
 /// space (inverse of the rigid transform). indices and triangle_order stay empty.
 /// Contracts: max_leaf >= 1, else throws patchcull::Error.
 ClusterHierarchy build_patch_clusters(const BezierPatch* patches, std::size_t n, const ClusterBuildOptions& options);

@@ -385,26 +385,37 @@ bool merge_pays(double p_merged, double p_a, std::size_t n_a, double p_b, std::s
 
 // ---- hierarchy -----------------------------------------------------------------------------
 
-ClusterHierarchy build_cluster_hierarchy(const std::vector<BackfaceCluster>& leaves, const ClusterBuildOptions& options,
-                                         const Bounds& default_viewpoints) {
-    ClusterHierarchy h;
-    if (leaves.empty()) return h;
-    const Bounds& U = (options.viewpoints.min.x <= options.viewpoints.max.x &&
-                       options.viewpoints.min.y <= options.viewpoints.max.y &&
-                       options.viewpoints.min.z <= options.viewpoints.max.z)
-                          ? options.viewpoints
-                          : default_viewpoints;
-    struct Temp {
-        BackfaceCluster c;
-        double p;
-        std::int64_t left = -1, right = -1;
-        std::uint32_t size = 1, leaves = 1;
-    };
-    std::vector<Temp> t;
-    t.reserve(2 * leaves.size());
-    for (const BackfaceCluster& c : leaves) t.push_back({c, culling_probability(c, U)});
-    // Current roots as a doubly linked list over temp ids.
-    const std::size_t L = leaves.size();
+namespace {
+
+const Bounds& viewpoint_box(const ClusterBuildOptions& options, const Bounds& fallback) {
+    const Bounds& v = options.viewpoints;
+    return (v.min.x <= v.max.x && v.min.y <= v.max.y && v.min.z <= v.max.z) ? v : fallback;
+}
+
+// Greedy bottom-up merging of adjacent nodes (a doubly linked list of the current roots): always
+// the pair with the largest gain T(A) + T(B) - T(C) (in units of r) among those where merge_pays
+// holds and the merged member count is <= max_count. Returns every node created (units first);
+// roots: the final roots in range order.
+struct MergeNode {
+    BackfaceCluster c;
+    double p = 0;
+    std::int64_t left = -1, right = -1;
+    std::uint32_t size = 1, leaves = 1;
+};
+
+std::vector<MergeNode> merge_adjacent(const std::vector<BackfaceCluster>& units, const Bounds& U, double tcr,
+                                      std::uint64_t max_count, std::vector<std::int64_t>& roots) {
+    std::vector<MergeNode> t;
+    roots.clear();
+    if (units.empty()) return t;
+    t.reserve(2 * units.size());
+    for (const BackfaceCluster& c : units) {
+        MergeNode m;
+        m.c = c;
+        m.p = culling_probability(c, U);
+        t.push_back(m);
+    }
+    const std::size_t L = units.size();
     std::vector<std::int64_t> prev(2 * L, -1), next(2 * L, -1);
     std::vector<std::uint32_t> version(2 * L, 0);
     std::vector<char> alive(2 * L, 0);
@@ -420,9 +431,9 @@ ClusterHierarchy build_cluster_hierarchy(const std::vector<BackfaceCluster>& lea
         bool operator<(const Cand& o) const { return gain < o.gain || (gain == o.gain && left > o.left); }
     };
     std::priority_queue<Cand> queue;
-    const double tcr = options.tc_over_r;
     auto consider = [&](std::int64_t a, std::int64_t b) {
         if (a < 0 || b < 0) return;
+        if (std::uint64_t(t[a].c.count) + t[b].c.count > max_count) return;
         const BackfaceCluster m = merge_clusters(t[a].c, t[b].c);
         const double pm = culling_probability(m, U);
         const double na = t[a].c.count, nb = t[b].c.count;
@@ -437,7 +448,7 @@ ClusterHierarchy build_cluster_hierarchy(const std::vector<BackfaceCluster>& lea
         if (!alive[c.left] || !alive[c.right] || version[c.left] != c.vl || version[c.right] != c.vr ||
             next[c.left] != c.right)
             continue;
-        Temp m;
+        MergeNode m;
         m.c = merge_clusters(t[c.left].c, t[c.right].c);
         m.p = culling_probability(m.c, U);
         m.left = c.left;
@@ -455,14 +466,36 @@ ClusterHierarchy build_cluster_hierarchy(const std::vector<BackfaceCluster>& lea
         consider(prev[id], id);
         consider(id, next[id]);
     }
-    // Roots in range order, then preorder emission.
     std::int64_t head = -1;
     for (std::size_t i = 0; i < t.size(); ++i)
         if (alive[i] && prev[i] < 0) head = std::int64_t(i);
+    for (std::int64_t r = head; r >= 0; r = next[r]) roots.push_back(r);
+    return t;
+}
+
+}  // namespace
+
+std::vector<BackfaceCluster> merge_into_leaves(const std::vector<BackfaceCluster>& units, const ClusterBuildOptions& options,
+                                               const Bounds& default_viewpoints) {
+    std::vector<std::int64_t> roots;
+    const std::vector<MergeNode> t =
+        merge_adjacent(units, viewpoint_box(options, default_viewpoints), options.tc_over_r, options.max_leaf, roots);
+    std::vector<BackfaceCluster> out;
+    out.reserve(roots.size());
+    for (std::int64_t r : roots) out.push_back(t[r].c);
+    return out;
+}
+
+ClusterHierarchy build_cluster_hierarchy(const std::vector<BackfaceCluster>& leaves, const ClusterBuildOptions& options,
+                                         const Bounds& default_viewpoints) {
+    ClusterHierarchy h;
+    std::vector<std::int64_t> roots;
+    const std::vector<MergeNode> t = merge_adjacent(leaves, viewpoint_box(options, default_viewpoints), options.tc_over_r,
+                                                    std::numeric_limits<std::uint64_t>::max(), roots);
     h.nodes.reserve(t.size());
     std::vector<std::int64_t> stack;
     std::uint32_t leaf_counter = 0;
-    for (std::int64_t r = head; r >= 0; r = next[r]) {
+    for (std::int64_t r : roots) {
         h.roots.push_back(static_cast<std::uint32_t>(h.nodes.size()));
         stack.push_back(r);
         while (!stack.empty()) {
@@ -667,8 +700,14 @@ ClusterHierarchy build_triangle_clusters(const std::vector<Vec3>& vertices, cons
         leaves.push_back(make_triangle_cluster(vertices.data(), reordered.data(), first,
                                                static_cast<std::uint32_t>(leaf_tris[l].size())));
     }
-    Bounds vb = triangle_box(vertices.data(), indices.data(), 0, static_cast<std::uint32_t>(T));
-    ClusterHierarchy h = build_cluster_hierarchy(leaves, options, near_field_viewpoints(vb));
+    // The grown regions as units of the lecture's cluster generation (adjacent ones merged while
+    // merge_pays holds, up to max_leaf triangles), each final leaf recomputed from its triangles.
+    const Bounds vb = triangle_box(vertices.data(), indices.data(), 0, static_cast<std::uint32_t>(T));
+    const Bounds U = near_field_viewpoints(vb);
+    const std::vector<BackfaceCluster> merged = merge_into_leaves(leaves, options, U);
+    leaves.clear();
+    for (const BackfaceCluster& m : merged) leaves.push_back(make_triangle_cluster(vertices.data(), reordered.data(), m.first, m.count));
+    ClusterHierarchy h = build_cluster_hierarchy(leaves, options, U);
     h.indices = std::move(reordered);
     h.triangle_order = std::move(tri_order);
     return h;

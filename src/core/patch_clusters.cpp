@@ -179,23 +179,18 @@ ClusterHierarchy build_patch_clusters(const BezierPatch* patches, std::size_t n,
     if (n > 0xffffffffu) throw Error("build_patch_clusters: too many patches");
     ClusterHierarchy h;
     if (n == 0) return h;
-    const double cos_max = std::cos(options.max_leaf_normal_angle);
-    std::vector<Vec3> normal(n);
-    for (std::size_t p = 0; p < n; ++p) normal[p] = normalize(evaluate_surface(patches[p], 0.5f, 0.5f).normal);
-    auto zero = [](Vec3 v) { return !(v.x != 0 || v.y != 0 || v.z != 0); };
-    std::vector<BackfaceCluster> leaves;
-    std::size_t i = 0;
-    while (i < n) {
-        std::size_t j = i + 1;
-        while (j < n && j - i < options.max_leaf &&
-               (zero(normal[i]) || zero(normal[j]) || !is_finite(normal[j]) || dot(normal[i], normal[j]) >= cos_max))
-            ++j;
-        leaves.push_back(make_patch_cluster(patches, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j - i)));
-        i = j;
-    }
+    // Single patches as units of the lecture's cluster generation (adjacent ones merged while
+    // merge_pays holds, up to max_leaf patches), each final leaf recomputed from its patches.
     bool finite = true;
     const Bounds all = control_point_box(patches, 0, n, finite);
-    return build_cluster_hierarchy(leaves, options, near_field_viewpoints(all));
+    const Bounds U = near_field_viewpoints(all);
+    std::vector<BackfaceCluster> units;
+    units.reserve(n);
+    for (std::size_t p = 0; p < n; ++p) units.push_back(make_patch_cluster(patches, static_cast<std::uint32_t>(p), 1));
+    std::vector<BackfaceCluster> leaves;
+    for (const BackfaceCluster& m : merge_into_leaves(units, options, U))
+        leaves.push_back(make_patch_cluster(patches, m.first, m.count));
+    return build_cluster_hierarchy(leaves, options, U);
 }
 
 ClusterHierarchy build_patch_clusters(const BezierPatch* patches, std::size_t n, double tc_over_r,
