@@ -199,46 +199,61 @@ TEST(SceneFile, DefaultJsonIsTheDefaultScene) {
     for (std::size_t p = 0; p < x.size(); p += 31) EXPECT_EQ(x[p].cp[5].x, y[p].cp[5].x);
 }
 
+// Bounds of the environment objects whose names start with one of the prefixes.
+std::vector<Bounds> solids(const Scene& scene, std::initializer_list<const char*> prefixes) {
+    std::vector<Bounds> out;
+    for (const EnvironmentObject& o : scene.environment) {
+        if (std::none_of(prefixes.begin(), prefixes.end(), [&](const char* p) { return o.name.rfind(p, 0) == 0; })) continue;
+        std::vector<Vec3> points;
+        for (std::uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t)
+            for (int k = 0; k < 3; ++k) points.push_back(scene.occluder_vertices[scene.occluder_indices[3 * t + k]]);
+        out.push_back(bounds_of(points));
+    }
+    return out;
+}
+
+// Over the CLI's 60 frames at 1/12 s (every third) no character's posed bounds overlap a solid,
+// and the eye is inside no character and no solid.
+void check_clear(const Scene& scene, const std::vector<Bounds>& solid) {
+    ScenePoser poser(scene);
+    const std::vector<Camera> cameras = scene.camera_path(60, 16.0f / 9.0f);
+    auto inside = [](Vec3 e, const Bounds& b) {
+        return e.x > b.min.x && e.x < b.max.x && e.y > b.min.y && e.y < b.max.y && e.z > b.min.z && e.z < b.max.z;
+    };
+    for (int f = 0; f < 60; f += 3) {
+        const std::vector<BezierPatch>& patches = poser.pose(f / 12.0f);
+        const Vec3 e = cameras[static_cast<std::size_t>(f)].eye;
+        for (const Bounds& s : solid) EXPECT_FALSE(inside(e, s)) << "eye in a solid at frame " << f;
+        std::size_t first = 0;
+        for (const SceneInstance& instance : scene.instances) {
+            std::vector<Vec3> points;
+            const std::size_t n = scene.models[instance.model].rest.patches.size();
+            for (std::size_t p = first; p < first + n; ++p)
+                for (const Vec4& c : patches[p].cp) points.push_back(cartesian(c));
+            first += n;
+            const Bounds b = bounds_of(points);
+            for (const Bounds& s : solid)
+                EXPECT_FALSE(b.min.x < s.max.x && s.min.x < b.max.x && b.min.y < s.max.y && s.min.y < b.max.y &&
+                             b.min.z < s.max.z && s.min.z < b.max.z)
+                    << instance.name << " frame " << f;
+            EXPECT_FALSE(inside(e, b)) << "eye inside " << instance.name << " at frame " << f;
+        }
+    }
+}
+
 TEST(SceneFile, ShippedCityAndBuildingFiles) {
     const Scene city = load_scene_file((kScenes / "city_small.json").string());
     EXPECT_EQ(city.instances.size(), 20u);
     EXPECT_EQ(city.models.size(), 2u);  // BigGuy and MonsterFrog, each loaded once
     EXPECT_TRUE(city.camera.walk);
-    std::vector<Bounds> buildings;
-    for (const EnvironmentObject& o : city.environment) {
-        EXPECT_TRUE(o.one_sided);
-        if (o.name.rfind("building#", 0) != 0) continue;
-        std::vector<Vec3> points;
-        for (std::uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t)
-            for (int k = 0; k < 3; ++k) points.push_back(city.occluder_vertices[city.occluder_indices[3 * t + k]]);
-        buildings.push_back(bounds_of(points));
-    }
-    ASSERT_EQ(buildings.size(), 4u);
-    // Over the CLI's 60 frames at 1/12 s no character enters a building, nor the eye a character.
-    ScenePoser poser(city);
-    const std::vector<Camera> cameras = city.camera_path(60, 16.0f / 9.0f);
+    for (const EnvironmentObject& o : city.environment) EXPECT_TRUE(o.one_sided) << o.name;
     int walking = 0, rigid = 0;
     for (const SceneInstance& i : city.instances) walking += length(i.velocity) > 0, rigid += !i.deforms;
     EXPECT_GT(walking, 0);
     EXPECT_GT(rigid, 0);
-    for (int f = 0; f < 60; f += 3) {
-        const std::vector<BezierPatch>& patches = poser.pose(f / 12.0f);
-        std::size_t first = 0;
-        for (const SceneInstance& instance : city.instances) {
-            std::vector<Vec3> points;
-            const std::size_t n = city.models[instance.model].rest.patches.size();
-            for (std::size_t p = first; p < first + n; ++p)
-                for (const Vec4& c : patches[p].cp) points.push_back(cartesian(c));
-            first += n;
-            const Bounds b = bounds_of(points);
-            for (const Bounds& s : buildings)
-                EXPECT_FALSE(b.min.x < s.max.x && s.min.x < b.max.x && b.min.z < s.max.z && s.min.z < b.max.z)
-                    << instance.name << " frame " << f;
-            const Vec3 e = cameras[static_cast<std::size_t>(f)].eye;
-            EXPECT_FALSE(e.x > b.min.x && e.x < b.max.x && e.y > b.min.y && e.y < b.max.y && e.z > b.min.z && e.z < b.max.z)
-                << "eye inside " << instance.name << " at frame " << f;
-        }
-    }
+    const std::vector<Bounds> buildings = solids(city, {"building#"});
+    ASSERT_EQ(buildings.size(), 4u);
+    check_clear(city, buildings);
 
     const Scene building = load_scene_file((kScenes / "building.json").string());
     ASSERT_EQ(building.cells.size(), 3u);
@@ -254,6 +269,25 @@ TEST(SceneFile, ShippedCityAndBuildingFiles) {
         const Vec3 n = cross(p.corners[1] - p.corners[0], p.corners[2] - p.corners[0]);
         EXPECT_GT(dot(n, building.cells[p.cell_a].box.center() - centre), 0.0f);
     }
+    // Walls, posts and ceilings (the floors are the ground): nobody inside one.
+    std::vector<Bounds> walls;
+    for (const EnvironmentObject& o : building.environment) {
+        if (o.name.find("-floor") != std::string::npos) continue;
+        std::vector<Vec3> points;
+        for (std::uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t)
+            for (int k = 0; k < 3; ++k) points.push_back(building.occluder_vertices[building.occluder_indices[3 * t + k]]);
+        walls.push_back(bounds_of(points));
+    }
+    std::size_t ceilings = 0;
+    for (const EnvironmentObject& o : building.environment) ceilings += o.name.find("-ceiling") != std::string::npos;
+    EXPECT_EQ(ceilings, 3u);
+    EXPECT_GT(walls.size(), 10u);
+    check_clear(building, walls);
+    // The camera walks from the hall into the kitchen.
+    const std::vector<Camera> cameras = building.camera_path(60, 1.5f);
+    auto in = [](Vec3 e, const Bounds& b) { return e.x >= b.min.x && e.x <= b.max.x && e.z >= b.min.z && e.z <= b.max.z; };
+    EXPECT_TRUE(in(cameras.front().eye, building.cells[0].box));
+    EXPECT_TRUE(in(cameras.back().eye, building.cells[1].box));
 }
 
 // The complete example of docs/SCENE_FORMAT.md loads (its OBJ files stood in for by cubes).
