@@ -32,7 +32,7 @@ namespace patchcull {
 /// One placed copy of a model.
 struct SceneInstance {
     std::size_t model = 0;   ///< index into Scene::models
-    Mat4 object_to_world;    ///< affine: the model's object space -> world, at scene time -time_offset
+    Mat4 object_to_world;    ///< affine: the model's object space -> world (moved by velocity: instance_to_world)
     float time_offset = 0;   ///< seconds added to the scene time, so copies move out of step
     bool displaced = false;  ///< displaced by Scene::displacement (when it is not empty)
     /// Unique among the scene's instances, e.g. "bigguy#3" (every scene builder and the scene
