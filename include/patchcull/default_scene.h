@@ -6,11 +6,21 @@
 // seen from a camera that moves along a path over a few frames, so that frustum, back-patch and
 // occlusion culling (and the temporal statuses of seed 000 §3) all have work to do.
 //
+// The `city` (a street grid of box buildings with 200+ characters, the camera walking a street)
+// and `building` (rooms joined by doors and windows, with cells and portals) scenes are the
+// object-level scenes of issue 11 and 12, after G. Zachmann's lecture "Advanced Visibility
+// Computations" (seed 004: bounding-volume hierarchies for many objects, occlusion in cities,
+// cells and portals in buildings). Scene files (patchcull/scene_file.h) describe the same Scene.
+//
 // Conventions: world space is y-up, the ground is y = 0, lengths are in character heights
 // (every character is scaled to height 1 before it is placed). Patches are world-space (the
 // renderer has no model matrix): each instance's control points are transformed by its affine
-// object_to_world, which maps homogeneous points exactly (w is kept). OBJ models are taken as
-// y-up, the built-in teapot as z-up.
+// instance_to_world (object_to_world moved by the instance's velocity), which maps homogeneous
+// points exactly (w is kept). OBJ models are taken as y-up, the built-in teapot as z-up.
+// Rounding: everything is float. ScenePoser's output is exactly instance_to_world times the
+// (animated) control points, in float (tested bit for bit); the built-in scenes keep characters
+// at least 0.1 (plus their reach, measured on the float control points) from walls and buildings,
+// far more than any rounding at their sizes (under 100 units from the origin).
 #pragma once
 
 #include <array>
