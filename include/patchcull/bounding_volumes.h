@@ -31,8 +31,9 @@
 // round outwards, so each volume holds every input point in real arithmetic.
 //
 // Empty volumes (n = 0): radius < 0, AABB min > max, OBB half_extents[0] < 0; every frustum test
-// reports them outside with no plane test. A NaN anywhere in a volume gives intersecting, never
-// outside; so does an infinite AABB coordinate (or a finite sum of them that overflows).
+// reports them outside with no plane test. A NaN anywhere in a (non-empty) volume gives
+// intersecting, never outside; so does an infinite AABB coordinate (or a finite sum of the six
+// that overflows).
 #pragma once
 
 #include <cstddef>
