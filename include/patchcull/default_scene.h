@@ -182,7 +182,7 @@ struct CityParams {
     float block_size = 8;            ///< side of a block's square footprint
     float street_width = 4;          ///< streets run between the blocks and around the grid
     float min_height = 3, max_height = 14;  ///< building heights, uniform in between
-    int characters = 220;            ///< BigGuys and MonsterFrogs (alternating), 0..100000
+    int characters = 220;            ///< BigGuys and MonsterFrogs (alternating), 0..5000
     float rigid_fraction = 0.25f;    ///< share of characters that do not deform
     float walking_fraction = 0.35f;  ///< share that walk along their street (velocity)
     float walk_seconds = 10;         ///< walkers stay in their street and out of the camera's corridor this long

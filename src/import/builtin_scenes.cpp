@@ -48,6 +48,35 @@ void check_range(const char* name, double value, double lo, double hi) {
                     ", got " + std::to_string(value));
 }
 
+// Start positions placed so far with their reaches, bucketed in square cells at least as wide as
+// any two reaches together, so a new position is checked against its own and the 8 neighbouring
+// cells only (placement stays linear in the number of characters).
+class SpacingGrid {
+public:
+    SpacingGrid(float x0, float z0, float width_x, float width_z, float max_reach)
+        : x0_(x0), z0_(z0), cell_(std::max({2 * max_reach, width_x / 256, width_z / 256, 1e-3f})),
+          nx_(static_cast<int>(width_x / cell_) + 1), nz_(static_cast<int>(width_z / cell_) + 1),
+          cells_(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(nz_)) {}
+
+    // True when the square of half side r around p is clear of every placed one's square.
+    bool clear(Vec3 p, float r) const {
+        const int cx = cell_x(p.x), cz = cell_z(p.z);
+        for (int z = std::max(0, cz - 1); z <= std::min(nz_ - 1, cz + 1); ++z)
+            for (int x = std::max(0, cx - 1); x <= std::min(nx_ - 1, cx + 1); ++x)
+                for (const auto& [q, rq] : cells_[static_cast<std::size_t>(z) * nx_ + x])
+                    if (std::fabs(q.x - p.x) < r + rq && std::fabs(q.z - p.z) < r + rq) return false;
+        return true;
+    }
+    void add(Vec3 p, float r) { cells_[static_cast<std::size_t>(cell_z(p.z)) * nx_ + cell_x(p.x)].push_back({p, r}); }
+
+private:
+    int cell_x(float x) const { return std::clamp(static_cast<int>((x - x0_) / cell_), 0, nx_ - 1); }
+    int cell_z(float z) const { return std::clamp(static_cast<int>((z - z0_) / cell_), 0, nz_ - 1); }
+    float x0_, z0_, cell_;
+    int nx_, nz_;
+    std::vector<std::vector<std::pair<Vec3, float>>> cells_;
+};
+
 // A character of the scene: model, where it stands at t = 0, heading, and motion.
 struct Character {
     std::size_t model;
@@ -93,7 +122,7 @@ Scene make_city_scene(Scheme scheme, const CityParams& params) {
     check_range("city street_width", params.street_width, 0.5, 1000);
     check_range("city min_height", params.min_height, 0.01, 10000);
     check_range("city max_height", params.max_height, params.min_height, 10000);
-    check_range("city characters", params.characters, 0, 100000);
+    check_range("city characters", params.characters, 0, 5000);
     check_range("city rigid_fraction", params.rigid_fraction, 0, 1);
     check_range("city walking_fraction", params.walking_fraction, 0, 1);
     check_range("city walk_seconds", params.walk_seconds, 0, 3600);
@@ -142,7 +171,7 @@ Scene make_city_scene(Scheme scheme, const CityParams& params) {
     // Characters: a random street (z streets run along z at x street columns, x streets along
     // x), a random point on it; walkers move along the street, so they keep its clearance.
     std::vector<Character> placed;
-    std::vector<float> placed_reach;
+    SpacingGrid spacing(x0, z0, width_x, width_z, std::max(reach[0], reach[1]));
     for (int k = 0; k < params.characters; ++k) {
         const std::size_t model = static_cast<std::size_t>(k % 2);
         const float r = reach[model];
@@ -178,14 +207,11 @@ Scene make_city_scene(Scheme scheme, const CityParams& params) {
                       path.z1 + grow <= z0 + width_z;
             for (std::size_t b = 0; ok && b < buildings.size(); ++b) ok = !overlaps(buildings[b], grow);
             if (ok) ok = !overlaps(Rect{camera_x - corridor, z0, camera_x + corridor, z0 + width_z}, grow);
-            // Standing start positions apart (walkers of one lane may meet later: harmless).
-            for (std::size_t o = 0; ok && o < placed.size(); ++o) {
-                const float g = r + placed_reach[o];
-                ok = std::fabs(placed[o].position.x - c.position.x) >= g || std::fabs(placed[o].position.z - c.position.z) >= g;
-            }
+            // Start positions apart (walkers may meet later: harmless).
+            if (ok) ok = spacing.clear(c.position, r);
             if (!ok) continue;
             placed.push_back(c);
-            placed_reach.push_back(r);
+            spacing.add(c.position, r);
             done = true;
         }
         if (!done)
@@ -330,7 +356,8 @@ Scene make_building_scene(Scheme scheme, const BuildingParams& params) {
     std::vector<std::size_t> placed_room;
     int count = 0;
     for (int j = 0; j < nz; ++j)
-        for (int i = 0; i < nx; ++i)
+        for (int i = 0; i < nx; ++i) {
+            const std::size_t room_first = placed.size();  // other rooms' characters are behind walls
             for (int n = 0; n < params.characters_per_room; ++n, ++count) {
                 const std::size_t model = static_cast<std::size_t>(count % 2);
                 const float r = reach[model], grow = r + kClearance;
@@ -346,7 +373,7 @@ Scene make_building_scene(Scheme scheme, const BuildingParams& params) {
                     bool ok = c.position.x > wall_x(i) + h + grow && c.position.x < wall_x(i + 1) - h - grow &&
                               c.position.z > wall_z(j) + h + grow && c.position.z < wall_z(j + 1) - h - grow;
                     if (ok) ok = std::fabs(c.position.x - camera_x) >= corridor + grow;
-                    for (std::size_t o = 0; ok && o < placed.size(); ++o) {
+                    for (std::size_t o = room_first; ok && o < placed.size(); ++o) {
                         const float g = r + placed_reach[o];
                         ok = std::fabs(placed[o].position.x - c.position.x) >= g ||
                              std::fabs(placed[o].position.z - c.position.z) >= g;
@@ -358,6 +385,7 @@ Scene make_building_scene(Scheme scheme, const BuildingParams& params) {
                     break;
                 }
             }
+        }
     add_characters(scene, placed, standing);
     for (std::size_t k = 0; k < placed_room.size(); ++k) scene.cells[placed_room[k]].instances.push_back(k);
     scene.displacement = make_procedural_displacement(512, kDefaultSceneDisplaceScale);
