@@ -101,9 +101,12 @@ struct Reader {
 
     long long integer(const json& j, const std::string& path, long long lo, long long hi) const {
         if (!j.is_number_integer()) fail(path, "expected an integer");
-        if (j.is_number_unsigned() ? j.get<unsigned long long>() > static_cast<unsigned long long>(hi)
-                                   : (j.get<long long>() < lo || j.get<long long>() > hi))
-            fail(path, "expected an integer between " + std::to_string(lo) + " and " + std::to_string(hi));
+        // Non-negative integers are stored unsigned (up to 2^64 - 1): compare before converting.
+        const bool in_range = j.is_number_unsigned()
+                                  ? j.get<unsigned long long>() <= static_cast<unsigned long long>(hi) &&
+                                        static_cast<long long>(j.get<unsigned long long>()) >= lo
+                                  : j.get<long long>() >= lo && j.get<long long>() <= hi;
+        if (!in_range) fail(path, "expected an integer between " + std::to_string(lo) + " and " + std::to_string(hi));
         return j.get<long long>();
     }
 
@@ -140,6 +143,13 @@ struct Reader {
     }
 };
 
+// A double as a float; beyond the float range: infinity (which check_placed reports), never the
+// undefined conversion.
+float to_float(double v) {
+    if (!(std::fabs(v) <= double(FLT_MAX))) return v < 0 ? -INFINITY : INFINITY;
+    return static_cast<float>(v);
+}
+
 // Determinant of the linear (upper-left 3x3) part, in double.
 double linear_determinant(const Mat4& m) {
     auto a = [&](int r, int c) { return double(m.at(r, c)); };
@@ -165,8 +175,8 @@ Mat4 read_transform(const Reader& r, const json& j, const std::string& path, con
         if (origin.x != 0 || origin.y != 0 || origin.z != 0) {
             // M * translation(origin), the new translation summed in double.
             for (int row = 0; row < 3; ++row)
-                m.at(row, 3) = static_cast<float>(double(m.at(row, 0)) * origin.x + double(m.at(row, 1)) * origin.y +
-                                                  double(m.at(row, 2)) * origin.z + double(m.at(row, 3)));
+                m.at(row, 3) = to_float(double(m.at(row, 0)) * origin.x + double(m.at(row, 1)) * origin.y +
+                                        double(m.at(row, 2)) * origin.z + double(m.at(row, 3)));
         }
         return m;
     }
@@ -187,7 +197,7 @@ Mat4 read_transform(const Reader& r, const json& j, const std::string& path, con
         }
     } else {
         const float s = r.number_or(j, path, "scale", 1, 0, 1e9, true);
-        local = scaling(s) * translation({static_cast<float>(origin.x), static_cast<float>(origin.y), static_cast<float>(origin.z)});
+        local = scaling(s) * translation({to_float(origin.x), to_float(origin.y), to_float(origin.z)});
     }
     return translation(position) * rotation_y(yaw) * local;
 }
@@ -479,9 +489,7 @@ Scene load_scene_file(const std::string& path) {
                 double w[3];
                 for (int row = 0; row < 3; ++row)
                     w[row] = double(m.at(row, 0)) * x + double(m.at(row, 1)) * y + double(m.at(row, 2)) * z + double(m.at(row, 3));
-                for (double& c : w)
-                    if (!(std::fabs(c) <= double(FLT_MAX))) c = INFINITY;  // reported by check_placed
-                world.push_back({static_cast<float>(w[0]), static_cast<float>(w[1]), static_cast<float>(w[2])});
+                world.push_back({to_float(w[0]), to_float(w[1]), to_float(w[2])});
             }
             check_placed(r, t ? join(p, "transform") : p, world, "environment object");
             // A mirroring transform turns counter-clockwise into clockwise: flip the triangles back.

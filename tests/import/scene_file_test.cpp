@@ -493,6 +493,10 @@ TEST_F(SceneFileErrors, NumbersOutOfRange) {
     expect(with(valid_scene(), "\"time_offset\": 0.5", "\"time_offset\": 1e7"),
            "objects[1].animation.time_offset: expected a number >= -1e+06 and <= 1e+06, got 1e+07");
     expect(with(valid_scene(), "\"size\": 64", "\"size\": 100000"), "displacement.size: expected an integer between 1 and 4096");
+    expect(with(valid_scene(), "\"size\": 64", "\"size\": 0"), "displacement.size: expected an integer between 1 and 4096");
+    expect(with(valid_scene(), "\"size\": 64", "\"size\": -3"), "displacement.size: expected an integer between 1 and 4096");
+    expect(with(valid_scene(), "\"size\": 64", "\"size\": 18446744073709551615"),
+           "displacement.size: expected an integer between 1 and 4096");
     expect(with(valid_scene(), "\"z_far\": 40", "\"z_far\": 0.05"), "camera.z_far: must be greater than z_near");
 }
 
