@@ -129,6 +129,10 @@ inline const BackfaceCluster& cluster_leaf(const ClusterHierarchy& h, std::size_
 /// Build parameters. viewpoints: the box U of culling_probability used by the merge criterion;
 /// empty (min > max, the default) means the members' bounding box grown by its largest side on
 /// every side (the lecture's "near field" around the object).
+/// tC / r is the cost of one cluster test over the cost of drawing one member. A triangle costs
+/// about one cluster test (1 - 16 here); a patch costs its per-patch cull tests and tessellation,
+/// hundreds of cluster tests (0.01 - 0.1): with tC / r >= 1 BigGuy's patches merge into clusters
+/// that cull little (bench/backface_bench.cpp, backface/hierarchy/bigguy_acc_*).
 struct ClusterBuildOptions {
     double tc_over_r = 4.0;                ///< tC / r of merge_pays
     std::uint32_t max_leaf = 64;           ///< members per leaf at most (>= 1)
