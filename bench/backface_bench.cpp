@@ -17,6 +17,8 @@
 //   triangles, flat faces like buildings), bigguy_tess (BigGuy's ACC patches tessellated 8 x 8,
 //   186k triangles), and the patch meshes bigguy_acc_s<levels> (BigGuy's ACC patches after 0, 1
 //   or 2 splits: 1450, 5800, 23200 patches), whose per-primitive test is ptp-pcnt (seed 001).
+// - backface/ptp_frame/bigguy_acc_s<levels>: one frame of the per-patch ptp-pcnt kernel (SIMD) on
+//   those patches, for the time the cluster tests stand against (items: frames).
 //
 // Run (numbers in the report of issue 11 / docs/PERFORMANCE.md):
 //   build-bf/bench/patchcull_bench --benchmark_filter='^backface/'
@@ -274,6 +276,31 @@ void BM_Hierarchy(benchmark::State& state, std::string mesh, double tcr) {
     state.counters["culled_per_primitive"] = by_primitive / n;
 }
 
+// The per-patch ptp-pcnt kernel (SIMD) on the same patches and eyes, per frame: what the
+// clusters' tests replace (a culled cluster's patches need no per-patch test).
+void BM_PtpFrame(benchmark::State& state, int splits) {
+    const LoadedModel& model = bigguy(splits);
+    const PatchBatch batch = make_batch(model.rest.patches);
+    const Bounds b = patch_bounds(model.rest);
+    const Mat4 proj = perspective(0.9f, 1.0f, 0.05f * b.radius(), 20 * b.radius());
+    std::vector<Mat4> views;
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<float> u(-1, 1);
+    for (int k = 0; k < 32; ++k) {
+        const Vec3 eye = b.center() + normalize(Vec3{u(rng), u(rng), u(rng)}) * (b.radius() * (2.0f + 2.0f * (k % 2)));
+        views.push_back(proj * look_at(eye, b.center(), {0, 1, 0}));
+    }
+    std::vector<std::uint8_t> out(batch.size());
+    std::size_t frame = 0;
+    for (auto _ : state) {
+        cull_ptp_simd(batch.view(), views[frame++ % views.size()], clip_space_eye_alpha(proj), PtpRule::pcnt, out.data());
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.SetItemsProcessed(state.iterations());
+    state.counters["patches"] = double(batch.size());
+    state.SetLabel(simd_target_name());
+}
+
 void BM_ClusterTest(benchmark::State& state) {
     HierarchyCase& c = hierarchy_case("bigguy_tess", 4.0);
     std::vector<BackfaceCluster> leaves;
@@ -305,6 +332,9 @@ const bool registered = [] {
             benchmark::RegisterBenchmark(("backface/hierarchy/" + std::string(mesh) + "/" + std::to_string(tcr)).c_str(),
                                          BM_Hierarchy, std::string(mesh), tcr)
                 ->Unit(benchmark::kMicrosecond);
+    for (int splits : {0, 1, 2})
+        benchmark::RegisterBenchmark(("backface/ptp_frame/bigguy_acc_s" + std::to_string(splits)).c_str(), BM_PtpFrame, splits)
+            ->Unit(benchmark::kMicrosecond);
     return true;
 }();
 
