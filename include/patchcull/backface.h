@@ -116,8 +116,8 @@ struct BackMask {
 /// of the sub-frustum (the eye is world_to_clip's projection centre; v_j = corner - eye), with
 /// a 1e-12 relative margin, in double precision. The test is exact for the cones: n . v is
 /// bilinear, so n = sum a_i n_i and v = sum b_j v_j (a, b >= 0) give n . v = sum a_i b_j
-/// n_i . v_j > 0, and a corner pair with n_i . v_j <= 0 is itself a class normal facing a ray of
-/// the sub-frustum. n . v > 0 is n . (p - eye) > 0: back-facing at every point on the ray.
+/// n_i . v_j > 0, and a corner pair with n_i . v_j <= 0 is itself a normal of the (grown) class
+/// facing a ray of the sub-frustum, so the test loses nothing beyond the growth and the margin. n . v > 0 is n . (p - eye) > 0: back-facing at every point on the ray.
 /// An orthographic world_to_clip (projection centre at infinity) uses its one view direction.
 /// A matrix that is singular, non-finite, or whose frustum corners lie behind its centre marks
 /// nothing (conservative).
