@@ -131,6 +131,10 @@ TEST(BackfaceClusters, CulledClustersHaveOnlyBackFacingMembers) {
                 ASSERT_FALSE(back && fr);
                 culled += back;
                 front += fr;
+                // The float test's margin: culled only inside the stored cluster's exact volume.
+                if (back) {
+                    ASSERT_LE(cluster_value(c, e), 0.0) << "culled outside the culling volume (rounding)";
+                }
                 for (std::size_t t = 0; t < m.triangles(); ++t) {
                     double mag;
                     const double f = facing(m, t, e, mag);
