@@ -24,11 +24,20 @@
 // (render_support.h scene_objects: one per instance) is culled with the tests of `all` (back-patch
 // only where applicable_cull_mode allows) or drawn whole, decided per frame from the measured pass
 // costs, its recent cull rate and its tessellation factor; "cull" is "auto" and every frame gains
-//   "objects":[{"name","patches","culling":"on"|"off","break_even","cull_rate"}]
+//   "auto_objects":[{"name","patches","culling":"on"|"off","break_even","cull_rate"}]
 // (break_even: x = (RT0 + CT) / (RT - RT0) at the object's tess factor, null until the costs are
 // measured or when there is no tessellation cost to save; cull_rate: the object's average rate the
 // decision used, null until measured). Without --json a line per frame says how many objects are
 // culled, and why each is on or off.
+// --objects frustum|bvh|bvh+backface (object_level_options.h, issue 11): the object level runs
+// before the patch passes (instances and environment objects; culled ones cost no patch work);
+// every frame gains
+//   "objects":{"total","frustum_culled","backface_culled","detail_culled","plane_tests",
+//              "bvh_nodes_visited","cluster_tests","patches_culled","triangles_culled",
+//              "backface_patches_culled"}
+// (with --verify also "false_culled_objects", "false_culled_triangles", "detail_pixels"), and
+// "false_culls" counts object-level false culls too (culled patches and environment triangles
+// in the unculled id buffer); --detail-cull's changes are reported as detail_pixels, not false culls.
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -39,6 +48,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "cull_auto.h"
+#include "object_level_options.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
 #include "render_support.h"
@@ -79,6 +89,7 @@ Runner add_render_command(CLI::App& app) {
         bool verify = false;
         std::string out;
         bool json = false;
+        ObjectLevelOptions objects;
     };
     auto state = std::make_shared<State>();
     CLI::App* command = app.add_subcommand("render", "Render an animated camera path with the GPU cull pipeline");
@@ -93,6 +104,7 @@ Runner add_render_command(CLI::App& app) {
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
     add_displace_options(*command, state->displace);
+    add_object_level_options(*command, state->objects);
     add_size_option(*command, "--size", state->size, "framebuffer size");
     command->add_flag("--aggressive", state->aggressive, "skip the second pass (seed 000 §3.1; not conservative)");
     command->add_flag("--verify", state->verify,
@@ -115,6 +127,7 @@ Runner add_render_command(CLI::App& app) {
         const gl::CullMode applied = applicable_cull_mode(scene, cull, "render");
         const bool backpatch_applied = (static_cast<std::uint32_t>(applied) & gl::kFlagBackPatch) != 0;
         const bool one_sided = scene_is_one_sided(scene);
+        ObjectLevelRun object_level(state->objects, scene, one_sided);  // before the occluders go up
 
         gl::GlContext context = gl::GlContext::create_headless();
         gl::CullPipeline pipeline(context);
@@ -122,7 +135,7 @@ Runner add_render_command(CLI::App& app) {
         const std::vector<BezierPatch>& first_pose = poser.pose(0);  // before pose_attributes reads it
         pipeline.set_patches(first_pose, pose_attributes(poser));
         pipeline.renderer().set_displacement_map(scene.displacement);
-        pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
+        upload_scene_occluders(pipeline.renderer(), scene);
         const std::vector<Camera> cameras = scene.camera_path(state->frames, float(width) / float(height));
         const std::vector<SceneObject> objects = scene_objects(scene);
         std::vector<gl::ObjectRange> ranges;
@@ -148,6 +161,7 @@ Runner add_render_command(CLI::App& app) {
             params.backpatch = backpatch;
             params.bound = displace_bound(state->displace);
             params.cone = displace_cone(state->displace);
+            object_level.apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height, params);
             if (automatic) {
                 policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
                 params.objects = policy.objects();
@@ -161,12 +175,16 @@ Runner add_render_command(CLI::App& app) {
                                  {"pass2", stats.pass2_ms}, {"total", stats.total_ms}};
             std::size_t false_culls = 0, depth_ties = 0;
             std::vector<std::uint32_t> false_culled;  // patch indices, ascending
+            ObjectVerification object_check;
             if (state->verify) {
                 const gl::FrameCapture culled = capture_culled_frame(pipeline.renderer());
                 const ReferenceFrame reference = render_reference(pipeline.renderer(), params.frame.render);
                 const gl::FrameComparison cmp = gl::compare_frames(reference.capture, culled);
-                false_culls = cmp.false_culled.size();
-                false_culled = cmp.false_culled;
+                // Patches culled by detail culling are not false culls (it is not conservative):
+                // they are reported as pixels changed.
+                object_check = object_level.verify(reference.capture.ids, cmp.false_culled);
+                false_culled = object_check.patch_false_culls;
+                false_culls = false_culled.size() + object_check.false_culled_triangles;
                 depth_ties = cmp.depth_ties;
                 ms["reference"] = reference.ms;
             }
@@ -184,7 +202,15 @@ Runner add_render_command(CLI::App& app) {
                               {"false_culls", false_culls},
                               {"depth_ties", depth_ties}});
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
-            if (automatic) frames.back()["objects"] = auto_objects_json(objects, policy.decisions());
+            if (automatic) frames.back()["auto_objects"] = auto_objects_json(objects, policy.decisions());
+            if (object_level.enabled()) {
+                nlohmann::json& o = frames.back()["objects"] = object_level.frame_json();
+                if (state->verify) {
+                    o["false_culled_objects"] = object_check.false_culled_objects;
+                    o["false_culled_triangles"] = object_check.false_culled_triangles;
+                    o["detail_pixels"] = object_check.detail_pixels;
+                }
+            }
             if (!state->json) {
                 std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
                             "(displaced %zu); ms pass1 %.1f hiz %.1f cull %.1f pass2 %.1f",
@@ -193,6 +219,14 @@ Runner add_render_command(CLI::App& app) {
                             stats.pass1_ms, stats.hiz_ms, stats.cull_ms, stats.pass2_ms);
                 if (state->verify) std::printf("; false culls %zu", false_culls);
                 std::printf("\n");
+                if (object_level.enabled()) {
+                    const ObjectCullStats& o = object_level.result().stats;
+                    std::printf("  objects (%s): %zu of %zu culled (frustum %zu, back-face %zu, detail %zu); %zu patches "
+                                "and %zu triangles skipped; %u plane tests, %u BVH nodes, %u cluster tests\n",
+                                object_level.method_name(), o.frustum_culled + o.backface_culled + o.detail_culled,
+                                o.total, o.frustum_culled, o.backface_culled, o.detail_culled, o.patches_culled,
+                                o.triangles_culled, o.plane_tests, o.bvh_nodes_visited, o.cluster_tests);
+                }
                 if (automatic) std::printf("%s\n", auto_summary_line(names, policy.decisions()).c_str());
             }
         }
@@ -212,6 +246,9 @@ Runner add_render_command(CLI::App& app) {
             out["displaced_patches"] = displaced_patch_count(poser);
             out["bound"] = state->displace.bound;
             out["cone"] = state->displace.cone;
+            out["objects_method"] = object_level.method_name();
+            out["detail_cull"] = state->objects.detail_pixels;
+            out["environment_objects"] = scene.environment.size();
             out["renderer"] = context.renderer();
             out["frames"] = frames;
             out["false_culls"] = total_false;

@@ -69,7 +69,7 @@ Runner add_view_command(CLI::App& app) {
         const std::vector<BezierPatch>& first_pose = poser.pose(0);  // before pose_attributes reads it
         pipeline.set_patches(first_pose, pose_attributes(poser));
         pipeline.renderer().set_displacement_map(scene.displacement);
-        pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
+        upload_scene_occluders(pipeline.renderer(), scene);
         // One lap of the camera path, repeated (the same cameras as `render --frames lap`).
         const int lap = state->frames > 0 ? state->frames : 72;
         const std::vector<Camera> cameras = scene.camera_path(lap, float(width) / float(height));

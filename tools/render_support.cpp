@@ -1,6 +1,8 @@
 // Helpers shared by the CLI's GPU commands (render_support.h).
 #include "render_support.h"
 
+#include "patchcull/scene_file.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -68,12 +70,23 @@ gl::PatchAttributes pose_attributes(const ScenePoser& poser) {
 Scene load_scene(const std::string& model, const std::string& scheme_text, int split) {
     Scheme scheme = Scheme::acc;
     if (!parse_scheme(scheme_text, scheme)) throw Error("--scheme: unknown scheme '" + scheme_text + "'");
-    if (model == "default" && split != 0)
-        throw Error("--split: not available for the default scene (its models are not split)");
-    const Scene scene = model == "default" ? make_default_scene(scheme) : make_model_scene(load_model(model, scheme, split));
+    const bool builtin = model == "default" || model == "city" || model == "building";
+    const bool file = model.size() > 5 && model.compare(model.size() - 5, 5, ".json") == 0;
+    if ((builtin || file) && split != 0)
+        throw Error("--split: not available for a scene (" + model + "); it splits a single model");
+    const Scene scene = builtin ? make_builtin_scene(model, scheme)
+                        : file  ? load_scene_file(model)
+                                : make_model_scene(load_model(model, scheme, split));
     for (const LoadedModel& m : scene.models)
         print_warnings(m.warnings);
     return scene;
+}
+
+void upload_scene_occluders(gl::PatchRenderer& renderer, const Scene& scene) {
+    std::vector<gl::TriangleSpan> one_sided;
+    for (const EnvironmentObject& e : scene.environment)
+        if (e.one_sided && e.triangle_count) one_sided.push_back({e.first_triangle, e.triangle_count});
+    renderer.set_occluders(scene.occluder_vertices, scene.occluder_indices, one_sided);
 }
 
 std::vector<SceneObject> scene_objects(const Scene& scene) {

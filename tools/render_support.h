@@ -48,10 +48,16 @@ gl::FrameComparison compare_with_reference(const gl::PatchRenderer& renderer, co
 /// refinement depths, and for a displaced scene the texcoords and displacement ranges.
 gl::PatchAttributes pose_attributes(const ScenePoser& poser);
 
-/// The scene of a MODEL argument: "default" (the default scene; split must be 0) or a model
-/// (OBJ path or "teapot") as make_model_scene places it. Prints the models' loader warnings.
-/// Throws patchcull::Error naming the flag or file.
+/// The scene of a MODEL argument: a built-in scene ("default", "city", "building";
+/// make_builtin_scene with --scheme), a scene file (a path ending in .json: load_scene_file, whose
+/// objects name their own schemes; --scheme is ignored), or a model (OBJ path or "teapot") as
+/// make_model_scene places it. --split applies to a model only. Prints the models' loader
+/// warnings. Throws patchcull::Error naming the flag or file.
 Scene load_scene(const std::string& model, const std::string& scheme_text, int split);
+
+/// PatchRenderer::set_occluders with the scene's occluders, the one-sided environment objects
+/// (EnvironmentObject::one_sided) drawn with back faces culled.
+void upload_scene_occluders(gl::PatchRenderer& renderer, const Scene& scene);
 
 /// One object of a scene for PipelineParams::objects: an instance's patches in the pose
 /// (ScenePoser's order: instance by instance, each in its model's order).

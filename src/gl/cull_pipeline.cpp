@@ -206,12 +206,19 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         if (at < end) out.push_back({at, end - at});
         return out;
     };
+    // Dispatch spans: an object (or gap) culled whole gets no pass; one with culled clusters
+    // inside is dispatched whole, its culled words pre-marked kCullObject so that every pass
+    // skips them (the chain's rule). Draws issue only the patches outside the culled spans.
     std::vector<std::vector<PatchSpan>> object_spans, gap_spans;
-    std::vector<PatchSpan> drawn;  // every active span (the draws)
-    for (const ObjectRange& o : objects) object_spans.push_back(active_spans(o));
-    for (const ObjectRange& g : gaps) gap_spans.push_back(active_spans(g));
-    for (const auto& list : {&object_spans, &gap_spans})
-        for (const std::vector<PatchSpan>& spans : *list) drawn.insert(drawn.end(), spans.begin(), spans.end());
+    std::vector<PatchSpan> drawn;
+    auto dispatch_spans = [&](const ObjectRange& o) {
+        std::vector<PatchSpan> active = active_spans(o);
+        drawn.insert(drawn.end(), active.begin(), active.end());
+        if (active.empty()) return std::vector<PatchSpan>{};
+        return std::vector<PatchSpan>{{o.first, o.count}};
+    };
+    for (const ObjectRange& o : objects) object_spans.push_back(dispatch_spans(o));
+    for (const ObjectRange& g : gaps) gap_spans.push_back(dispatch_spans(g));
     auto buffers_of = [&chain](const PatchSpan& s) {
         PatchBuffers b = chain;
         b.first = s.first;
@@ -227,8 +234,12 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     // The flag chain (gl_passes.h) per culled object, in three timed parts: begin + frustum,
     // back-patch, the rest.
     auto run_chain = [&](const HiZTexture* hiz) {
-        for (const PatchSpan& s : drawn) m.status.begin(buffers_of(s));
-        // The culled spans' words: kFlagObject, status cleared (a buffer clear, no pass).
+        for (const auto* list : {&object_spans, &gap_spans})
+            for (const std::vector<PatchSpan>& spans : *list)
+                for (const PatchSpan& s : spans) m.status.begin(buffers_of(s));
+        // The culled spans' words: kFlagObject, status cleared (a buffer clear after begin's
+        // shader writes, no pass).
+        if (!culled.empty()) glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         const std::uint32_t object_word = sh::kCullObject;
         for (const PatchSpan& s : culled)
             if (s.count)
@@ -303,7 +314,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         ObjectStats o;
         o.patches = objects[i].count;
         o.object_culled = objects[i].count;
-        for (const PatchSpan& s : object_spans[i]) o.object_culled -= s.count;
+        for (const PatchSpan& s : active_spans(objects[i])) o.object_culled -= s.count;
         o.frustum_culled = slot[sh::kCounterFrustum];
         o.backpatch_culled = slot[sh::kCounterBackPatch];
         o.occlusion_culled = slot[sh::kCounterOcclusion];

@@ -16,9 +16,10 @@ namespace {
 const std::set<std::string> kCoreHeaders = {"math.h", "patch.h", "mesh.h", "displacement.h", "camera.h",
                                             "frustum.h", "ground_truth.h", "parallel.h", "teapot.h", "error.h",
                                             "hiz.h", "cones.h", "backpatch.h", "displaced_bounds.h",
-                                            "clip_space.h"};
+                                            "clip_space.h", "bounding_volumes.h", "object_bvh.h", "backface.h",
+                                            "backface_clusters.h", "object_culling.h"};
 const std::set<std::string> kImportHeaders = {"obj.h", "subdivision.h", "image.h", "animation.h", "scene.h",
-                                              "default_scene.h"};
+                                              "default_scene.h", "scene_file.h", "scene_object_level.h"};
 
 std::vector<std::pair<std::string, std::string>> includes_under(const std::string& dir) {
     std::vector<std::pair<std::string, std::string>> found;

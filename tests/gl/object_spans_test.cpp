@@ -130,7 +130,8 @@ TEST(ObjectSpans, OneSidedOccludersShowOnlyTheirFront) {
     for (std::uint32_t id : r.read_ids()) EXPECT_EQ(id, 0u);
     r.set_occluders(v, idx);
     r.render(inside);
-    EXPECT_TRUE(std::any_of(r.read_ids().begin(), r.read_ids().end(), [](std::uint32_t id) { return id != 0; }));
+    const std::vector<std::uint32_t> walls = r.read_ids();
+    EXPECT_TRUE(std::any_of(walls.begin(), walls.end(), [](std::uint32_t id) { return id != 0; }));
     EXPECT_THROW(r.set_occluders(v, idx, {{10, 3}}), Error);
 }
 

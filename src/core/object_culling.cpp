@@ -1,0 +1,176 @@
+// The object level before patch culling (patchcull/object_culling.h).
+//
+// Order of the tests in one frame: the frustum test of every object (flat or BVH; both return,
+// object for object, classify_aabb's answer, so the method changes the cost and never the
+// decision), detail culling of the objects that remain (when asked for), then the clustered
+// back-face test of the remaining objects that have clusters. Culled spans are collected in
+// object order and sorted once (objects may list their spans in any order).
+#include "patchcull/object_culling.h"
+
+#include <algorithm>
+
+#include "patchcull/error.h"
+
+namespace patchcull {
+
+const char* object_cull_method_name(ObjectCullMethod method) {
+    switch (method) {
+        case ObjectCullMethod::none: return "none";
+        case ObjectCullMethod::frustum: return "frustum";
+        case ObjectCullMethod::bvh: return "bvh";
+        case ObjectCullMethod::bvh_backface: return "bvh+backface";
+    }
+    return "?";
+}
+
+bool parse_object_cull_method(const std::string& text, ObjectCullMethod& method) {
+    for (ObjectCullMethod m : {ObjectCullMethod::none, ObjectCullMethod::frustum, ObjectCullMethod::bvh,
+                               ObjectCullMethod::bvh_backface})
+        if (text == object_cull_method_name(m)) {
+            method = m;
+            return true;
+        }
+    return false;
+}
+
+namespace {
+
+void check_disjoint(const std::vector<CullableObject>& objects, bool triangles) {
+    std::vector<IndexSpan> spans;
+    for (const CullableObject& o : objects)
+        if (o.triangles == triangles && o.span.count) spans.push_back(o.span);
+    std::sort(spans.begin(), spans.end(), [](const IndexSpan& a, const IndexSpan& b) { return a.first < b.first; });
+    for (std::size_t i = 1; i < spans.size(); ++i)
+        if (spans[i].first < spans[i - 1].first + spans[i - 1].count)
+            throw Error(std::string("object level: two objects share ") + (triangles ? "triangle " : "patch ") +
+                        std::to_string(spans[i].first));
+}
+
+// Appends [first, first + count) to spans, merging with the last span when they touch.
+void append_span(std::vector<IndexSpan>& spans, std::size_t first, std::size_t count) {
+    if (count == 0) return;
+    if (!spans.empty() && spans.back().first + spans.back().count == first) {
+        spans.back().count += count;
+        return;
+    }
+    spans.push_back({first, count});
+}
+
+void sort_and_merge(std::vector<IndexSpan>& spans) {
+    std::sort(spans.begin(), spans.end(), [](const IndexSpan& a, const IndexSpan& b) { return a.first < b.first; });
+    std::size_t out = 0;
+    for (std::size_t i = 0; i < spans.size(); ++i) {
+        if (out > 0 && spans[out - 1].first + spans[out - 1].count == spans[i].first)
+            spans[out - 1].count += spans[i].count;
+        else
+            spans[out++] = spans[i];
+    }
+    spans.resize(out);
+}
+
+Vec3 transform_point(const Mat4& m, Vec3 p) { return cartesian(m * Vec4{p.x, p.y, p.z, 1.0f}); }
+
+}  // namespace
+
+ObjectCuller::ObjectCuller(std::vector<CullableObject> objects)
+    : objects_(std::move(objects)), clusters_(objects_.size()), object_space_(objects_.size(), 0),
+      flat_states_(objects_.size()), containment_(objects_.size()) {
+    check_disjoint(objects_, false);
+    check_disjoint(objects_, true);
+}
+
+void ObjectCuller::set_clusters(std::size_t object, ClusterHierarchy clusters, bool object_space) {
+    if (object >= objects_.size()) throw Error("object level: set_clusters: no object " + std::to_string(object));
+    const std::size_t members = objects_[object].span.count;
+    for (std::size_t leaf = 0; leaf < cluster_leaf_count(clusters); ++leaf) {
+        const BackfaceCluster& c = cluster_leaf(clusters, leaf);
+        if (c.first > members || c.count > members - c.first)
+            throw Error("object level: " + objects_[object].name + ": cluster [" + std::to_string(c.first) + ", +" +
+                        std::to_string(c.count) + ") leaves the object's " + std::to_string(members) + " members");
+    }
+    clusters_[object] = std::move(clusters);
+    object_space_[object] = object_space ? 1 : 0;
+}
+
+const ObjectCullResult& ObjectCuller::cull(const ObjectFrame& frame, const ObjectCullOptions& options) {
+    const std::size_t n = objects_.size();
+    ObjectCullResult& r = result_;
+    r.verdicts.assign(n, ObjectVerdict::visible);
+    r.culled_patches.clear();
+    r.culled_triangles.clear();
+    r.stats = {};
+    r.stats.total = n;
+    if (options.method == ObjectCullMethod::none || n == 0) return r;
+    if (!frame.boxes) throw Error("object level: cull: no object boxes");
+
+    // 1. Frustum: each object's AABB (flat list or BVH: the same answers).
+    const FrustumPlanes planes = make_frustum_planes(frame.world_to_clip, frame.depth);
+    ObjectBvh::Stats bvh_stats;
+    if (options.method == ObjectCullMethod::frustum) {
+        cull_objects_flat(planes, frame.boxes, n, flat_states_.data(), options.coherence, containment_.data(), bvh_stats);
+    } else {
+        if (!bvh_built_ || bvh_.object_count() != n) {
+            bvh_.build(frame.boxes, n);
+            bvh_built_ = true;
+        } else {
+            bvh_.refit(frame.boxes);
+        }
+        bvh_.cull(planes, {options.plane_masking, options.coherence}, containment_.data(), bvh_stats);
+    }
+    r.stats.plane_tests = bvh_stats.plane_tests;
+    r.stats.bvh_nodes_visited = bvh_stats.nodes_visited;
+    for (std::size_t i = 0; i < n; ++i)
+        if (containment_[i] == Containment::outside) r.verdicts[i] = ObjectVerdict::frustum;
+
+    // 2. Detail culling (not conservative), of the objects still in.
+    if (options.detail_min_pixels > 0)
+        for (std::size_t i = 0; i < n; ++i)
+            if (r.verdicts[i] == ObjectVerdict::visible &&
+                detail_culled(sphere_of_aabb(frame.boxes[i]), frame.eye, frame.pixel_scale, options.detail_min_pixels))
+                r.verdicts[i] = ObjectVerdict::detail;
+
+    // 3. Clustered back-face culling of the rest.
+    for (std::size_t i = 0; i < n; ++i) {
+        const CullableObject& o = objects_[i];
+        std::vector<IndexSpan>& culled = o.triangles ? r.culled_triangles : r.culled_patches;
+        if (r.verdicts[i] != ObjectVerdict::visible) {
+            append_span(culled, o.span.first, o.span.count);
+            continue;
+        }
+        if (options.method != ObjectCullMethod::bvh_backface || clusters_[i].nodes.empty()) continue;
+        const Vec3 eye = object_space_[i] && frame.world_to_cluster ? transform_point(frame.world_to_cluster[i], frame.eye)
+                                                                    : frame.eye;
+        const std::size_t leaves = cluster_leaf_count(clusters_[i]);
+        leaf_culled_.assign(leaves, 0);
+        cull_cluster_hierarchy(clusters_[i], eye, leaf_culled_.data(), r.stats.cluster_tests);
+        std::size_t culled_members = 0;
+        for (std::size_t leaf = 0; leaf < leaves; ++leaf) {
+            if (!leaf_culled_[leaf]) continue;
+            const BackfaceCluster& c = cluster_leaf(clusters_[i], leaf);
+            culled_members += c.count;
+        }
+        if (culled_members == o.span.count && o.span.count > 0) {
+            r.verdicts[i] = ObjectVerdict::backface;
+            append_span(culled, o.span.first, o.span.count);
+        } else {
+            for (std::size_t leaf = 0; leaf < leaves; ++leaf)
+                if (leaf_culled_[leaf]) {
+                    const BackfaceCluster& c = cluster_leaf(clusters_[i], leaf);
+                    culled.push_back({o.span.first + c.first, c.count});
+                }
+        }
+        if (!o.triangles) r.stats.backface_patches_culled += culled_members;
+    }
+    sort_and_merge(r.culled_patches);
+    sort_and_merge(r.culled_triangles);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (r.verdicts[i] == ObjectVerdict::frustum) ++r.stats.frustum_culled;
+        if (r.verdicts[i] == ObjectVerdict::backface) ++r.stats.backface_culled;
+        if (r.verdicts[i] == ObjectVerdict::detail) ++r.stats.detail_culled;
+    }
+    for (const IndexSpan& s : r.culled_patches) r.stats.patches_culled += s.count;
+    for (const IndexSpan& s : r.culled_triangles) r.stats.triangles_culled += s.count;
+    return r;
+}
+
+}  // namespace patchcull

@@ -1,0 +1,123 @@
+// The object level of a Scene (patchcull/scene_object_level.h).
+#include "patchcull/scene_object_level.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "patchcull/error.h"
+
+namespace patchcull {
+namespace {
+
+std::vector<CullableObject> scene_cullable_objects(const Scene& scene) {
+    std::vector<CullableObject> objects;
+    std::size_t first = 0;
+    for (const SceneInstance& instance : scene.instances) {
+        const std::size_t count = scene.models.at(instance.model).rest.patches.size();
+        objects.push_back({instance.name, false, {first, count}});
+        first += count;
+    }
+    for (const EnvironmentObject& e : scene.environment)
+        objects.push_back({e.name, true, {e.first_triangle, e.triangle_count}});
+    return objects;
+}
+
+}  // namespace
+
+SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
+    : scene_(&scene), culler_(scene_cullable_objects(scene)) {
+    std::size_t first = 0;
+    for (const SceneInstance& instance : scene.instances) {
+        instance_first_.push_back(first);
+        first += scene.models.at(instance.model).rest.patches.size();
+    }
+    const std::size_t instances = scene.instances.size();
+    boxes_.resize(culler_.object_count());
+    world_to_cluster_.assign(culler_.object_count(), Mat4{});
+
+    // Triangle clusters of the one-sided environment objects, their triangles reordered in place.
+    for (std::size_t e = 0; e < scene.environment.size(); ++e) {
+        const EnvironmentObject& object = scene.environment[e];
+        const std::size_t begin = 3 * std::size_t{object.first_triangle};
+        const std::size_t end = begin + 3 * std::size_t{object.triangle_count};
+        std::vector<Vec3> points;
+        for (std::size_t i = begin; i < end; ++i) points.push_back(scene.occluder_vertices.at(scene.occluder_indices[i]));
+        boxes_[instances + e] = aabb_of_points(points.data(), points.size());
+        if (!object.one_sided || object.triangle_count == 0) continue;
+        const std::vector<std::uint32_t> own(scene.occluder_indices.begin() + static_cast<std::ptrdiff_t>(begin),
+                                             scene.occluder_indices.begin() + static_cast<std::ptrdiff_t>(end));
+        ClusterHierarchy clusters =
+            build_triangle_clusters(scene.occluder_vertices, own, setup.tc_over_r, setup.max_leaf_triangles);
+        if (clusters.indices.size() != own.size())
+            throw Error("object level: " + object.name + ": the cluster builder lost triangles");
+        std::copy(clusters.indices.begin(), clusters.indices.end(),
+                  scene.occluder_indices.begin() + static_cast<std::ptrdiff_t>(begin));
+        culler_.set_clusters(instances + e, std::move(clusters), false);
+        ++clustered_;
+    }
+
+    // Patch clusters of rigid, undisplaced instances (one build per model, in model space).
+    if (!setup.patches_one_sided) return;
+    std::map<std::size_t, ClusterHierarchy> per_model;
+    for (std::size_t i = 0; i < instances; ++i) {
+        const SceneInstance& instance = scene.instances[i];
+        const bool displaced = instance.displaced && !scene.displacement.empty();
+        const LoadedModel& model = scene.models.at(instance.model);
+        if (instance.deforms && model.subdiv) continue;  // deforming: its tangent planes change every frame
+        if (displaced || model.rest.patches.empty()) continue;
+        auto it = per_model.find(instance.model);
+        if (it == per_model.end())
+            it = per_model
+                     .emplace(instance.model, build_patch_clusters(model.rest.patches.data(), model.rest.patches.size(),
+                                                                   setup.tc_over_r, setup.max_leaf_patches))
+                     .first;
+        culler_.set_clusters(i, it->second, true);
+        ++clustered_;
+        ++patch_clustered_;
+    }
+}
+
+const ObjectCullResult& SceneObjectLevel::cull(const std::vector<BezierPatch>& pose,
+                                               const std::vector<DisplacementRange>& ranges, float time_seconds,
+                                               const Camera& camera, int viewport_height,
+                                               const ObjectCullOptions& options) {
+    const Scene& scene = *scene_;
+    const std::size_t instances = scene.instances.size();
+    if (pose.size() != scene.patch_count())
+        throw Error("object level: the pose has " + std::to_string(pose.size()) + " patches, the scene " +
+                    std::to_string(scene.patch_count()));
+    if (options.method != ObjectCullMethod::none) {
+        std::vector<Vec3> points;
+        for (std::size_t i = 0; i < instances; ++i) {
+            const std::size_t first = instance_first_[i];
+            const std::size_t count = culler_.object(i).span.count;
+            points.clear();
+            float displacement = 0;
+            for (std::size_t p = first; p < first + count; ++p) {
+                for (const Vec4& c : pose[p].cp) points.push_back(cartesian(c));
+                if (!ranges.empty())
+                    displacement = std::max({displacement, std::fabs(ranges[p].d_min), std::fabs(ranges[p].d_max)});
+            }
+            Bounds box = aabb_of_points(points.data(), points.size());
+            if (displacement > 0) box = grow_bounds(box, displacement);  // rounded outwards
+            boxes_[i] = box;
+            if (culler_.has_clusters(i)) {
+                Mat4 inverse;
+                if (!invert(instance_to_world(scene.instances[i], time_seconds), inverse))
+                    throw Error("object level: " + scene.instances[i].name + ": its transform is singular");
+                world_to_cluster_[i] = inverse;
+            }
+        }
+    }
+    ObjectFrame frame;
+    frame.world_to_clip = camera.view_projection();
+    frame.depth = ClipDepth::zero_to_one;
+    frame.eye = camera.eye;
+    frame.boxes = boxes_.data();
+    frame.world_to_cluster = world_to_cluster_.data();
+    frame.pixel_scale = projection_pixel_scale(camera.fovy_radians, static_cast<float>(viewport_height));
+    return culler_.cull(frame, options);
+}
+
+}  // namespace patchcull

@@ -1,0 +1,114 @@
+// The object level in the CLI (object_level_options.h).
+#include "object_level_options.h"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+
+#include "cli_options.h"
+#include "patchcull/error.h"
+
+namespace patchcull::cli {
+
+void add_object_level_options(CLI::App& command, ObjectLevelOptions& options) {
+    add_choice_option(command, "--objects", options.method, {"none", "frustum", "bvh", "bvh+backface"},
+                      "object level before the patch passes: AABB frustum test (flat), through a BVH, and "
+                      "clustered back-face culling (seed 004)");
+    add_float_option(command, "--detail-cull", options.detail_pixels, 0, 1e6,
+                     "detail culling: cull objects whose bounding sphere covers fewer pixels (not conservative; "
+                     "0 = off; needs --objects)");
+}
+
+ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, bool patches_one_sided) {
+    if (!parse_object_cull_method(options.method, method_))
+        throw Error("--objects: unknown method '" + options.method + "'");
+    if (options.detail_pixels > 0 && method_ == ObjectCullMethod::none)
+        throw Error("--detail-cull: needs --objects frustum, bvh or bvh+backface");
+    options_.method = method_;
+    options_.detail_min_pixels = options.detail_pixels;
+    if (!enabled()) return;
+    ObjectLevelSetup setup;
+    setup.patches_one_sided = patches_one_sided;
+    level_ = std::make_unique<SceneObjectLevel>(scene, setup);
+}
+
+void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatch>& pose, float time_seconds,
+                           const Camera& camera, int viewport_height, gl::PipelineParams& params) {
+    params.object_culled.clear();
+    params.culled_occluders.clear();
+    if (!enabled()) return;
+    result_ = &level_->cull(pose, poser.displacement_ranges(), time_seconds, camera, viewport_height, options_);
+    for (const IndexSpan& s : result_->culled_patches) params.object_culled.push_back({s.first, s.count});
+    for (const IndexSpan& s : result_->culled_triangles) params.culled_occluders.push_back({s.first, s.count});
+}
+
+ObjectVerification ObjectLevelRun::verify(const std::vector<std::uint32_t>& reference_ids,
+                                          const std::vector<std::uint32_t>& patch_false_culls) const {
+    ObjectVerification v;
+    if (!enabled()) {
+        v.patch_false_culls = patch_false_culls;
+        return v;
+    }
+    const ObjectCuller& culler = level_->culler();
+    // Object of each patch / triangle index, by binary search over the object spans.
+    std::vector<std::pair<std::size_t, std::size_t>> patch_objects, triangle_objects;  // (first, object)
+    for (std::size_t i = 0; i < culler.object_count(); ++i)
+        (culler.object(i).triangles ? triangle_objects : patch_objects).push_back({culler.object(i).span.first, i});
+    std::sort(patch_objects.begin(), patch_objects.end());
+    std::sort(triangle_objects.begin(), triangle_objects.end());
+    auto object_of = [&](const std::vector<std::pair<std::size_t, std::size_t>>& table, std::size_t index) -> std::size_t {
+        auto it = std::upper_bound(table.begin(), table.end(), std::make_pair(index, ~std::size_t{0}));
+        if (it == table.begin()) return ~std::size_t{0};
+        const std::size_t object = std::prev(it)->second;
+        const IndexSpan& s = culler.object(object).span;
+        return index < s.first + s.count ? object : ~std::size_t{0};
+    };
+    auto culled = [](const std::vector<IndexSpan>& spans, std::size_t index) {
+        auto it = std::upper_bound(spans.begin(), spans.end(), index,
+                                   [](std::size_t i, const IndexSpan& s) { return i < s.first; });
+        return it != spans.begin() && index < std::prev(it)->first + std::prev(it)->count;
+    };
+    std::vector<std::uint8_t> false_object(culler.object_count(), 0);
+    std::vector<std::uint8_t> triangle_counted;  // per triangle index: already counted
+    const ObjectCullResult& r = *result_;
+    for (std::uint32_t id : reference_ids) {
+        if (id == 0) continue;
+        const bool triangle = (id & gl::kIdOccluderBit) != 0;
+        const std::size_t index = triangle ? (id & ~gl::kIdOccluderBit) : id - 1;
+        const std::size_t object = object_of(triangle ? triangle_objects : patch_objects, index);
+        if (object == ~std::size_t{0}) continue;
+        if (r.verdicts[object] == ObjectVerdict::detail) {
+            ++v.detail_pixels;
+            continue;
+        }
+        if (!triangle || !culled(r.culled_triangles, index)) continue;
+        false_object[object] = 1;
+        if (index >= triangle_counted.size()) triangle_counted.resize(index + 1, 0);
+        if (!triangle_counted[index]) ++v.false_culled_triangles;
+        triangle_counted[index] = 1;
+    }
+    for (std::uint32_t p : patch_false_culls) {
+        const std::size_t object = object_of(patch_objects, p);
+        if (object != ~std::size_t{0} && r.verdicts[object] == ObjectVerdict::detail) continue;
+        v.patch_false_culls.push_back(p);
+        if (object != ~std::size_t{0} && culled(r.culled_patches, p)) false_object[object] = 1;
+    }
+    for (std::uint8_t f : false_object) v.false_culled_objects += f;
+    return v;
+}
+
+nlohmann::json ObjectLevelRun::frame_json() const {
+    const ObjectCullStats& s = result_->stats;
+    return {{"total", s.total},
+            {"frustum_culled", s.frustum_culled},
+            {"backface_culled", s.backface_culled},
+            {"detail_culled", s.detail_culled},
+            {"plane_tests", s.plane_tests},
+            {"bvh_nodes_visited", s.bvh_nodes_visited},
+            {"cluster_tests", s.cluster_tests},
+            {"patches_culled", s.patches_culled},
+            {"triangles_culled", s.triangles_culled},
+            {"backface_patches_culled", s.backface_patches_culled}};
+}
+
+}  // namespace patchcull::cli
