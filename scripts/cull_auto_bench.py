@@ -45,7 +45,7 @@ def mean_total(result):
 
 def culled_objects(result):
     frames = result["frames"][1:]
-    return sum(sum(o["culling"] == "on" for o in f["objects"]) for f in frames) / len(frames)
+    return sum(sum(o["culling"] == "on" for o in f["auto_objects"]) for f in frames) / len(frames)
 
 
 def load():

@@ -292,8 +292,8 @@ TEST(CullAutoCli, JsonHasTheObjectsOfEveryFrameAndVerifiesWithoutFalseCulls) {
     std::size_t culled = 0;
     for (const auto& frame : j["frames"]) {
         EXPECT_EQ(frame["false_culls"], 0) << frame.dump();
-        ASSERT_TRUE(frame.contains("objects")) << frame.dump();
-        const auto& objects = frame["objects"];
+        ASSERT_TRUE(frame.contains("auto_objects")) << frame.dump();
+        const auto& objects = frame["auto_objects"];
         ASSERT_EQ(objects.size(), 6u);
         std::size_t patches = 0;
         for (const auto& o : objects) {
@@ -309,7 +309,7 @@ TEST(CullAutoCli, JsonHasTheObjectsOfEveryFrameAndVerifiesWithoutFalseCulls) {
         culled += frame["frustum_culled"].get<std::size_t>() + frame["occlusion_culled"].get<std::size_t>();
     }
     // Names in instance order; frame 0 probes every object (nothing measured yet).
-    const auto& first = j["frames"][0]["objects"];
+    const auto& first = j["frames"][0]["auto_objects"];
     EXPECT_EQ(first[0]["name"], "bigguy#0");
     EXPECT_EQ(first[1]["name"], "monsterfrog#0");
     EXPECT_EQ(first[5]["name"], "monsterfrog#2");
@@ -319,7 +319,7 @@ TEST(CullAutoCli, JsonHasTheObjectsOfEveryFrameAndVerifiesWithoutFalseCulls) {
         EXPECT_TRUE(o["break_even"].is_null());
         EXPECT_TRUE(o["cull_rate"].is_null());
     }
-    EXPECT_TRUE(j["frames"][1]["objects"][0]["cull_rate"].is_number());
+    EXPECT_TRUE(j["frames"][1]["auto_objects"][0]["cull_rate"].is_number());
     // Something was culled, so the verification compared culled frames.
     EXPECT_GT(culled, 0u);
 
@@ -333,7 +333,7 @@ TEST(CullAutoCli, JsonHasTheObjectsOfEveryFrameAndVerifiesWithoutFalseCulls) {
     // Other modes keep their frames as they were.
     const cli_test::CliRun all = cli_test::run("render default --size 96x54 --tess 4 --frames 1 --cull all --json");
     ASSERT_EQ(all.status, 0) << all.err;
-    EXPECT_FALSE(nlohmann::json::parse(all.out)["frames"][0].contains("objects"));
+    EXPECT_FALSE(nlohmann::json::parse(all.out)["frames"][0].contains("auto_objects"));
 }
 
 TEST(CullAutoCli, TextOutputHasOneAutoLinePerFrame) {
