@@ -17,6 +17,20 @@ void add_object_level_options(CLI::App& command, ObjectLevelOptions& options) {
     add_float_option(command, "--detail-cull", options.detail_pixels, 0, 1e6,
                      "detail culling: cull objects whose bounding sphere covers fewer pixels (not conservative; "
                      "0 = off; needs --objects)");
+    add_choice_option(command, "--plane-masking", options.plane_masking, {"on", "off"},
+                      "bvh: children test only the planes their parent straddles");
+    add_choice_option(command, "--plane-coherence", options.plane_coherence, {"on", "off"},
+                      "the plane that rejected a volume last frame is tried first");
+    add_choice_option(command, "--meta-bv", options.meta_bv, {"on", "off"},
+                      "test object boxes against the frustum's bounding sphere and box too");
+    add_choice_option(command, "--backface-triangles", options.backface_triangles, {"clusters", "masks", "triangles"},
+                      "bvh+backface on one-sided environment objects: cluster hierarchy, normal masks, or per triangle");
+    add_int_option(command, "--mask-sectors", options.mask_sectors, 1, 8,
+                   "normal masks: screen sectors per side (an object inside one uses that sector's mask)");
+    add_float_option(command, "--cluster-cost", options.cluster_cost, 0, 1e6,
+                     "tC/r of the triangle cluster hierarchy: a cluster test's cost in triangles drawn");
+    add_float_option(command, "--patch-cluster-cost", options.patch_cluster_cost, 0, 1e6,
+                     "tC/r of the patch cluster hierarchy: a cluster test's cost in patches drawn");
 }
 
 ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, bool patches_one_sided) {
@@ -26,9 +40,17 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
         throw Error("--detail-cull: needs --objects frustum, bvh or bvh+backface");
     options_.method = method_;
     options_.detail_min_pixels = options.detail_pixels;
+    options_.plane_masking = options.plane_masking == "on";
+    options_.coherence = options.plane_coherence == "on";
+    options_.meta_bvs = options.meta_bv == "on";
+    if (!parse_triangle_backface(options.backface_triangles, options_.triangle_backface))
+        throw Error("--backface-triangles: unknown variant '" + options.backface_triangles + "'");
+    options_.mask_sectors = options.mask_sectors;
     if (!enabled()) return;
     ObjectLevelSetup setup;
     setup.patches_one_sided = patches_one_sided;
+    setup.tc_over_r = options.cluster_cost;
+    setup.patch_tc_over_r = options.patch_cluster_cost;
     level_ = std::make_unique<SceneObjectLevel>(scene, setup);
 }
 
@@ -108,7 +130,9 @@ nlohmann::json ObjectLevelRun::frame_json() const {
             {"cluster_tests", s.cluster_tests},
             {"patches_culled", s.patches_culled},
             {"triangles_culled", s.triangles_culled},
-            {"backface_patches_culled", s.backface_patches_culled}};
+            {"backface_patches_culled", s.backface_patches_culled},
+            {"triangle_tests", s.triangle_tests},
+            {"meta_rejected", s.meta_rejected}};
 }
 
 }  // namespace patchcull::cli

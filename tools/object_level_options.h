@@ -23,6 +23,13 @@ namespace patchcull::cli {
 struct ObjectLevelOptions {
     std::string method = "none";
     float detail_pixels = 0;  ///< 0: off
+    std::string plane_masking = "on";
+    std::string plane_coherence = "on";
+    std::string meta_bv = "off";
+    std::string backface_triangles = "clusters";
+    int mask_sectors = 1;
+    float cluster_cost = 1;          ///< tC/r of triangle clusters
+    float patch_cluster_cost = 0.05f;  ///< tC/r of patch clusters
 };
 void add_object_level_options(CLI::App& command, ObjectLevelOptions& options);
 

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "patchcull/backface.h"
 #include "patchcull/backface_clusters.h"
 #include "patchcull/bounding_volumes.h"
 #include "patchcull/clip_space.h"
@@ -75,10 +76,27 @@ struct ObjectFrame {
     float pixel_scale = 1;
 };
 
+/// How bvh_backface tests the triangles of a one-sided triangle object that survived the frustum.
+enum class TriangleBackface : std::uint8_t {
+    clusters,      ///< the object's cluster hierarchy (Johannsen & Carter)
+    normal_masks,  ///< each triangle's normal class against the frame's back mask (Zhang & Hoff)
+    per_triangle,  ///< each triangle's own test (cull_backfacing_triangles_simd)
+};
+/// "clusters", "masks", "triangles".
+const char* triangle_backface_name(TriangleBackface t);
+bool parse_triangle_backface(const std::string& text, TriangleBackface& t);
+
 struct ObjectCullOptions {
     ObjectCullMethod method = ObjectCullMethod::none;
     bool plane_masking = true;  ///< bvh: children test only the planes their parent straddles
     bool coherence = true;      ///< the plane that rejected a volume last frame is tried first
+    /// Meta-BVs: before its planes, a volume is tested against the frustum's bounding sphere
+    /// and box (meta_rejects; it can only reject more, also conservatively). frustum and bvh.
+    bool meta_bvs = false;
+    TriangleBackface triangle_backface = TriangleBackface::clusters;
+    /// normal_masks: screen sectors per side (1: one mask for the frustum); an object whose box
+    /// projects into one sector uses that sector's tighter mask.
+    int mask_sectors = 1;
     /// Detail culling (not conservative): objects whose bounding sphere projects to less than
     /// this many pixels of area are culled; 0 (default) turns it off.
     float detail_min_pixels = 0;
@@ -93,6 +111,8 @@ struct ObjectCullStats {
     std::uint32_t plane_tests = 0;    ///< frustum planes evaluated (nodes and objects)
     std::uint32_t bvh_nodes_visited = 0;  ///< BVH nodes tested (the flat list: objects tested)
     std::uint32_t cluster_tests = 0;      ///< back-face cluster tests (hierarchies: nodes tested)
+    std::size_t triangle_tests = 0;       ///< per-triangle tests or normal-mask lookups
+    std::uint32_t meta_rejected = 0;      ///< objects rejected by the meta-BVs
     std::size_t patches_culled = 0;       ///< patches in culled spans (no patch test runs on them)
     std::size_t triangles_culled = 0;     ///< triangles in culled spans
     std::size_t backface_patches_culled = 0;  ///< of patches_culled: in back-facing clusters
@@ -126,6 +146,11 @@ public:
     /// True when set_clusters gave the object clusters.
     bool has_clusters(std::size_t i) const { return !clusters_[i].nodes.empty(); }
 
+    /// The triangles the triangle objects' spans index (world space, as drawn: after any cluster
+    /// reordering), for the normal_masks and per_triangle variants; their normal classes are
+    /// computed here once. Only objects with clusters (the one-sided ones) are back-face tested.
+    void set_triangle_mesh(std::vector<Vec3> vertices, std::vector<std::uint32_t> indices);
+
     /// One frame. Allocates only on the first call and when the result grows.
     const ObjectCullResult& cull(const ObjectFrame& frame, const ObjectCullOptions& options);
 
@@ -138,6 +163,14 @@ private:
     bool bvh_built_ = false;
     std::vector<Containment> containment_;
     std::vector<std::uint8_t> leaf_culled_;
+    std::vector<Vec3> mesh_vertices_;
+    std::vector<std::uint32_t> mesh_indices_;
+    NormalMaskGrid mask_grid_{16};
+    std::vector<std::uint16_t> triangle_classes_;
+    std::vector<BackMask> masks_;  // [0]: the frustum; then sectors x sectors
+    std::vector<std::uint8_t> triangle_culled_;
+    std::size_t cull_triangles_individually(std::size_t object, const ObjectFrame& frame, const ObjectCullOptions& options,
+                                     std::vector<IndexSpan>& culled);
     ObjectCullResult result_;
 };
 

@@ -30,8 +30,13 @@ struct ObjectLevelSetup {
     /// may cull. False: only one-sided environment objects get clusters.
     bool patches_one_sided = false;
     /// Cost of one cluster test over the cost of drawing one primitive (the merge criterion
-    /// P(C) > (tC/r + P(A) nA + P(B) nB) / (nA + nB)); measured in docs/PERFORMANCE.md.
-    double tc_over_r = 4.0;
+    /// P(C) > (P(A) nA + P(B) nB - tC/r) / (nA + nB), backface_clusters.h). 1: a cluster test
+    /// costs about one triangle drawn; at 4 a box building's faces merge into one cluster that
+    /// never culls (docs/PERFORMANCE.md).
+    double tc_over_r = 1.0;
+    /// The same for patch clusters: a patch costs far more to draw than a cluster test (it is
+    /// tessellated), so clusters stay small (backface_clusters.h: 0.01-0.1 keep most of ptp's culls).
+    double patch_tc_over_r = 0.05;
     unsigned max_leaf_triangles = 64;
     unsigned max_leaf_patches = 32;
 };

@@ -33,6 +33,24 @@ bool parse_object_cull_method(const std::string& text, ObjectCullMethod& method)
     return false;
 }
 
+const char* triangle_backface_name(TriangleBackface t) {
+    switch (t) {
+        case TriangleBackface::clusters: return "clusters";
+        case TriangleBackface::normal_masks: return "masks";
+        case TriangleBackface::per_triangle: return "triangles";
+    }
+    return "?";
+}
+
+bool parse_triangle_backface(const std::string& text, TriangleBackface& t) {
+    for (TriangleBackface v : {TriangleBackface::clusters, TriangleBackface::normal_masks, TriangleBackface::per_triangle})
+        if (text == triangle_backface_name(v)) {
+            t = v;
+            return true;
+        }
+    return false;
+}
+
 namespace {
 
 void check_disjoint(const std::vector<CullableObject>& objects, bool triangles) {
@@ -92,6 +110,58 @@ void ObjectCuller::set_clusters(std::size_t object, ClusterHierarchy clusters, b
     object_space_[object] = object_space ? 1 : 0;
 }
 
+void ObjectCuller::set_triangle_mesh(std::vector<Vec3> vertices, std::vector<std::uint32_t> indices) {
+    if (indices.size() % 3 != 0) throw Error("object level: set_triangle_mesh: indices not a multiple of 3");
+    for (std::uint32_t i : indices)
+        if (i >= vertices.size()) throw Error("object level: set_triangle_mesh: index " + std::to_string(i) + " out of range");
+    for (const CullableObject& o : objects_)
+        if (o.triangles && o.span.first + o.span.count > indices.size() / 3)
+            throw Error("object level: " + o.name + ": its triangles leave the mesh");
+    mesh_vertices_ = std::move(vertices);
+    mesh_indices_ = std::move(indices);
+    triangle_classes_.resize(mesh_indices_.size() / 3);
+    mask_grid_.classify_triangles(mesh_vertices_.data(), mesh_indices_.data(), triangle_classes_.size(),
+                                  triangle_classes_.data());
+}
+
+// The normal-mask or per-triangle back-face test of one triangle object: runs of culled
+// triangles become spans. Returns the triangles culled.
+std::size_t ObjectCuller::cull_triangles_individually(std::size_t object, const ObjectFrame& frame,
+                                               const ObjectCullOptions& options, std::vector<IndexSpan>& culled) {
+    const IndexSpan span = objects_[object].span;
+    if (span.count == 0 || mesh_indices_.size() < 3 * (span.first + span.count)) return 0;
+    triangle_culled_.resize(span.count);
+    if (options.triangle_backface == TriangleBackface::per_triangle) {
+        cull_backfacing_triangles_simd(mesh_vertices_.data(), mesh_indices_.data() + 3 * span.first, span.count, frame.eye,
+                                       triangle_culled_.data());
+    } else {
+        // The sector mask when the object's box projects into one sector (every corner in
+        // front of the eye and in that sector: then every triangle has a point there), else the
+        // whole frustum's.
+        const int sectors = std::max(1, options.mask_sectors);
+        std::size_t mask = 0;
+        if (sectors > 1) {
+            const Bounds& b = frame.boxes[object];
+            int sector = -2;
+            for (int k = 0; k < 8 && sector != -1; ++k) {
+                const Vec3 corner{(k & 1) ? b.max.x : b.min.x, (k & 2) ? b.max.y : b.min.y, (k & 4) ? b.max.z : b.min.z};
+                const int s = sector_of_point(frame.world_to_clip, corner, sectors);
+                sector = (sector == -2 || sector == s) ? s : -1;
+            }
+            if (sector >= 0) mask = 1 + static_cast<std::size_t>(sector);
+        }
+        cull_by_normal_mask_simd(triangle_classes_.data() + span.first, span.count, masks_[mask], triangle_culled_.data());
+    }
+    result_.stats.triangle_tests += span.count;
+    std::size_t count = 0;
+    for (std::size_t t = 0; t < span.count; ++t)
+        if (triangle_culled_[t]) {
+            append_span(culled, span.first + t, 1);
+            ++count;
+        }
+    return count;
+}
+
 const ObjectCullResult& ObjectCuller::cull(const ObjectFrame& frame, const ObjectCullOptions& options) {
     const std::size_t n = objects_.size();
     ObjectCullResult& r = result_;
@@ -121,6 +191,28 @@ const ObjectCullResult& ObjectCuller::cull(const ObjectFrame& frame, const Objec
     r.stats.bvh_nodes_visited = bvh_stats.nodes_visited;
     for (std::size_t i = 0; i < n; ++i)
         if (containment_[i] == Containment::outside) r.verdicts[i] = ObjectVerdict::frustum;
+    // Meta-BVs: the frustum's bounding sphere and box reject what the planes' n/p-vertex test
+    // calls intersecting beyond a frustum edge (the lecture's false negatives).
+    if (options.meta_bvs) {
+        const FrustumMetaBounds meta = frustum_meta_bounds(frame.world_to_clip, frame.depth);
+        for (std::size_t i = 0; i < n; ++i)
+            if (r.verdicts[i] == ObjectVerdict::visible && meta_rejects(meta, frame.boxes[i])) {
+                r.verdicts[i] = ObjectVerdict::frustum;
+                ++r.stats.meta_rejected;
+            }
+    }
+    const bool individual = options.method == ObjectCullMethod::bvh_backface &&
+                            options.triangle_backface != TriangleBackface::clusters && !mesh_indices_.empty();
+    if (individual && options.triangle_backface == TriangleBackface::normal_masks) {
+        const int sectors = std::max(1, options.mask_sectors);
+        masks_.resize(1 + static_cast<std::size_t>(sectors > 1 ? sectors * sectors : 0));
+        make_back_mask(mask_grid_, frame.world_to_clip, frame.depth, 0, 0, 1, masks_[0]);
+        if (sectors > 1)
+            for (int y = 0; y < sectors; ++y)
+                for (int x = 0; x < sectors; ++x)
+                    make_back_mask(mask_grid_, frame.world_to_clip, frame.depth, x, y, sectors,
+                                   masks_[1 + static_cast<std::size_t>(y * sectors + x)]);
+    }
 
     // 2. Detail culling (not conservative), of the objects still in.
     if (options.detail_min_pixels > 0)
@@ -138,6 +230,10 @@ const ObjectCullResult& ObjectCuller::cull(const ObjectFrame& frame, const Objec
             continue;
         }
         if (options.method != ObjectCullMethod::bvh_backface || clusters_[i].nodes.empty()) continue;
+        if (o.triangles && individual) {
+            if (cull_triangles_individually(i, frame, options, culled) == o.span.count) r.verdicts[i] = ObjectVerdict::backface;
+            continue;
+        }
         const Vec3 eye = object_space_[i] && frame.world_to_cluster ? transform_point(frame.world_to_cluster[i], frame.eye)
                                                                     : frame.eye;
         const std::size_t leaves = cluster_leaf_count(clusters_[i]);

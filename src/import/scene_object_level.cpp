@@ -57,6 +57,8 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
         ++clustered_;
     }
 
+    culler_.set_triangle_mesh(scene.occluder_vertices, scene.occluder_indices);  // as reordered
+
     // Patch clusters of rigid, undisplaced instances (one build per model, in model space).
     if (!setup.patches_one_sided) return;
     std::map<std::size_t, ClusterHierarchy> per_model;
@@ -70,7 +72,7 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
         if (it == per_model.end())
             it = per_model
                      .emplace(instance.model, build_patch_clusters(model.rest.patches.data(), model.rest.patches.size(),
-                                                                   setup.tc_over_r, setup.max_leaf_patches))
+                                                                   setup.patch_tc_over_r, setup.max_leaf_patches))
                      .first;
         culler_.set_clusters(i, it->second, true);
         ++clustered_;
