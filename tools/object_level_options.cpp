@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <cmath>
 
 #include "cli_options.h"
 #include "patchcull/error.h"
@@ -61,6 +62,20 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
     if (!enabled()) return;
     result_ = &level_->cull(pose, poser.displacement_ranges(), time_seconds, camera, viewport_height, options_);
     for (const IndexSpan& s : result_->culled_patches) params.object_culled.push_back({s.first, s.count});
+    // The CPU path after the object level (object_culling.h): the frustum kernel on the patches
+    // left, to report the patch tests an object cull saves there too.
+    const PatchBatch batch = make_batch(pose);
+    const std::vector<DisplacementRange>& ranges = poser.displacement_ranges();
+    cpu_margins_.assign(ranges.empty() ? 0 : pose.size(), 0.0f);
+    for (std::size_t i = 0; i < cpu_margins_.size(); ++i)
+        cpu_margins_[i] = std::max(std::fabs(ranges[i].d_min), std::fabs(ranges[i].d_max));
+    cpu_culled_.assign(pose.size(), 0);
+    cpu_patch_tests_ = cull_frustum_after_objects(
+        *result_, batch.view(), cpu_margins_.empty() ? nullptr : cpu_margins_.data(),
+        make_frustum_planes(camera.view_projection(), ClipDepth::zero_to_one), cpu_culled_.data());
+    cpu_frustum_culled_ = 0;
+    for (std::uint8_t c : cpu_culled_) cpu_frustum_culled_ += c;
+    cpu_frustum_culled_ -= result_->stats.patches_culled;
     for (const IndexSpan& s : result_->culled_triangles) params.culled_occluders.push_back({s.first, s.count});
 }
 
@@ -132,7 +147,9 @@ nlohmann::json ObjectLevelRun::frame_json() const {
             {"triangles_culled", s.triangles_culled},
             {"backface_patches_culled", s.backface_patches_culled},
             {"triangle_tests", s.triangle_tests},
-            {"meta_rejected", s.meta_rejected}};
+            {"meta_rejected", s.meta_rejected},
+            {"cpu_patch_tests", cpu_patch_tests_},
+            {"cpu_frustum_culled", cpu_frustum_culled_}};
 }
 
 }  // namespace patchcull::cli

@@ -64,7 +64,9 @@ public:
                               const std::vector<std::uint32_t>& patch_false_culls) const;
     /// The per-frame "objects" JSON: {"total","frustum_culled","backface_culled","detail_culled",
     /// "plane_tests","bvh_nodes_visited","cluster_tests","patches_culled","triangles_culled",
-    /// "backface_patches_culled"}.
+    /// "backface_patches_culled","triangle_tests","meta_rejected","cpu_patch_tests",
+    /// "cpu_frustum_culled"} (cpu_*: the CPU frustum kernel run on the patches the object level
+    /// left, cull_frustum_after_objects: the patch tests it ran and the patches it culled).
     nlohmann::json frame_json() const;
 
 private:
@@ -72,6 +74,9 @@ private:
     ObjectCullOptions options_;
     std::unique_ptr<SceneObjectLevel> level_;
     ObjectCullResult empty_;
+    std::vector<float> cpu_margins_;
+    std::vector<std::uint8_t> cpu_culled_;
+    std::size_t cpu_patch_tests_ = 0, cpu_frustum_culled_ = 0;  // the CPU frustum kernel after the object level
     const ObjectCullResult* result_ = &empty_;
 };
 

@@ -28,6 +28,7 @@
 #include "patchcull/backface_clusters.h"
 #include "patchcull/bounding_volumes.h"
 #include "patchcull/clip_space.h"
+#include "patchcull/frustum.h"
 #include "patchcull/math.h"
 #include "patchcull/mesh.h"
 #include "patchcull/object_bvh.h"
@@ -185,5 +186,13 @@ void for_each_active_span(const std::vector<IndexSpan>& culled, std::size_t tota
     }
     if (at < total) visit(at, total - at);
 }
+
+/// The CPU patch level after the object level: the frustum kernel (cull_frustum_simd) runs on the
+/// patches outside result.culled_patches only; culled[i] = 1 for the patches of culled spans and
+/// for those the kernel culls, else 0. max_displacement: null or one value >= 0 per patch. Returns
+/// the patches the kernel tested (patches.count minus the culled spans'). Never allocates.
+std::size_t cull_frustum_after_objects(const ObjectCullResult& result, const PatchBatchView& patches,
+                                       const float* max_displacement, const FrustumPlanes& planes,
+                                       std::uint8_t* culled);
 
 }  // namespace patchcull

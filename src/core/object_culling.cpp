@@ -269,4 +269,20 @@ const ObjectCullResult& ObjectCuller::cull(const ObjectFrame& frame, const Objec
     return r;
 }
 
+std::size_t cull_frustum_after_objects(const ObjectCullResult& result, const PatchBatchView& patches,
+                                       const float* max_displacement, const FrustumPlanes& planes,
+                                       std::uint8_t* culled) {
+    for (const IndexSpan& s : result.culled_patches) {
+        const std::size_t end = std::min(patches.count, s.first + s.count);
+        for (std::size_t i = s.first; i < end; ++i) culled[i] = 1;
+    }
+    std::size_t tested = 0;
+    for_each_active_span(result.culled_patches, patches.count, [&](std::size_t first, std::size_t count) {
+        cull_frustum_simd(patches.subrange(first, count), max_displacement ? max_displacement + first : nullptr, planes,
+                          culled + first);
+        tested += count;
+    });
+    return tested;
+}
+
 }  // namespace patchcull
