@@ -13,6 +13,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "cull_auto.h"
+#include "object_level_options.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
 #include "render_support.h"
@@ -32,10 +33,11 @@ Runner add_view_command(CLI::App& app) {
         DisplaceOptions displace;
         std::string size = "960x540";
         std::string screenshot;
+        ObjectLevelOptions objects;
     };
     auto state = std::make_shared<State>();
     CLI::App* command = app.add_subcommand("view", "Show the GPU cull pipeline in a window (GLFW)");
-    add_text_option(*command, "MODEL", state->model, "OBJ control mesh, 'teapot', or 'default' (the default scene)");
+    add_text_option(*command, "MODEL", state->model, "OBJ control mesh, 'teapot', a built-in scene ('default', 'city', 'building') or a scene file (.json)");
     add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 0, 1000000,
@@ -47,6 +49,7 @@ Runner add_view_command(CLI::App& app) {
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
     add_displace_options(*command, state->displace);
+    add_object_level_options(*command, state->objects);
     add_size_option(*command, "--size", state->size, "window size");
     add_output_file_option(*command, "--screenshot", state->screenshot,
                            "after the last frame, write the window's content as a PNG");
@@ -62,6 +65,7 @@ Runner add_view_command(CLI::App& app) {
         apply_displace_options(state->displace, scene);
         const TessMode tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         const gl::CullMode applied = applicable_cull_mode(scene, cull, "view");
+        ObjectLevelRun object_level(state->objects, scene, scene_is_one_sided(scene));  // before the occluders go up
 
         gl::GlContext context = gl::GlContext::create_window(width, height, "patchcull view: " + scene.name);
         gl::CullPipeline pipeline(context);
@@ -92,6 +96,8 @@ Runner add_view_command(CLI::App& app) {
             params.backpatch = backpatch;
             params.bound = displace_bound(state->displace);
             params.cone = displace_cone(state->displace);
+            object_level.apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f % lap)], height,
+                               params);
             if (automatic) {
                 policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
                 params.objects = policy.objects();
@@ -109,6 +115,11 @@ Runner add_view_command(CLI::App& app) {
                         stats.backpatch_culled, stats.occlusion_culled, stats.displaced_occlusion_culled,
                         stats.total_ms);
             if (automatic) std::printf("%s\n", auto_summary_line(names, policy.decisions()).c_str());
+            if (object_level.enabled())
+                std::printf("  objects (%s): %zu frustum-culled, %zu back-face-culled of %zu; %zu patches skipped\n",
+                            object_level.method_name(), object_level.result().stats.frustum_culled,
+                            object_level.result().stats.backface_culled, object_level.result().stats.total,
+                            object_level.result().stats.patches_culled);
         }
         return 0;
     };
