@@ -24,6 +24,8 @@ void add_object_level_options(CLI::App& command, ObjectLevelOptions& options) {
                       "the plane that rejected a volume last frame is tried first");
     add_choice_option(command, "--meta-bv", options.meta_bv, {"on", "off"},
                       "test object boxes against the frustum's bounding sphere and box too");
+    add_choice_option(command, "--object-volume", options.volume, {"aabb", "sphere", "obb"},
+                      "after the AABB test (flat or BVH), also test each object's sphere or PCA OBB");
     add_choice_option(command, "--backface-triangles", options.backface_triangles, {"clusters", "masks", "triangles"},
                       "bvh+backface on one-sided environment objects: cluster hierarchy, normal masks, or per triangle");
     add_int_option(command, "--mask-sectors", options.mask_sectors, 1, 8,
@@ -44,6 +46,8 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
     options_.plane_masking = options.plane_masking == "on";
     options_.coherence = options.plane_coherence == "on";
     options_.meta_bvs = options.meta_bv == "on";
+    if (!parse_object_volume(options.volume, options_.volume))
+        throw Error("--object-volume: unknown volume '" + options.volume + "'");
     if (!parse_triangle_backface(options.backface_triangles, options_.triangle_backface))
         throw Error("--backface-triangles: unknown variant '" + options.backface_triangles + "'");
     options_.mask_sectors = options.mask_sectors;
@@ -148,6 +152,7 @@ nlohmann::json ObjectLevelRun::frame_json() const {
             {"backface_patches_culled", s.backface_patches_culled},
             {"triangle_tests", s.triangle_tests},
             {"meta_rejected", s.meta_rejected},
+            {"volume_rejected", s.volume_rejected},
             {"cpu_patch_tests", cpu_patch_tests_},
             {"cpu_frustum_culled", cpu_frustum_culled_}};
 }

@@ -26,6 +26,7 @@ struct ObjectLevelOptions {
     std::string plane_masking = "on";
     std::string plane_coherence = "on";
     std::string meta_bv = "off";
+    std::string volume = "aabb";
     std::string backface_triangles = "clusters";
     int mask_sectors = 1;
     float cluster_cost = 1;          ///< tC/r of triangle clusters

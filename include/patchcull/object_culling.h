@@ -75,7 +75,19 @@ struct ObjectFrame {
     const Mat4* world_to_cluster = nullptr;
     /// Pixels per unit of tan(angle) (projection_pixel_scale), for detail culling.
     float pixel_scale = 1;
+    /// Per object, for ObjectCullOptions::volume sphere / obb (holding everything it draws); may
+    /// be null when that volume is not asked for.
+    const Sphere* spheres = nullptr;
+    const Obb* obbs = nullptr;
 };
+
+/// The bounding volume an object is tested with after its AABB (flat list or BVH) left it in:
+/// the object is culled when either volume is outside (both hold it, so both tests are
+/// conservative and together tighter).
+enum class ObjectVolume : std::uint8_t { aabb, sphere, obb };
+/// "aabb", "sphere", "obb".
+const char* object_volume_name(ObjectVolume v);
+bool parse_object_volume(const std::string& text, ObjectVolume& v);
 
 /// How bvh_backface tests the triangles of a one-sided triangle object that survived the frustum.
 enum class TriangleBackface : std::uint8_t {
@@ -94,6 +106,7 @@ struct ObjectCullOptions {
     /// Meta-BVs: before its planes, a volume is tested against the frustum's bounding sphere
     /// and box (meta_rejects; it can only reject more, also conservatively). frustum and bvh.
     bool meta_bvs = false;
+    ObjectVolume volume = ObjectVolume::aabb;
     TriangleBackface triangle_backface = TriangleBackface::clusters;
     /// normal_masks: screen sectors per side (1: one mask for the frustum); an object whose box
     /// projects into one sector uses that sector's tighter mask.
@@ -114,6 +127,7 @@ struct ObjectCullStats {
     std::uint32_t cluster_tests = 0;      ///< back-face cluster tests (hierarchies: nodes tested)
     std::size_t triangle_tests = 0;       ///< per-triangle tests or normal-mask lookups
     std::uint32_t meta_rejected = 0;      ///< objects rejected by the meta-BVs
+    std::uint32_t volume_rejected = 0;    ///< objects the sphere / OBB rejected after the AABB
     std::size_t patches_culled = 0;       ///< patches in culled spans (no patch test runs on them)
     std::size_t triangles_culled = 0;     ///< triangles in culled spans
     std::size_t backface_patches_culled = 0;  ///< of patches_culled: in back-facing clusters

@@ -5,7 +5,9 @@
 // - Boxes: an instance's box is the AABB of its posed control points (the convex hull holds the
 //   surface and every tessellated triangle), grown by the largest |D| of its displaced patches
 //   (a displaced vertex moves by at most that along the unit normal), recomputed every frame; an
-//   environment object's box is the AABB of its triangles, fixed.
+//   environment object's box is the AABB of its triangles, fixed. With ObjectCullOptions::volume
+//   sphere or obb, the same points give a sphere (sphere_of_points) or a PCA OBB
+//   (obb_of_points), grown by |D| alike, recomputed every frame.
 // - Clusters (Johannsen & Carter's clustered back-face culling, G. Zachmann's lecture "Advanced
 //   Visibility Computations"): for every one-sided environment object, triangle clusters in world
 //   space (the object's triangles are reordered in Scene::occluder_indices so that each cluster
@@ -66,6 +68,8 @@ private:
     ObjectCuller culler_;
     std::vector<std::size_t> instance_first_;  // first patch of each instance
     std::vector<Bounds> boxes_;
+    std::vector<Sphere> spheres_;
+    std::vector<Obb> obbs_;
     std::vector<Mat4> world_to_cluster_;
     std::size_t clustered_ = 0, patch_clustered_ = 0;
 };

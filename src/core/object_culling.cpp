@@ -33,6 +33,24 @@ bool parse_object_cull_method(const std::string& text, ObjectCullMethod& method)
     return false;
 }
 
+const char* object_volume_name(ObjectVolume v) {
+    switch (v) {
+        case ObjectVolume::aabb: return "aabb";
+        case ObjectVolume::sphere: return "sphere";
+        case ObjectVolume::obb: return "obb";
+    }
+    return "?";
+}
+
+bool parse_object_volume(const std::string& text, ObjectVolume& v) {
+    for (ObjectVolume x : {ObjectVolume::aabb, ObjectVolume::sphere, ObjectVolume::obb})
+        if (text == object_volume_name(x)) {
+            v = x;
+            return true;
+        }
+    return false;
+}
+
 const char* triangle_backface_name(TriangleBackface t) {
     switch (t) {
         case TriangleBackface::clusters: return "clusters";
@@ -191,6 +209,22 @@ const ObjectCullResult& ObjectCuller::cull(const ObjectFrame& frame, const Objec
     r.stats.bvh_nodes_visited = bvh_stats.nodes_visited;
     for (std::size_t i = 0; i < n; ++i)
         if (containment_[i] == Containment::outside) r.verdicts[i] = ObjectVerdict::frustum;
+    // The object's own sphere or OBB, for the objects its AABB left in.
+    if (options.volume != ObjectVolume::aabb) {
+        const bool sphere = options.volume == ObjectVolume::sphere;
+        if (sphere ? !frame.spheres : !frame.obbs)
+            throw Error(std::string("object level: cull: no object ") + object_volume_name(options.volume) + "s");
+        for (std::size_t i = 0; i < n; ++i) {
+            if (r.verdicts[i] != ObjectVerdict::visible) continue;
+            PlaneCullState fresh;
+            const Containment c = sphere ? classify_sphere(planes, frame.spheres[i], fresh, r.stats.plane_tests)
+                                         : classify_obb(planes, frame.obbs[i], fresh, r.stats.plane_tests);
+            if (c == Containment::outside) {
+                r.verdicts[i] = ObjectVerdict::frustum;
+                ++r.stats.volume_rejected;
+            }
+        }
+    }
     // Meta-BVs: the frustum's bounding sphere and box reject what the planes' n/p-vertex test
     // calls intersecting beyond a frustum edge (the lecture's false negatives).
     if (options.meta_bvs) {

@@ -3,12 +3,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "patchcull/error.h"
 
 namespace patchcull {
 namespace {
+
+// r + d rounded up (a float sum may round down by half an ulp).
+float grow_radius(float r, float d) {
+    if (d <= 0) return r;
+    const float sum = r + d;
+    return std::nextafter(sum, std::numeric_limits<float>::infinity());
+}
 
 std::vector<CullableObject> scene_cullable_objects(const Scene& scene) {
     std::vector<CullableObject> objects;
@@ -34,6 +42,8 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
     }
     const std::size_t instances = scene.instances.size();
     boxes_.resize(culler_.object_count());
+    spheres_.resize(culler_.object_count());
+    obbs_.resize(culler_.object_count());
     world_to_cluster_.assign(culler_.object_count(), Mat4{});
 
     // Triangle clusters of the one-sided environment objects, their triangles reordered in place.
@@ -44,6 +54,8 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
         std::vector<Vec3> points;
         for (std::size_t i = begin; i < end; ++i) points.push_back(scene.occluder_vertices.at(scene.occluder_indices[i]));
         boxes_[instances + e] = aabb_of_points(points.data(), points.size());
+        spheres_[instances + e] = sphere_of_points(points.data(), points.size());
+        obbs_[instances + e] = obb_of_points(points.data(), points.size());
         if (!object.one_sided || object.triangle_count == 0) continue;
         const std::vector<std::uint32_t> own(scene.occluder_indices.begin() + static_cast<std::ptrdiff_t>(begin),
                                              scene.occluder_indices.begin() + static_cast<std::ptrdiff_t>(end));
@@ -104,6 +116,15 @@ const ObjectCullResult& SceneObjectLevel::cull(const std::vector<BezierPatch>& p
             Bounds box = aabb_of_points(points.data(), points.size());
             if (displacement > 0) box = grow_bounds(box, displacement);  // rounded outwards
             boxes_[i] = box;
+            if (options.volume == ObjectVolume::sphere) {
+                Sphere sphere = sphere_of_points(points.data(), points.size());
+                sphere.radius = grow_radius(sphere.radius, displacement);
+                spheres_[i] = sphere;
+            } else if (options.volume == ObjectVolume::obb) {
+                Obb obb = obb_of_points(points.data(), points.size());
+                for (float& h : obb.half_extents) h = grow_radius(h, displacement);
+                obbs_[i] = obb;
+            }
             if (culler_.has_clusters(i)) {
                 Mat4 inverse;
                 if (!invert(instance_to_world(scene.instances[i], time_seconds), inverse))
@@ -118,6 +139,8 @@ const ObjectCullResult& SceneObjectLevel::cull(const std::vector<BezierPatch>& p
     frame.eye = camera.eye;
     frame.boxes = boxes_.data();
     frame.world_to_cluster = world_to_cluster_.data();
+    frame.spheres = spheres_.data();
+    frame.obbs = obbs_.data();
     frame.pixel_scale = projection_pixel_scale(camera.fovy_radians, static_cast<float>(viewport_height));
     return culler_.cull(frame, options);
 }
