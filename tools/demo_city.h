@@ -11,7 +11,7 @@ namespace patchcull::cli {
 
 struct DemoCityOptions {
     int width = 640, height = 360;
-    int frames = 4;
+    int frames = 3;
     int tess = 2;
 };
 
