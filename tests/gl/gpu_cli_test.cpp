@@ -234,12 +234,13 @@ TEST(GpuCli, MainJobWritesFrameAndCullImages) {
     std::filesystem::remove_all(dir);
     // The main job's code path (`patchcull` without arguments runs `demo` with its defaults) at a
     // small size, two frames.
-    const CliRun r = run("demo --size 96x54 --frames 2 --tess 2 --out-dir " + dir);
+    const CliRun r = run("demo --size 96x54 --frames 2 --tess 2 --city-frames 2 --out-dir " + dir);
     ASSERT_EQ(r.status, 0) << r.out << r.err;
     EXPECT_TRUE(is_png(dir + "/frame.png"));
     EXPECT_TRUE(is_png(dir + "/cull.png"));
     for (const char* method : {"none (reference)", "frustum", "backpatch tcone", "backpatch ncone", "backpatch ptp",
-                               "occlusion", "all (tcone)", "auto (tcone)", "(objects culled per frame: "})
+                               "occlusion", "all (tcone)", "auto (tcone)", "(objects culled per frame: ",
+                               "patchcull city: ", "\nnone ", "\nfrustum ", "\nbvh ", "\nbvh+backface "})
         EXPECT_NE(r.out.find(method), std::string::npos) << method << " missing from\n" << r.out;
     EXPECT_NE(r.out.find("in total: 0 (must be 0)"), std::string::npos) << r.out;
 }
