@@ -3,8 +3,8 @@
 // city, the default scene, a small building, a scene file, scenes far from the origin and with
 // degenerate objects), over camera paths and adversarial cameras (eyes inside boxes, boxes
 // straddling the near plane), for every method and variant: frustum, bvh, bvh+backface; plane
-// masking, plane coherence and meta-BVs on and off; clusters, normal masks (1 and 3 sectors) and
-// per-triangle tests. The object-level tests of G. Zachmann's lecture "Advanced Visibility
+// masking, plane coherence and meta-BVs on and off; AABB alone or followed by the sphere or OBB;
+// clusters, normal masks (1, 2, 3 and 8 sectors) and per-triangle tests. The object-level tests of G. Zachmann's lecture "Advanced Visibility
 // Computations" (seed 004) and the patch clusters built from Loop, Niessner & Eisenacher's tangent
 // control planes ("Effective Back-Patch Culling for Hardware Tessellation", seed 001).
 //
@@ -18,7 +18,8 @@
 //   fragment test sees it); every culled triangle is back-facing for the eye in double precision
 //   (up to the distance between Camera::eye and the float matrix's projection centre);
 // - frustum and bvh (masking, coherence on or off) give the same frustum verdicts, meta-BVs only
-//   add to them (and give the same with both methods);
+//   add to them, and so do the sphere and OBB tests after the AABB (each the same with both
+//   methods);
 // - spans: ascending, disjoint, each culled object's span whole, and for_each_active_span visits
 //   exactly their complement.
 #include <gtest/gtest.h>
@@ -63,8 +64,10 @@ struct Config {
 std::vector<Config> all_configs() {
     std::vector<Config> out;
     auto add = [&](const std::string& label, ObjectCullMethod m, bool masking, bool coherence, bool meta,
-                   TriangleBackface tb = TriangleBackface::clusters, int sectors = 1) {
+                   TriangleBackface tb = TriangleBackface::clusters, int sectors = 1,
+                   ObjectVolume volume = ObjectVolume::aabb) {
         Config c;
+        c.options.volume = volume;
         c.label = label;
         c.options.method = m;
         c.options.plane_masking = masking;
@@ -88,6 +91,12 @@ std::vector<Config> all_configs() {
     add("bvh+backface masks sectors=3", ObjectCullMethod::bvh_backface, true, true, true, TriangleBackface::normal_masks, 3);
     add("bvh+backface masks sectors=8", ObjectCullMethod::bvh_backface, true, true, false, TriangleBackface::normal_masks, 8);
     add("bvh+backface triangles", ObjectCullMethod::bvh_backface, true, true, false, TriangleBackface::per_triangle);
+    // The sphere and the OBB after the AABB (--object-volume).
+    add("frustum volume=sphere", ObjectCullMethod::frustum, true, true, false, TriangleBackface::clusters, 1,
+        ObjectVolume::sphere);
+    add("bvh volume=obb meta=on", ObjectCullMethod::bvh, true, true, true, TriangleBackface::clusters, 1, ObjectVolume::obb);
+    add("bvh+backface volume=obb masks sectors=2", ObjectCullMethod::bvh_backface, true, true, false,
+        TriangleBackface::normal_masks, 2, ObjectVolume::obb);
     return out;
 }
 
@@ -431,7 +440,9 @@ void check_scene_into(const Scene& base, const std::vector<Camera>& cameras, con
     for (std::size_t k = 0; k < cameras.size(); ++k) {
         const std::vector<BezierPatch>& pose = poser.pose(times[k]);
         FrameTruth truth(base, poser, pose, cameras[k], instance_first, times[k], world_float_truth);
-        std::vector<ObjectVerdict> plain, meta;  // frustum verdicts without and with meta-BVs
+        // Frustum verdicts per (meta-BVs, volume): equal for every method, and those with meta-BVs
+        // or a sphere / OBB hold at least the AABB's alone.
+        std::map<int, std::vector<ObjectVerdict>> verdict_sets;
         for (const Config& config : configs) {
             const std::string what = config.label + ", camera " + std::to_string(k);
             const ObjectCullResult& r =
@@ -536,18 +547,21 @@ void check_scene_into(const Scene& base, const std::vector<Camera>& cameras, con
             totals.frustum += frustum;
             totals.meta += r.stats.meta_rejected;
             // Every method gives the same frustum verdicts; meta-BVs only add (the same with both).
-            std::vector<ObjectVerdict>& reference = config.options.meta_bvs ? meta : plain;
+            std::vector<ObjectVerdict>& reference =
+                verdict_sets[(config.options.meta_bvs ? 3 : 0) + static_cast<int>(config.options.volume)];
             if (reference.empty()) {
                 reference = frustum_verdicts;
             } else {
                 EXPECT_EQ(frustum_verdicts, reference) << what << ": frustum verdicts differ between methods";
             }
         }
-        for (std::size_t i = 0; i < objects && !plain.empty() && !meta.empty(); ++i) {
-            if (plain[i] == ObjectVerdict::frustum) {
-                EXPECT_EQ(meta[i], ObjectVerdict::frustum) << "camera " << k << ": meta-BVs kept object " << i;
+        const std::vector<ObjectVerdict>& plain = verdict_sets[0];
+        for (const auto& [key, set] : verdict_sets)
+            for (std::size_t i = 0; i < objects && !plain.empty(); ++i) {
+                if (plain[i] == ObjectVerdict::frustum) {
+                    EXPECT_EQ(set[i], ObjectVerdict::frustum) << "camera " << k << ": set " << key << " kept object " << i;
+                }
             }
-        }
         ++totals.checked_frames;
     }
 }
