@@ -12,7 +12,7 @@
 //   Visibility Computations"): for every one-sided environment object, triangle clusters in world
 //   space (the object's triangles are reordered in Scene::occluder_indices so that each cluster
 //   is a contiguous run: the same triangles, so the same image); for every rigid (deforms ==
-//   false), undisplaced instance when patches are drawn one-sided, patch clusters from the
+//   false), undisplaced, unmirrored (det > 0) instance when patches are drawn one-sided, patch clusters from the
 //   patches' object-space tangent control planes (Loop, Niessner & Eisenacher, "Effective
 //   Back-Patch Culling for Hardware Tessellation"), built once per model and tested with the eye
 //   moved into the instance's space each frame.

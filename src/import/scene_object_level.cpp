@@ -18,6 +18,12 @@ float grow_radius(float r, float d) {
     return std::nextafter(sum, std::numeric_limits<float>::infinity());
 }
 
+double linear_determinant(const Mat4& m) {
+    auto a = [&](int r, int c) { return static_cast<double>(m.at(r, c)); };
+    return a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
+           a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
+}
+
 std::vector<CullableObject> scene_cullable_objects(const Scene& scene) {
     std::vector<CullableObject> objects;
     std::size_t first = 0;
@@ -80,6 +86,10 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
         const LoadedModel& model = scene.models.at(instance.model);
         if (instance.deforms && model.subdiv) continue;  // deforming: its tangent planes change every frame
         if (displaced || model.rest.patches.empty()) continue;
+        // A mirroring transform (det < 0) flips du x dv against the planes moved into world space:
+        // the side the clusters call back-facing in object space is the side drawn in the world.
+        // Such instances get no patch clusters (nothing of them is back-face culled whole).
+        if (linear_determinant(instance.object_to_world) <= 0) continue;
         auto it = per_model.find(instance.model);
         if (it == per_model.end())
             it = per_model
