@@ -201,8 +201,8 @@ struct CityParams {
 /// (kDefaultSceneDisplaceScale); time offsets from `phases` values k * 0.37 s (so ScenePoser
 /// shares one deformation per model and phase). Over [0, walk_seconds] no character comes within
 /// its animated reach (over one animation period, any yaw) plus 0.1 of a building on x or z,
-/// leaves the grid, or enters the camera's corridor (0.6 either side of its line); characters
-/// start apart. The camera walks down the middle of z street camera_street (streets 0..blocks_x
+/// leaves the grid, or enters the camera's corridor (0.3 either side of its line); characters
+/// start apart, a fifth of them in the camera's street. The camera walks down the middle of z street camera_street (streets 0..blocks_x
 /// from -x) from the grid's +z edge towards -z at eye height 0.8 (a character is 1 high), 0.15
 /// units per frame, looking down the street (60 degrees): buildings hide the parallel streets,
 /// the characters behind the camera are outside the view. Names: "bigguy#k" / "monsterfrog#k"

@@ -156,7 +156,7 @@ Scene make_city_scene(Scheme scheme, const CityParams& params) {
     // The camera walks the middle of z street `street` towards -z; nothing stands in its corridor.
     const int street = params.camera_street >= 0 ? params.camera_street : params.blocks_x / 2;
     const float camera_x = x0 + street * P + 0.5f * S;
-    const float corridor = 0.6f;  // half width of the camera's corridor
+    const float corridor = 0.3f;  // half width of the camera's corridor (characters keep their reach + 0.1 more)
     scene.camera.walk = true;
     scene.camera.walk_start = {camera_x, 0.8f, z0 + width_z - 0.5f * S};
     scene.camera.walk_step = {0, 0, -0.15f};
@@ -177,8 +177,11 @@ Scene make_city_scene(Scheme scheme, const CityParams& params) {
         const float r = reach[model];
         bool done = false;
         for (int attempt = 0; attempt < 400 && !done; ++attempt) {
-            const bool along_z = rng.below(2) == 0;
-            const int index = rng.below(along_z ? params.blocks_x + 1 : params.blocks_z + 1);
+            // A fifth of the characters in the camera's street (beside its corridor), so the
+            // street the camera walks is not empty; the others in any street.
+            const bool in_camera_street = rng.below(5) == 0;
+            const bool along_z = in_camera_street || rng.below(2) == 0;
+            const int index = in_camera_street ? street : rng.below(along_z ? params.blocks_x + 1 : params.blocks_z + 1);
             const float lateral = rng.uniform(-0.5f * S, 0.5f * S);
             const float along = rng.uniform(0, along_z ? width_z : width_x);
             const bool walking = rng.uniform() < params.walking_fraction;
