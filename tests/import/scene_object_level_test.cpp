@@ -665,6 +665,9 @@ TEST(SceneObjectLevelTruth, SmallCity) {
     const Vec3 mid = (c0.min + c0.max) * 0.5f;
     cameras.push_back(make_camera({mid.x, mid.y, c0.max.z + 0.1f}, mid, 0.3f));
     cameras.push_back(make_camera({mid.x, mid.y, c0.max.z + 0.1f}, {mid.x, mid.y, c0.max.z + 5.0f}, 0.3f));
+    // Inside the character's box (and body), looking out through it, and just above its head.
+    cameras.push_back(make_camera(mid, {mid.x + 2.0f, mid.y, mid.z - 1.0f}, 0.01f));
+    cameras.push_back(make_camera({mid.x, c0.max.y - 0.05f, mid.z}, {mid.x, 0.0f, mid.z + 0.01f}, 0.01f));
     // From the ground looking up, and from high above looking down.
     cameras.push_back(make_camera({0.0f, 0.01f, 0.0f}, {0.5f, 20.0f, -0.3f}));
     cameras.push_back(make_camera({1.0f, 40.0f, 2.0f}, {0.0f, 0.0f, 0.0f}, 0.5f, 100.0f));
