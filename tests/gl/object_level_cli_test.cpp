@@ -196,6 +196,20 @@ TEST(ObjectLevelCli, DISABLED_MirroredRigidInstanceHasNoFalseCulls) {
     (void)s;
 }
 
+// A rigid BigGuy at 1e5 from the origin (the scene-file limit is 2e11): its world-space float
+// control points are rounded by ~0.008, so the drawn patch differs from the exact transform of
+// its rest patch that the object-space patch clusters bound; near the silhouette the clusters cull
+// patches whose drawn tangent planes face the eye (--cull none, so only the object level culls:
+// 26 false culls over these 6 frames, 1 at 2e4, 4 at 6e4; --objects bvh gives 0). DISABLED until
+// the patch clusters allow for the rounding of the posed patches (or are not used where it
+// matters).
+TEST(ObjectLevelCli, DISABLED_FarRigidInstanceHasNoFalseCulls) {
+    const Summary s = verified_render("render " + test_scene("far_rigid_1e5.json") +
+                                          " --objects bvh+backface --cull none --size 320x180 --tess 4 --frames 6",
+                                      1, 6);
+    (void)s;
+}
+
 namespace patchcull::gl {
 namespace {
 

