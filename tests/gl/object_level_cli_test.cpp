@@ -164,8 +164,8 @@ TEST(ObjectLevelCli, BuildingAndDefaultSceneHaveNoFalseCulls) {
     EXPECT_GT(b.triangles, 0u);
     for (const char* scheme : {"acc", "osd"}) {
         const Summary d = verified_render(std::string("render default --scheme ") + scheme +
-                                              " --objects bvh+backface --size 96x54 --tess 2 --frames 2",
-                                          10, 2);
+                                              " --objects bvh+backface --size 96x54 --tess 2 --frames 1",
+                                          10, 1);
         EXPECT_GT(d.triangles, 0u) << scheme;
     }
 }
