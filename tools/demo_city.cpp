@@ -19,7 +19,7 @@ CityParams demo_city_params() {
     CityParams p;
     p.blocks_x = 4;
     p.blocks_z = 4;
-    p.characters = 64;
+    p.characters = 48;
     return p;
 }
 
