@@ -24,7 +24,9 @@ Usage: python3 scripts/object_level_bench.py [BUILD_DIR] [ROUNDS] [FRAMES] [TESS
    per frame (1..FRAMES-1): plane_tests, plane tests per object, bvh_nodes_visited, objects
    culled, meta_rejected. Their times are bench/object_level_bench.cpp's.
 
-The load average (/proc/loadavg) is printed before every round and at the end.
+The load average (/proc/loadavg) is printed before every round and at the end. Bad arguments
+(ROUNDS 1..100, FRAMES 2..1000, TESS 1..64, a BUILD_DIR without patchcull) give one line on stderr
+and exit status 2; a failing render gives its command and last error line, and its status.
 """
 import json
 import os
@@ -32,10 +34,33 @@ import statistics
 import subprocess
 import sys
 
+
+
+def fail(message):
+    """Bad input: one line naming what is wrong, exit status 2."""
+    print(f"object_level_bench: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
+def int_arg(index, name, default, low, high):
+    if len(sys.argv) <= index:
+        return default
+    text = sys.argv[index]
+    try:
+        value = int(text)
+    except ValueError:
+        fail(f"{name}: '{text}' is not an integer")
+    if not low <= value <= high:
+        fail(f"{name}: {value} is outside {low}..{high}")
+    return value
+
+
+if len(sys.argv) > 6:
+    fail(f"too many arguments ({len(sys.argv) - 1}; at most BUILD_DIR ROUNDS FRAMES TESS SCENE)")
 BUILD = sys.argv[1] if len(sys.argv) > 1 else "build"
-ROUNDS = int(sys.argv[2]) if len(sys.argv) > 2 else 4
-FRAMES = int(sys.argv[3]) if len(sys.argv) > 3 else 6
-TESS = int(sys.argv[4]) if len(sys.argv) > 4 else 8
+ROUNDS = int_arg(2, "ROUNDS", 4, 1, 100)
+FRAMES = int_arg(3, "FRAMES", 6, 2, 1000)
+TESS = int_arg(4, "TESS", 8, 1, 64)
 SCENE = sys.argv[5] if len(sys.argv) > 5 else "city"
 CLI = os.path.join(BUILD, "patchcull")
 MODES = ("none", "frustum", "bvh", "bvh+backface")
@@ -59,7 +84,9 @@ def render(args):
     cmd = [CLI, "render", SCENE, "--frames", str(FRAMES), "--json"] + args
     run = subprocess.run(cmd, capture_output=True, text=True)
     if run.returncode != 0:
-        sys.exit(f"object_level_bench: `{' '.join(cmd)}` failed ({run.returncode}): {run.stderr.strip()}")
+        last = run.stderr.strip().splitlines()[-1] if run.stderr.strip() else "no message"
+        print(f"object_level_bench: `{' '.join(cmd)}` failed ({run.returncode}): {last}", file=sys.stderr)
+        sys.exit(run.returncode if run.returncode == 2 else 1)
     return json.loads(run.stdout)
 
 
@@ -161,7 +188,7 @@ def variant_table():
 
 def main():
     if not os.access(CLI, os.X_OK):
-        sys.exit(f"object_level_bench: {CLI}: not an executable (build the patchcull_cli target)")
+        fail(f"BUILD_DIR: {CLI} is not an executable (build the patchcull_cli target)")
     variant_table()
     frame_time_table()
     print(f"end load {load()}")
