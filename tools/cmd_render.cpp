@@ -31,7 +31,7 @@
 // culled, and why each is on or off.
 // --objects frustum|bvh|bvh+backface (object_level_options.h, issue 11): the object level runs
 // before the patch passes (instances and environment objects; culled ones cost no patch work);
-// every frame gains
+// every frame (also with the default --objects none: zeros) gains
 //   "objects":{"total","frustum_culled","backface_culled","detail_culled","plane_tests",
 //              "bvh_nodes_visited","cluster_tests","patches_culled","triangles_culled",
 //              "backface_patches_culled"}
@@ -203,7 +203,7 @@ Runner add_render_command(CLI::App& app) {
                               {"depth_ties", depth_ties}});
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
             if (automatic) frames.back()["auto_objects"] = auto_objects_json(objects, policy.decisions());
-            if (object_level.enabled()) {
+            {
                 nlohmann::json& o = frames.back()["objects"] = object_level.frame_json();
                 if (state->verify) {
                     o["false_culled_objects"] = object_check.false_culled_objects;

@@ -51,6 +51,7 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
     if (!parse_triangle_backface(options.backface_triangles, options_.triangle_backface))
         throw Error("--backface-triangles: unknown variant '" + options.backface_triangles + "'");
     options_.mask_sectors = options.mask_sectors;
+    empty_.stats.total = scene.instances.size() + scene.environment.size();  // --objects none: nothing culled
     if (!enabled()) return;
     ObjectLevelSetup setup;
     setup.patches_one_sided = patches_one_sided;
