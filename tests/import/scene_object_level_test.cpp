@@ -879,3 +879,27 @@ TEST(SceneObjectLevelTruth, DISABLED_MirroredRigidInstanceIsNotBackFaceCulledWro
     EXPECT_EQ(t.checked_frames, cameras.size());
     EXPECT_EQ(t.false_backface, 0u);
 }
+
+// for_each_active_span on its own: random ascending, disjoint spans (touching ones, spans at 0
+// and at the end, the whole set, none) visit exactly the complement, in order, without empty runs.
+TEST(SceneObjectLevelTruth, ActiveSpansAreTheComplement) {
+    std::uint32_t state = 12345;
+    auto next = [&](std::uint32_t n) {
+        state = state * 1664525u + 1013904223u;
+        return (state >> 8) % n;
+    };
+    for (int round = 0; round < 400; ++round) {
+        const std::size_t total = next(60);
+        std::vector<IndexSpan> spans;
+        std::size_t at = next(3) == 0 ? 0 : next(4);
+        while (at < total && next(5) != 0) {
+            const std::size_t count = 1 + next(static_cast<std::uint32_t>(std::min<std::size_t>(8, total - at)));
+            spans.push_back({at, std::min(count, total - at)});
+            at += spans.back().count + (next(3) == 0 ? 0 : next(4));  // 0: the next span touches
+        }
+        check_spans(spans, total, "round " + std::to_string(round));
+    }
+    check_spans({{0, 10}}, 10, "whole set");
+    check_spans({}, 0, "empty set");
+    check_spans({}, 7, "no spans");
+}
