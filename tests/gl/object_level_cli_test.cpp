@@ -109,10 +109,24 @@ TEST(ObjectLevelCli, CitySmallEveryMethodHasNoFalseCulls) {
             EXPECT_EQ(s.backface, 0u) << method;
         }
     }
-    // --objects none: no object level, and 0 false culls.
+    // --objects none: the objects JSON is there (the contract lists none too), nothing is
+    // culled by the object level, and 0 false culls.
     const CliRun r = run(kCitySmall + "--objects none --verify --json");
     ASSERT_EQ(r.status, 0) << r.err;
-    EXPECT_EQ(nlohmann::json::parse(r.out)["false_culls"], 0);
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["false_culls"], 0);
+    for (const auto& frame : j["frames"]) {
+        ASSERT_TRUE(frame.contains("objects")) << frame.dump();
+        const nlohmann::json& o = frame["objects"];
+        for (const char* key : {"total", "frustum_culled", "backface_culled", "detail_culled", "plane_tests",
+                                "bvh_nodes_visited"})
+            ASSERT_TRUE(o.contains(key) && o[key].is_number_unsigned()) << key << " in " << o.dump();
+        EXPECT_EQ(o["total"], kCitySmallObjects);
+        EXPECT_EQ(o["frustum_culled"], 0);
+        EXPECT_EQ(o["backface_culled"], 0);
+        EXPECT_EQ(o["patches_culled"], 0);
+        EXPECT_EQ(o["triangles_culled"], 0);
+    }
 }
 
 TEST(ObjectLevelCli, CitySmallEveryVariantHasNoFalseCulls) {
