@@ -93,5 +93,10 @@ Mat4 look_at(Vec3 eye, Vec3 target, Vec3 up);
 
 /// Inverse of an affine or projective matrix; returns false when singular.
 bool invert(const Mat4& a, Mat4& out);
+/// The inverse of a (taken as exact) in double precision, out[r][c] its row r, column c
+/// (Gauss-Jordan with partial pivoting); false when a is singular or the result not finite.
+bool invert_double(const double a[4][4], double out[4][4]);
+/// The same for a Mat4's entries.
+bool invert_double(const Mat4& a, double out[4][4]);
 
 }  // namespace patchcull

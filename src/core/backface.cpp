@@ -67,35 +67,6 @@ inline __attribute__((always_inline)) bool triangle_backfacing(Vec3 p0, Vec3 p1,
     return degenerate || (s <= -margin && margin <= std::numeric_limits<float>::max());
 }
 
-// 4x4 inverse in double (Gauss-Jordan with partial pivoting); false when singular or not finite.
-bool invert_double(const double a[4][4], double out[4][4]) {
-    double m[4][8];
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 8; ++c) m[r][c] = c < 4 ? a[r][c] : (c - 4 == r ? 1.0 : 0.0);
-    for (int c = 0; c < 4; ++c) {
-        int piv = c;
-        for (int r = c + 1; r < 4; ++r)
-            if (std::fabs(m[r][c]) > std::fabs(m[piv][c])) piv = r;
-        if (!(std::fabs(m[piv][c]) > 0) || !std::isfinite(m[piv][c])) return false;
-        if (piv != c)
-            for (int k = 0; k < 8; ++k) std::swap(m[c][k], m[piv][k]);
-        const double inv = 1.0 / m[c][c];
-        for (int k = 0; k < 8; ++k) m[c][k] *= inv;
-        for (int r = 0; r < 4; ++r) {
-            if (r == c) continue;
-            const double f = m[r][c];
-            if (f == 0) continue;
-            for (int k = 0; k < 8; ++k) m[r][k] -= f * m[c][k];
-        }
-    }
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c) {
-            out[r][c] = m[r][c + 4];
-            if (!std::isfinite(out[r][c])) return false;
-        }
-    return true;
-}
-
 double det3(double a0, double a1, double a2, double b0, double b1, double b2, double c0, double c1, double c2) {
     return a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0);
 }

@@ -312,34 +312,6 @@ double obb_measure(const Obb& o) {
     return h0 * h1 * h2;
 }
 
-// Gauss-Jordan inverse of a 4x4 matrix in double (column-major like Mat4); false when singular.
-bool invert4d(const Mat4& a, double out[16]) {
-    double m[4][8];
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c) {
-            m[r][c] = a.at(r, c);
-            m[r][c + 4] = r == c ? 1.0 : 0.0;
-        }
-    for (int c = 0; c < 4; ++c) {
-        int pivot = c;
-        for (int r = c + 1; r < 4; ++r)
-            if (std::fabs(m[r][c]) > std::fabs(m[pivot][c])) pivot = r;
-        if (!(std::fabs(m[pivot][c]) > 0)) return false;
-        if (pivot != c)
-            for (int k = 0; k < 8; ++k) std::swap(m[c][k], m[pivot][k]);
-        const double inv = 1.0 / m[c][c];
-        for (int k = 0; k < 8; ++k) m[c][k] *= inv;
-        for (int r = 0; r < 4; ++r) {
-            if (r == c) continue;
-            const double f = m[r][c];
-            if (f == 0) continue;
-            for (int k = 0; k < 8; ++k) m[r][k] -= f * m[c][k];
-        }
-    }
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c) out[4 * c + r] = m[r][c + 4];
-    return true;
-}
 
 }  // namespace
 
@@ -570,8 +542,8 @@ FrustumMetaBounds frustum_meta_bounds(const Mat4& world_to_clip, ClipDepth depth
     meta.box = {{-kInf, -kInf, -kInf}, {kInf, kInf, kInf}};
     meta.sphere = {{}, kInf};
     const Mat4 m = to_zero_to_one(world_to_clip, depth);
-    double inv[16];
-    if (!invert4d(m, inv)) return meta;
+    double inv[4][4];
+    if (!invert_double(m, inv)) return meta;
     D3 corners[8];
     int sign = 0;
     for (int i = 0; i < 8; ++i) {
@@ -579,7 +551,7 @@ FrustumMetaBounds frustum_meta_bounds(const Mat4& world_to_clip, ClipDepth depth
         double h[4];
         for (int r = 0; r < 4; ++r) {
             h[r] = 0;
-            for (int c = 0; c < 4; ++c) h[r] += inv[4 * c + r] * ndc[c];
+            for (int c = 0; c < 4; ++c) h[r] += inv[r][c] * ndc[c];
         }
         const double mag = std::fabs(h[0]) + std::fabs(h[1]) + std::fabs(h[2]);
         // A corner at (or numerically at) infinity: the frustum is unbounded.

@@ -29,19 +29,15 @@ Mat4 look_at(Vec3 eye, Vec3 target, Vec3 up) {
     return v;
 }
 
-bool invert(const Mat4& a, Mat4& out) {
-    // Gauss-Jordan with partial pivoting in double precision.
+bool invert_double(const double a[4][4], double out[4][4]) {
     double m[4][8];
     for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c) {
-            m[r][c] = a.at(r, c);
-            m[r][c + 4] = r == c ? 1.0 : 0.0;
-        }
+        for (int c = 0; c < 8; ++c) m[r][c] = c < 4 ? a[r][c] : (c - 4 == r ? 1.0 : 0.0);
     for (int c = 0; c < 4; ++c) {
         int pivot = c;
         for (int r = c + 1; r < 4; ++r)
             if (std::fabs(m[r][c]) > std::fabs(m[pivot][c])) pivot = r;
-        if (m[pivot][c] == 0.0) return false;
+        if (!(std::fabs(m[pivot][c]) > 0) || !std::isfinite(m[pivot][c])) return false;
         if (pivot != c)
             for (int k = 0; k < 8; ++k) std::swap(m[c][k], m[pivot][k]);
         const double inv = 1.0 / m[c][c];
@@ -49,11 +45,30 @@ bool invert(const Mat4& a, Mat4& out) {
         for (int r = 0; r < 4; ++r) {
             if (r == c) continue;
             const double f = m[r][c];
+            if (f == 0) continue;
             for (int k = 0; k < 8; ++k) m[r][k] -= f * m[c][k];
         }
     }
     for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c) out.at(r, c) = static_cast<float>(m[r][c + 4]);
+        for (int c = 0; c < 4; ++c) {
+            out[r][c] = m[r][c + 4];
+            if (!std::isfinite(out[r][c])) return false;
+        }
+    return true;
+}
+
+bool invert_double(const Mat4& a, double out[4][4]) {
+    double m[4][4];
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) m[r][c] = a.at(r, c);
+    return invert_double(m, out);
+}
+
+bool invert(const Mat4& a, Mat4& out) {
+    double inv[4][4];
+    if (!invert_double(a, inv)) return false;
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) out.at(r, c) = static_cast<float>(inv[r][c]);
     return true;
 }
 
