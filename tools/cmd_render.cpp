@@ -35,7 +35,8 @@
 //   "objects":{"total","frustum_culled","backface_culled","detail_culled","plane_tests",
 //              "bvh_nodes_visited","cluster_tests","patches_culled","triangles_culled",
 //              "backface_patches_culled"}
-// (with --verify also "false_culled_objects", "false_culled_triangles", "detail_pixels"), and
+// (with --verify also "false_culled_objects", "false_culled_triangles", "detail_pixels"; "ms" gains
+// "object_level" and "cpu_frustum_after_objects", CPU wall-clock times outside "total"), and
 // "false_culls" counts object-level false culls too (culled patches and environment triangles
 // in the unculled id buffer); --detail-cull's changes are reported as detail_pixels, not false culls.
 #include <cmath>
@@ -173,6 +174,10 @@ Runner add_render_command(CLI::App& app) {
             if (last && !state->out.empty()) pipeline.renderer().write_color_png(state->out);
             nlohmann::json ms = {{"pass1", stats.pass1_ms}, {"hiz", stats.hiz_ms}, {"cull", stats.cull_ms},
                                  {"pass2", stats.pass2_ms}, {"total", stats.total_ms}};
+            if (object_level.enabled()) {
+                ms["object_level"] = object_level.object_level_ms();  // CPU, before the GPU frame
+                ms["cpu_frustum_after_objects"] = object_level.cpu_frustum_ms();
+            }
             std::size_t false_culls = 0, depth_ties = 0;
             std::vector<std::uint32_t> false_culled;  // patch indices, ascending
             ObjectVerification object_check;

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "cli_options.h"
@@ -65,7 +66,10 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
     params.object_culled.clear();
     params.culled_occluders.clear();
     if (!enabled()) return;
+    const auto start = std::chrono::steady_clock::now();
     result_ = &level_->cull(pose, poser.displacement_ranges(), time_seconds, camera, viewport_height, options_);
+    const auto culled = std::chrono::steady_clock::now();
+    object_level_ms_ = std::chrono::duration<double, std::milli>(culled - start).count();
     for (const IndexSpan& s : result_->culled_patches) params.object_culled.push_back({s.first, s.count});
     // The CPU path after the object level (object_culling.h): the frustum kernel on the patches
     // left, to report the patch tests an object cull saves there too.
@@ -81,6 +85,7 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
     cpu_frustum_culled_ = 0;
     for (std::uint8_t c : cpu_culled_) cpu_frustum_culled_ += c;
     cpu_frustum_culled_ -= result_->stats.patches_culled;
+    cpu_frustum_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - culled).count();
     for (const IndexSpan& s : result_->culled_triangles) params.culled_occluders.push_back({s.first, s.count});
 }
 

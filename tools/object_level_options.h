@@ -58,6 +58,10 @@ public:
                const Camera& camera, int viewport_height, gl::PipelineParams& params);
     /// The last frame's result (all zero when disabled).
     const ObjectCullResult& result() const { return *result_; }
+    /// Wall-clock milliseconds of the last apply: the object level (boxes + tests), and the CPU
+    /// frustum kernel after it (its batch included); 0 when disabled.
+    double object_level_ms() const { return object_level_ms_; }
+    double cpu_frustum_ms() const { return cpu_frustum_ms_; }
 
     /// The object-level false culls of the last frame against the unculled reference's ids and
     /// the frame's patch false culls (compare_frames).
@@ -77,7 +81,8 @@ private:
     ObjectCullResult empty_;
     std::vector<float> cpu_margins_;
     std::vector<std::uint8_t> cpu_culled_;
-    std::size_t cpu_patch_tests_ = 0, cpu_frustum_culled_ = 0;  // the CPU frustum kernel after the object level
+    std::size_t cpu_patch_tests_ = 0, cpu_frustum_culled_ = 0;
+    double object_level_ms_ = 0, cpu_frustum_ms_ = 0;  // the CPU frustum kernel after the object level
     const ObjectCullResult* result_ = &empty_;
 };
 

@@ -71,6 +71,7 @@ private:
     std::vector<Sphere> spheres_;
     std::vector<Obb> obbs_;
     std::vector<Mat4> world_to_cluster_;
+    std::vector<Vec3> points_;  // an instance's control points (sphere / OBB volumes), reused
     std::size_t clustered_ = 0, patch_clustered_ = 0;
 };
 

@@ -11,6 +11,8 @@
 namespace patchcull {
 namespace {
 
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
 // r + d rounded up (a float sum may round down by half an ulp).
 float grow_radius(float r, float d) {
     if (d <= 0) return r;
@@ -86,10 +88,11 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
         const LoadedModel& model = scene.models.at(instance.model);
         if (instance.deforms && model.subdiv) continue;  // deforming: its tangent planes change every frame
         if (displaced || model.rest.patches.empty()) continue;
-        // A mirroring transform (det < 0) flips du x dv against the planes moved into world space:
-        // the side the clusters call back-facing in object space is the side drawn in the world.
-        // Such instances get no patch clusters (nothing of them is back-face culled whole).
-        if (linear_determinant(instance.object_to_world) <= 0) continue;
+        // A mirroring transform (det < 0) would flip du x dv against the planes moved into world
+        // space, but ScenePoser poses mirrored instances transposed (default_scene.h), which keeps
+        // the drawn side the model-space clusters' front side for the eye moved into model space:
+        // they get clusters. A singular transform (det == 0) has no inverse to move the eye: none.
+        if (linear_determinant(instance.object_to_world) == 0) continue;
         auto it = per_model.find(instance.model);
         if (it == per_model.end())
             it = per_model
@@ -112,18 +115,26 @@ const ObjectCullResult& SceneObjectLevel::cull(const std::vector<BezierPatch>& p
         throw Error("object level: the pose has " + std::to_string(pose.size()) + " patches, the scene " +
                     std::to_string(scene.patch_count()));
     if (options.method != ObjectCullMethod::none) {
-        std::vector<Vec3> points;
+        const bool need_points = options.volume != ObjectVolume::aabb;
         for (std::size_t i = 0; i < instances; ++i) {
             const std::size_t first = instance_first_[i];
             const std::size_t count = culler_.object(i).span.count;
-            points.clear();
+            points_.clear();
             float displacement = 0;
+            // The exact min / max of the control points (aabb_of_points' answer), without a copy
+            // of them unless a sphere or OBB needs them.
+            Bounds box{{kInf, kInf, kInf}, {-kInf, -kInf, -kInf}};
             for (std::size_t p = first; p < first + count; ++p) {
-                for (const Vec4& c : pose[p].cp) points.push_back(cartesian(c));
+                for (const Vec4& c : pose[p].cp) {
+                    const Vec3 q = cartesian(c);
+                    box.min = {std::min(box.min.x, q.x), std::min(box.min.y, q.y), std::min(box.min.z, q.z)};
+                    box.max = {std::max(box.max.x, q.x), std::max(box.max.y, q.y), std::max(box.max.z, q.z)};
+                    if (need_points) points_.push_back(q);
+                }
                 if (!ranges.empty())
                     displacement = std::max({displacement, std::fabs(ranges[p].d_min), std::fabs(ranges[p].d_max)});
             }
-            Bounds box = aabb_of_points(points.data(), points.size());
+            std::vector<Vec3>& points = points_;
             if (displacement > 0) box = grow_bounds(box, displacement);  // rounded outwards
             boxes_[i] = box;
             if (options.volume == ObjectVolume::sphere) {
