@@ -53,7 +53,16 @@ struct SceneInstance {
     bool deforms = true;
     /// Rigid motion in world units per second (see instance_to_world); zero: it stays in place.
     Vec3 velocity{0, 0, 0};
+    // A mirroring object_to_world (instance_mirrors: det of the linear part < 0) is allowed:
+    // ScenePoser poses such an instance with its patches' parameterisation reversed (u and v
+    // swapped), so that du x dv of the world patches points out of the mirrored solid.
 };
+
+/// True when the instance's transform mirrors: the determinant of object_to_world's linear part
+/// (upper-left 3x3, computed in double from the float entries) is < 0. Singular (det == 0) and
+/// proper transforms: false. The velocity does not change it (instance_to_world's linear part is
+/// object_to_world's).
+bool instance_mirrors(const SceneInstance& instance);
 
 /// The instance's transform at scene time t:
 /// translation(velocity * (t + time_offset)) * object_to_world. Affine (the w row is kept, so
@@ -247,22 +256,39 @@ Scene make_builtin_scene(const std::string& name, Scheme scheme = Scheme::acc);
 /// Instances that share a model and an effective time (time_seconds + time_offset, compared as
 /// floats; every rigid instance of a model shares its rest frame) share one deformation and one
 /// patch evaluation per pose() call: a city of 220 characters in 6 phases evaluates 12 frames.
+///
+/// Mirrored instances (instance_mirrors): a mirror turns du x dv of the placed patches into the
+/// solid (drawn one-sided, the instance would render inside out). ScenePoser transposes each patch
+/// of such an instance, P'(u, v) = P(v, u) (world control point 4j + i is instance_to_world times
+/// the model's control point 4i + j), which makes du x dv point outward again (the derivation is in
+/// default_scene.cpp); the surface is the same point set, the transposition is exact (only the
+/// order of the float products changes). Everything attached to the patch follows: its tangent
+/// patches are the model's with du and dv swapped and transposed (du'[3j + i] = mapped dv[4i + j],
+/// dv'[4j + i] = mapped du[3i + j]), its corner texcoords have corners (1,0) and (0,1) swapped;
+/// its depth and displacement range are the model patch's. The eye-facing test of a transposed
+/// world patch equals the model-space test of the model patch with the eye moved into model space
+/// by the inverse transform, so model-space patch clusters stay valid for mirrored instances.
 class ScenePoser {
 public:
     explicit ScenePoser(const Scene& scene);
     /// World-space patches of every instance at time_seconds, instance by instance (each
-    /// instance's patches in its model's order). The reference stays valid until the next call.
+    /// instance's patches in its model's order): instance_to_world times the (animated) model
+    /// patch, transposed for mirrored instances (see above). The reference stays valid until the
+    /// next call.
     const std::vector<BezierPatch>& pose(float time_seconds);
     /// The ACC tangent patches of the last pose (PatchInfo::tangent_index semantics): the entry
     /// of each patch of pose(), -1 when it has none, indexing tangents(), whose vectors are mapped
-    /// by the instances' linear parts. Empty before the first pose.
+    /// by the instances' linear parts (du and dv swapped and transposed for mirrored instances,
+    /// so that they are the derivatives of pose()'s patch). Empty before the first pose.
     const std::vector<std::int32_t>& tangent_index() const { return tangent_index_; }
     const std::vector<TangentPatches>& tangents() const { return tangents_; }
     /// PatchInfo::depth of each patch of the last pose (for gl::PatchAttributes::depth).
     const std::vector<std::uint8_t>& depth() const { return depth_; }
-    /// Corner texcoords (PatchInfo::uv) and displacement range of each patch of pose(), fixed for
-    /// the scene (computed at construction from Scene::displacement: (0, 0) for instances that are
-    /// not displaced); both empty when the scene has no displacement.
+    /// Corner texcoords (PatchInfo::uv, in the order of pose()'s patch: corners (1,0) and (0,1)
+    /// swapped for instances that mirrored at construction) and displacement range (the model
+    /// patch's, unchanged by the swap) of each patch of pose(), fixed for the scene (computed at
+    /// construction from Scene::displacement: the range is zero for instances that are not
+    /// displaced); both empty when the scene has no displacement.
     const std::vector<std::array<Vec2, 4>>& texcoords() const { return texcoords_; }
     const std::vector<DisplacementRange>& displacement_ranges() const { return ranges_; }
 

@@ -145,6 +145,15 @@ void add_environment_object(Scene& scene, std::string name, const std::vector<Ve
 
 void add_environment_box(Scene& scene, std::string name, Vec3 lo, Vec3 hi) { add_box(scene, std::move(name), lo, hi); }
 
+bool instance_mirrors(const SceneInstance& instance) {
+    const Mat4& m = instance.object_to_world;
+    auto a = [&](int r, int c) { return static_cast<double>(m.at(r, c)); };
+    const double det = a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) -
+                       a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
+                       a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
+    return det < 0;
+}
+
 Mat4 instance_to_world(const SceneInstance& instance, float time_seconds) {
     const float t = time_seconds + instance.time_offset;
     Mat4 m = instance.object_to_world;
@@ -260,12 +269,30 @@ Scene make_model_scene(LoadedModel model, float degrees_per_frame) {
     return scene;
 }
 
+// Mirrored instances (instance_mirrors): M with det M < 0 maps du x dv to cof(M) (du x dv) =
+// det(M) M^-T (du x dv), which points into the mirrored solid (the outward normal of the image is
+// along M^-T n). Posing the transposed patch P'(u, v) = P(v, u) swaps the derivatives, du' = dv and
+// dv' = du, so du' x dv' = -(du x dv) and the world normal is |det M| M^-T n: outward again. The
+// transposition only reorders control points (exact); for a world point M P(v, u) and an eye e,
+// (e - M p) . N' = |det M| (M^-1 e - p) . n, so the one-sided fragment test of the world patch
+// is the model-space test with the eye moved into model space (what the patch clusters test).
+// Transposed, with everything that goes with the patch:
+// - control points: cp'[4j + i] = cp[4i + j];
+// - ACC tangent patches: du'(u, v) = dv(v, u) and dv'(u, v) = du(v, u), i.e.
+//   du'[3j + i] = dv[4i + j] (i < 3, j < 4) and dv'[4j + i] = du[3i + j] (i < 4, j < 3);
+// - corner texcoords (corners (0,0), (1,0), (0,1), (1,1)): corners 1 and 2 swap;
+// - the displacement range (over the corners' texcoord box) and the depth are per patch: unchanged.
+
 ScenePoser::ScenePoser(const Scene& scene) : scene_(&scene) {
     if (scene.displacement.empty()) return;
     for (const SceneInstance& instance : scene.instances) {
         const PatchFrame& rest = scene.models.at(instance.model).rest;
+        const bool mirrored = instance_mirrors(instance);
         for (const PatchInfo& info : rest.info) {
-            texcoords_.push_back({info.uv[0], info.uv[1], info.uv[2], info.uv[3]});
+            if (mirrored)
+                texcoords_.push_back({info.uv[0], info.uv[2], info.uv[1], info.uv[3]});
+            else
+                texcoords_.push_back({info.uv[0], info.uv[1], info.uv[2], info.uv[3]});
             ranges_.push_back(instance.displaced ? scene.displacement.patch_range(info.uv) : DisplacementRange{});
         }
     }
@@ -331,17 +358,31 @@ const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
             const Vec4 m = to_world * Vec4{d.x, d.y, d.z, 0.0f};
             return Vec3{m.x, m.y, m.z};
         };
+        const bool mirrored = instance_mirrors(instance);  // transposed (see above ScenePoser::ScenePoser)
         std::size_t next = first_patch_[i];
         std::size_t next_tangent = first_tangent_[i];
         for (std::size_t p = 0; p < frame->patches.size(); ++p) {
             BezierPatch& out = patches_[next];
-            for (int k = 0; k < kPatchPoints; ++k) out.cp[k] = to_world * frame->patches[p].cp[k];
+            const BezierPatch& in = frame->patches[p];
+            if (mirrored) {
+                for (int j = 0; j < 4; ++j)
+                    for (int k = 0; k < 4; ++k) out.cp[4 * j + k] = to_world * in.cp[4 * k + j];
+            } else {
+                for (int k = 0; k < kPatchPoints; ++k) out.cp[k] = to_world * in.cp[k];
+            }
             depth_[next] = frame->info[p].depth;
             const std::int32_t t = frame->info[p].tangent_index;
             if (t >= 0) {
                 TangentPatches& mapped = tangents_[next_tangent];
                 const TangentPatches& source = frame->tangents[static_cast<std::size_t>(t)];
-                for (int k = 0; k < 12; ++k) mapped.du[k] = linear(source.du[k]), mapped.dv[k] = linear(source.dv[k]);
+                if (mirrored) {
+                    for (int j = 0; j < 4; ++j)
+                        for (int k = 0; k < 3; ++k) mapped.du[3 * j + k] = linear(source.dv[4 * k + j]);
+                    for (int j = 0; j < 3; ++j)
+                        for (int k = 0; k < 4; ++k) mapped.dv[4 * j + k] = linear(source.du[3 * k + j]);
+                } else {
+                    for (int k = 0; k < 12; ++k) mapped.du[k] = linear(source.du[k]), mapped.dv[k] = linear(source.dv[k]);
+                }
                 tangent_index_[next] = static_cast<std::int32_t>(next_tangent);
                 ++next_tangent;
             }

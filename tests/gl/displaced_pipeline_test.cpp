@@ -32,13 +32,14 @@ Scene displaced_frog_scene(Scheme scheme = Scheme::acc) {
     scene.displacement = make_procedural_displacement(128, 0.2f);
     scene.displacement_name = "procedural";
     scene.instances[0].displaced = true;
-    const auto base = static_cast<std::uint32_t>(scene.occluder_vertices.size());
     const CameraPath& c = scene.camera;
     const Vec3 toward{0, 0, 1};  // the path starts on +z
     const Vec3 mid = c.target + toward * (0.45f * c.distance);
-    for (Vec3 p : {Vec3{-2, 0, 0}, Vec3{2, 0, 0}, Vec3{2, 0.45f, 0}, Vec3{-2, 0.45f, 0}})
-        scene.occluder_vertices.push_back(Vec3{p.x, p.y, mid.z});
-    for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) scene.occluder_indices.push_back(base + i);
+    std::vector<Vec3> wall;
+    for (Vec3 p : {Vec3{-2, 0, 0}, Vec3{2, 0, 0}, Vec3{2, 0.45f, 0}, Vec3{-2, 0.45f, 0}}) wall.push_back(Vec3{p.x, p.y, mid.z});
+    // An environment object of its own (Scene::environment tiles occluder_indices), two-sided:
+    // a single quad is no closed solid.
+    add_environment_object(scene, "wall", wall, {0, 1, 2, 0, 2, 3}, false);
     return scene;
 }
 

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
@@ -246,4 +248,206 @@ TEST(DefaultScene, AddEnvironmentObjects) {
     EXPECT_THROW(add_environment_object(scene, "bad", {{0, 0, 0}}, {0, 0, 1}, false), Error);
     EXPECT_THROW(add_environment_object(scene, "bad", {{0, 0, 0}}, {0, 0}, false), Error);
     EXPECT_EQ(scene.environment.size(), 3u);
+}
+
+// ---- mirrored instances (ScenePoser transposes their patches) ----------------------------------
+
+namespace {
+
+Mat4 diagonal(float x, float y, float z) {
+    Mat4 m;
+    m.at(0, 0) = x;
+    m.at(1, 1) = y;
+    m.at(2, 2) = z;
+    return m;
+}
+
+Vec3 linear_part(const Mat4& m, Vec3 d) { return xyz(m * Vec4{d.x, d.y, d.z, 0}); }
+
+// Signed volume of a set of patches, 1/3 sum of P . (Pu x Pv) over an n x n midpoint grid per patch
+// (the divergence theorem; positive for a closed surface whose du x dv points outward).
+double patch_volume(const std::vector<BezierPatch>& patches, std::size_t first, std::size_t count, Vec3 centre, int n = 6) {
+    double v = 0;
+    for (std::size_t p = first; p < first + count; ++p)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                const SurfacePoint s = evaluate_surface(patches[p], (i + 0.5f) / n, (j + 0.5f) / n);
+                const Vec3 q = s.position - centre;  // about a point near the model: less cancellation
+                v += (double(q.x) * s.normal.x + double(q.y) * s.normal.y + double(q.z) * s.normal.z) / (3.0 * n * n);
+            }
+    return v;
+}
+
+}  // namespace
+
+TEST(DefaultScene, InstanceMirrorsIsTheDeterminantsSign) {
+    SceneInstance instance;
+    EXPECT_FALSE(instance_mirrors(instance));
+    instance.object_to_world = diagonal(-1, 1, 1);
+    EXPECT_TRUE(instance_mirrors(instance));
+    instance.object_to_world = diagonal(-1, -1, 1);  // a half turn: no mirror
+    EXPECT_FALSE(instance_mirrors(instance));
+    instance.object_to_world = diagonal(-1, -1, -1);
+    EXPECT_TRUE(instance_mirrors(instance));
+    instance.object_to_world = diagonal(-1, 0, 1);  // singular
+    EXPECT_FALSE(instance_mirrors(instance));
+    instance.object_to_world = diagonal(1e-3f, 1e-3f, -1e-3f);  // tiny but mirrored
+    EXPECT_TRUE(instance_mirrors(instance));
+    instance.object_to_world = diagonal(1, 1, -1);
+    instance.velocity = {3, 0, 0};
+    EXPECT_TRUE(instance_mirrors(instance));
+}
+
+// A mirrored BigGuy (deforming, displaced, with ACC tangent patches) next to the unmirrored one:
+// its patches are the transposed mirror images (bit for bit), the same surfaces at (v, u), with
+// du x dv the mirrored outward normal, ACC normals and texcoords that follow; the posed closed
+// surface has positive volume (it is right side out), which the plain mirror image has not. Also
+// far from the origin (1e4) and with a mirror that is also rotated and scaled unevenly.
+TEST(DefaultScene, MirroredInstancesArePosedRightSideOut) {
+    Scene scene = make_model_scene(load_model(shipped_model_path("bigguy.obj"), Scheme::acc, 0));
+    ASSERT_TRUE(scene.models[0].closed);
+    scene.displacement = make_procedural_displacement(64, 0.02f);
+    scene.displacement_name = "procedural";
+    scene.instances[0].displaced = true;
+    scene.instances[0].time_offset = 0.3f;
+    const Mat4 standing = scene.instances[0].object_to_world;
+    Mat4 tilted;  // a rotation about y by 30 degrees, then a mirror in z with uneven scale
+    tilted.at(0, 0) = 0.8660254f, tilted.at(0, 2) = 0.5f, tilted.at(2, 0) = -0.5f, tilted.at(2, 2) = 0.8660254f;
+    tilted = diagonal(1.5f, 0.7f, -1.2f) * tilted;
+    struct Case {
+        const char* name;
+        Mat4 linear;
+        Vec3 offset;
+    };
+    const Case cases[] = {{"mirror x", diagonal(-1, 1, 1), {3, 0, 0}},
+                          {"mirror x at 1e4", diagonal(-1, 1, 1), {1e4f, 0, -1e4f}},
+                          {"tilted mirror", tilted, {-3, 0, 1}},
+                          {"unmirrored copy", diagonal(1, 1, 1), {0, 0, 3}}};
+    for (const Case& c : cases) {
+        SceneInstance copy = scene.instances[0];
+        copy.name = std::string("bigguy#") + c.name;
+        Mat4 t;
+        t.at(0, 3) = c.offset.x, t.at(1, 3) = c.offset.y, t.at(2, 3) = c.offset.z;
+        copy.object_to_world = t * c.linear * standing;
+        scene.instances.push_back(copy);
+    }
+    const std::size_t n = scene.models[0].rest.patches.size();
+    ScenePoser poser(scene);
+    const float time = 0.2f;
+    const std::vector<BezierPatch>& posed = poser.pose(time);
+    ASSERT_EQ(posed.size(), 5 * n);
+    ASSERT_EQ(poser.texcoords().size(), 5 * n);
+
+    // The model's frame at the shared effective time, for the bit-for-bit check.
+    std::vector<Vec3> positions;
+    PatchFrame frame;
+    animate(scene.models[0].subdiv->mesh.positions, time + scene.instances[0].time_offset, scene.animation, positions);
+    evaluate_frame(scene.models[0], positions, frame);
+
+    const Bounds b0 = bounds_of(posed, 0, n);
+    const double v0 = patch_volume(posed, 0, n, b0.center());
+    EXPECT_GT(v0, 0.0);
+    for (std::size_t k = 0; k < 4; ++k) {
+        const Case& c = cases[k];
+        const SceneInstance& instance = scene.instances[k + 1];
+        const bool mirrored = k < 3;
+        ASSERT_EQ(instance_mirrors(instance), mirrored) << c.name;
+        const std::size_t first = (k + 1) * n;
+        const Mat4 to_world = instance_to_world(instance, time);
+        double det = 0;
+        {
+            const Mat4& l = c.linear;
+            auto a = [&](int r, int cc) { return double(l.at(r, cc)); };
+            det = a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
+                  a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
+        }
+        // Outward normals map by the inverse transpose of the linear part.
+        Mat4 inverse;
+        ASSERT_TRUE(invert(c.linear, inverse));
+        auto normal_map = [&](Vec3 nn) {
+            return Vec3{inverse.at(0, 0) * nn.x + inverse.at(1, 0) * nn.y + inverse.at(2, 0) * nn.z,
+                        inverse.at(0, 1) * nn.x + inverse.at(1, 1) * nn.y + inverse.at(2, 1) * nn.z,
+                        inverse.at(0, 2) * nn.x + inverse.at(1, 2) * nn.y + inverse.at(2, 2) * nn.z};
+        };
+        const float scale = 1.0f + length(c.offset);  // positions' magnitude, for tolerances
+        // At 1e4 the float control points are rounded by ~1e-3 of patches ~0.05 across: the
+        // normals of both poses turn by a few degrees (their sign is what must agree).
+        const float min_cos = scale > 100 ? 0.5f : 0.999f;
+        std::size_t normals_checked = 0, acc_checked = 0;
+        for (std::size_t p = 0; p < n; ++p) {
+            const BezierPatch& a = posed[p];          // the unmirrored instance (object_to_world = standing)
+            const BezierPatch& m = posed[first + p];  // this instance
+            // Control points: instance_to_world times the model's, transposed when mirrored.
+            for (int j = 0; j < 4; ++j)
+                for (int i = 0; i < 4; ++i) {
+                    const Vec4 e = to_world * frame.patches[p].cp[mirrored ? 4 * i + j : 4 * j + i];
+                    const Vec4 g = m.cp[4 * j + i];
+                    ASSERT_TRUE(g.x == e.x && g.y == e.y && g.z == e.z && g.w == e.w) << c.name << " patch " << p;
+                }
+            ASSERT_EQ(poser.depth()[first + p], poser.depth()[p]);
+            // Texcoords: corners (1,0) and (0,1) swap; the displacement range stays.
+            const auto& ta = poser.texcoords()[p];
+            const auto& tm = poser.texcoords()[first + p];
+            const int swap[4] = {0, 2, 1, 3};
+            for (int q = 0; q < 4; ++q) {
+                EXPECT_EQ(tm[q].x, ta[mirrored ? swap[q] : q].x);
+                EXPECT_EQ(tm[q].y, ta[mirrored ? swap[q] : q].y);
+            }
+            EXPECT_EQ(poser.displacement_ranges()[first + p].d_min, poser.displacement_ranges()[p].d_min);
+            EXPECT_EQ(poser.displacement_ranges()[first + p].d_max, poser.displacement_ranges()[p].d_max);
+            // Dense samples: the same surface (the image of the unmirrored one), du x dv the image
+            // of the unmirrored outward normal (by the inverse transpose), same direction.
+            if (p % 7 == 0) {
+                for (int sj = 0; sj <= 8; ++sj)
+                    for (int si = 0; si <= 8; ++si) {
+                        const float u = si / 8.0f, v = sj / 8.0f;
+                        const SurfacePoint sa = evaluate_surface(a, u, v);
+                        const SurfacePoint sm = mirrored ? evaluate_surface(m, v, u) : evaluate_surface(m, u, v);
+                        const Vec3 expected = linear_part(c.linear, sa.position) + c.offset;
+                        ASSERT_LT(length(sm.position - expected), 2e-6f * scale) << c.name << " patch " << p;
+                        const Vec3 na = normal_map(sa.normal);
+                        if (length(na) < 1e-6f || length(sm.normal) < 1e-9f) continue;
+                        ASSERT_GT(dot(normalize(sm.normal), normalize(na)), min_cos)
+                            << c.name << " patch " << p << " (" << u << ", " << v << ")";
+                        ++normals_checked;
+                    }
+            }
+            // ACC tangent patches: the shading normal at (v, u) is the mirrored one, scaled by |det|.
+            const std::int32_t ia = poser.tangent_index()[p], im = poser.tangent_index()[first + p];
+            ASSERT_EQ(ia >= 0, im >= 0);
+            if (ia < 0) continue;
+            const TangentPatches& tp_a = poser.tangents()[static_cast<std::size_t>(ia)];
+            const TangentPatches& tp_m = poser.tangents()[static_cast<std::size_t>(im)];
+            for (float u : {0.0f, 0.3f, 1.0f})
+                for (float v : {0.0f, 0.6f, 1.0f}) {
+                    const Vec3 na = normal_map(evaluate_tangent_normal(tp_a, u, v)) * static_cast<float>(std::fabs(det));
+                    const Vec3 nm = mirrored ? evaluate_tangent_normal(tp_m, v, u) : evaluate_tangent_normal(tp_m, u, v);
+                    ASSERT_LT(length(nm - na), 1e-3f * length(na) + 1e-9f) << c.name << " patch " << p;
+                    // ... and the ACC normal agrees in direction with the patch's own du x dv.
+                    const SurfacePoint sm = mirrored ? evaluate_surface(m, v, u) : evaluate_surface(m, u, v);
+                    if (length(sm.normal) > 1e-6f * length(nm)) {
+                        EXPECT_GT(dot(sm.normal, nm), 0.0f) << c.name << " patch " << p;
+                    }
+                    ++acc_checked;
+                }
+        }
+        EXPECT_GT(normals_checked, n * 81 / 7 / 2) << c.name;
+        EXPECT_GT(acc_checked, 100u) << c.name;
+        // Right side out: the posed closed surface has positive volume, |det| times the model's
+        // (the volume's quadrature rounds the same way for both); the naive mirror image (the
+        // model's patches transformed without the transposition) is inside out.
+        const Bounds bm = bounds_of(posed, first, n);
+        const double vm = patch_volume(posed, first, n, bm.center());
+        EXPECT_GT(vm, 0.0) << c.name;
+        EXPECT_NEAR(vm, v0 * std::fabs(det), 1e-3 * v0 * std::fabs(det)) << c.name;
+        std::vector<BezierPatch> naive(n);
+        for (std::size_t p = 0; p < n; ++p)
+            for (int q = 0; q < kPatchPoints; ++q) naive[p].cp[q] = to_world * frame.patches[p].cp[q];
+        const double vn = patch_volume(naive, 0, n, bm.center());
+        if (mirrored) {
+            EXPECT_LT(vn, 0.0) << c.name;
+        } else {
+            EXPECT_GT(vn, 0.0) << c.name;
+        }
+    }
 }
