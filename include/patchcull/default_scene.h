@@ -18,7 +18,8 @@
 // instance_to_world (object_to_world moved by the instance's velocity), which maps homogeneous
 // points exactly (w is kept). OBJ models are taken as y-up, the built-in teapot as z-up.
 // Rounding: everything is float. ScenePoser's output is exactly instance_to_world times the
-// (animated) control points, in float (tested bit for bit); the built-in scenes keep characters
+// (animated) control points, in float (tested bit for bit; for a mirroring transform the same
+// products in transposed order, see ScenePoser); the built-in scenes keep characters
 // at least 0.1 (plus their reach, measured on the float control points) from walls and buildings,
 // far more than any rounding at their sizes (under 100 units from the origin).
 #pragma once
