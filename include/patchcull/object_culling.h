@@ -79,6 +79,9 @@ struct ObjectFrame {
     /// be null when that volume is not asked for.
     const Sphere* spheres = nullptr;
     const Obb* obbs = nullptr;
+    /// Per object: 0 leaves its back-face clusters out this frame (e.g. float rounding of its
+    /// world coordinates too large against its size, scene_object_level.h); null: all usable.
+    const std::uint8_t* clusters_usable = nullptr;
 };
 
 /// The bounding volume an object is tested with after its AABB (flat list or BVH) left it in:

@@ -264,6 +264,7 @@ const ObjectCullResult& ObjectCuller::cull(const ObjectFrame& frame, const Objec
             continue;
         }
         if (options.method != ObjectCullMethod::bvh_backface || clusters_[i].nodes.empty()) continue;
+        if (frame.clusters_usable && !frame.clusters_usable[i]) continue;
         if (o.triangles && individual) {
             if (cull_triangles_individually(i, frame, options, culled) == o.span.count) r.verdicts[i] = ObjectVerdict::backface;
             continue;

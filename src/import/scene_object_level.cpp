@@ -154,7 +154,18 @@ const ObjectCullResult& SceneObjectLevel::cull(const std::vector<BezierPatch>& p
             }
         }
     }
+    // Clusters only where float rounding is small against the object (the header's rule).
+    clusters_usable_.assign(culler_.object_count(), 1);
+    const float eye_far = std::max({std::fabs(camera.eye.x), std::fabs(camera.eye.y), std::fabs(camera.eye.z)});
+    for (std::size_t i = 0; i < culler_.object_count(); ++i) {
+        const Bounds& b = boxes_[i];
+        const float far = std::max({eye_far, std::fabs(b.min.x), std::fabs(b.min.y), std::fabs(b.min.z), std::fabs(b.max.x),
+                                    std::fabs(b.max.y), std::fabs(b.max.z)});
+        const float diagonal = length(b.max - b.min);
+        if (!(far <= kClusterRoundingRatio * diagonal)) clusters_usable_[i] = 0;
+    }
     ObjectFrame frame;
+    frame.clusters_usable = clusters_usable_.data();
     frame.world_to_clip = camera.view_projection();
     frame.depth = ClipDepth::zero_to_one;
     frame.eye = camera.eye;

@@ -201,10 +201,10 @@ TEST(ObjectLevelCli, BadObjectFlagsAreOneLineErrors) {
 // A rigid BigGuy placed with a mirroring matrix (x scale -0.05): the patch clusters test the eye
 // in object space, where facing is the opposite of the drawn (world-space) one, and cull what is
 // drawn (~270 false culls per frame, found by this suite's probe; the CPU truth is
-// tests/import/scene_object_level_test.cpp DISABLED_MirroredRigidInstanceIsNotBackFaceCulledWrongly).
-// DISABLED until the fix is committed (ScenePoser posing mirrored instances transposed, the lead's
-// working tree at 02:30 UTC: this test passes with it).
-TEST(ObjectLevelCli, DISABLED_MirroredRigidInstanceHasNoFalseCulls) {
+// tests/import/scene_object_level_test.cpp MirroredRigidInstanceIsNotBackFaceCulledWrongly).
+// Fixed: ScenePoser poses mirrored instances transposed (default_scene.h), so they are drawn
+// right side out and their model-space patch clusters hold.
+TEST(ObjectLevelCli, MirroredRigidInstanceHasNoFalseCulls) {
     const Summary s = verified_render("render " + test_scene("mirrored_rigid.json") +
                                           " --objects bvh+backface --size 160x90 --tess 2 --frames 3 --cull none",
                                       2, 3);
@@ -215,10 +215,10 @@ TEST(ObjectLevelCli, DISABLED_MirroredRigidInstanceHasNoFalseCulls) {
 // control points are rounded by ~0.008, so the drawn patch differs from the exact transform of
 // its rest patch that the object-space patch clusters bound; near the silhouette the clusters cull
 // patches whose drawn tangent planes face the eye (--cull none, so only the object level culls:
-// 26 false culls over these 6 frames, 1 at 2e4, 4 at 6e4; --objects bvh gives 0). DISABLED until
-// the patch clusters allow for the rounding of the posed patches (or are not used where it
-// matters).
-TEST(ObjectLevelCli, DISABLED_FarRigidInstanceHasNoFalseCulls) {
+// 26 false culls over these 6 frames, 1 at 2e4, 4 at 6e4; --objects bvh gives 0). Fixed: a frame
+// leaves an object's clusters out where its box or the eye lies farther from the origin than
+// kClusterRoundingRatio times its size (scene_object_level.h).
+TEST(ObjectLevelCli, FarRigidInstanceHasNoFalseCulls) {
     const Summary s = verified_render("render " + test_scene("far_rigid_1e5.json") +
                                           " --objects bvh+backface --cull none --size 320x180 --tess 4 --frames 6",
                                       1, 6);
