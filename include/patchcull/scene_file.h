@@ -29,6 +29,14 @@
 
 namespace patchcull {
 
+/// The largest world coordinate a scene file may place anything at (objects' control points,
+/// environment vertices, positions, cameras). A scene is drawn and culled in float world space
+/// (no per-object local frame yet): at 2e4 from the origin a rigid BigGuy had visible patches
+/// culled by the Hi-Z test (2 in 6 frames, tests/data/scenes/far_rigid_1e5.json moved there), at
+/// 1e4 none; 8192 keeps a margin. Farther scenes are refused with one line (move them nearer
+/// the origin), not culled wrongly.
+inline constexpr double kMaxSceneCoordinate = 8192;
+
 /// Largest scene file load_scene_file reads (a regular file; devices and FIFOs are refused).
 inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
 

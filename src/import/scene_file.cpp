@@ -127,12 +127,13 @@ struct Reader {
         return s;
     }
 
-    // A finite coordinate: any float within kMaxMeshExtent of 0.
+    // A finite coordinate: any float within kMaxSceneCoordinate of 0.
     Vec3 vec3(const json& j, const std::string& path) const {
         if (!j.is_array() || j.size() != 3) fail(path, "expected 3 numbers");
         Vec3 v;
         float* out = &v.x;
-        for (std::size_t k = 0; k < 3; ++k) out[k] = number(j[k], index(path, k), -kMaxMeshExtent, kMaxMeshExtent);
+        for (std::size_t k = 0; k < 3; ++k)
+            out[k] = number(j[k], index(path, k), -kMaxSceneCoordinate, kMaxSceneCoordinate);
         return v;
     }
 
@@ -202,16 +203,17 @@ Mat4 read_transform(const Reader& r, const json& j, const std::string& path, con
     return translation(position) * rotation_y(yaw) * local;
 }
 
-// World-space points must be finite, within kMaxMeshExtent of 0 and (together) at least
+// World-space points must be finite, within kMaxSceneCoordinate of 0 and (together) at least
 // kMinMeshDiagonal across.
 void check_placed(const Reader& r, const std::string& path, const std::vector<Vec3>& points, const char* what) {
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
     for (const Vec3& p : points) {
         const float* c = &p.x;
         for (int a = 0; a < 3; ++a) {
-            if (!std::isfinite(c[a]) || std::fabs(double(c[a])) > kMaxMeshExtent)
+            if (!std::isfinite(c[a]) || std::fabs(double(c[a])) > kMaxSceneCoordinate)
                 r.fail(path, std::string("the placed ") + what + " reaches " + number_text(c[a]) +
-                                 "; patchcull takes coordinates up to 2e+11 (the kernels work in float)");
+                                 "; scene files take world coordinates up to 8192 (scenes are drawn and culled in "
+                                 "float world space; move the scene nearer the origin)");
             lo[a] = std::min(lo[a], double(c[a]));
             hi[a] = std::max(hi[a], double(c[a]));
         }

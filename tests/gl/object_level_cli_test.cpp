@@ -211,18 +211,14 @@ TEST(ObjectLevelCli, MirroredRigidInstanceHasNoFalseCulls) {
     (void)s;
 }
 
-// A rigid BigGuy at 1e5 from the origin (the scene-file limit is 2e11): its world-space float
-// control points are rounded by ~0.008, so the drawn patch differs from the exact transform of
-// its rest patch that the object-space patch clusters bound; near the silhouette the clusters cull
-// patches whose drawn tangent planes face the eye (--cull none, so only the object level culls:
-// 26 false culls over these 6 frames, 1 at 2e4, 4 at 6e4; --objects bvh gives 0). Fixed: a frame
-// leaves an object's clusters out where its box or the eye lies farther from the origin than
-// kClusterRoundingRatio times its size (scene_object_level.h).
-TEST(ObjectLevelCli, FarRigidInstanceHasNoFalseCulls) {
-    const Summary s = verified_render("render " + test_scene("far_rigid_1e5.json") +
-                                          " --objects bvh+backface --cull none --size 320x180 --tess 4 --frames 6",
-                                      1, 6);
-    (void)s;
+// A rigid BigGuy at 1e5 from the origin. Its world-space float control points are rounded by
+// ~0.008: the object-space patch clusters culled drawn patches at the silhouette (26 false culls
+// in 6 frames; fixed by kClusterRoundingRatio, scene_object_level.h), and with --cull occlusion
+// the Hi-Z test culled visible patches from 2e4 on. Scene files now refuse world coordinates
+// beyond kMaxSceneCoordinate (8192) with one line naming the file and the JSON path.
+TEST(ObjectLevelCli, FarSceneFilesAreRefused) {
+    expect_one_line_error(run("render " + test_scene("far_rigid_1e5.json") + " --objects bvh+backface --frames 1 --json"),
+                          "far_rigid_1e5.json: objects[0].transform.position[0]: expected a number >= -8192 and <= 8192");
 }
 
 namespace patchcull::gl {

@@ -394,14 +394,14 @@ TEST(SceneFile, PathsAreRelativeToTheFile) {
 
 TEST(SceneFile, FarFromTheOriginAndMirrored) {
     const TempDir dir("far");
-    // An OBJ environment mesh at 1e5 (the OBJ reader recentres it; the file adds the origin back
-    // in double), a character and a box at 1e4-1e5.
-    write(dir / "far.obj", cube_obj(1e5, 2));
+    // An OBJ environment mesh at 5000 (the OBJ reader recentres it; the file adds the origin back
+    // in double), a character and a box at 2000-8000 (kMaxSceneCoordinate is 8192).
+    write(dir / "far.obj", cube_obj(5000, 2));
     write(dir / "cube.obj", cube_obj());
     std::string text = with(valid_scene(), R"("obj": "cube.obj", "transform": {"position": [-3, 0, 3], "scale": 2})",
                             R"("obj": "far.obj", "one_sided": true)");
-    text = with(text, R"("position": [2, 0, 0], "yaw_degrees": 30)", R"("position": [20000, 0, 90000], "yaw_degrees": 30)");
-    text = with(text, R"("min": [3, 0, 3], "max": [4, 1, 4])", R"("min": [30000, 0, 30000], "max": [30001, 1, 30001])");
+    text = with(text, R"("position": [2, 0, 0], "yaw_degrees": 30)", R"("position": [2000, 0, 8000], "yaw_degrees": 30)");
+    text = with(text, R"("min": [3, 0, 3], "max": [4, 1, 4])", R"("min": [3000, 0, 3000], "max": [3001, 1, 3001])");
     write(dir / "a.json", text);
     const Scene s = load_scene_file((dir / "a.json").string());
     std::vector<Vec3> mesh;
@@ -409,10 +409,19 @@ TEST(SceneFile, FarFromTheOriginAndMirrored) {
     for (std::uint32_t t = far.first_triangle; t < far.first_triangle + far.triangle_count; ++t)
         for (int k = 0; k < 3; ++k) mesh.push_back(s.occluder_vertices[s.occluder_indices[3 * t + k]]);
     const Bounds b = bounds_of(mesh);
-    EXPECT_EQ(b.min.x, 1e5f);
-    EXPECT_EQ(b.max.x, 100002.0f);
-    EXPECT_EQ(b.max.z, 100002.0f);
-    EXPECT_EQ(s.instances[1].object_to_world.at(2, 3), 90000.0f);
+    EXPECT_EQ(b.min.x, 5000.0f);
+    EXPECT_EQ(b.max.x, 5002.0f);
+    EXPECT_EQ(b.max.z, 5002.0f);
+    EXPECT_EQ(s.instances[1].object_to_world.at(2, 3), 8000.0f);
+    // An OBJ environment mesh beyond it is refused with one line.
+    write(dir / "far2.obj", cube_obj(1e5, 2));
+    write(dir / "b.json", with(text, R"("obj": "far.obj")", R"("obj": "far2.obj")"));
+    try {
+        load_scene_file((dir / "b.json").string());
+        ADD_FAILURE() << "a mesh at 1e5 loaded";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("scene files take world coordinates up to 8192"), std::string::npos) << e.what();
+    }
     // A mirroring matrix keeps boxes outward: the triangles are flipped back.
     text = with(valid_scene(), R"("box": {"min": [3, 0, 3], "max": [4, 1, 4]})",
                 R"("box": {"min": [3, 0, 3], "max": [4, 1, 4]}, "transform": [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])");
@@ -509,11 +518,15 @@ TEST_F(SceneFileErrors, TransformsAndDegenerateInputs) {
                   .find("e-09 units across; patchcull takes meshes of at least 1e-06 units across (the kernels work in float)"),
               std::string::npos);
     expect(with(valid_scene(), "\"position\": [2, 0, 0]", "\"position\": [2, 0, 3e11]"),
-           "objects[1].transform.position[2]: expected a number >= -2e+11 and <= 2e+11, got 3e+11");
+           "objects[1].transform.position[2]: expected a number >= -8192 and <= 8192, got 3e+11");
+    // kMaxSceneCoordinate: scenes are culled in float world space; 2e4 showed false culls.
+    expect(with(valid_scene(), "\"position\": [2, 0, 0]", "\"position\": [2, 0, 20000]"),
+           "objects[1].transform.position[2]: expected a number >= -8192 and <= 8192, got 20000");
     const std::string huge = with(valid_scene(), "[1, 0, 0, -2, 0, 1, 0, 0, 0, 0, 1, 0", "[5e11, 0, 0, -2, 0, 5e11, 0, 0, 0, 0, 5e11, 0");
     expect_prefix(huge, "objects[2].transform: the placed model reaches ");
     EXPECT_NE(load_error(dir_, huge)
-                  .find("e+11; patchcull takes coordinates up to 2e+11 (the kernels work in float)"),
+                  .find("e+11; scene files take world coordinates up to 8192 (scenes are drawn and culled in float "
+                        "world space; move the scene nearer the origin)"),
               std::string::npos);
     expect(with(valid_scene(), "\"max\": [4, 1, 4]", "\"max\": [4, 0, 4]"),
            "environment[1].box: max must be greater than min on every axis (a flat or empty box)");

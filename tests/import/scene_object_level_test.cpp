@@ -788,7 +788,7 @@ TEST(SceneObjectLevelTruth, SceneFile) {
     EXPECT_GT(t.truth_facing, 0u);
 }
 
-// A scene file at ~1e4 units from the origin: rigid and deforming characters (one walking), a
+// A scene file at ~8e3 units from the origin: rigid and deforming characters (one walking), a
 // box building, a one-sided ground quad, a camera walking past them. Float spacing there is
 // ~1e-3: the volumes' relative growth and the clusters' margins must keep every cull honest.
 Totals far_scene_truth(bool world_float_truth) {
@@ -797,20 +797,20 @@ Totals far_scene_truth(bool world_float_truth) {
       "name": "far",
       "displacement": {"map": "procedural", "scale": 0.03},
       "objects": [
-        {"model": "bigguy", "transform": {"position": [10000, 0, 20000], "yaw_degrees": 30, "height": 1},
+        {"model": "bigguy", "transform": {"position": [4000, 0, 8000], "yaw_degrees": 30, "height": 1},
          "animation": {"deform": false}},
-        {"model": "bigguy", "transform": {"position": [10001.5, 0, 19999], "yaw_degrees": 200, "height": 1},
+        {"model": "bigguy", "transform": {"position": [4001.5, 0, 7999], "yaw_degrees": 200, "height": 1},
          "animation": {"deform": false, "velocity": [0.3, 0, 0]}},
-        {"model": "monsterfrog", "transform": {"position": [9998.5, 0, 20000.5], "yaw_degrees": 90, "height": 0.6},
+        {"model": "monsterfrog", "transform": {"position": [3998.5, 0, 8000.5], "yaw_degrees": 90, "height": 0.6},
          "displaced": true},
-        {"model": "bigguy", "transform": {"position": [10000, 0, 19990], "height": 1}, "animation": {"deform": false}}
+        {"model": "bigguy", "transform": {"position": [4000, 0, 7990], "height": 1}, "animation": {"deform": false}}
       ],
       "environment": [
-        {"name": "ground", "quad": [[9980, -0.002, 19980], [9980, -0.002, 20020], [10020, -0.002, 20020],
-                                    [10020, -0.002, 19980]], "one_sided": true},
-        {"name": "block", "box": {"min": [10003, 0, 19995], "max": [10006, 4, 19998]}}
+        {"name": "ground", "quad": [[3980, -0.002, 7980], [3980, -0.002, 8020], [4020, -0.002, 8020],
+                                    [4020, -0.002, 7980]], "one_sided": true},
+        {"name": "block", "box": {"min": [4003, 0, 7995], "max": [4006, 4, 7998]}}
       ],
-      "camera": {"walk": {"start": [10000, 0.8, 20005], "step": [0.05, 0, -0.4], "direction": [0.1, -0.05, -1]},
+      "camera": {"walk": {"start": [4000, 0.8, 8005], "step": [0.05, 0, -0.4], "direction": [0.1, -0.05, -1]},
                  "z_near": 0.05, "z_far": 60}
     })";
     const std::string path = (dir.path / "far.json").string();
@@ -820,8 +820,8 @@ Totals far_scene_truth(bool world_float_truth) {
     std::vector<float> times;
     path_cameras(scene, 40, 8, cameras, times);
     // Looking back (every character behind the camera) and from inside the block.
-    cameras.push_back(make_camera({10000.0f, 0.8f, 20003.0f}, {10000.0f, 0.8f, 20010.0f}));
-    cameras.push_back(make_camera({10004.5f, 2.0f, 19996.5f}, {10000.0f, 0.5f, 20000.0f}));
+    cameras.push_back(make_camera({4000.0f, 0.8f, 8003.0f}, {4000.0f, 0.8f, 8010.0f}));
+    cameras.push_back(make_camera({4004.5f, 2.0f, 7996.5f}, {4000.0f, 0.5f, 8000.0f}));
     while (times.size() < cameras.size()) times.push_back(1.0f);
     return check_scene(scene, cameras, times, {}, world_float_truth);
 }
