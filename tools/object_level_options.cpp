@@ -56,6 +56,7 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
     if (!enabled()) return;
     ObjectLevelSetup setup;
     setup.patches_one_sided = patches_one_sided;
+    setup.clusters = method_ == ObjectCullMethod::bvh_backface;  // the only method that tests them
     setup.tc_over_r = options.cluster_cost;
     setup.patch_tc_over_r = options.patch_cluster_cost;
     level_ = std::make_unique<SceneObjectLevel>(scene, setup);

@@ -47,6 +47,8 @@ struct ObjectLevelSetup {
     /// The same for patch clusters: a patch costs far more to draw than a cluster test (it is
     /// tessellated), so clusters stay small (backface_clusters.h: 0.01-0.1 keep most of ptp's culls).
     double patch_tc_over_r = 0.05;
+    /// False: no clusters at all (a frustum-only level; the occluders keep their order).
+    bool clusters = true;
     unsigned max_leaf_triangles = 64;
     unsigned max_leaf_patches = 32;
 };
@@ -54,8 +56,9 @@ struct ObjectLevelSetup {
 class SceneObjectLevel {
 public:
     /// Builds the objects and clusters of scene, reordering scene.occluder_indices within each
-    /// one-sided environment object (call before the occluders are uploaded). scene must outlive
-    /// this object and keep its instances.
+    /// one-sided environment object (call before the occluders are uploaded; the clusters refer to
+    /// the order they leave, so build at most one level with clusters per scene). scene must
+    /// outlive this object and keep its instances.
     SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup = {});
 
     /// The object level for the pose (ScenePoser::pose at time_seconds; its displacement ranges

@@ -64,7 +64,7 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
         boxes_[instances + e] = aabb_of_points(points.data(), points.size());
         spheres_[instances + e] = sphere_of_points(points.data(), points.size());
         obbs_[instances + e] = obb_of_points(points.data(), points.size());
-        if (!object.one_sided || object.triangle_count == 0) continue;
+        if (!setup.clusters || !object.one_sided || object.triangle_count == 0) continue;
         const std::vector<std::uint32_t> own(scene.occluder_indices.begin() + static_cast<std::ptrdiff_t>(begin),
                                              scene.occluder_indices.begin() + static_cast<std::ptrdiff_t>(end));
         ClusterHierarchy clusters =
@@ -80,7 +80,7 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
     culler_.set_triangle_mesh(scene.occluder_vertices, scene.occluder_indices);  // as reordered
 
     // Patch clusters of rigid, undisplaced instances (one build per model, in model space).
-    if (!setup.patches_one_sided) return;
+    if (!setup.clusters || !setup.patches_one_sided) return;
     std::map<std::size_t, ClusterHierarchy> per_model;
     for (std::size_t i = 0; i < instances; ++i) {
         const SceneInstance& instance = scene.instances[i];
