@@ -42,7 +42,11 @@ std::size_t run_demo_city(const gl::GlContext& context, const DemoCityOptions& o
     // same triangles, so one upload serves every method).
     const char* methods[] = {"none", "frustum", "bvh", "bvh+backface"};
     std::vector<std::unique_ptr<ObjectLevelRun>> levels;
-    for (const char* m : methods) levels.push_back(std::make_unique<ObjectLevelRun>(ObjectLevelOptions{m}, scene, one_sided));
+    for (const char* m : methods) {
+        ObjectLevelOptions o;
+        o.method = m;
+        levels.push_back(std::make_unique<ObjectLevelRun>(o, scene, one_sided));
+    }
     pipeline.set_patches(poses[0], attributes[0]);
     upload_scene_occluders(renderer, scene);
     renderer.set_displacement_map(scene.displacement);

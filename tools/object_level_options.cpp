@@ -19,21 +19,21 @@ void add_object_level_options(CLI::App& command, ObjectLevelOptions& options) {
     add_float_option(command, "--detail-cull", options.detail_pixels, 0, 1e6,
                      "detail culling: cull objects whose bounding sphere covers fewer pixels (not conservative; "
                      "0 = off; needs --objects)");
-    add_choice_option(command, "--plane-masking", options.plane_masking, {"on", "off"},
+    options.given["--plane-masking"] = add_choice_option(command, "--plane-masking", options.plane_masking, {"on", "off"},
                       "bvh: children test only the planes their parent straddles");
-    add_choice_option(command, "--plane-coherence", options.plane_coherence, {"on", "off"},
+    options.given["--plane-coherence"] = add_choice_option(command, "--plane-coherence", options.plane_coherence, {"on", "off"},
                       "the plane that rejected a volume last frame is tried first");
-    add_choice_option(command, "--meta-bv", options.meta_bv, {"on", "off"},
+    options.given["--meta-bv"] = add_choice_option(command, "--meta-bv", options.meta_bv, {"on", "off"},
                       "test object boxes against the frustum's bounding sphere and box too");
-    add_choice_option(command, "--object-volume", options.volume, {"aabb", "sphere", "obb"},
+    options.given["--object-volume"] = add_choice_option(command, "--object-volume", options.volume, {"aabb", "sphere", "obb"},
                       "after the AABB test (flat or BVH), also test each object's sphere or PCA OBB");
-    add_choice_option(command, "--backface-triangles", options.backface_triangles, {"clusters", "masks", "triangles"},
+    options.given["--backface-triangles"] = add_choice_option(command, "--backface-triangles", options.backface_triangles, {"clusters", "masks", "triangles"},
                       "bvh+backface on one-sided environment objects: cluster hierarchy, normal masks, or per triangle");
-    add_int_option(command, "--mask-sectors", options.mask_sectors, 1, 8,
+    options.given["--mask-sectors"] = add_int_option(command, "--mask-sectors", options.mask_sectors, 1, 8,
                    "normal masks: screen sectors per side (an object inside one uses that sector's mask)");
-    add_float_option(command, "--cluster-cost", options.cluster_cost, 0, 1e6,
+    options.given["--cluster-cost"] = add_float_option(command, "--cluster-cost", options.cluster_cost, 0, 1e6,
                      "tC/r of the triangle cluster hierarchy: a cluster test's cost in triangles drawn");
-    add_float_option(command, "--patch-cluster-cost", options.patch_cluster_cost, 0, 1e6,
+    options.given["--patch-cluster-cost"] = add_float_option(command, "--patch-cluster-cost", options.patch_cluster_cost, 0, 1e6,
                      "tC/r of the patch cluster hierarchy: a cluster test's cost in patches drawn");
 }
 
@@ -42,6 +42,21 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
         throw Error("--objects: unknown method '" + options.method + "'");
     if (options.detail_pixels > 0 && method_ == ObjectCullMethod::none)
         throw Error("--detail-cull: needs --objects frustum, bvh or bvh+backface");
+    // A variant flag the chosen method would ignore is an error, not a silent no-op.
+    auto given = [&](const char* flag) {
+        const auto it = options.given.find(flag);
+        return it != options.given.end() && it->second && it->second->count() > 0;
+    };
+    const bool bvh = method_ == ObjectCullMethod::bvh || method_ == ObjectCullMethod::bvh_backface;
+    const bool backface = method_ == ObjectCullMethod::bvh_backface;
+    for (const char* flag : {"--plane-coherence", "--meta-bv", "--object-volume"})
+        if (given(flag) && method_ == ObjectCullMethod::none)
+            throw Error(std::string(flag) + ": needs --objects frustum, bvh or bvh+backface");
+    if (given("--plane-masking") && !bvh) throw Error("--plane-masking: needs --objects bvh or bvh+backface");
+    for (const char* flag : {"--backface-triangles", "--mask-sectors", "--cluster-cost", "--patch-cluster-cost"})
+        if (given(flag) && !backface) throw Error(std::string(flag) + ": needs --objects bvh+backface");
+    if (given("--mask-sectors") && options.backface_triangles != "masks")
+        throw Error("--mask-sectors: needs --backface-triangles masks");
     options_.method = method_;
     options_.detail_min_pixels = options.detail_pixels;
     options_.plane_masking = options.plane_masking == "on";

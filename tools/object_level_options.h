@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 
 namespace CLI {
 class App;
+class Option;
 }
 
 namespace patchcull::cli {
@@ -31,6 +33,9 @@ struct ObjectLevelOptions {
     int mask_sectors = 1;
     float cluster_cost = 1;          ///< tC/r of triangle clusters
     float patch_cluster_cost = 0.05f;  ///< tC/r of patch clusters
+    /// The variant flags' options (add_object_level_options): given ones the method would ignore
+    /// are errors.
+    std::map<std::string, CLI::Option*> given;
 };
 void add_object_level_options(CLI::App& command, ObjectLevelOptions& options);
 

@@ -196,6 +196,13 @@ TEST(ObjectLevelCli, BadObjectFlagsAreOneLineErrors) {
     expect_one_line_error(run(r + "--objects bvh+backface --backface-triangles some --json"), "--backface-triangles");
     expect_one_line_error(run(r + "--objects bvh --plane-masking maybe --json"), "--plane-masking");
     expect_one_line_error(run(r + "--objects bvh --object-volume cone --json"), "--object-volume");
+    // A variant flag the method would ignore is an error, not a silent no-op.
+    expect_one_line_error(run(r + "--mask-sectors 2 --json"), "--mask-sectors: needs --objects bvh+backface");
+    expect_one_line_error(run(r + "--objects bvh+backface --mask-sectors 2 --json"),
+                          "--mask-sectors: needs --backface-triangles masks");
+    expect_one_line_error(run(r + "--objects frustum --plane-masking off --json"), "--plane-masking: needs --objects bvh");
+    expect_one_line_error(run(r + "--objects bvh --cluster-cost 2 --json"), "--cluster-cost: needs --objects bvh+backface");
+    expect_one_line_error(run(r + "--meta-bv on --json"), "--meta-bv: needs --objects");
 }
 
 // A rigid BigGuy placed with a mirroring matrix (x scale -0.05): the patch clusters test the eye
