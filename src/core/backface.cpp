@@ -28,11 +28,7 @@
 #include "patchcull/backface.h"
 #include "patchcull/error.h"
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__SANITIZE_ADDRESS__)
-#define PATCHCULL_SCALAR_CLONES __attribute__((target_clones("fma", "default")))
-#else
-#define PATCHCULL_SCALAR_CLONES
-#endif
+#include "core/scalar_clones.h"
 
 namespace patchcull {
 

@@ -46,11 +46,7 @@
 #include <cmath>
 #include <limits>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__SANITIZE_ADDRESS__)
-#define PATCHCULL_SCALAR_CLONES __attribute__((target_clones("fma", "default")))
-#else
-#define PATCHCULL_SCALAR_CLONES
-#endif
+#include "core/scalar_clones.h"
 // The templates below must be inlined into each clone, or the FMA clone would call a shared
 // non-FMA copy that calls libm's fmaf.
 #if defined(__GNUC__) || defined(__clang__)

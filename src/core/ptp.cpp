@@ -42,11 +42,7 @@
 #include "patchcull/backpatch.h"
 
 // As in frustum.cpp: a clone with FMA enabled so std::fma is one instruction (identical results).
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__SANITIZE_ADDRESS__)
-#define PATCHCULL_SCALAR_CLONES __attribute__((target_clones("fma", "default")))
-#else
-#define PATCHCULL_SCALAR_CLONES
-#endif
+#include "core/scalar_clones.h"
 
 namespace patchcull {
 
