@@ -34,3 +34,7 @@ add_library(PatchcullDeps::epoxy ALIAS PkgConfig::EPOXY)
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 # The window context (GlContext::create_window): GLFW 3 (libglfw3-dev), CMake target `glfw`.
 find_package(glfw3 3.3 REQUIRED)
+# The viewer's panel (patchcull view): Dear ImGui 1.86 (libimgui-dev), a static library with the
+# GLFW and OpenGL 3 backends, found through pkg-config; backends included as <backends/imgui_impl_glfw.h>.
+pkg_check_modules(IMGUI REQUIRED IMPORTED_TARGET imgui)
+add_library(PatchcullDeps::imgui ALIAS PkgConfig::IMGUI)

@@ -10,6 +10,8 @@ PACKAGES=(
   libosd-dev libstb-dev libtbb-dev libhwy-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
   libglfw3-dev xvfb xauth  # the window context; its test runs under xvfb-run
+  libimgui-dev  # the viewer's panel (Dear ImGui with its GLFW and OpenGL 3 backends)
+  python3-matplotlib  # scripts/plot_figures.py
   assimp-testmodels  # third-party OBJ files for the unseen-models test
   clang-14 libclang-rt-14-dev  # libFuzzer for the fuzz targets (scripts/fuzz.sh)
 )
