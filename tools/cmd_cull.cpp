@@ -13,6 +13,7 @@
 #include "patchcull/cull_eval.h"
 #include "patchcull/error.h"
 #include "patchcull/frustum.h"
+#include "progress.h"
 
 namespace patchcull::cli {
 namespace {
@@ -69,7 +70,11 @@ Runner add_cull_command(CLI::App& app) {
             return m != "frustum" && m != "frustum-disp";
         });
         const DisplacementMap displacement = displacement_from_options(state->model, model);
+        // Views done on stderr when it is a terminal (progress.h); nothing with --json or a pipe.
+        Progress progress("cull", "views", std::uint64_t(options.views), progress_wanted(state->json));
+        options.on_view_done = [&progress](int done) { progress.step(std::uint64_t(done)); };
         const CullEvalResult result = evaluate_cull(model.rest, displacement.empty() ? nullptr : &displacement, options);
+        progress.finish();
         if (backpatch_requested && !model.closed)  // after the run: an error stays the only line
             print_warnings({"cull: " + model.name + " is not a closed solid: it is drawn two-sided, and the back-patch "
                             "methods' false culls here count only front-facing samples"});

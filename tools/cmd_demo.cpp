@@ -10,8 +10,10 @@
 // and verified as the other rows. Then the object level (demo_city.h): the built-in city with
 // each --objects method in front of the patch passes.
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <memory>
 
 #include "cli_options.h"
@@ -20,6 +22,7 @@
 #include "demo_city.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
+#include "progress.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -90,26 +93,6 @@ int run_demo(const DemoOptions& options) {
                 height, options.tess, context.renderer().c_str(),
                 context.is_software() ? "software: wall-clock pass times" : "GPU timer queries");
 
-    // Compiles every pass's program before anything is timed (llvmpipe takes seconds for ncone):
-    // one untimed frame per back-patch method with every test.
-    for (gl::BackpatchMethod m : {gl::BackpatchMethod::tcone, gl::BackpatchMethod::ncone, gl::BackpatchMethod::ptp}) {
-        gl::PipelineParams warm_up;
-        warm_up.frame.render = params_of(0);
-        warm_up.frame.cull = gl::CullMode::all;
-        warm_up.frame.timing = gl::TimingMethod::off;
-        warm_up.backpatch = m;
-        pipeline.render_frame(warm_up);
-    }
-    std::vector<ReferenceFrame> references;
-    double reference_ms = 0;
-    for (int f = 0; f < options.frames; ++f) {
-        pipeline.update_patches(poses[static_cast<std::size_t>(f)], attributes[static_cast<std::size_t>(f)]);
-        references.push_back(render_reference(renderer, params_of(f)));
-        if (f > 0 || options.frames == 1) reference_ms += references.back().ms;
-    }
-    const int timed_frames = options.frames > 1 ? options.frames - 1 : 1;
-    reference_ms /= timed_frames;
-
     const Method methods[] = {
         {"frustum", gl::CullMode::frustum, gl::BackpatchMethod::tcone},
         {"backpatch tcone", gl::CullMode::backpatch, gl::BackpatchMethod::tcone},
@@ -119,8 +102,37 @@ int run_demo(const DemoOptions& options) {
         {"all (tcone)", gl::CullMode::all, gl::BackpatchMethod::tcone},
         {"auto (tcone)", gl::CullMode::all, gl::BackpatchMethod::tcone, true},
     };
+    // Frames rendered so far, on stderr when it is a terminal (progress.h): the 3 warm-up frames,
+    // the references and every method's frames. Cleared before each line printed on stdout.
+    const std::uint64_t frames = static_cast<std::uint64_t>(options.frames);
+    Progress progress("demo", "frames", 3 + frames + std::size(methods) * frames, progress_wanted(false));
+    progress.erase_when_done();
+    std::uint64_t frames_done = 0;
+    // Compiles every pass's program before anything is timed (llvmpipe takes seconds for ncone):
+    // one untimed frame per back-patch method with every test.
+    for (gl::BackpatchMethod m : {gl::BackpatchMethod::tcone, gl::BackpatchMethod::ncone, gl::BackpatchMethod::ptp}) {
+        gl::PipelineParams warm_up;
+        warm_up.frame.render = params_of(0);
+        warm_up.frame.cull = gl::CullMode::all;
+        warm_up.frame.timing = gl::TimingMethod::off;
+        warm_up.backpatch = m;
+        pipeline.render_frame(warm_up);
+        progress.step(++frames_done);
+    }
+    std::vector<ReferenceFrame> references;
+    double reference_ms = 0;
+    for (int f = 0; f < options.frames; ++f) {
+        pipeline.update_patches(poses[static_cast<std::size_t>(f)], attributes[static_cast<std::size_t>(f)]);
+        references.push_back(render_reference(renderer, params_of(f)));
+        if (f > 0 || options.frames == 1) reference_ms += references.back().ms;
+        progress.step(++frames_done);
+    }
+    const int timed_frames = options.frames > 1 ? options.frames - 1 : 1;
+    reference_ms /= timed_frames;
+
     std::vector<gl::ObjectRange> ranges;
     for (const SceneObject& o : scene_objects(scene)) ranges.push_back(o.range);
+    progress.clear();
     std::printf("\nPer method, averaged over frames 1..%d (frame 0 starts with half the patches tagged visible, "
                 "seed 000 §3);\ncull rates are fractions of the %zu patches; times in ms; 'x ref' = total / unculled "
                 "render.\n\n",
@@ -136,6 +148,8 @@ int run_demo(const DemoOptions& options) {
         // Back-patch tests are conservative only on closed surfaces (README: "What contributes a
         // pixel"): on a --scene with an open model those rows are left out.
         if (!one_sided && (static_cast<std::uint32_t>(method.cull) & gl::kFlagBackPatch)) {
+            frames_done += frames;  // not rendered: counted as done
+            progress.clear();
             std::printf("%-17s (left out: the scene has an open model, back-patch culling is not conservative on it)\n",
                         method.label);
             continue;
@@ -158,6 +172,7 @@ int run_demo(const DemoOptions& options) {
             if (method.automatic) policy.observe(s);
             const gl::FrameComparison cmp = compare_with_reference(renderer, references[static_cast<std::size_t>(f)]);
             sums.false_culls += cmp.false_culled.size();
+            progress.step(++frames_done);
             if (f == 0 && options.frames > 1) continue;
             ++sums.frames;
             sums.objects_culled += static_cast<double>(policy.culled_objects());
@@ -172,6 +187,7 @@ int run_demo(const DemoOptions& options) {
             sums.total += s.total_ms;
         }
         const double n = sums.frames, pct = 100.0 / (n * double(patches));
+        progress.clear();
         std::printf("%-17s %6.1f%% %6.1f%% %6.1f%% %6.1f%% %6.1f%% %7.1f %7.1f %7.1f %7.1f %8.1f %6.2f %6zu\n",
                     method.label, (sums.frustum + sums.backpatch + sums.occlusion) * pct, sums.frustum * pct,
                     sums.backpatch * pct, sums.occlusion * pct, sums.drawn * pct, sums.pass1 / n, sums.hiz / n,
@@ -193,6 +209,7 @@ int run_demo(const DemoOptions& options) {
             renderer.write_status_png((out_dir / "cull.png").string(), render_params(overview, width, height, options.tess, one_sided));
         }
     }
+    progress.finish();
     // The object level (issue 11): the city's objects culled before the patch passes.
     if (options.city_frames > 0) {
         DemoCityOptions city;

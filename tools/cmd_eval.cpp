@@ -25,6 +25,7 @@
 #include "eval_temporal.h"
 #include "patchcull/error.h"
 #include "patchcull/gl_backpatch.h"
+#include "progress.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -69,6 +70,7 @@ int run_occlusion(const OcclusionOptions& o) {
     double frames_sum = 0;
     std::size_t false_culls = 0, unstable = 0;
     std::vector<std::uint8_t> culled;
+    Progress progress("eval occlusion", "views", std::uint64_t(o.views), progress_wanted(o.json));
     for (int v = 0; v < o.views; ++v) {
         const Camera camera = views.next();
         gl::PipelineParams params;
@@ -94,6 +96,7 @@ int run_occlusion(const OcclusionOptions& o) {
         tcone_sum += fraction_culled(culled);
         culler.cull(gl::BackpatchMethod::ncone, rp.projection * rp.view, eye, 0, PtpRule::ncnt, &culled);
         ncone_sum += fraction_culled(culled);
+        progress.step(std::uint64_t(v) + 1);
     }
     const double n = std::max(o.views, 1);
     nlohmann::json out;

@@ -1,6 +1,7 @@
 // The main job's object-level rows (demo_city.h).
 #include "demo_city.h"
 
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -8,6 +9,7 @@
 #include "object_level_options.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/gl_pipeline.h"
+#include "progress.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -61,6 +63,11 @@ std::size_t run_demo_city(const gl::GlContext& context, const DemoCityOptions& o
                 "nodes", "clusters", "patch-cl", "drawn", "ms", "x none", "false");
     std::size_t total_false = 0;
     double none_ms = 0;
+    // Frames rendered so far, on stderr when it is a terminal (progress.h), erased before each row.
+    Progress progress("demo city", "frames", levels.size() * static_cast<std::uint64_t>(options.frames),
+                      progress_wanted(false));
+    progress.erase_when_done();
+    std::uint64_t frames_done = 0;
     for (std::size_t k = 0; k < levels.size(); ++k) {
         ObjectLevelRun& level = *levels[k];
         pipeline.set_patches(poses[0], attributes[0]);
@@ -80,6 +87,7 @@ std::size_t run_demo_city(const gl::GlContext& context, const DemoCityOptions& o
             const gl::FrameComparison cmp = gl::compare_frames(reference.capture, culled);
             const ObjectVerification v = level.verify(reference.capture.ids, cmp.false_culled);
             false_culls += v.patch_false_culls.size() + v.false_culled_triangles;
+            progress.step(++frames_done);
             if (f == 0 && options.frames > 1) continue;
             ++timed;
             const ObjectCullStats& o = level.result().stats;
@@ -95,6 +103,7 @@ std::size_t run_demo_city(const gl::GlContext& context, const DemoCityOptions& o
         }
         const double n = timed;
         if (k == 0) none_ms = ms / n;
+        progress.clear();
         std::printf("%-13s %8.1f %8.0f %8.0f %8.0f %8.0f %8.0f %8.0f %8.0f %8.1f %6.2f %6zu\n", methods[k], objects / n,
                     skipped / n, tris / n, planes / n, nodes / n, clusters / n, patch_culled / n, drawn / n, ms / n,
                     ms / n / none_ms, false_culls);

@@ -32,6 +32,7 @@
 #include "patchcull/displaced_bounds.h"
 #include "patchcull/error.h"
 #include "eval_temporal.h"
+#include "progress.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -88,6 +89,9 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
     std::vector<std::uint8_t> decision(patches);
     std::vector<bool> visible(patches);
     HiZPyramid hiz;
+    // One unit per view and bound (the running pipeline per bound is most of a view's time).
+    Progress progress("eval displaced", "view-bounds", std::uint64_t(o.views) * rows.size(), progress_wanted(o.json));
+    std::uint64_t done = 0;
     for (int v = 0; v < o.views; ++v) {
         const Camera camera = views.next();
         gl::RenderParams params = render_params(camera, width, height, o.tess, false);  // displaced: two-sided
@@ -126,6 +130,7 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
             const gl::FrameCapture culled_frame = capture_culled_frame(pipeline.renderer());
             const ReferenceFrame reference = render_reference(pipeline.renderer(), pp.frame.render);
             row.pipeline_false_culls += gl::compare_frames(reference.capture, culled_frame).false_culled.size();
+            progress.step(++done);
         }
     }
     nlohmann::json out;

@@ -43,6 +43,7 @@
 #include "commands.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
+#include "progress.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -125,6 +126,9 @@ int run_temporal_eval(const TemporalEvalOptions& o) {
         std::size_t false_culls;
     };
     std::vector<Row> table;
+    Progress progress("eval temporal", "frames", std::uint64_t(speeds.size()) * std::uint64_t(o.frames),
+                      progress_wanted(o.json));
+    std::uint64_t frames_done = 0;
     for (double speed : speeds) {
         scene.camera.degrees_per_frame = static_cast<float>(speed);
         const std::vector<Camera> cameras = scene.camera_path(o.frames, float(width) / float(height));
@@ -141,7 +145,10 @@ int run_temporal_eval(const TemporalEvalOptions& o) {
             const gl::FrameCapture moving_frame = capture_culled_frame(moving.renderer());
             const ReferenceFrame reference = render_reference(moving.renderer(), params.frame.render);
             false_culls += gl::compare_frames(reference.capture, moving_frame).false_culled.size();
-            if (f == 0) continue;  // primes the statuses
+            if (f == 0) {  // primes the statuses
+                progress.step(++frames_done);
+                continue;
+            }
             occluded_sum += double(stats.occlusion_culled) * per_patch;
             frustum_sum += double(stats.frustum_culled) * per_patch;
 
@@ -154,6 +161,7 @@ int run_temporal_eval(const TemporalEvalOptions& o) {
                 found = converged_views.emplace(eye, Converged{double(c.stats.occlusion_culled) * per_patch}).first;
             }
             converged_sum += found->second.occluded;
+            progress.step(++frames_done);
         }
         const double n = std::max(o.frames - 1, 1);
         table.push_back({speed, occluded_sum / n, converged_sum / n, frustum_sum / n, false_culls});

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,10 @@ struct CullEvalOptions {
     std::vector<std::string> methods{"frustum", "frustum-disp"};
     int ground_truth_grid = 17;   ///< samples per side for false-cull checks
     float aspect = 1.0f;
+    /// Called on the calling thread after each view with the views done so far (1..views),
+    /// between views, never inside a kernel or the ground-truth check; empty: nothing is called.
+    /// For progress reports (the CLI's `cull` draws one on a terminal); it cannot change results.
+    std::function<void(int views_done)> on_view_done;
 };
 
 struct CullMethodResult {

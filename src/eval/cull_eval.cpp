@@ -170,6 +170,7 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
             result.methods[m].culled += culled_count;
             result.methods[m].false_culls += false_count;
         }
+        if (options.on_view_done) options.on_view_done(view + 1);
     }
     const double pairs = static_cast<double>(n) * std::max(1, options.views);
     for (std::size_t m = 0; m < selected.size(); ++m) {
