@@ -1,4 +1,4 @@
-// examples/01_gpu_passes_in_your_engine.cpp: patchcull's GPU cull passes (patchcull/gl_passes.h)
+// examples/03_gpu_passes_in_your_engine.cpp: patchcull's GPU cull passes (patchcull/gl_passes.h)
 // in a program that is NOT patchcull's renderer: it opens its own window and OpenGL 4.5 core
 // context with GLFW, loads GL through libepoxy, owns every buffer, texture, framebuffer and shader
 // program, draws with its own tessellation shaders, and calls only the passes. This is what an
@@ -37,7 +37,7 @@
 // shaders/patch.frag.glsl does (README.md, "What contributes a pixel"). Open and displaced
 // surfaces are drawn two-sided and must never be given to a back-patch pass.
 //
-// Usage: 01_gpu_passes_in_your_engine [--frames N] [--size WxH] [--aggressive]
+// Usage: 03_gpu_passes_in_your_engine [--frames N] [--size WxH] [--aggressive]
 //            [--backpatch tcone|ncone|ptp] [--bound caf|oobb] [--cone full|acon|con] [--backpatch-open]
 //   --frames N    frames per camera position (3 positions, the camera moving), N in 1..1000, default 4
 //   --size WxH    framebuffer (and window) size, each in 1..8192, default 320x240
