@@ -8,7 +8,7 @@
 //
 // Scene: MonsterFrog split once (5168 patches), procedural displacement (2% of the diagonal), one
 // whole-object view, 512x512, uniform tessellation level L. Times are wall clock around glFinish
-// (llvmpipe: GL timer queries see only part of the work, ../shared/PLATFORM.md), so every figure
+// (llvmpipe's GL_TIME_ELAPSED measures only the vertex/tessellation stage, not rasterization), so every figure
 // includes the driver's CPU work; the counters are per-iteration means.
 #include <benchmark/benchmark.h>
 

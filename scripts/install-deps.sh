@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs every Debian package patchcull needs to build, run and test (see ../shared/PLATFORM.md).
+# Installs every Debian package patchcull needs to build, run and test (Debian 12).
 # Nothing else is downloaded at build time.
 set -euo pipefail
 SUDO=""

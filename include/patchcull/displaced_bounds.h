@@ -80,7 +80,7 @@
 // sends a convex polytope in t > 0 to the hull of its vertices' images).
 //
 // ---- Non-projectable bounds and the frustum test ---------------------------------------------------
-// A bound that reaches t <= 0 (the eye plane) has no screen rectangle (DESIGN.md): it is culled
+// A bound that reaches t <= 0 (the eye plane) has no bounded screen rectangle: it is culled
 // only by the homogeneous plane test: the six clip planes as rows q over view-space points
 // (make_frustum_planes(projection)); culled when for some plane every box (caf: the 16 boxes,
 // value max_k q.(Q_k,1) + sum_i max(q_i ext+_i, -q_i ext-_i)) or every corner (oobb) is < 0. Such

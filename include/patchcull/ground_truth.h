@@ -1,4 +1,5 @@
-// patchcull/ground_truth.h: what "conservative" is measured against (DESIGN.md, CPU side).
+// patchcull/ground_truth.h: what "conservative" is measured against on the CPU (the GPU side is
+// the unculled render's patch-id buffer; README, "What contributes a pixel").
 //
 // The (displaced) surface is sampled densely: a grid x grid lattice over the patch domain, each
 // sample S(u,v) = B(u,v) + D(s,t) * n(u,v) with n the unit normal (from the ACC tangent patches

@@ -43,7 +43,7 @@
 //    s_k bounds the terms of w_k, and the rounding error of the computed w_k is below 2^-22 s_k, so
 //    this proves the exact w_k > 0 (a plain `w > 0` can be wrong for a point within rounding of
 //    the eye plane, whose projection would then be mirrored). Otherwise (control points straddle
-//    w <= 0, or touch it) the patch cannot be projected: kHiZVisible (DESIGN.md: such patches are
+//    w <= 0, or touch it) the patch cannot be projected: kHiZVisible (such patches are
 //    culled by the homogeneous plane tests only, never by a screen rectangle).
 //    Why the box is exact: with all weights and all w_k > 0, every point of the patch is a convex
 //    combination of the control points in clip space, and x/w, y/w, z/w of such a point are convex

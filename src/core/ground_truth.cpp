@@ -1,4 +1,4 @@
-// Dense-sample ground truth for cull tests (patchcull/ground_truth.h; DESIGN.md "Ground truth").
+// Dense-sample ground truth for cull tests (patchcull/ground_truth.h).
 #include "patchcull/ground_truth.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// DESIGN.md's layering, checked by grepping includes: dependencies point one way, downwards.
+// The library's layering, checked by grepping includes: dependencies point one way, downwards.
 //   tools -> public headers; src/eval -> import + core; src/import -> core; src/core -> nothing
 //   of ours above it (and no OpenSubdiv, stb or GL).
 #include <gtest/gtest.h>

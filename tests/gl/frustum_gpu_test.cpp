@@ -1,5 +1,5 @@
 // The GPU frustum pass (FrustumPass, shaders/frustum.comp.glsl) against the CPU reference kernel
-// cull_frustum_scalar, and the strict test of DESIGN.md: with GPU frustum culling on, the patch-id
+// cull_frustum_scalar, and the strict id-buffer test: with GPU frustum culling on, the patch-id
 // buffer is identical to the unculled render's at the same resolution and tessellation level.
 #include <gtest/gtest.h>
 

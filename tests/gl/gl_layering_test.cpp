@@ -1,4 +1,4 @@
-// DESIGN.md's layering for the renderer: src/gl uses public headers (and its own files, the shared
+// The library's layering for the renderer: src/gl uses public headers (and its own files, the shared
 // shader header), never src/import or src/eval internals; shaders are real files, not C++ strings.
 #include <gtest/gtest.h>
 

@@ -19,7 +19,7 @@
 namespace patchcull::gl::test {
 
 /// The process's context (created on first use, on the calling thread). Creation failing is a
-/// test failure, not a skip: the platform guarantees Mesa's llvmpipe (../shared/PLATFORM.md).
+/// test failure, not a skip: the supported platform (Debian 12) always has Mesa's llvmpipe.
 inline GlContext& context() {
     static GlContext ctx = GlContext::create_headless();
     return ctx;
