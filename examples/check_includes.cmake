@@ -3,6 +3,7 @@
 # patchcull_gl's include path), the standard library and the examples' own GL stack (epoxy, GLFW).
 #   cmake -DSOURCE_DIR=<repository root> -P check_includes.cmake
 # Prints each offending example:line and include.
+cmake_minimum_required(VERSION 3.25)
 if(NOT DEFINED SOURCE_DIR)
   message(FATAL_ERROR "usage: cmake -DSOURCE_DIR=<repository root> -P check_includes.cmake")
 endif()
