@@ -23,7 +23,6 @@
 // each culled patch's 17x17 surface samples (ground_truth.h) lie behind the depth stored at
 // their pixel. Exit status 0 when all hold, 1 otherwise, 2 on bad arguments (one line).
 #include <charconv>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
