@@ -4,14 +4,19 @@
 // through printable_line as a last line of defence: whatever a flag, path or library put in them,
 // the user sees one printable line of bounded length.
 #include <iostream>
+#include <string>
 
 #include "commands.h"
 #include "patchcull/error.h"
+#include "patchcull/version.h"
 
 int main(int argc, char** argv) {
     using namespace patchcull::cli;
     CLI::App app{"patchcull: conservative culling of bicubic patches before hardware tessellation"};
     app.require_subcommand(0, 1);
+    // "patchcull 0.1.0" on stdout, exit 0: the linked library's version, not the header's.
+    app.set_version_flag("--version", std::string("patchcull ") + patchcull::version_string(),
+                         "Print the version and exit");
     const Runner info = add_info_command(app);
     const Runner cull = add_cull_command(app);
     const Runner render = add_render_command(app);
@@ -29,6 +34,8 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         std::cerr << "patchcull: error: " << patchcull::printable_line(e.what()) << "\n";

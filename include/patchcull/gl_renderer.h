@@ -82,6 +82,8 @@
 #include "patchcull/math.h"
 #include "patchcull/patch.h"
 
+struct GLFWwindow;  // GLFW's window type (GlContext::glfw_window); GLFW's header is not needed here
+
 namespace patchcull::gl {
 
 // Flag word bits and id encoding (equal to shaders/shared.h's; static_asserts in the renderer).
@@ -148,6 +150,9 @@ public:
 
     /// True for a create_window context.
     bool has_window() const;
+    /// Window: the GLFW window, for the caller's own input handling and UI (e.g. Dear ImGui's GLFW
+    /// backend; install callbacks before window_open() polls). Headless: nullptr.
+    GLFWwindow* glfw_window() const;
     /// Window: processes pending events; false once the user has closed the window (or Escape).
     /// Headless: always true.
     bool window_open() const;

@@ -250,6 +250,7 @@ void GlContext::make_current() const {
 }
 
 bool GlContext::has_window() const { return impl_->window != nullptr; }
+GLFWwindow* GlContext::glfw_window() const { return impl_->window; }
 
 bool GlContext::window_open() const {
     if (!impl_->window) return true;

@@ -1,0 +1,61 @@
+# Imports, under PatchcullDeps::, the libraries patchcull links that have no usable CMake package
+# on Debian 12. Shared by the build (cmake/Dependencies.cmake) and the installed package
+# (patchcullConfig.cmake includes its installed copy), so that a consumer links the same files the
+# build did. Both functions define only what is missing (a second find_package is harmless) and
+# never fail: they put what they could not find into <missing-var>, and the caller decides.
+#
+#   patchcull_import_core_deps(<missing-var>)  PatchcullDeps::OpenSubdiv (osdCPU), PatchcullDeps::stb
+#   patchcull_import_gl_deps(<missing-var>)    PatchcullDeps::epoxy
+
+# OpenSubdiv 3.5's package config is broken on Debian 12 (its targets file names static
+# libraries that are not shipped) and there is no pkg-config file: osdCPU is imported by hand.
+# libstb (pkg-config stb) already contains the implementations: never define STB_*_IMPLEMENTATION.
+function(patchcull_import_core_deps missing_var)
+  set(missing)
+  if(NOT TARGET PatchcullDeps::OpenSubdiv)
+    find_path(PATCHCULL_OPENSUBDIV_INCLUDE_DIR opensubdiv/version.h)
+    find_library(PATCHCULL_OPENSUBDIV_CPU_LIBRARY osdCPU)
+    if(PATCHCULL_OPENSUBDIV_INCLUDE_DIR AND PATCHCULL_OPENSUBDIV_CPU_LIBRARY)
+      add_library(PatchcullDeps::OpenSubdiv UNKNOWN IMPORTED)
+      set_target_properties(PatchcullDeps::OpenSubdiv PROPERTIES
+        IMPORTED_LOCATION "${PATCHCULL_OPENSUBDIV_CPU_LIBRARY}"
+        INTERFACE_INCLUDE_DIRECTORIES "${PATCHCULL_OPENSUBDIV_INCLUDE_DIR}")
+    else()
+      list(APPEND missing "OpenSubdiv (opensubdiv/version.h and libosdCPU: Debian libosd-dev)")
+    endif()
+  endif()
+  if(NOT TARGET PatchcullDeps::stb)
+    _patchcull_pkg_config_target(stb PATCHCULL_STB PatchcullDeps::stb)
+    if(NOT TARGET PatchcullDeps::stb)
+      list(APPEND missing "stb (pkg-config module stb: Debian libstb-dev)")
+    endif()
+  endif()
+  set(${missing_var} "${missing}" PARENT_SCOPE)
+endfunction()
+
+# libepoxy loads libEGL / libOpenGL at run time: linking patchcull_gl needs only epoxy itself.
+function(patchcull_import_gl_deps missing_var)
+  set(missing)
+  if(NOT TARGET PatchcullDeps::epoxy)
+    _patchcull_pkg_config_target(epoxy PATCHCULL_EPOXY PatchcullDeps::epoxy)
+    if(NOT TARGET PatchcullDeps::epoxy)
+      list(APPEND missing "libepoxy (pkg-config module epoxy: Debian libepoxy-dev)")
+    endif()
+  endif()
+  set(${missing_var} "${missing}" PARENT_SCOPE)
+endfunction()
+
+# PatchcullDeps::<name> as an interface target over pkg-config's PkgConfig::<prefix>: a real
+# (not ALIAS) imported name, so that the exported link interfaces name it and the installed config
+# can define it again.
+function(_patchcull_pkg_config_target module prefix target)
+  find_package(PkgConfig QUIET)
+  if(NOT PKG_CONFIG_FOUND)
+    return()
+  endif()
+  pkg_check_modules(${prefix} QUIET IMPORTED_TARGET ${module})
+  if(TARGET PkgConfig::${prefix})
+    add_library(${target} INTERFACE IMPORTED)
+    set_target_properties(${target} PROPERTIES INTERFACE_LINK_LIBRARIES PkgConfig::${prefix})
+  endif()
+endfunction()

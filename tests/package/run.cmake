@@ -1,0 +1,148 @@
+# Packaging checks (tests/package/CMakeLists.txt runs them under ctest, label package):
+#
+#   cmake -DMODE=install -DBUILD_DIR=... -DWORK=... -DSOURCE_DIR=... -DCXX=... -DNEXT_MINOR=... -P run.cmake
+#     installs the build BUILD_DIR into WORK/prefix (cmake --install), checks the layout, that no
+#     PATCHCULL_* definition reaches a consumer, then configures, builds and runs
+#     tests/package/consumer with find_package(patchcull 0.1 CONFIG): with patchcull::gl
+#     (core_consumer, gl_consumer), and with COMPONENTS core alone, which must search for no GL
+#     package; find_package(patchcull NEXT_MINOR) must refuse the package (version file).
+#   cmake -DMODE=cpu -DCPU_BUILD_DIR=... -DWORK=... -DSOURCE_DIR=... -DCXX=... -P run.cmake
+#     configures SOURCE_DIR with PATCHCULL_WITH_GL=OFF and find_package(OpenGL/glfw3) disabled
+#     (a REQUIRED search for them is then an error), checks that nothing of GL was searched for
+#     and no GL target exists while the core tests do, builds and installs the core library alone
+#     (CPU_BUILD_DIR is kept between runs: incremental), runs core_consumer against that install,
+#     and checks that asking the CPU-only package for COMPONENTS gl fails.
+#   cmake -DMODE=version -DCLI=... -DVERSION=... -P run.cmake
+#     `patchcull --version` prints exactly "patchcull VERSION" and exits 0.
+# Any failure: FATAL_ERROR naming the step (the test fails).
+cmake_minimum_required(VERSION 3.25)
+
+function(run step)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  message(STATUS "[${step}] ${out}${err}")
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${step} failed (exit status ${rc}): ${ARGN}")
+  endif()
+endfunction()
+
+function(expect_files step)
+  foreach(file IN LISTS ARGN)
+    if(NOT EXISTS "${file}")
+      message(FATAL_ERROR "${step}: ${file} is missing")
+    endif()
+  endforeach()
+endfunction()
+
+function(expect_no_files step)
+  foreach(file IN LISTS ARGN)
+    if(EXISTS "${file}")
+      message(FATAL_ERROR "${step}: ${file} should not be there")
+    endif()
+  endforeach()
+endfunction()
+
+# Cache entries that betray a search for a GL package (or its pkg-config modules, or glslang).
+function(expect_no_gl_search step cache)
+  file(STRINGS "${cache}" hits REGEX "^(OpenGL_|OPENGL_|glfw3_DIR|PATCHCULL_EPOXY|IMGUI_|GLSLANG_VALIDATOR|EGL_)")
+  if(hits)
+    message(FATAL_ERROR "${step}: GL packages were searched for (${cache}): ${hits}")
+  endif()
+endfunction()
+
+# Configures, builds and runs the consumer (EXTRA: more -D options) in WORK/<name>.
+function(build_consumer name prefix consumer_gl)
+  set(dir "${WORK}/${name}")
+  file(REMOVE_RECURSE "${dir}")
+  run("${name}: configure" ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package/consumer" -B "${dir}"
+      -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=${CXX} "-DCMAKE_PREFIX_PATH=${prefix}"
+      -DCONSUMER_GL=${consumer_gl} ${ARGN})
+  run("${name}: build" ${CMAKE_COMMAND} --build "${dir}" -j2)
+  # The installed data, as a program moved away from the source tree finds it.
+  run("${name}: core_consumer" ${CMAKE_COMMAND} -E env "PATCHCULL_DATA_DIR=${prefix}/share/patchcull"
+      "${dir}/core_consumer")
+  if(consumer_gl)
+    run("${name}: gl_consumer" "${dir}/gl_consumer")
+  else()
+    expect_no_gl_search("${name}" "${dir}/CMakeCache.txt")
+  endif()
+endfunction()
+
+if(MODE STREQUAL "install")
+  file(REMOVE_RECURSE "${WORK}")
+  set(prefix "${WORK}/prefix")
+  run("install" ${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${prefix}")
+  set(cmakedir "${prefix}/lib/cmake/patchcull")
+  expect_files("install" "${cmakedir}/patchcullConfig.cmake" "${cmakedir}/patchcullConfigVersion.cmake"
+    "${cmakedir}/patchcullCoreTargets.cmake" "${cmakedir}/patchcullGLTargets.cmake"
+    "${cmakedir}/PatchcullImportedDeps.cmake" "${prefix}/lib/libpatchcull.a" "${prefix}/lib/libpatchcull_gl.a"
+    "${prefix}/include/patchcull/frustum.h" "${prefix}/include/patchcull/gl_passes.h"
+    "${prefix}/include/patchcull/version.h" "${prefix}/include/patchcull/glsl/shared.h"
+    "${prefix}/include/patchcull/glsl/patchcull_tcs.h" "${prefix}/share/patchcull/models/bigguy.obj"
+    "${prefix}/share/patchcull/models/README.md" "${prefix}/share/doc/patchcull/LICENSE"
+    "${prefix}/share/doc/patchcull/NOTICE" "${prefix}/bin/patchcull")
+  # Nothing of the build's own configuration in a consumer's flags.
+  file(GLOB targets_files "${cmakedir}/patchcull*Targets*.cmake")
+  foreach(file IN LISTS targets_files)
+    file(STRINGS "${file}" leaks REGEX "PATCHCULL_|${SOURCE_DIR}|${BUILD_DIR}")
+    if(leaks)
+      message(FATAL_ERROR "install: ${file} passes the build's settings to consumers: ${leaks}")
+    endif()
+  endforeach()
+  build_consumer(consumer "${prefix}" ON)
+  build_consumer(consumer_core_only "${prefix}" OFF)
+  # The version file: 0.x releases are compatible within a minor version only.
+  execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package/consumer" -B "${WORK}/consumer_next_minor"
+                  -DCMAKE_CXX_COMPILER=${CXX} "-DCMAKE_PREFIX_PATH=${prefix}" -DCONSUMER_GL=OFF
+                  -DCONSUMER_VERSION=${NEXT_MINOR}
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "considered but not accepted")
+    message(FATAL_ERROR "install: find_package(patchcull ${NEXT_MINOR}) accepted the package: exit ${rc}: ${err}")
+  endif()
+  message(STATUS "[find_package(patchcull ${NEXT_MINOR}) refused] ${err}")
+elseif(MODE STREQUAL "cpu")
+  file(REMOVE_RECURSE "${WORK}")
+  # Build type None (no -O, no -g): the check is about packaging, and unoptimised the core
+  # library compiles in about half the time (its first run compiles it all; later ones only
+  # what changed).
+  run("cpu-only: configure" ${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${CPU_BUILD_DIR}"
+      -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_COMPILER=${CXX} -DPATCHCULL_WITH_GL=OFF
+      -DPATCHCULL_BUILD_TESTS=ON -DPATCHCULL_BUILD_BENCHMARKS=ON -DPATCHCULL_BUILD_TOOLS=ON
+      -DPATCHCULL_BUILD_EXAMPLES=OFF -DPATCHCULL_BUILD_FUZZERS=OFF
+      -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON)
+  expect_no_gl_search("cpu-only" "${CPU_BUILD_DIR}/CMakeCache.txt")
+  execute_process(COMMAND ${CMAKE_COMMAND} --build "${CPU_BUILD_DIR}" --target help OUTPUT_VARIABLE targets)
+  foreach(target patchcull patchcull_core_tests patchcull_import_tests)
+    if(NOT targets MATCHES "\\.\\.\\. ${target}\n")
+      message(FATAL_ERROR "cpu-only: no target ${target}")
+    endif()
+  endforeach()
+  foreach(target patchcull_gl patchcull_cli patchcull_shaders patchcull_gl_tests patchcull_bench)
+    if(targets MATCHES "\\.\\.\\. ${target}\n")
+      message(FATAL_ERROR "cpu-only: target ${target} exists without GL")
+    endif()
+  endforeach()
+  run("cpu-only: build" ${CMAKE_COMMAND} --build "${CPU_BUILD_DIR}" -j2 --target patchcull)
+  set(prefix "${WORK}/prefix")
+  run("cpu-only: install" ${CMAKE_COMMAND} --install "${CPU_BUILD_DIR}" --prefix "${prefix}")
+  expect_files("cpu-only: install" "${prefix}/lib/libpatchcull.a" "${prefix}/include/patchcull/frustum.h"
+    "${prefix}/lib/cmake/patchcull/patchcullConfig.cmake")
+  expect_no_files("cpu-only: install" "${prefix}/lib/libpatchcull_gl.a" "${prefix}/include/patchcull/gl_passes.h"
+    "${prefix}/include/patchcull/glsl" "${prefix}/lib/cmake/patchcull/patchcullGLTargets.cmake")
+  build_consumer(consumer_cpu "${prefix}" OFF
+    -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON)
+  # A package without GL refuses COMPONENTS gl, and says why.
+  execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package/consumer" -B "${WORK}/consumer_cpu_gl"
+                  -DCMAKE_CXX_COMPILER=${CXX} "-DCMAKE_PREFIX_PATH=${prefix}" -DCONSUMER_GL=ON
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(rc EQUAL 0 OR NOT err MATCHES "PATCHCULL_WITH_GL=OFF")
+    message(FATAL_ERROR "cpu-only: find_package(patchcull COMPONENTS gl) on a CPU-only install: exit ${rc}: ${err}")
+  endif()
+  message(STATUS "[cpu-only: COMPONENTS gl refused] ${err}")
+elseif(MODE STREQUAL "version")
+  execute_process(COMMAND "${CLI}" --version RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT out STREQUAL "patchcull ${VERSION}\n" OR NOT err STREQUAL "")
+    message(FATAL_ERROR "patchcull --version: exit ${rc}, stdout '${out}', stderr '${err}' (expected 'patchcull ${VERSION}')")
+  endif()
+else()
+  message(FATAL_ERROR "run.cmake: MODE must be install, cpu or version")
+endif()
