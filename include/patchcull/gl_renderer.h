@@ -42,7 +42,7 @@
 //   by the frustum pass (with their margin) and the displaced pass (seed 000 §4.2's bounds, from
 //   PatchAttributes::displacement_ranges); never by the back-patch or control-point Hi-Z tests.
 //
-// Workarounds for Mesa llvmpipe (../shared/PLATFORM.md), applied ALWAYS (they cost nothing
+// Workarounds for Mesa llvmpipe (22.3.6 and still in 25.0.7), applied ALWAYS (they cost nothing
 // measurable on a GPU and keep one code path):
 // 1. gl_PrimitiveID restarts every 4096 input vertices on llvmpipe: the patch index is derived as
 //    gl_VertexID / 16 in the vertex shader and passed on; gl_PrimitiveID is never used (occluder
