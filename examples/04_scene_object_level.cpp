@@ -12,9 +12,10 @@
 //               PIXELS: NOT conservative (off by default); a large value shows the check failing
 // Prints one line per frame. Checks every culled patch (by the object level or the kernel)
 // against the ground truth (ground_truth.h, 17x17 samples in double): it is a false cull when a
-// sample lies in the view volume and, unless the patch is drawn one-sided, or when that sample's
-// tangent plane faces the eye. Exit status: 0 no false cull; 1 a false cull, or nothing culled
-// over the run (the check proved nothing); 2 bad arguments or an unreadable scene (one line).
+// sample lies in the view volume and could be seen there: always for two-sided patches (open or
+// displaced), and for one-sided ones when that sample's tangent plane faces the eye. Exit status:
+// 0 no false cull; 1 a false cull, or nothing culled over the run (the check proved nothing); 2
+// bad arguments or an unreadable scene (one line).
 #include <algorithm>
 #include <charconv>
 #include <cstdint>
@@ -34,6 +35,8 @@
 namespace pc = patchcull;
 
 namespace {
+
+constexpr int kViewHeight = 360;  // pixels of a 640x360 view: the scale of detail culling's areas
 
 struct Options {
     std::string scene_file;  // empty: the built-in city, small
@@ -99,7 +102,7 @@ int run(const Options& options) {
             if (!ranges.empty()) margins[i] = ranges[i].max_abs();
         }
         const pc::Camera& camera = cameras[f];
-        const pc::ObjectCullResult& objects = level.cull(pose, ranges, t, camera, 360, object_options);
+        const pc::ObjectCullResult& objects = level.cull(pose, ranges, t, camera, kViewHeight, object_options);
         const pc::FrustumPlanes frustum = pc::make_frustum_planes(camera.view_projection(), pc::ClipDepth::zero_to_one);
         const std::size_t tested = pc::cull_frustum_after_objects(objects, batch.view(), margins.data(), frustum,
                                                                   culled.data());
