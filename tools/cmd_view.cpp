@@ -1,5 +1,5 @@
-// `patchcull view [MODEL|default] ...`: the `render` pipeline (seed 000 §3 with seed 001's GPU
-// back-patch pass) in a window (viewer_app.h). Interactive (no --frames, or with --script): an
+// `patchcull view [MODEL|default] ...`: the `render` pipeline (Niessner & Loop §3, with Loop,
+// Niessner & Eisenacher's GPU back-patch pass) in a window (viewer_app.h). Interactive (no --frames, or with --script): an
 // orbit/fly camera, a Dear ImGui panel with every cull test, method, bound and cone, the
 // tessellation, the displacement and the status colouring of cull.png live, keys for the main
 // toggles and a screenshot key; --script FILE drives it by frame number (viewer_script.h).
@@ -62,7 +62,7 @@ Runner add_view_command(CLI::App& app) {
                    "stop after N frames; without --script: render's camera path, no panel (0: interactive, until "
                    "the window is closed)");
     add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all", "auto"},
-                      "cull tests at the start (auto: all, per object where it pays, seed 000 §6.3)");
+                      "cull tests at the start (auto: all, per object where it pays, Niessner & Loop §6.3)");
     add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
                       "back-patch test of backpatch/all");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
@@ -70,7 +70,7 @@ Runner add_view_command(CLI::App& app) {
     add_displace_options(*command, state->displace);
     add_object_level_options(*command, state->objects);
     add_size_option(*command, "--size", state->size, "window size");
-    command->add_flag("--aggressive", state->aggressive, "skip the second pass (seed 000 §3.1; not conservative)");
+    command->add_flag("--aggressive", state->aggressive, "skip the second pass (Niessner & Loop §3.1; not conservative)");
     add_output_file_option(*command, "--screenshot", state->screenshot,
                            "after the last of --frames, write the window's content as a PNG");
     add_text_option(*command, "--screenshot-dir", state->screenshot_dir,

@@ -26,7 +26,7 @@ struct ViewerSettings {
     gl::BackpatchMethod backpatch_method = gl::BackpatchMethod::tcone;
     DisplacedBoundKind bound = DisplacedBoundKind::caf;
     NormalConeKind cone = NormalConeKind::acon;
-    bool aggressive = false;  ///< skip the second pass (not conservative, seed 000 §3.1)
+    bool aggressive = false;  ///< skip the second pass (not conservative, Niessner & Loop §3.1)
     int tess = 8;             ///< 1..64
     bool adaptive_tess = false;
     bool displace = false;          ///< the scene's (or --displace's) map applied; else none
