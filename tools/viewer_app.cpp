@@ -187,7 +187,8 @@ int run_viewer(ViewerConfig& config) {
     ViewerSettings settings = config.settings;
     const bool scripted = config.script != nullptr;
     const bool print_frames = !config.interactive || scripted || config.frames > 0;
-    const std::string scene_name = config.scene.name;
+    // A model's scene is named by its path: the panel's title shows the file name.
+    const std::string scene_name = std::filesystem::path(config.scene.name).filename().string();
     ViewerWorld world(std::move(config.scene), config.objects);
     int anim_frame = 0;  // frames the animation (and the path camera) advanced: time = anim_frame / 12 s
     world.build(settings, 0);  // before the window: a bad object-level flag is an error without one

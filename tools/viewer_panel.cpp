@@ -142,11 +142,13 @@ PanelActions ViewerPanel::draw(ViewerSettings& settings, const PanelInfo& info) 
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
     ImGui::SetNextWindowPos(ImVec2(0, 0), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(420, 0), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0), ImVec2(1e6f, ImGui::GetIO().DisplaySize.y));  // scrolls
     ImGui::SetNextWindowBgAlpha(0.8f);
     PanelActions actions;
     const std::string title = "patchcull view: " + info.scene_name + "###panel";
     if (ImGui::Begin(title.c_str())) {
+        ImGui::PushItemWidth(150);  // widgets narrow enough for their labels beside them
         if (ImGui::CollapsingHeader("Frame", ImGuiTreeNodeFlags_DefaultOpen)) stats_section(info);
         if (ImGui::CollapsingHeader("Culling", ImGuiTreeNodeFlags_DefaultOpen)) culling_section(settings, info);
         if (ImGui::CollapsingHeader("Tessellation and displacement")) scene_section(settings);
@@ -158,6 +160,7 @@ PanelActions ViewerPanel::draw(ViewerSettings& settings, const PanelInfo& info) 
                                "+/- tess level, x displacement, v view, space pause, p or F12 screenshot, "
                                "h hide this panel, Esc quit");
         if (!info.message.empty()) ImGui::TextWrapped("%s", info.message.c_str());
+        ImGui::PopItemWidth();
     }
     ImGui::End();
     ImGui::Render();
