@@ -236,6 +236,7 @@ TEST(ViewerCli, ScriptedCameraMoveToggleAndPanelShowInTheScreenshots) {
                                           "0 key space\n"
                                           "2 screenshot " + d + "/still0.png\n"
                                           "3 screenshot " + d + "/still1.png\n"
+                                          "3 key p\n"  // the screenshot key: DIR/view_0000.png
                                           "4 orbit 200 0\n"
                                           "4 screenshot " + d + "/orbited.png\n"
                                           "5 set view status-second\n"
@@ -247,10 +248,12 @@ TEST(ViewerCli, ScriptedCameraMoveToggleAndPanelShowInTheScreenshots) {
                                           "11 key h\n"  // ImGui sizes a new window on its first frame, draws it on the next
                                           "12 screenshot " + d + "/panel.png\n"
                                           "12 quit\n");
-    const CliRun r = run_under_xvfb("view " + model("bigguy.obj") + " --size 640x300 --tess 2 --script " + script);
+    const CliRun r = run_under_xvfb("view " + model("bigguy.obj") + " --size 640x300 --tess 2 --script " + script +
+                                    " --screenshot-dir " + d + "/keyed");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("screenshot " + d + "/panel.png (frame 12)"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("frame 13:"), std::string::npos) << "quit did not stop the viewer\n" << r.out;
+    EXPECT_NE(r.out.find("screenshot " + d + "/keyed/view_0000.png (frame 3)"), std::string::npos) << r.out;
     const Rgb still0 = load_rgb(d + "/still0.png"), still1 = load_rgb(d + "/still1.png"),
               orbited = load_rgb(d + "/orbited.png"), on = load_rgb(d + "/status_on.png"),
               off = load_rgb(d + "/status_off.png"), again = load_rgb(d + "/status_again.png"),
@@ -263,6 +266,10 @@ TEST(ViewerCli, ScriptedCameraMoveToggleAndPanelShowInTheScreenshots) {
     // Paused and unmoved, the picture stays (statuses settle, the image does not change); the
     // orbit (50 degrees) changes a large part of it.
     EXPECT_LT(differing(still0, still1, 0, 640), pixels / 200);
+    const Rgb keyed = load_rgb(d + "/keyed/view_0000.png");
+    ASSERT_EQ(keyed.width, 640);
+    ASSERT_EQ(keyed.height, 300);
+    EXPECT_EQ(differing(still1, keyed, 0, 640), 0u);  // the same frame
     EXPECT_GT(differing(still1, orbited, 0, 640), pixels / 20);
     // Status colouring from the second camera: the back-patch test's magenta is there when the
     // test runs, gone when it is off (occlusion then culls the back: red), back with its key.
