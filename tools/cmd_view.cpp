@@ -76,7 +76,7 @@ Runner add_view_command(CLI::App& app) {
     add_text_option(*command, "--screenshot-dir", state->screenshot_dir,
                     "directory of the screenshot key's view_NNNN.png (created when first needed)");
     add_text_option(*command, "--script", state->script,
-                    "timed input events by frame number (orbit, look, zoom, key, set, screenshot, quit; README)");
+                    "timed input events by frame number (orbit, look, zoom, key, set, screenshot, quit; docs/VIEWER.md)");
     return [state]() {
         // The script first: a malformed line is reported before anything is loaded or opened.
         std::unique_ptr<ViewerScript> script;

@@ -247,18 +247,26 @@ TEST(ViewerCli, ScriptedCameraMoveToggleAndPanelShowInTheScreenshots) {
                                           "10 screenshot " + d + "/status_again.png\n"
                                           "11 key h\n"  // ImGui sizes a new window on its first frame, draws it on the next
                                           "12 screenshot " + d + "/panel.png\n"
-                                          "12 quit\n");
+                                          "13 set panel off\n"
+                                          "13 set view colour\n"
+                                          "14 screenshot " + d + "/plain.png\n"
+                                          "15 set displace on\n"  // BigGuy has no map: the procedural one
+                                          "15 set displace.scale 0.05\n"
+                                          "15 set objects bvh\n"  // rebuilds the scene with an object level
+                                          "16 screenshot " + d + "/displaced.png\n"
+                                          "16 quit\n");
     const CliRun r = run_under_xvfb("view " + model("bigguy.obj") + " --size 640x300 --tess 2 --script " + script +
                                     " --screenshot-dir " + d + "/keyed");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("screenshot " + d + "/panel.png (frame 12)"), std::string::npos) << r.out;
-    EXPECT_EQ(r.out.find("frame 13:"), std::string::npos) << "quit did not stop the viewer\n" << r.out;
+    EXPECT_EQ(r.out.find("frame 17:"), std::string::npos) << "quit did not stop the viewer\n" << r.out;
     EXPECT_NE(r.out.find("screenshot " + d + "/keyed/view_0000.png (frame 3)"), std::string::npos) << r.out;
     const Rgb still0 = load_rgb(d + "/still0.png"), still1 = load_rgb(d + "/still1.png"),
               orbited = load_rgb(d + "/orbited.png"), on = load_rgb(d + "/status_on.png"),
               off = load_rgb(d + "/status_off.png"), again = load_rgb(d + "/status_again.png"),
-              panel = load_rgb(d + "/panel.png");
-    for (const Rgb* image : {&still0, &still1, &orbited, &on, &off, &again, &panel}) {
+              panel = load_rgb(d + "/panel.png"), plain = load_rgb(d + "/plain.png"),
+              displaced = load_rgb(d + "/displaced.png");
+    for (const Rgb* image : {&still0, &still1, &orbited, &on, &off, &again, &panel, &plain, &displaced}) {
         ASSERT_EQ(image->width, 640);
         ASSERT_EQ(image->height, 300);
     }
@@ -282,4 +290,8 @@ TEST(ViewerCli, ScriptedCameraMoveToggleAndPanelShowInTheScreenshots) {
     // edge does not.
     EXPECT_GT(differing(again, panel, 0, 320), 320u * 300 / 4);
     EXPECT_LT(differing(again, panel, 560, 640), 80u * 300 / 50);
+    // Displacement turned on through `set` (and an object level with it: the scene is rebuilt)
+    // moves the surface: the picture changes although the camera and the animation stand still.
+    EXPECT_GT(differing(plain, displaced, 0, 640), pixels / 100);
+    EXPECT_NE(r.out.find("objects (bvh)"), std::string::npos) << r.out;
 }
