@@ -19,7 +19,10 @@ if [ ! -x "$CLI" ]; then
   echo "make_figures.sh: error: BUILD_DIR: $CLI is not an executable (build the patchcull_cli target first)" >&2
   exit 2
 fi
-mkdir -p "$DATA"/cull_pass "$DATA"/tess_levels "$DATA"/backpatch_table "$DATA"/displaced_table
+if ! mkdir -p "$DATA"/cull_pass "$DATA"/tess_levels "$DATA"/backpatch_table "$DATA"/displaced_table 2>/dev/null; then
+  echo "make_figures.sh: error: DATA_DIR: cannot create the folders under $DATA" >&2
+  exit 2
+fi
 note() { echo "$(date -u +%H:%M:%S) $1: $(uptime | sed 's/.*load/load/')" | tee -a "$DATA/uptime.txt"; }
 : > "$DATA/uptime.txt"
 
