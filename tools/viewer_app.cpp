@@ -9,14 +9,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <set>
-#include <utility>
 #include <vector>
 
 #include "commands.h"
 #include "cull_auto.h"
 #include "patchcull/error.h"
 #include "viewer_camera.h"
+#include "viewer_controls.h"
 #include "viewer_panel.h"
 #include "viewer_world.h"
 
@@ -87,83 +86,6 @@ private:
     GLuint texture_ = 0, fbo_ = 0;
 };
 
-// Turns input (script events, keys, mouse, held keys) into settings and camera changes: the one
-// path every source of input goes through.
-class Controls {
-public:
-    Controls(ViewerSettings& settings, ViewerCamera& camera) : s_(settings), camera_(camera), mode_(settings.camera) {}
-
-    /// Repositions the camera when the mode changed (panel, key or script): leaving the path it
-    /// starts where the path camera is; orbiting turns it to the centre.
-    void sync(const Camera& path_camera) {
-        if (s_.camera == mode_) return;
-        if (mode_ == ViewerCameraMode::path) camera_.set_eye_and_target(path_camera.eye, path_camera.target);
-        if (s_.camera == ViewerCameraMode::orbit) camera_.look_at_centre();
-        mode_ = s_.camera;
-    }
-    void key(ViewerKey k, const Camera& path_camera) {
-        if (is_movement_key(k)) held_.insert(k);
-        else if (k == ViewerKey::reset_camera) reset();
-        else if (k == ViewerKey::screenshot) screenshot_ = true;
-        else if (k == ViewerKey::quit) quit_ = true;
-        else apply_settings_key(s_, k);
-        sync(path_camera);
-    }
-    void reset() {
-        camera_.reset();
-        if (s_.camera == ViewerCameraMode::path) s_.camera = mode_ = ViewerCameraMode::orbit;
-    }
-    /// A drag of the left (orbit; fly: look) or right (look; orbit: orbit) button, in pixels. On the
-    /// path, the left button starts orbiting, the right one flying.
-    void drag(bool left, float dx, float dy, const Camera& path_camera) {
-        if (s_.camera == ViewerCameraMode::path) {
-            s_.camera = left ? ViewerCameraMode::orbit : ViewerCameraMode::fly;
-            sync(path_camera);
-        }
-        if (s_.camera == ViewerCameraMode::orbit) camera_.orbit(dx, dy);
-        else camera_.look(dx, dy);
-    }
-    void wheel(float steps, const Camera& path_camera) {
-        if (s_.camera == ViewerCameraMode::path) {
-            s_.camera = ViewerCameraMode::orbit;
-            sync(path_camera);
-        }
-        if (s_.camera == ViewerCameraMode::orbit) camera_.zoom(steps);
-        else camera_.move(0, 0, steps * 0.2f, 1.0f);  // fly: a step forward is 10% of the start distance
-    }
-    void hold(ViewerKey k) { held_.insert(k); }
-    /// Applies the held movement keys for seconds, then forgets them (they are held again next
-    /// frame when they still are).
-    void move(float seconds, const Camera& path_camera) {
-        if (held_.empty()) return;
-        auto axis = [&](ViewerKey plus, ViewerKey minus) {
-            return float(held_.count(plus)) - float(held_.count(minus));
-        };
-        const float f = axis(ViewerKey::forward, ViewerKey::back), r = axis(ViewerKey::right, ViewerKey::left),
-                    u = axis(ViewerKey::up, ViewerKey::down);
-        held_.clear();
-        if (s_.camera == ViewerCameraMode::path) {
-            s_.camera = ViewerCameraMode::orbit;
-            sync(path_camera);
-        }
-        if (s_.camera == ViewerCameraMode::fly) {
-            camera_.move(r, u, f, seconds);
-        } else {
-            camera_.zoom(f * 4 * seconds);  // 4 wheel steps per second
-            camera_.orbit(-r * 240 * seconds, -u * 240 * seconds);
-        }
-    }
-    bool take_screenshot() { return std::exchange(screenshot_, false); }
-    bool quit() const { return quit_; }
-
-private:
-    ViewerSettings& s_;
-    ViewerCamera& camera_;
-    ViewerCameraMode mode_;
-    std::set<ViewerKey> held_;
-    bool screenshot_ = false, quit_ = false;
-};
-
 // The next free DIR/view_NNNN.png from counter on (created directory), or "" with why set.
 std::string numbered_screenshot(const std::string& dir, int& counter, std::string& why) {
     std::error_code ec;
@@ -199,7 +121,7 @@ int run_viewer(ViewerConfig& config) {
     const int lap = !config.interactive && config.frames > 0 ? config.frames : 72;
     const std::vector<Camera> cameras = world.scene().camera_path(lap, float(width) / float(height));
     ViewerCamera camera(cameras[0], cameras[0].target);
-    Controls controls(settings, camera);
+    ViewerControls controls(settings, camera);
     CullAutoPolicy policy(world.ranges(), world.scene().patch_count());
 
     InputQueue queue;

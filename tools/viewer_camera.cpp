@@ -47,7 +47,7 @@ void ViewerCamera::orbit(float dx, float dy) {
     // The eye's direction from the centre, as yaw/pitch of a view direction (the opposite one).
     float yaw = 0, pitch = 0;
     angles_of(offset * -1.0f, yaw, pitch);
-    yaw -= dx * 0.25f * kDegree;  // drag right: the scene turns right (the eye goes left)
+    yaw += dx * 0.25f * kDegree;  // drag right: the scene turns right, as if grabbed (the eye goes left)
     pitch = std::clamp(pitch - dy * 0.25f * kDegree, -kMaxPitch, kMaxPitch);
     eye_ = centre_ - direction(yaw, pitch) * r;
     look_at_centre();

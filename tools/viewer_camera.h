@@ -13,8 +13,9 @@ public:
     /// held movement key) is a fraction of the start's distance to centre.
     ViewerCamera(const Camera& start, Vec3 centre);
 
-    /// Orbit: turns the eye about the centre, 0.25 degrees per pixel (dx: around the vertical,
-    /// dy: up/down, the elevation kept within +-89 degrees); the eye looks at the centre.
+    /// Orbit: turns the eye about the centre, 0.25 degrees per pixel, as if the scene were grabbed
+    /// (dx > 0: the eye goes left around the vertical; dy > 0: the eye goes up, the elevation kept
+    /// within +-89 degrees); the eye looks at the centre.
     void orbit(float dx_pixels, float dy_pixels);
     /// Orbit: moves the eye toward the centre (steps > 0) or away, 10% of the distance per step;
     /// the distance stays within 1/50 .. 20 times the start's.

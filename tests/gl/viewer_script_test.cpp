@@ -14,6 +14,7 @@
 #include "cli/cli_test_util.h"
 #include "patchcull/error.h"
 #include "viewer_camera.h"
+#include "viewer_controls.h"
 #include "viewer_script.h"
 #include "viewer_settings.h"
 
@@ -165,7 +166,9 @@ TEST(ViewerCamera, OrbitKeepsTheDistanceAndZoomChangesIt) {
     start.target = {0, 0.5f, 0};
     ViewerCamera camera(start, start.target);
     const float d0 = length(camera.eye() - start.target);
-    camera.orbit(360, 0);  // 90 degrees about the vertical
+    const Vec3 right = cross(camera.forward(), Vec3{0, 1, 0});
+    camera.orbit(360, 0);  // 90 degrees about the vertical; dragged right, the eye goes left
+    EXPECT_LT(dot(camera.eye() - start.eye, right), -3.0f);
     EXPECT_NEAR(length(camera.eye() - start.target), d0, 1e-4f * d0);
     EXPECT_NEAR(camera.eye().z, 0.0f, 1e-3f);  // from +z to the side
     EXPECT_GT(std::fabs(camera.eye().x), 3.0f);
@@ -205,6 +208,73 @@ TEST(ViewerCamera, FlyMovesAlongTheViewAndLooks) {
     EXPECT_NEAR(dot(normalize(second.eye - second.target) - Vec3{0, normalize(second.eye - second.target).y, 0},
                     normalize(start.eye - start.target)),
                 0.0f, 1e-4f);
+}
+
+TEST(ViewerControls, LeavingThePathStartsWhereThePathCameraIs) {
+    Camera start;
+    start.eye = {0, 1, 4};
+    start.target = {0, 0, 0};
+    Camera path = start;  // the path's camera of this frame, elsewhere on the circle
+    path.eye = {4, 1, 0};
+    ViewerSettings s;
+    s.camera = ViewerCameraMode::path;
+    ViewerCamera camera(start, start.target);
+    ViewerControls controls(s, camera);
+    controls.drag(true, 0, 0, path);  // a left-drag on the path: orbit from the path camera
+    EXPECT_EQ(s.camera, ViewerCameraMode::orbit);
+    EXPECT_NEAR(length(camera.eye() - path.eye), 0.0f, 1e-5f);
+    controls.wheel(1, path);
+    EXPECT_NEAR(length(camera.eye() - start.target), 0.9f * length(path.eye - start.target), 1e-4f);
+    // c: orbit -> fly -> path -> orbit; the eye stays where it is when flying starts.
+    const Vec3 before = camera.eye();
+    controls.key(ViewerKey::next_camera, path);
+    EXPECT_EQ(s.camera, ViewerCameraMode::fly);
+    EXPECT_NEAR(length(camera.eye() - before), 0.0f, 1e-6f);
+    controls.key(ViewerKey::next_camera, path);
+    EXPECT_EQ(s.camera, ViewerCameraMode::path);
+    controls.drag(false, 0, 0, path);  // a right-drag on the path: fly from the path camera
+    EXPECT_EQ(s.camera, ViewerCameraMode::fly);
+    EXPECT_NEAR(length(camera.eye() - path.eye), 0.0f, 1e-5f);
+    controls.key(ViewerKey::reset_camera, path);
+    EXPECT_NEAR(length(camera.eye() - start.eye), 0.0f, 1e-5f);
+}
+
+TEST(ViewerControls, HeldKeysMoveForTheFrameOnly) {
+    Camera start;
+    start.eye = {0, 0, 4};
+    start.target = {0, 0, 0};
+    ViewerSettings s;
+    s.camera = ViewerCameraMode::fly;
+    ViewerCamera camera(start, start.target);
+    ViewerControls controls(s, camera);
+    controls.key(ViewerKey::forward, start);  // a script's `key w`: held for one frame
+    controls.move(0.5f, start);                // half a second: a quarter of the start distance
+    EXPECT_NEAR(camera.eye().z, 3.0f, 1e-4f);
+    controls.move(0.5f, start);  // not held any more
+    EXPECT_NEAR(camera.eye().z, 3.0f, 1e-4f);
+    // Orbiting: e raises the eye, d moves it to the view's right; the distance stays.
+    s.camera = ViewerCameraMode::orbit;
+    controls.sync(start);
+    const float d = length(camera.eye() - start.target);
+    const Vec3 right = cross(camera.forward(), Vec3{0, 1, 0});
+    const Vec3 before = camera.eye();
+    controls.hold(ViewerKey::up);
+    controls.hold(ViewerKey::right);
+    controls.move(0.1f, start);
+    EXPECT_GT(camera.eye().y, before.y);
+    EXPECT_GT(dot(camera.eye() - before, right), 0.0f);
+    EXPECT_NEAR(length(camera.eye() - start.target), d, 1e-4f * d);
+    // Screenshot and quit keys are remembered, not settings.
+    const ViewerSettings settings_before = s;
+    controls.key(ViewerKey::screenshot, start);
+    EXPECT_TRUE(controls.take_screenshot());
+    EXPECT_FALSE(controls.take_screenshot());
+    EXPECT_FALSE(controls.quit());
+    controls.key(ViewerKey::quit, start);
+    EXPECT_TRUE(controls.quit());
+    EXPECT_EQ(s.tess, settings_before.tess);
+    controls.key(ViewerKey::tess_down, start);  // the others are settings keys
+    EXPECT_EQ(s.tess, settings_before.tess - 1);
 }
 
 TEST(ViewerCli, MalformedScriptsAreOneLineErrorsBeforeAnyWindow) {
