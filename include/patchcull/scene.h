@@ -52,7 +52,9 @@ std::vector<DisplacementRange> displacement_ranges(const PatchFrame& frame, cons
 /// Bounds of the Cartesian control points of all patches (holds the whole surface).
 Bounds patch_bounds(const PatchFrame& frame);
 
-/// Path of a model shipped with patchcull (data/models/NAME), e.g. "bigguy.obj".
+/// Path of a model shipped with patchcull (data/models/NAME), e.g. "bigguy.obj": under
+/// $PATCHCULL_DATA_DIR when set, else the source tree's data/ while it exists, else the data
+/// installed under the configured prefix (share/patchcull/models). Does not check the file exists.
 std::string shipped_model_path(const std::string& file_name);
 
 }  // namespace patchcull

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 
 #include "patchcull/error.h"
 #include "patchcull/obj.h"
@@ -103,7 +104,13 @@ Bounds patch_bounds(const PatchFrame& frame) {
 
 std::string shipped_model_path(const std::string& file_name) {
     if (const char* dir = std::getenv("PATCHCULL_DATA_DIR")) return std::string(dir) + "/models/" + file_name;
-    return std::string(PATCHCULL_DATA_DIR) + "/models/" + file_name;
+    // The source tree's data/ while it exists (builds and tests), else the configured install
+    // prefix's share/patchcull, so an installed library finds its models after the source is gone.
+    const std::string source = std::string(PATCHCULL_DATA_DIR) + "/models/" + file_name;
+    std::error_code error;
+    if (std::filesystem::exists(source, error)) return source;
+    const std::string installed = std::string(PATCHCULL_INSTALLED_DATA_DIR) + "/models/" + file_name;
+    return std::filesystem::exists(installed, error) ? installed : source;
 }
 
 }  // namespace patchcull
