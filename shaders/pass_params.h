@@ -54,6 +54,15 @@ PC_PARAMS(FrustumParams, kUniformPassParams) {
     PC_UINT(write_plane_values);       // diagnostics: 6 maxima per patch at kBindingPlaneValues
 } PC_END(frustum);
 
+// frustum_disp.comp.glsl (FrustumDispPass): cull_frustum_disp_scalar's test (Sathe's displaced AABB).
+PC_PARAMS(FrustumDispParams, kUniformPassParams) {
+    PC_VEC4(clip_rows[4]);             // rows of to_zero_to_one(object_to_clip): clip_rows[r][c] = at(r, c)
+    PC_UINT(first_patch);
+    PC_UINT(patch_count);
+    PC_UINT(has_margins);              // the margin is the patch's max |D| (the box grows by it on every side)
+    PC_UINT(write_plane_values);       // diagnostics: 6 maxima per patch at kBindingPlaneValues
+} PC_END(frustum_disp);
+
 // occlusion.comp.glsl (OcclusionPass): cull_occlusion_scalar's test against a Hi-Z pyramid.
 PC_PARAMS(OcclusionParams, kUniformPassParams) {
     PC_MAT4(object_to_clip);           // column-major, as Mat4::m

@@ -5,6 +5,7 @@
 //
 //   test                   CPU kernel (scalar)            pass               shader
 //   frustum                cull_frustum_scalar            FrustumPass        frustum.comp.glsl
+//   frustum-disp (AABB)    cull_frustum_disp_scalar       FrustumDispPass    frustum_disp.comp.glsl
 //   Hi-Z pyramid           HiZPyramid::build              HiZBuildPass       hiz_build.comp.glsl
 //   Hi-Z occlusion         cull_occlusion_scalar          OcclusionPass      occlusion.comp.glsl
 //   back-patch tcone/ncone cull_tcone/ncone_scalar        BackpatchConePass  backpatch_cones.comp.glsl
@@ -191,6 +192,33 @@ public:
     /// plane_values (optional, diagnostics): a buffer of >= 6 floats per patch of the buffers that
     /// receives, for each tested patch p, the six maxima the decision compares with 0 at 6p.
     void run(const PatchBuffers& patches, const FrustumPlanes& planes, std::uint32_t plane_values = 0);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// cull_frustum_disp_scalar on the GPU (Sathe, "View Frustum Culling of Catmull-Clark Patches in
+/// DirectX 11", Game Programming Gems 8): reason kCullFrustum for a patch whose Cartesian
+/// control-point AABB, grown by its margin (max |D|) on every side, has all 8 corners outside one
+/// clip plane of object_to_clip. Decisions equal the CPU kernel's on the same inputs, bit for bit
+/// (same operation order; X / W and the multiply-adds correctly rounded also on llvmpipe), and so
+/// are the maxima written to plane_values. Conservative for a patch displaced along unit normals
+/// by at most its margin (the base surface lies in the hull of its control points, inside the
+/// box; displacement moves it at most |D|). A drop-in for FrustumPass in the flag chain: it tests
+/// displaced patches too (their margin > 0), and is looser than FrustumPass's hull test for
+/// undisplaced ones (a box instead of the points; about the same work per patch).
+class FrustumDispPass {
+public:
+    explicit FrustumDispPass(PassContext& context);
+    FrustumDispPass(FrustumDispPass&&) noexcept;
+    FrustumDispPass& operator=(FrustumDispPass&&) noexcept;
+    ~FrustumDispPass();
+    /// depth: the convention of object_to_clip (converted with to_zero_to_one, as the CPU kernel
+    /// does). plane_values (optional, diagnostics): a buffer of >= 6 floats per patch of the
+    /// buffers that receives, for each tested patch p, the six maxima over the corners (left,
+    /// right, bottom, top, near, far) that the decision compares with 0, at 6p.
+    void run(const PatchBuffers& patches, const Mat4& object_to_clip, ClipDepth depth, std::uint32_t plane_values = 0);
 
 private:
     struct Impl;

@@ -1,0 +1,41 @@
+// FrustumDispPass (patchcull/gl_passes.h): cull_frustum_disp_scalar (Sathe's displaced AABB) on the
+// GPU, shaders/frustum_disp.comp.glsl.
+#include "pass_common.h"
+
+namespace patchcull::gl {
+
+// The std140 block of pass_params.h: four vec4 rows, then four uints.
+static_assert(sizeof(pp::FrustumDispParams) == 4 * 16 + 16);
+static_assert(offsetof(pp::FrustumDispParams, first_patch) == 4 * 16);
+
+struct FrustumDispPass::Impl : detail::PassState {
+    using PassState::PassState;
+};
+
+FrustumDispPass::FrustumDispPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
+FrustumDispPass::FrustumDispPass(FrustumDispPass&&) noexcept = default;
+FrustumDispPass& FrustumDispPass::operator=(FrustumDispPass&&) noexcept = default;
+FrustumDispPass::~FrustumDispPass() = default;
+
+void FrustumDispPass::run(const PatchBuffers& patches, const Mat4& object_to_clip, ClipDepth depth,
+                          std::uint32_t plane_values) {
+    detail::begin_pass("FrustumDispPass");
+    detail::check_patch_buffers("FrustumDispPass", patches);
+    if (plane_values)
+        detail::check_buffer_size("FrustumDispPass", "plane-value", plane_values,
+                                  (patches.first + patches.count) * 6 * sizeof(float));
+    if (patches.count == 0) return;
+    // The CPU kernel converts first too (frustum.cpp): the same matrix, so the same corners.
+    const Mat4 m = to_zero_to_one(object_to_clip, depth);
+    pp::FrustumDispParams params;
+    for (int r = 0; r < 4; ++r) params.clip_rows[r] = {m.at(r, 0), m.at(r, 1), m.at(r, 2), m.at(r, 3)};
+    params.has_margins = patches.margins ? 1u : 0u;
+    params.write_plane_values = plane_values ? 1u : 0u;
+    glUseProgram(impl_->context.program("frustum_disp.comp.glsl"));
+    detail::bind_patch_buffers(patches);
+    if (plane_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingPlaneValues, plane_values);
+    detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kCullGroupSize);
+    detail::finish_pass("FrustumDispPass");
+}
+
+}  // namespace patchcull::gl
