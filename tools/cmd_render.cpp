@@ -3,7 +3,7 @@
 // against the unculled render (compare_frames: a patch visible unculled but culled is a false
 // cull). Output (--json), one object:
 //   {"model","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
-//    "displace","displace_scale","displaced_patches","bound","cone",
+//    "displace","displace_scale","displaced_patches","bound","cone","frustum",
 //    "frames":[{"frame","pass1_drawn","pass2_drawn","frustum_culled","backpatch_culled",
 //               "occlusion_culled","displaced_occlusion_culled","visible","newly_visible",
 //               "ms":{"pass1","hiz","cull","pass2",
@@ -20,6 +20,9 @@
 // patches are culled by the frustum and the running pipeline's Hi-Z with the bound ("caf" or
 // "oobb") and cone ("full", "acon", "con") of seed 000 §4.2, and never by back-patch tests;
 // "displaced_occlusion_culled" counts those of "occlusion_culled" that are displaced.
+// --frustum hull|aabb (gl_pipeline.h's FrustumTest; "frustum" in the JSON): the frustum test of the
+// chain, hull (Niessner & Loop: the control points, the default) or aabb (Sathe: the control
+// points' box grown by max |D|, which also bounds the displaced patches against the frustum).
 // --cull auto (cull_auto.h: Niessner & Loop §6.3's per-object switch): each object of the scene
 // (render_support.h scene_objects: one per instance) is culled with the tests of `all` (back-patch
 // only where applicable_cull_mode allows) or drawn whole, decided per frame from the measured pass
@@ -52,6 +55,7 @@
 #include "object_level_options.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
+#include "render_dumps.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -82,6 +86,7 @@ Runner add_render_command(CLI::App& app) {
         int frames = 6;
         std::string cull = "all";
         std::string backpatch = "tcone";
+        std::string frustum = "hull";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -89,6 +94,8 @@ Runner add_render_command(CLI::App& app) {
         bool aggressive = false;
         bool verify = false;
         std::string out;
+        std::string dump_hiz;     // render_dumps.h
+        std::string draw_bounds;  // patch indices, comma-separated
         bool json = false;
         ObjectLevelOptions objects;
     };
@@ -102,6 +109,8 @@ Runner add_render_command(CLI::App& app) {
                       "cull tests of the pipeline (auto: all, per object where it pays, seed 000 §6.3)");
     add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
                       "back-patch test of backpatch/all");
+    add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
+                      "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
     add_displace_options(*command, state->displace);
@@ -111,6 +120,12 @@ Runner add_render_command(CLI::App& app) {
     command->add_flag("--verify", state->verify,
                       "render the unculled reference of every frame and count false culls (exit status 1 if any)");
     add_output_file_option(*command, "--out", state->out, "write the colour image of the last frame as a PNG");
+    add_text_option(*command, "--dump-hiz", state->dump_hiz,
+                    "write the last frame's Hi-Z levels into DIR (created): hiz_level_NN.png (grey: white = depth 1, "
+                    "else black..grey 254 = the level's min..max depth below 1), raw .f32 levels, depth, ids, hiz.json");
+    add_text_option(*command, "--draw-bounds", state->draw_bounds,
+                    "P[,P...]: draw these patches' CAF (green) and OOBB (red) screen rectangles, as the occlusion "
+                    "test uses them, over the last frame into --out (seed 000 Fig. 6)");
     command->add_flag("--json", state->json, "print one JSON object");
     return [state]() {
         int width = 0, height = 0;
@@ -118,8 +133,18 @@ Runner add_render_command(CLI::App& app) {
         const bool automatic = state->cull == "auto";
         const gl::CullMode cull = automatic ? gl::CullMode::all : parse_cull_mode_option("--cull", state->cull);
         const gl::BackpatchMethod backpatch = parse_backpatch_method("--backpatch", state->backpatch);
+        if (!state->draw_bounds.empty() && state->out.empty())
+            throw Error("--draw-bounds: needs --out FILE.png (the picture it draws)");
+        if (!state->dump_hiz.empty()) {
+            if (!(static_cast<std::uint32_t>(cull) & gl::kFlagOcclusion))
+                throw Error("--dump-hiz: the pyramid is built only with occlusion (--cull occlusion, all or auto)");
+            prepare_output_dir("--dump-hiz", state->dump_hiz, {"hiz.json"});
+        }
         Scene scene = load_scene(state->model, state->scheme, state->split);
         apply_displace_options(state->displace, scene);
+        const std::vector<std::size_t> bounds_patches =
+            state->draw_bounds.empty() ? std::vector<std::size_t>{}
+                                       : parse_patch_list(state->draw_bounds, scene.patch_count());
         const TessMode tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         // Back-patch culling is conservative only on closed surfaces (both sides are drawn, and
         // through an opening the inside of a patch that faces away shows): `all` leaves it out
@@ -148,6 +173,7 @@ Runner add_render_command(CLI::App& app) {
         const std::vector<BezierPatch>* pose = &first_pose;
         nlohmann::json frames = nlohmann::json::array();
         std::size_t total_false = 0;
+        nlohmann::json hiz_dump, drawn_bounds;
         for (int f = 0; f < state->frames; ++f) {
             if (f > 0) {
                 pose = &poser.pose(f * kSecondsPerFrame);
@@ -162,6 +188,7 @@ Runner add_render_command(CLI::App& app) {
             params.backpatch = backpatch;
             params.bound = displace_bound(state->displace);
             params.cone = displace_cone(state->displace);
+            params.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
             object_level.apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height, params);
             if (automatic) {
                 policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
@@ -171,7 +198,24 @@ Runner add_render_command(CLI::App& app) {
             const gl::FrameStats stats = pipeline.render_frame(params);
             if (automatic) policy.observe(stats);
             const bool last = f + 1 == state->frames;
-            if (last && !state->out.empty()) pipeline.renderer().write_color_png(state->out);
+            if (last && !state->out.empty() && bounds_patches.empty()) pipeline.renderer().write_color_png(state->out);
+            if (last && !state->dump_hiz.empty()) hiz_dump = dump_hiz(pipeline, state->dump_hiz);
+            if (last && !bounds_patches.empty()) {
+                const std::vector<std::uint32_t> ids = pipeline.renderer().read_ids();
+                const std::vector<DisplacementRange>& ranges = poser.displacement_ranges();
+                std::vector<PatchBounds> bounds;
+                drawn_bounds = nlohmann::json::array();
+                for (std::size_t p : bounds_patches) {
+                    PatchBounds b;
+                    b.patch = p;
+                    if (!ranges.empty() && !scene.displacement.empty()) b.range = ranges[p];  // else drawn undisplaced
+                    b.caf = screen_bound((*pose)[p], b.range, DisplacedBoundKind::caf, params.cone, params.frame.render);
+                    b.oobb = screen_bound((*pose)[p], b.range, DisplacedBoundKind::oobb, params.cone, params.frame.render);
+                    drawn_bounds.push_back(patch_bounds_json(b, ids));
+                    bounds.push_back(b);
+                }
+                write_bounds_png(state->out, pipeline.renderer().read_color(), ids, width, height, bounds);
+            }
             nlohmann::json ms = {{"pass1", stats.pass1_ms}, {"hiz", stats.hiz_ms}, {"cull", stats.cull_ms},
                                  {"pass2", stats.pass2_ms}, {"total", stats.total_ms}};
             if (object_level.enabled()) {
@@ -251,12 +295,15 @@ Runner add_render_command(CLI::App& app) {
             out["displaced_patches"] = displaced_patch_count(poser);
             out["bound"] = state->displace.bound;
             out["cone"] = state->displace.cone;
+            out["frustum"] = state->frustum;
             out["objects_method"] = object_level.method_name();
             out["detail_cull"] = state->objects.detail_pixels;
             out["environment_objects"] = scene.environment.size();
             out["renderer"] = context.renderer();
             out["frames"] = frames;
             out["false_culls"] = total_false;
+            if (!hiz_dump.is_null()) out["hiz_dump"] = hiz_dump;
+            if (!drawn_bounds.is_null()) out["draw_bounds"] = drawn_bounds;
             std::cout << out.dump() << "\n";
         } else if (state->verify) {
             std::printf("false culls in total: %zu\n", total_false);
