@@ -3,7 +3,7 @@
 // against the unculled render (compare_frames: a patch visible unculled but culled is a false
 // cull). Output (--json), one object:
 //   {"model","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
-//    "displace","displace_scale","displaced_patches","bound","cone",
+//    "displace","displace_scale","displaced_patches","bound","cone","frustum",
 //    "frames":[{"frame","pass1_drawn","pass2_drawn","frustum_culled","backpatch_culled",
 //               "occlusion_culled","displaced_occlusion_culled","visible","newly_visible",
 //               "ms":{"pass1","hiz","cull","pass2",
@@ -20,6 +20,9 @@
 // patches are culled by the frustum and the running pipeline's Hi-Z with the bound ("caf" or
 // "oobb") and cone ("full", "acon", "con") of seed 000 §4.2, and never by back-patch tests;
 // "displaced_occlusion_culled" counts those of "occlusion_culled" that are displaced.
+// --frustum hull|aabb (gl_pipeline.h's FrustumTest; "frustum" in the JSON): the frustum test of the
+// chain, hull (Niessner & Loop: the control points, the default) or aabb (Sathe: the control
+// points' box grown by max |D|, which also bounds the displaced patches against the frustum).
 // --cull auto (cull_auto.h: Niessner & Loop §6.3's per-object switch): each object of the scene
 // (render_support.h scene_objects: one per instance) is culled with the tests of `all` (back-patch
 // only where applicable_cull_mode allows) or drawn whole, decided per frame from the measured pass
@@ -83,6 +86,7 @@ Runner add_render_command(CLI::App& app) {
         int frames = 6;
         std::string cull = "all";
         std::string backpatch = "tcone";
+        std::string frustum = "hull";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -105,6 +109,8 @@ Runner add_render_command(CLI::App& app) {
                       "cull tests of the pipeline (auto: all, per object where it pays, seed 000 §6.3)");
     add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
                       "back-patch test of backpatch/all");
+    add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
+                      "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
     add_displace_options(*command, state->displace);
@@ -182,6 +188,7 @@ Runner add_render_command(CLI::App& app) {
             params.backpatch = backpatch;
             params.bound = displace_bound(state->displace);
             params.cone = displace_cone(state->displace);
+            params.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
             object_level.apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height, params);
             if (automatic) {
                 policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
@@ -288,6 +295,7 @@ Runner add_render_command(CLI::App& app) {
             out["displaced_patches"] = displaced_patch_count(poser);
             out["bound"] = state->displace.bound;
             out["cone"] = state->displace.cone;
+            out["frustum"] = state->frustum;
             out["objects_method"] = object_level.method_name();
             out["detail_cull"] = state->objects.detail_pixels;
             out["environment_objects"] = scene.environment.size();

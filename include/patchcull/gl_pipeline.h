@@ -74,6 +74,17 @@ struct ObjectStats {
     std::size_t object_culled = 0;  ///< in PipelineParams::object_culled
 };
 
+/// The frustum test of the flag chain. hull: FrustumPass (Niessner & Loop §4.1.1: every control
+/// point outside one clip plane, displaced patches with their margin scaled by each plane's
+/// normal), then for displaced patches DisplacedPass's bound (PipelineParams::bound) against the
+/// frustum too. aabb: FrustumDispPass (Sathe: the control points' object-space box, grown by
+/// max |D| on every side) for every patch, displaced ones included; DisplacedPass then runs only
+/// in modes with occlusion, for its Hi-Z test (its bound's frustum test may still cull there what
+/// the box kept). Both are conservative; aabb's box contains hull's points, so it culls fewer
+/// undisplaced patches, and no CAF/OOBB is built for the frustum alone.
+enum class FrustumTest { hull, aabb };
+const char* frustum_test_name(FrustumTest test);  ///< "hull", "aabb"
+
 /// Parameters of one pipeline frame: the frame and the choice of each test.
 struct PipelineParams {
     FrameParams frame;
@@ -83,6 +94,8 @@ struct PipelineParams {
     /// displacement_ranges and a displacement map is set).
     DisplacedBoundKind bound = DisplacedBoundKind::caf;
     NormalConeKind cone = NormalConeKind::acon;
+    /// The frustum test of the chain (FrustumTest; hull is the pipeline's original behaviour).
+    FrustumTest frustum = FrustumTest::hull;
     /// The objects (disjoint ranges, in any order, within the set), or empty: one object of every
     /// patch, culled. Patches outside every range are drawn unculled. Throws when a range leaves
     /// the set or two overlap.

@@ -61,7 +61,7 @@ private:
 
 struct CullPipeline::Impl {
     explicit Impl(const GlContext& ctx)
-        : renderer(ctx), frustum(passes), hiz_build(passes), occlusion(passes), cones(passes), ptp(passes),
+        : renderer(ctx), frustum(passes), frustum_disp(passes), hiz_build(passes), occlusion(passes), cones(passes), ptp(passes),
           displaced(passes), status(passes) {
         glCreateBuffers(1, &counters);
         GLint alignment = 16;
@@ -79,6 +79,7 @@ struct CullPipeline::Impl {
     PatchRenderer renderer;  // first: makes the context current before the passes bind to it
     PassContext passes;
     FrustumPass frustum;
+    FrustumDispPass frustum_disp;
     HiZBuildPass hiz_build;
     OcclusionPass occlusion;
     BackpatchConePass cones;
@@ -133,6 +134,8 @@ void CullPipeline::update_patches(const std::vector<BezierPatch>& patches, const
 std::size_t CullPipeline::patch_count() const { return impl_->renderer.patch_count(); }
 void CullPipeline::reset_visibility() { impl_->primed_generation = ~std::uint64_t{0}; }
 
+const char* frustum_test_name(FrustumTest test) { return test == FrustumTest::aabb ? "aabb" : "hull"; }
+
 Vec3 eye_of_view(const Mat4& view) {
     Mat4 inverse;
     if (!invert(view, inverse)) throw Error("render: the view matrix is singular (no eye position)");
@@ -163,6 +166,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     stats.timing = method;
     const Mat4 object_to_clip = rp.projection * rp.view;
     const Vec3 eye = eye_of_view(rp.view);
+    const bool aabb = params.frustum == FrustumTest::aabb;
 
     // The objects, and the ranges between them (drawn unculled, counted in the last slot).
     const std::size_t count = r.patch_count();
@@ -249,7 +253,12 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
         for (std::size_t i = 0; i < objects.size(); ++i)
             if (objects[i].cull && (tests & sh::kCullFrustum))
-                for (const PatchSpan& s : object_spans[i]) m.frustum.run(buffers_of(s), planes);
+                for (const PatchSpan& s : object_spans[i]) {
+                    if (aabb)
+                        m.frustum_disp.run(buffers_of(s), object_to_clip, ClipDepth::zero_to_one);
+                    else
+                        m.frustum.run(buffers_of(s), planes);
+                }
         clock.mark();
         for (std::size_t i = 0; i < objects.size(); ++i) {
             if (!objects[i].cull || !(tests & sh::kCullBackPatch)) continue;
@@ -265,7 +274,9 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         const HiZTexture* occluding = (tests & sh::kCullOcclusion) ? hiz : nullptr;
         // The displaced pass runs when either test is asked for, with the bound's frustum test
         // too (a bound outside the frustum is invisible), against the pyramid when occluding.
-        const bool bounds = ranges && (tests & (sh::kCullFrustum | sh::kCullOcclusion));
+        // With the aabb frustum test the box (grown by max |D|) already tested the displaced patches
+        // against the frustum: the bound is built only for the Hi-Z test.
+        const bool bounds = ranges && (aabb ? occluding != nullptr : (tests & (sh::kCullFrustum | sh::kCullOcclusion)) != 0);
         const DisplacedCullView view =
             bounds ? make_displaced_cull_view(rp.view, rp.projection, ClipDepth::zero_to_one) : DisplacedCullView{};
         for (std::size_t i = 0; i < objects.size(); ++i) {

@@ -1,0 +1,77 @@
+// `render --frustum hull|aabb` (issue 15): the pipeline's frustum test chosen on the command line.
+// With aabb (FrustumDispPass, Sathe's box grown by max |D|) `--verify` finds no false culls against
+// the unculled render on BigGuy half outside the view, for acc and osd patches, undisplaced and
+// displaced (procedural map; frustum alone and with the two-pass occlusion pipeline), and the
+// test culls; the JSON reports the choice; a bad value is a one-line error naming --frustum.
+// Tiny sizes (64x36, level 2, 2 frames) on llvmpipe: about 10 s in all.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/cli_test_util.h"
+
+using namespace patchcull::cli_test;
+
+namespace {
+
+// BigGuy (1 high) with a still camera 1.8 away whose view centre is 1.75 to its side: about half
+// of the patches lie outside the frustum (the setup of the Sathe study, scripts/sathe_study.py).
+std::string half_out_scene(const std::string& scheme) {
+    return write_file("sathe_half_" + scheme + ".json",
+                      R"({"name":"sathe_half","objects":[{"model":")" + model("bigguy.obj") +
+                          R"(","scheme":")" + scheme +
+                          R"(","transform":{"position":[0,0,0],"height":1},"animation":{"deform":false}}],)"
+                          R"("camera":{"orbit":{"target":[1.75,0.5,0],"distance":1.8,"height":0,"degrees_per_frame":0}}})");
+}
+
+nlohmann::json render_json(const std::string& args) {
+    const CliRun r = run("render " + args + " --frames 2 --size 64x36 --tess 2 --verify --json");
+    EXPECT_EQ(r.status, 0) << args << ": " << r.err;
+    return r.status == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
+}
+
+std::size_t last_frustum_culled(const nlohmann::json& j) { return j["frames"].back()["frustum_culled"].get<std::size_t>(); }
+
+}  // namespace
+
+TEST(FrustumDispCli, AabbVerifiesWithoutFalseCullsAndCulls) {
+    for (const std::string scheme : {"acc", "osd"}) {
+        SCOPED_TRACE(scheme);
+        const std::string scene = half_out_scene(scheme);
+        const nlohmann::json aabb = render_json(scene + " --cull frustum --frustum aabb");
+        ASSERT_TRUE(aabb.is_object());
+        EXPECT_EQ(aabb["frustum"], "aabb");
+        EXPECT_EQ(aabb["false_culls"], 0);
+        const std::size_t culled = last_frustum_culled(aabb);
+        EXPECT_GT(culled, aabb["patches"].get<std::size_t>() / 5);
+        // The box contains the control points, so it culls no more than the hull test (the
+        // default; counts, as rounding may differ at a plane).
+        const nlohmann::json hull = render_json(scene + " --cull frustum");
+        ASSERT_TRUE(hull.is_object());
+        EXPECT_EQ(hull["frustum"], "hull");
+        EXPECT_EQ(hull["false_culls"], 0);
+        EXPECT_LE(culled, last_frustum_culled(hull));
+    }
+}
+
+TEST(FrustumDispCli, AabbBoundsDisplacedPatches) {
+    const std::string scene = half_out_scene("acc");
+    // Frustum alone: the box grown by max |D| is the only frustum test of the displaced patches.
+    const nlohmann::json frustum = render_json(scene + " --cull frustum --frustum aabb --displace procedural");
+    ASSERT_TRUE(frustum.is_object());
+    EXPECT_EQ(frustum["displaced_patches"], frustum["patches"]);
+    EXPECT_EQ(frustum["false_culls"], 0);
+    EXPECT_GT(last_frustum_culled(frustum), 0u);
+    // Two-pass pipeline: the displaced bound still runs for the Hi-Z test.
+    const nlohmann::json all = render_json(scene + " --cull all --frustum aabb --displace procedural");
+    ASSERT_TRUE(all.is_object());
+    EXPECT_EQ(all["false_culls"], 0);
+    EXPECT_GT(last_frustum_culled(all), 0u);
+}
+
+TEST(FrustumDispCli, BadFrustumValueIsAOneLineError) {
+    expect_one_line_error(run("render teapot --frustum box --json"), "--frustum");
+    expect_one_line_error(run("render teapot --frustum --json"), "--frustum");
+}
