@@ -67,6 +67,10 @@ note "displaced_table start"
 # 5. Temporal coherence (Fig. 9 right): BigGuy, the camera orbiting at each speed (docs/RESULTS.md's run).
 note "temporal start"
 "$CLI" eval temporal "$BIGGUY" --speeds 0,1,2,5,10,20,45,90,180 --frames 36 --json > "$DATA/temporal.json"
+# 6. Cull-pass time of the undisplaced and displaced kernels against patch count (Niessner & Loop,
+#    Fig. 7 left: NoDisp, Full, ACoN, CoN; scripts/fig7_sweep.py writes DATA_DIR/fig7).
+note "fig7 start"
+python3 scripts/fig7_sweep.py "$BUILD" "$DATA"
 note "end"
 
 # The plots need matplotlib: Debian's python3-matplotlib is for /usr/bin/python3, which a

@@ -21,6 +21,10 @@ command's stdout):
                          -> table1_displaced.png, beside Table 1 of Niessner & Loop
   temporal.json          `patchcull eval temporal MODEL --speeds LIST --frames N --json`
                          -> temporal_coherence.png, beside Fig. 9 right of Niessner & Loop
+  fig7/*.json            scripts/fig7_sweep.py: `patchcull render monsterfrog.obj --split S --cull
+                         occlusion` undisplaced (nodisp) and displaced with --bound caf --cone
+                         full|acon|con (and oobb_acon): cull-pass time against patch count
+                         -> fig7_cull_pass_displaced.png (Niessner & Loop, Fig. 7 left)
 The papers' values drawn beside ours are typed in below from the papers' tables and text.
 
 Bad input (a missing file or directory, a file that is not JSON or not the shape its command
@@ -345,6 +349,39 @@ def plot_temporal(plt, data, out):
     save(fig, out, "temporal_coherence.png")
 
 
+FIG7_CURVES = [("nodisp", "NoDisp (undisplaced: frustum + Hi-Z of the control points)"),
+               ("full", "Full (CAF, no cone)"), ("acon", "ACoN (CAF, approximate cone)"),
+               ("con", "CoN (CAF, exact cone of normals)"), ("oobb_acon", "OOBB with ACoN (Munkberg et al.)")]
+
+
+def plot_fig7(plt, data, out):
+    """Cull-pass time (ms) against patch count: undisplaced and displaced kernels (Fig. 7 left)."""
+    series = {}  # curve -> [(patches, ms)]
+    for path in json_files(os.path.join(data, "fig7")):
+        curve = os.path.basename(path).rsplit("_split", 1)[0]
+        if curve not in dict(FIG7_CURVES):
+            raise InputError(path, f"unknown curve '{curve}' (expected one of {', '.join(dict(FIG7_CURVES))})")
+        r = load_json(path)
+        displaced = field(path, r, "displaced_patches", int)
+        if (curve == "nodisp") != (displaced == 0):
+            raise InputError(path, f"'displaced_patches' is {displaced}, which does not fit the curve '{curve}'")
+        series.setdefault(curve, []).append((field(path, r, "patches", int), mean_ms(path, r, "cull")))
+    fig, ax = plt.subplots(figsize=(8, 5), dpi=100)
+    for c, (curve, label) in enumerate(FIG7_CURVES):
+        pts = sorted(series.get(curve, []))
+        if pts:
+            ax.plot([p for p, _ in pts], [ms for _, ms in pts], marker="osD^v"[c], color=f"C{c}",
+                    linestyle="--" if curve == "oobb_acon" else "-", label=label)
+    log_axes(ax, "both")
+    ax.set_xlabel("patches (MonsterFrog split 0..3; displaced: procedural map on every patch)")
+    ax.set_ylabel("cull passes per frame (ms, llvmpipe: the CPU runs the kernels)")
+    ax.set_title("Cull-pass time against patch count. Niessner & Loop, Fig. 7 left (a GPU): NoDisp, Full\n"
+                 "and ACoN about equal, CoN about 10x slower, OOBB kernels within 3% of CAF's", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    save(fig, out, "fig7_cull_pass_displaced.png")
+
+
 def save(fig, out, name):
     fig.tight_layout()
     path = os.path.join(out, name)
@@ -389,7 +426,8 @@ def main(argv):
     except ImportError:
         fail("matplotlib is not installed for this Python (Debian: python3-matplotlib, for /usr/bin/python3)")
     try:
-        for plot in (plot_cull_pass, plot_tess_levels, plot_backpatch_table, plot_displaced_table, plot_temporal):
+        for plot in (plot_cull_pass, plot_tess_levels, plot_backpatch_table, plot_displaced_table, plot_temporal,
+                     plot_fig7):
             plot(plt, data, out)
     except InputError as e:
         fail(str(e))

@@ -17,7 +17,7 @@ ROOT = sys.argv[1]
 SCRIPT = os.path.join(ROOT, "scripts", "plot_figures.py")
 DATA = os.path.join(ROOT, "docs", "figures", "data")
 FIGURES = ["cull_pass_vs_patches.png", "frame_time_vs_tess.png", "table1_backpatch.png", "table1_displaced.png",
-           "temporal_coherence.png"]
+           "temporal_coherence.png", "fig7_cull_pass_displaced.png"]
 failures = []
 
 
@@ -84,6 +84,10 @@ with tempfile.TemporaryDirectory() as tmp:
     with open(os.path.join(broken, "backpatch_table", victim), "w") as f:
         f.write('{"model": "x", "patches": 1, "views": 1, "methods": {"tcone": {"cull_rate": "high"}}}')
     expect_one_line_error(run(broken, "--out", out), victim, "cull_rate not a number")
+    fig7 = os.path.join(tmp, "fig7_broken")  # fig7 is drawn last: the other files must be good
+    shutil.copytree(DATA, fig7)
+    shutil.copy(os.path.join(fig7, "fig7", "acon_split0.json"), os.path.join(fig7, "fig7", "nodisp_split9.json"))
+    expect_one_line_error(run(fig7, "--out", out), "nodisp_split9.json", "displaced patches in the NoDisp curve")
     expect_one_line_error(run(DATA, "--out", os.path.join(tmp, "no_such_dir")), "no_such_dir", "missing --out")
     expect_one_line_error(run(DATA, "--bogus"), "--bogus", "unknown option")
 
@@ -91,4 +95,4 @@ if failures:
     for f in failures:
         print("FAIL:", f)
     sys.exit(1)
-print(f"plot_figures.py: {len(FIGURES)} figures drawn, 6 bad inputs refused")
+print(f"plot_figures.py: {len(FIGURES)} figures drawn, 7 bad inputs refused")
