@@ -9,6 +9,8 @@
 //               "ms":{"pass1","hiz","cull","pass2",
 //               "total"[,"reference"]},"false_culls"[,"false_culled_patches":[indices]]}],
 //    "false_culls"}
+// --dump-hiz DIR adds "hiz_dump" (hiz.json's object) and --draw-bounds P[,P...] adds
+// "draw_bounds" (one object per patch): tools/render_dumps.h (seed 000 Figs. 3 and 6).
 // Without --verify nothing is compared: every false_culls is 0 and "verified" is false. Patch
 // indices are positions in the scene's pose (instances in order, each in its model's order).
 // "backpatch" is "off" when no back-patch test ran (--cull none/frustum/occlusion, or `all` on a
