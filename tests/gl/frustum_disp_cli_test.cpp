@@ -3,9 +3,14 @@
 // the unculled render on BigGuy half outside the view, for acc and osd patches, undisplaced and
 // displaced (procedural map; frustum alone and with the two-pass occlusion pipeline), and the
 // test culls; the JSON reports the choice; a bad value is a one-line error naming --frustum.
-// Tiny sizes (64x36, level 2, 2 frames) on llvmpipe: about 10 s in all.
+// scripts/sathe_study.py (docs/PERFORMANCE.md, "Sathe's study"): its camera setups give what the
+// study claims (nothing culled with the whole object in view, about half culled in the other),
+// and bad input is one line naming the flag.
+// Tiny sizes (64x36, level 1-2, 2 frames) on llvmpipe: about 10 s in all.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -74,4 +79,53 @@ TEST(FrustumDispCli, AabbBoundsDisplacedPatches) {
 TEST(FrustumDispCli, BadFrustumValueIsAOneLineError) {
     expect_one_line_error(run("render teapot --frustum box --json"), "--frustum");
     expect_one_line_error(run("render teapot --frustum --json"), "--frustum");
+}
+
+namespace {
+
+// python3 scripts/sathe_study.py ARGS, with the build's CLI unless args name one.
+CliRun run_study(const std::string& args, bool with_cli = true) {
+    const std::string out = scratch_dir() + "/study_stdout", err = scratch_dir() + "/study_stderr";
+    const std::string cmd = std::string("python3 ") + PATCHCULL_SOURCE_DIR + "/scripts/sathe_study.py " +
+                            (with_cli ? std::string("--cli ") + PATCHCULL_CLI + " " : std::string()) + args + " >" +
+                            out + " 2>" + err + " </dev/null";
+    const int raw = std::system(cmd.c_str());
+    CliRun r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+}  // namespace
+
+TEST(FrustumDispCli, SatheStudySetupsCullNothingAndAboutHalf) {
+    const std::string json = scratch_dir() + "/sathe_study.json";
+    const CliRun r = run_study("--scenes bigguy --levels 1 --size 64x36 --frames 2 --json " + json);
+    ASSERT_EQ(r.status, 0) << r.err;
+    std::ifstream in(json);
+    const auto j = nlohmann::json::parse(in);
+    ASSERT_EQ(j["rows"].size(), 2u);
+    for (const auto& row : j["rows"]) {
+        const double patches = row["patches"].get<double>();
+        for (const char* mode : {"hull", "aabb"}) {
+            const double culled = row[std::string(mode) + "_culled"].get<double>() / patches;
+            if (row["setup"] == "whole") {
+                EXPECT_EQ(culled, 0.0) << mode;
+            } else {
+                EXPECT_GT(culled, 0.3) << mode;
+                EXPECT_LT(culled, 0.7) << mode;
+            }
+            EXPECT_GT(row[std::string(mode) + "_ratio"].get<double>(), 0.0);
+        }
+        EXPECT_EQ(row["none_culled"], 0);
+    }
+}
+
+TEST(FrustumDispCli, SatheStudyBadInputIsAOneLineError) {
+    expect_one_line_error(run_study("--levels two"), "--levels");
+    expect_one_line_error(run_study("--scenes teapot"), "--scenes");
+    expect_one_line_error(run_study("--size 64"), "--size");
+    expect_one_line_error(run_study("--bogus 1"), "--bogus");
+    expect_one_line_error(run_study("--cli /nonexistent/patchcull", false), "/nonexistent/patchcull");
 }
