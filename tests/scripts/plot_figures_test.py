@@ -88,6 +88,19 @@ with tempfile.TemporaryDirectory() as tmp:
     shutil.copytree(DATA, fig7)
     shutil.copy(os.path.join(fig7, "fig7", "acon_split0.json"), os.path.join(fig7, "fig7", "nodisp_split9.json"))
     expect_one_line_error(run(fig7, "--out", out), "nodisp_split9.json", "displaced patches in the NoDisp curve")
+    # scripts/fig7_sweep.py's bad arguments (no CLI is run: the checks come first).
+    sweep = os.path.join(ROOT, "scripts", "fig7_sweep.py")
+    def run_sweep(*args):
+        return subprocess.run([sys.executable, sweep, *args], capture_output=True, text=True)
+    expect_one_line_error(run_sweep(os.path.join(tmp, "no_build")), "BUILD_DIR", "fig7_sweep.py without a CLI")
+    fake_build = os.path.join(tmp, "fake_build")
+    os.mkdir(fake_build)
+    with open(os.path.join(fake_build, "patchcull"), "w") as f:
+        f.write("#!/bin/sh\nexit 1\n")
+    os.chmod(os.path.join(fake_build, "patchcull"), 0o755)
+    expect_one_line_error(run_sweep(fake_build, os.path.join(broken, "temporal.json", "sub")), "DATA_DIR",
+                          "fig7_sweep.py with a DATA_DIR under a file")
+    expect_one_line_error(run_sweep("--bogus"), "usage", "fig7_sweep.py with an option")
     expect_one_line_error(run(DATA, "--out", os.path.join(tmp, "no_such_dir")), "no_such_dir", "missing --out")
     expect_one_line_error(run(DATA, "--bogus"), "--bogus", "unknown option")
 
@@ -95,4 +108,4 @@ if failures:
     for f in failures:
         print("FAIL:", f)
     sys.exit(1)
-print(f"plot_figures.py: {len(FIGURES)} figures drawn, 7 bad inputs refused")
+print(f"plot_figures.py: {len(FIGURES)} figures drawn, 10 bad inputs refused")
