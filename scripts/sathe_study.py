@@ -20,6 +20,8 @@ taken seconds apart on the same machine state:
 each with --tess L --size WxH --frames N --json. A time is the median of ms.total over frames
 1..N-1 (frame 0 compiles the shaders); the table prints each culled time over the unculled one
 (< 1: culling pays) and the culled fraction. With --rounds R > 1 a ratio is the median over rounds.
+The "min" ratios divide the fastest frame of all rounds by the fastest unculled one: on a shared
+machine the other load only ever adds time, so the minimum is the steadier estimate.
 Errors (a bad flag, a CLI that fails) are one line naming the flag or the command, exit status 2.
 """
 import json
@@ -73,13 +75,17 @@ def scene_json(scene, setup):
 
 def render(cli, path, level, size, frames, mode_args):
     cmd = [cli, "render", path, "--tess", str(level), "--size", size, "--frames", str(frames), "--json", *mode_args]
-    r = subprocess.run(cmd, capture_output=True, text=True)
+    try:
+        r = subprocess.run(cmd, capture_output=True, text=True)
+    except OSError as e:  # e.g. the binary being relinked by a build
+        fail(f"--cli: {cli}: {e.strerror}")
     if r.returncode != 0:
         last = (r.stderr.strip().splitlines() or ["(no output)"])[-1]
         fail(f"{' '.join(cmd[1:])}: exit status {r.returncode}: {last}")
     out = json.loads(r.stdout)
     timed = out["frames"][1:]
-    return {"ms": statistics.median(f["ms"]["total"] for f in timed),
+    times = [f["ms"]["total"] for f in timed]
+    return {"ms": statistics.median(times), "ms_min": min(times),
             "frustum_culled": out["frames"][-1]["frustum_culled"], "patches": out["patches"]}
 
 
@@ -155,15 +161,18 @@ def main(argv):
                     for mode, _ in MODES:
                         row[f"{mode}_ms"] = statistics.median(r["ms"] for r in runs[mode])
                         row[f"{mode}_culled"] = runs[mode][0]["frustum_culled"]
+                        row[f"{mode}_ms_min"] = min(r["ms_min"] for r in runs[mode])
                     for mode in ("hull", "aabb"):
                         row[f"{mode}_ratio"] = statistics.median(
                             c["ms"] / n["ms"] for c, n in zip(runs[mode], runs["none"]))
+                        row[f"{mode}_ratio_min"] = row[f"{mode}_ms_min"] / row["none_ms_min"]
                     rows.append(row)
                     print(f"{scene:8} {setup:5} L{level:<3} none {row['none_ms']:8.1f} ms | "
                           f"hull {row['hull_ms']:8.1f} ms x{row['hull_ratio']:.3f} "
                           f"({row['hull_culled'] / row['patches']:.0%} culled) | "
                           f"aabb {row['aabb_ms']:8.1f} ms x{row['aabb_ratio']:.3f} "
-                          f"({row['aabb_culled'] / row['patches']:.0%} culled)", flush=True)
+                          f"({row['aabb_culled'] / row['patches']:.0%} culled) | "
+                          f"min: x{row['hull_ratio_min']:.3f} x{row['aabb_ratio_min']:.3f}", flush=True)
     result = {"size": opts["size"], "frames": opts["frames"], "rounds": opts["rounds"],
               "load_after": os.getloadavg(), "rows": rows}
     if opts["json"]:
