@@ -7,7 +7,8 @@
 // One frame with occlusion in the mode:
 //   1. clear, occluders, the patches tagged visible by the previous frame (draw pass 1);
 //   2. HiZBuildPass from that depth buffer;
-//   3. the flag chain: CullStatusPass::begin; FrustumPass (with the displacement margins);
+//   3. the flag chain: CullStatusPass::begin; FrustumPass (with the displacement margins; or
+//      FrustumDispPass, PipelineParams::frustum);
 //      the back-patch pass of PipelineParams::backpatch (BackpatchConePass or BackpatchPtpPass;
 //      displaced patches skipped); OcclusionPass (control-point boxes; displaced patches
 //      skipped); DisplacedPass (seed 000 §4.2's bound of each displaced patch, against the frustum
