@@ -43,6 +43,7 @@ Runner add_view_command(CLI::App& app) {
         int frames = 0;
         std::string cull = "all";
         std::string backpatch = "tcone";
+        std::string frustum = "hull";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -65,6 +66,8 @@ Runner add_view_command(CLI::App& app) {
                       "cull tests at the start (auto: all, per object where it pays, Niessner & Loop §6.3)");
     add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
                       "back-patch test of backpatch/all");
+    add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
+                      "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
     add_displace_options(*command, state->displace);
@@ -93,6 +96,7 @@ Runner add_view_command(CLI::App& app) {
         Scene scene = load_scene(state->model, state->scheme, state->split);
         apply_displace_options(state->displace, scene);
         config.tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
+        config.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
 
         ViewerSettings& s = config.settings;
         set_cull_toggles(s, applicable_cull_mode(scene, cull, "view"));

@@ -216,6 +216,7 @@ int run_viewer(ViewerConfig& config) {
         params.backpatch = settings.backpatch_method;
         params.bound = settings.bound;
         params.cone = settings.cone;
+        params.frustum = config.frustum;
         if (settings.backpatch && !world.one_sided() && config.interactive && !warned_open_backpatch) {
             // As `render --cull backpatch` on an open surface: kept, with one warning.
             warned_open_backpatch = true;

@@ -5,7 +5,7 @@
 // test culls; the JSON reports the choice; a bad value is a one-line error naming --frustum.
 // scripts/sathe_study.py (docs/PERFORMANCE.md, "Sathe's study"): its camera setups give what the
 // study claims (nothing culled with the whole object in view, about half culled in the other),
-// and bad input is one line naming the flag.
+// and bad input is one line naming the flag. `view --frustum` reaches the pipeline (xvfb).
 // Tiny sizes (64x36, level 1-2, 2 frames) on llvmpipe: about 10 s in all.
 #include <gtest/gtest.h>
 
@@ -79,6 +79,31 @@ TEST(FrustumDispCli, AabbBoundsDisplacedPatches) {
 TEST(FrustumDispCli, BadFrustumValueIsAOneLineError) {
     expect_one_line_error(run("render teapot --frustum box --json"), "--frustum");
     expect_one_line_error(run("render teapot --frustum --json"), "--frustum");
+    expect_one_line_error(run("view teapot --frustum box"), "--frustum");
+}
+
+TEST(FrustumDispCli, ViewRunsTheChosenTest) {
+    // `view --frames N` without a script runs render's frames in a window (xvfb here) and prints a
+    // line per frame: its frustum count must be render's for the same test, and the two tests
+    // must differ on this view (else the flag could be ignored unnoticed).
+    ASSERT_EQ(std::system("command -v xvfb-run >/dev/null 2>&1"), 0) << "xvfb-run is missing (scripts/install-deps.sh)";
+    const std::string scene = half_out_scene("acc");
+    std::size_t culled[2] = {};
+    int i = 0;
+    for (const std::string test : {"hull", "aabb"}) {
+        SCOPED_TRACE(test);
+        const std::string args = scene + " --frames 2 --size 64x36 --tess 2 --cull frustum --frustum " + test;
+        const CliRun v = run("view " + args, "xvfb-run -a -s '-screen 0 1280x1024x24'");
+        ASSERT_EQ(v.status, 0) << v.err;
+        const CliRun r = run("render " + args + " --json");
+        ASSERT_EQ(r.status, 0) << r.err;
+        culled[i] = last_frustum_culled(nlohmann::json::parse(r.out));
+        const std::string expected = "frame 1: drawn " + std::to_string(1450 - culled[i]) + " + 0 of 1450; culled frustum " +
+                                     std::to_string(culled[i]) + ",";
+        EXPECT_NE(v.out.find(expected), std::string::npos) << v.out;
+        ++i;
+    }
+    EXPECT_NE(culled[0], culled[1]);
 }
 
 namespace {
