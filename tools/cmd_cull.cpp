@@ -1,5 +1,6 @@
 // `patchcull cull MODEL ... --json`: CPU cull kernels over random views, checked against the
-// dense-sample ground truth. Output: {"model","patches","views","methods":{name:{cull_rate,
+// dense-sample ground truth. Output: {"model","patches","views","view_mode","view_distribution",
+// "mean_eye_distance_radii","methods":{name:{cull_rate,
 // false_culls, ns_per_patch}}}.
 #include <algorithm>
 #include <cstdint>
@@ -36,6 +37,20 @@ std::vector<std::string> split_methods(const std::string& list) {
     }
 }
 
+// "A,B" -> DistanceViews{A, B}: two reals, 1 <= A <= B <= 1000 (cull_eval.h). One line naming the
+// flag otherwise.
+DistanceViews parse_distance_range(const std::string& text) {
+    const std::size_t comma = text.find(',');
+    if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos)
+        throw Error("--distance-range: expected A,B (two multiples of the containing distance), got " + quote_input(text));
+    DistanceViews d;
+    d.min = float(parse_real("--distance-range", text.substr(0, comma), 1.0, 1000.0));
+    d.max = float(parse_real("--distance-range", text.substr(comma + 1), 1.0, 1000.0));
+    if (d.max < d.min)
+        throw Error("--distance-range: A must not exceed B, got " + quote_input(text));
+    return d;
+}
+
 }  // namespace
 
 Runner add_cull_command(CLI::App& app) {
@@ -45,6 +60,7 @@ Runner add_cull_command(CLI::App& app) {
         std::uint64_t seed = 1;
         std::string view_mode = "contain";
         std::string methods = "frustum,frustum-disp";
+        std::string distance_range;  // empty: not given
         bool json = false;
     };
     auto state = std::make_shared<State>();
@@ -52,15 +68,25 @@ Runner add_cull_command(CLI::App& app) {
     add_model_options(*command, state->model, true);
     add_int_option(*command, "--views", state->views, 1, 10000000, "number of random views");
     add_uint64_option(*command, "--seed", state->seed, UINT64_MAX, "view generator seed");
-    add_choice_option(*command, "--view-mode", state->view_mode, {"contain", "free"},
-                      "contain: whole object in view; free: anywhere");
+    add_choice_option(*command, "--view-mode", state->view_mode, {"contain", "free", "distance"},
+                      "contain: whole object in view; free: anywhere; distance: whole object, centred, "
+                      "45-degree view, eye at --distance-range times the containing distance");
+    add_text_option(*command, "--distance-range", state->distance_range,
+                    "A,B: with --view-mode distance, eye distance uniform in A..B times the distance at which "
+                    "the object's bounding sphere just fits the view (1 <= A <= B <= 1000; default 1,3)");
     add_text_option(*command, "--methods", state->methods, "comma-separated cull methods");
     command->add_flag("--json", state->json, "print one JSON object");
     return [state]() {
         CullEvalOptions options;
         options.views = state->views;
         options.seed = state->seed;
-        parse_view_mode(state->view_mode.c_str(), options.mode);
+        if (state->view_mode == "distance") {
+            options.distance = state->distance_range.empty() ? DistanceViews{} : parse_distance_range(state->distance_range);
+        } else {
+            if (!state->distance_range.empty())
+                throw Error("--distance-range: only with --view-mode distance (the view mode is " + state->view_mode + ")");
+            parse_view_mode(state->view_mode.c_str(), options.mode);
+        }
         options.methods = split_methods(state->methods);
         const LoadedModel model = load_model_from_options(state->model);
         print_warnings(model.warnings);
@@ -83,6 +109,19 @@ Runner add_cull_command(CLI::App& app) {
         out["patches"] = result.patches;
         out["views"] = result.views;
         out["view_mode"] = state->view_mode;
+        // The distribution the views came from (cull_eval.h, camera.cpp), and the mean eye
+        // distance in bounding-sphere radii, the quantity that moves the back-patch rates.
+        if (options.distance)
+            out["view_distribution"] = {{"distance_range", {options.distance->min, options.distance->max}},
+                                        {"fovy_degrees", DistanceViews::fovy_degrees},
+                                        {"target", "centre"}};
+        else if (options.mode == ViewMode::contain)
+            out["view_distribution"] = {{"distance_range", {1.05, 2.55}}, {"fovy_degrees", {30, 70}},
+                                        {"target", "off centre, object kept in view"}};
+        else
+            out["view_distribution"] = {{"eye", "inside the object's box or the box enlarged 3x"},
+                                        {"fovy_degrees", {20, 90}}, {"target", "random direction"}};
+        out["mean_eye_distance_radii"] = result.mean_eye_distance_radii;
         out["seed"] = state->seed;
         out["simd"] = simd_target_name();
         out["methods"] = nlohmann::json::object();
@@ -93,7 +132,8 @@ Runner add_cull_command(CLI::App& app) {
             std::cout << out.dump() << "\n";
         } else {
             std::cout << model.name << ": " << result.patches << " patches, " << result.views << " "
-                      << state->view_mode << " views\n";
+                      << state->view_mode << " views, eye " << result.mean_eye_distance_radii
+                      << " radii away on average\n";
             for (const CullMethodResult& r : result.methods)
                 std::cout << "  " << r.name << ": cull rate " << 100.0 * r.cull_rate << "%, false culls "
                           << r.false_culls << ", " << r.ns_per_patch << " ns/patch\n";

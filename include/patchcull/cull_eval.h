@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,10 +22,30 @@ namespace patchcull {
 std::vector<std::string> cull_method_names();
 bool is_cull_method(const std::string& name);
 
+/// The "distance" view distribution (`cull --view-mode distance`), closer to seed 001's Table 1
+/// whole-object views than ViewMode::contain: every view looks at the centre of the object's
+/// bounding sphere with a fixed 45-degree field of view (narrower side), from a uniformly random
+/// direction, at distance m * fit, where fit is the distance at which that sphere just touches the
+/// sides of the view and m is uniform in [min, max]. m >= 1 keeps the whole object in view.
+/// What moves the back-patch rates is the eye's distance in object radii, m * fit / radius
+/// (= m / sin 22.5 deg, 2.6 to 7.8 for the default 1..3): a nearer eye sees a smaller part of
+/// a closed surface (of a sphere, the cap (1 - r/d)/2), so more patches are wholly back-facing;
+/// far away the rates fall toward their orthographic values. (ViewMode::contain draws the field
+/// of view in 30..70 degrees and m in 1.05..2.55, so its eyes are 1.8 to 9.9 radii away: the
+/// field of view moves the rates only through this distance.)
+struct DistanceViews {
+    float min = 1.0f;  ///< in [1, 1000], <= max
+    float max = 3.0f;  ///< in [min, 1000]
+    static constexpr float fovy_degrees = 45.0f;
+};
+
 struct CullEvalOptions {
     int views = 1000;
     std::uint64_t seed = 1;
     ViewMode mode = ViewMode::contain;
+    /// Set: views come from this distribution instead of mode (seeded by seed, at aspect).
+    /// evaluate_cull throws patchcull::Error naming the bound for a range outside its contract.
+    std::optional<DistanceViews> distance;
     std::vector<std::string> methods{"frustum", "frustum-disp"};
     int ground_truth_grid = 17;   ///< samples per side for false-cull checks
     float aspect = 1.0f;
@@ -45,6 +66,9 @@ struct CullMethodResult {
 struct CullEvalResult {
     std::size_t patches = 0;
     int views = 0;
+    /// Mean over the views of the eye's distance from the centre of the object's bounding
+    /// sphere, in sphere radii: the quantity that moves the back-patch rates (DistanceViews).
+    double mean_eye_distance_radii = 0;
     std::vector<CullMethodResult> methods;
 };
 

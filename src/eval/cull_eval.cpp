@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <functional>
+#include <string>
 
 #include "patchcull/backpatch.h"
 #include "patchcull/error.h"
@@ -26,6 +28,65 @@ struct ViewContext {
     Vec3 eye;     ///< object space
     float alpha;  ///< clip-space eye z (backpatch.h)
 };
+
+/// Seeded views of the DistanceViews distribution (cull_eval.h). Its own splitmix64 stream, so
+/// the contain and free distributions (camera.cpp) keep their sequences.
+class DistanceViewGenerator {
+public:
+    DistanceViewGenerator(const Bounds& object, const DistanceViews& range, std::uint64_t seed, float aspect)
+        : object_(object), range_(range), state_(seed * 0x9E3779B97F4A7C15ull + 0xD1B54A32D192ED03ull), aspect_(aspect) {}
+
+    Camera next() {
+        Camera cam;
+        cam.aspect = aspect_;
+        cam.fovy_radians = DistanceViews::fovy_degrees * 3.14159265f / 180.0f;
+        const Vec3 c = object_.center();
+        const float radius = std::max(object_.radius(), 1e-6f);
+        // The narrower side of the view: the bounding sphere must fit inside it.
+        const float half_v = 0.5f * cam.fovy_radians;
+        const float half = std::min(half_v, std::atan(std::tan(half_v) * std::min(aspect_, 1.0f)));
+        const float fit = radius / std::sin(half);
+        const float distance = fit * (range_.min + (range_.max - range_.min) * uniform());
+        const Vec3 dir = unit_vector();
+        cam.eye = c + dir * distance;
+        cam.target = c;
+        // An up vector across the view direction (a random one could lie along it).
+        Vec3 up = cross(dir, unit_vector());
+        if (length(up) < 1e-3f) up = cross(dir, std::fabs(dir.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0});
+        cam.up = normalize(up);
+        cam.z_near = std::max(1e-4f * radius, (distance - radius) * 0.9f);
+        cam.z_far = (distance + radius) * 1.1f;
+        return cam;
+    }
+
+private:
+    float uniform() {  // [0, 1), the top 24 bits of splitmix64 as camera.cpp does
+        std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        z ^= z >> 31;
+        return static_cast<float>(z >> 40) * (1.0f / 16777216.0f);
+    }
+    Vec3 unit_vector() {
+        const float z = 2 * uniform() - 1;
+        const float a = 6.2831853f * uniform();
+        const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+        return {r * std::cos(a), r * std::sin(a), z};
+    }
+
+    Bounds object_;
+    DistanceViews range_;
+    std::uint64_t state_;
+    float aspect_;
+};
+
+void check_distance_views(const DistanceViews& d) {
+    // Written so NaN fails every test.
+    if (!(d.min >= 1.0f && d.min <= 1000.0f))
+        throw Error("distance range: min " + std::to_string(d.min) + " is not in 1..1000 (below 1 the object leaves the view)");
+    if (!(d.max >= d.min && d.max <= 1000.0f))
+        throw Error("distance range: max " + std::to_string(d.max) + " is not in min..1000");
+}
 
 /// Which ground truth judges a method's decisions: a sample inside the view volume (frustum
 /// methods), or a sampled tangent plane facing the eye (back-patch methods, seed 001).
@@ -95,6 +156,7 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
     }
     if (needs_backface_truth && displacement && !displacement->empty())
         throw Error("--displace: back-patch methods (tcone, ncone, ptp) do not bound displaced patches (seed 001 §8)");
+    if (options.distance) check_distance_views(*options.distance);
     const std::size_t n = frame.patches.size();
     const PatchBatch batch = make_batch(frame.patches);
     const std::vector<DisplacementRange> ranges = displacement_ranges(frame, displacement);
@@ -128,6 +190,11 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
     bounds.min = bounds.min - Vec3{largest, largest, largest};
     bounds.max = bounds.max + Vec3{largest, largest, largest};
     ViewGenerator views(bounds, options.mode, options.seed, options.aspect);
+    std::optional<DistanceViewGenerator> distance_views;
+    if (options.distance) distance_views.emplace(bounds, *options.distance, options.seed, options.aspect);
+    const Vec3 centre = bounds.center();
+    const double radius = std::max(bounds.radius(), 1e-6f);
+    double eye_distance_sum = 0;
 
     CullEvalResult result;
     result.patches = n;
@@ -136,7 +203,8 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
     std::vector<double> seconds(selected.size(), 0.0);
     std::vector<std::uint8_t> culled(n);
     for (int view = 0; view < options.views; ++view) {
-        const Camera camera = views.next();
+        const Camera camera = distance_views ? distance_views->next() : views.next();
+        eye_distance_sum += length(camera.eye - centre) / radius;
         ViewContext ctx;
         ctx.object_to_clip = camera.view_projection();
         ctx.planes = make_frustum_planes(ctx.object_to_clip, ClipDepth::zero_to_one);
@@ -173,6 +241,7 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
         if (options.on_view_done) options.on_view_done(view + 1);
     }
     const double pairs = static_cast<double>(n) * std::max(1, options.views);
+    result.mean_eye_distance_radii = options.views > 0 ? eye_distance_sum / options.views : 0.0;
     for (std::size_t m = 0; m < selected.size(); ++m) {
         CullMethodResult& r = result.methods[m];
         r.name = selected[m]->name;

@@ -127,6 +127,54 @@ TEST(Cli, CullBackPatchMethodsOnTheTeapot) {
     EXPECT_GE(j["methods"]["ptp-pcnt"]["cull_rate"].get<double>(), j["methods"]["ptp"]["cull_rate"].get<double>());
 }
 
+// Issue 15: `--view-mode distance` (cull_eval.h, DistanceViews). Every view holds the whole
+// object, so the frustum tests cull nothing; the ground truth still finds no false cull; and the
+// eye distance moves the back-patch rates: near eyes (1..1.2 times the containing distance) see
+// less of BigGuy than far ones (4..6 times) and cull more with each method.
+TEST(Cli, CullDistanceViewsHoldTheObjectAndDistanceMovesTheRates) {
+    const std::string common = "cull " + model("bigguy.obj") +
+                               " --views 60 --seed 5 --view-mode distance --methods frustum,frustum-disp,tcone,ncone,ptp --json";
+    const CliRun near_run = run(common + " --distance-range 1,1.2");
+    const CliRun far_run = run(common + " --distance-range 4,6");
+    ASSERT_EQ(near_run.status, 0) << near_run.err;
+    ASSERT_EQ(far_run.status, 0) << far_run.err;
+    const auto near_j = nlohmann::json::parse(near_run.out);
+    const auto far_j = nlohmann::json::parse(far_run.out);
+    EXPECT_EQ(near_j["view_mode"], "distance");
+    EXPECT_EQ(near_j["view_distribution"]["distance_range"][0].get<double>(), 1.0);
+    EXPECT_NEAR(near_j["view_distribution"]["distance_range"][1].get<double>(), 1.2, 1e-6);
+    EXPECT_EQ(near_j["view_distribution"]["fovy_degrees"].get<double>(), 45.0);
+    // Eye distance in radii is m / sin(22.5 deg): 2.6..3.1 near, 10.5..15.7 far.
+    EXPECT_GT(near_j["mean_eye_distance_radii"].get<double>(), 2.6);
+    EXPECT_LT(near_j["mean_eye_distance_radii"].get<double>(), 3.2);
+    EXPECT_GT(far_j["mean_eye_distance_radii"].get<double>(), 10.4);
+    EXPECT_LT(far_j["mean_eye_distance_radii"].get<double>(), 15.8);
+    for (const auto* j : {&near_j, &far_j}) {
+        for (const char* m : {"frustum", "frustum-disp", "tcone", "ncone", "ptp"})
+            EXPECT_EQ((*j)["methods"][m]["false_culls"], 0) << m;
+        EXPECT_EQ((*j)["methods"]["frustum"]["cull_rate"].get<double>(), 0.0);
+        EXPECT_EQ((*j)["methods"]["frustum-disp"]["cull_rate"].get<double>(), 0.0);
+    }
+    for (const char* m : {"tcone", "ncone", "ptp"}) {
+        EXPECT_GT(far_j["methods"][m]["cull_rate"].get<double>(), 0.1) << m;
+        EXPECT_GT(near_j["methods"][m]["cull_rate"].get<double>(), far_j["methods"][m]["cull_rate"].get<double>()) << m;
+    }
+    // Without --distance-range the default range 1..3 is reported.
+    const CliRun d = run("cull teapot --views 2 --view-mode distance --methods tcone --json");
+    ASSERT_EQ(d.status, 0) << d.err;
+    const auto dj = nlohmann::json::parse(d.out);
+    EXPECT_EQ(dj["view_distribution"]["distance_range"][0].get<double>(), 1.0);
+    EXPECT_EQ(dj["view_distribution"]["distance_range"][1].get<double>(), 3.0);
+}
+
+TEST(Cli, CullDistanceRangeBadValuesAreOneLine) {
+    for (const char* bad : {"0.5,2", "3,2", "3", "1,2,3", "nan,3", "1,inf", "1,", ",2", "''", "1,1001", "a,b"})
+        expect_one_line_error(run(std::string("cull teapot --views 1 --view-mode distance --distance-range ") + bad),
+                              "--distance-range");
+    expect_one_line_error(run("cull teapot --views 1 --view-mode free --distance-range 1,2"), "--distance-range");
+    expect_one_line_error(run("cull teapot --views 1 --distance-range 1,2"), "--distance-range");
+}
+
 TEST(Cli, BackPatchMethodsRefuseDisplacement) {
     expect_one_line_error(run("cull teapot --methods ptp --displace procedural --views 1 --json"), "--displace");
 }
