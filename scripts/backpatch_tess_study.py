@@ -22,9 +22,10 @@ Errors (a bad flag, a CLI that fails) are one line naming the flag or the comman
 import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
+
+import render_study
 
 PROG = "backpatch_tess_study.py"
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -39,72 +40,32 @@ SCENE = {"name": "backpatch_tess_bigguy",
 
 
 def fail(message):
-    # Printable and bounded, whatever an argument holds.
-    text = message.encode("ascii", "backslashreplace").decode("ascii").replace("\n", "\\n")
-    print(f"{PROG}: error: {text[:500]}", file=sys.stderr)
-    sys.exit(2)
+    render_study.fail(PROG, message)
 
 
 def render(cli, path, level, size, frames, mode_args):
-    cmd = [cli, "render", path, "--tess", str(level), "--size", size, "--frames", str(frames), "--json", *mode_args]
-    try:
-        r = subprocess.run(cmd, capture_output=True, text=True)
-    except OSError as e:  # e.g. the binary being relinked by a build
-        fail(f"--cli: {cli}: {e.strerror}")
-    if r.returncode != 0:
-        last = (r.stderr.strip().splitlines() or ["(no output)"])[-1]
-        fail(f"{' '.join(cmd[1:])}: exit status {r.returncode}: {last}")
-    out = json.loads(r.stdout)
-    timed = out["frames"][1:]
+    out, timed = render_study.render_json(PROG, cli, path, level, size, frames, mode_args)
     return {"ms": statistics.median(f["ms"]["total"] for f in timed),
             "ms_min": min(f["ms"]["total"] for f in timed),
             "cull_ms": statistics.median(f["ms"]["cull"] for f in timed),
             "culled": out["frames"][-1]["backpatch_culled"], "patches": out["patches"]}
 
 
+def parse_levels(value):
+    try:
+        levels = [int(t) for t in value.split(",")]
+    except ValueError:
+        fail(f"--levels: expected a comma-separated list of integers, got {value!r}")
+    for v in levels:
+        if not 1 <= v <= 64:
+            fail(f"--levels: level {v} is outside 1..64")
+    return "levels", levels
+
+
 def parse_args(argv):
-    opts = {"cli": os.path.join(ROOT, "build", "patchcull"), "levels": [1, 2, 4, 8, 16], "size": "320x180",
-            "frames": 3, "rounds": 1, "json": None}
-    i = 0
-    while i < len(argv):
-        flag = argv[i]
-        if flag in ("-h", "--help"):
-            print(__doc__)
-            sys.exit(0)
-        if flag not in ("--cli", "--levels", "--size", "--frames", "--rounds", "--json"):
-            fail(f"unknown option {flag!r} (see --help)")
-        if i + 1 >= len(argv) or not argv[i + 1]:
-            fail(f"{flag}: expected a value")
-        value = argv[i + 1]
-        i += 2
-        if flag == "--cli":
-            if not os.access(value, os.X_OK):
-                fail(f"--cli: {value}: not an executable file")
-            opts["cli"] = value
-        elif flag == "--levels":
-            try:
-                levels = [int(t) for t in value.split(",")]
-            except ValueError:
-                fail(f"--levels: expected a comma-separated list of integers, got {value!r}")
-            for v in levels:
-                if not 1 <= v <= 64:
-                    fail(f"--levels: level {v} is outside 1..64")
-            opts["levels"] = levels
-        elif flag == "--size":
-            w, _, h = value.partition("x")
-            if not (w.isdigit() and h.isdigit() and 16 <= int(w) <= 4096 and 16 <= int(h) <= 4096):
-                fail(f"--size: expected WxH with 16..4096 each, got {value!r}")
-            opts["size"] = value
-        elif flag in ("--frames", "--rounds"):
-            lo, hi = (2, 100) if flag == "--frames" else (1, 20)
-            if not (value.isdigit() and lo <= int(value) <= hi):
-                fail(f"{flag}: expected an integer in {lo}..{hi}, got {value!r}")
-            opts[flag[2:]] = int(value)
-        else:
-            opts["json"] = value
-    if not os.access(opts["cli"], os.X_OK):
-        fail(f"--cli: {opts['cli']}: not an executable file (build patchcull_cli first)")
-    return opts
+    defaults = {"cli": os.path.join(ROOT, "build", "patchcull"), "levels": [1, 2, 4, 8, 16], "size": "320x180",
+                "frames": 3, "rounds": 1, "json": None}
+    return render_study.parse_options(PROG, __doc__, argv, defaults, {"--levels": parse_levels})
 
 
 def main(argv):

@@ -27,9 +27,10 @@ Errors (a bad flag, a CLI that fails) are one line naming the flag or the comman
 import json
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
+
+import render_study
 
 PROG = "sathe_study.py"
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -53,10 +54,7 @@ CAMERAS = {
 
 
 def fail(message):
-    # Printable and bounded, whatever an argument holds.
-    text = message.encode("ascii", "backslashreplace").decode("ascii").replace("\n", "\\n")
-    print(f"{PROG}: error: {text[:500]}", file=sys.stderr)
-    sys.exit(2)
+    render_study.fail(PROG, message)
 
 
 def scene_json(scene, setup):
@@ -74,16 +72,7 @@ def scene_json(scene, setup):
 
 
 def render(cli, path, level, size, frames, mode_args):
-    cmd = [cli, "render", path, "--tess", str(level), "--size", size, "--frames", str(frames), "--json", *mode_args]
-    try:
-        r = subprocess.run(cmd, capture_output=True, text=True)
-    except OSError as e:  # e.g. the binary being relinked by a build
-        fail(f"--cli: {cli}: {e.strerror}")
-    if r.returncode != 0:
-        last = (r.stderr.strip().splitlines() or ["(no output)"])[-1]
-        fail(f"{' '.join(cmd[1:])}: exit status {r.returncode}: {last}")
-    out = json.loads(r.stdout)
-    timed = out["frames"][1:]
+    out, timed = render_study.render_json(PROG, cli, path, level, size, frames, mode_args)
     times = [f["ms"]["total"] for f in timed]
     return {"ms": statistics.median(times), "ms_min": min(times),
             "frustum_culled": out["frames"][-1]["frustum_culled"], "patches": out["patches"]}
@@ -104,43 +93,11 @@ def parse_list(flag, text, convert, allowed=None):
 
 
 def parse_args(argv):
-    opts = {"cli": os.path.join(ROOT, "build", "patchcull"), "scenes": ["bigguy", "default"],
-            "levels": [2, 4, 8, 16], "size": "480x270", "frames": 4, "rounds": 1, "json": None}
-    i = 0
-    while i < len(argv):
-        flag = argv[i]
-        if flag in ("-h", "--help"):
-            print(__doc__)
-            sys.exit(0)
-        if flag not in ("--cli", "--scenes", "--levels", "--size", "--frames", "--rounds", "--json"):
-            fail(f"unknown option {flag!r} (see --help)")
-        if i + 1 >= len(argv) or not argv[i + 1]:
-            fail(f"{flag}: expected a value")
-        value = argv[i + 1]
-        i += 2
-        if flag == "--cli":
-            if not os.access(value, os.X_OK):
-                fail(f"--cli: {value}: not an executable file")
-            opts["cli"] = value
-        elif flag == "--scenes":
-            opts["scenes"] = parse_list(flag, value, str, tuple(CAMERAS))
-        elif flag == "--levels":
-            opts["levels"] = parse_list(flag, value, int)
-        elif flag == "--size":
-            w, _, h = value.partition("x")
-            if not (w.isdigit() and h.isdigit() and 16 <= int(w) <= 4096 and 16 <= int(h) <= 4096):
-                fail(f"--size: expected WxH with 16..4096 each, got {value!r}")
-            opts["size"] = value
-        elif flag in ("--frames", "--rounds"):
-            lo, hi = (2, 100) if flag == "--frames" else (1, 20)
-            if not (value.isdigit() and lo <= int(value) <= hi):
-                fail(f"{flag}: expected an integer in {lo}..{hi}, got {value!r}")
-            opts[flag[2:]] = int(value)
-        else:
-            opts["json"] = value
-    if not os.access(opts["cli"], os.X_OK):
-        fail(f"--cli: {opts['cli']}: not an executable file (build patchcull_cli first)")
-    return opts
+    defaults = {"cli": os.path.join(ROOT, "build", "patchcull"), "scenes": ["bigguy", "default"],
+                "levels": [2, 4, 8, 16], "size": "480x270", "frames": 4, "rounds": 1, "json": None}
+    extra = {"--scenes": lambda v: ("scenes", parse_list("--scenes", v, str, tuple(CAMERAS))),
+             "--levels": lambda v: ("levels", parse_list("--levels", v, int))}
+    return render_study.parse_options(PROG, __doc__, argv, defaults, extra)
 
 
 def main(argv):
