@@ -220,9 +220,13 @@ TEST(GpuFrustumDispCull, MarginIsUsedAndCatchesAZeroBuffer) {
     std::size_t kept = 0;
     for (std::size_t p = 0; p < patches.size(); ++p) {
         EXPECT_EQ(flags[p] != 0, cpu[p] != 0) << "patch " << p;
-        if (margins[p] == 0.0f) EXPECT_EQ(flags[p], 1u) << "patch " << p;
+        if (margins[p] == 0.0f) {
+            EXPECT_EQ(flags[p], 1u) << "patch " << p;
+        }
         // A margin larger than the gap (the box reaches over the plane) keeps the patch.
-        if (margins[p] > 0.05f * static_cast<float>(p + 1) * 1.5f) EXPECT_EQ(flags[p], 0u) << "patch " << p;
+        if (margins[p] > 0.05f * static_cast<float>(p + 1) * 1.5f) {
+            EXPECT_EQ(flags[p], 0u) << "patch " << p;
+        }
         kept += flags[p] == 0;
     }
     EXPECT_GT(kept, 0u);
@@ -236,16 +240,7 @@ TEST(GpuFrustumDispCull, StrictIdBufferUnchangedByCullingDisplaced) {
     const std::vector<BezierPatch> patches = test::split_teapot(2);  // 512 patches
     const Bounds bounds = test::control_point_bounds(patches);
     const DisplacementMap map = make_procedural_displacement(64, 0.08f * length(bounds.max - bounds.min));
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
-    PatchAttributes attributes;
-    for (std::size_t p = 0; p < patches.size(); ++p) {
-        const Vec2 o{2.0f * u01(rng) - 0.5f, 2.0f * u01(rng) - 0.5f};
-        const float s = 0.05f + 0.3f * u01(rng);
-        const std::array<Vec2, 4> uv = {o, o + Vec2{s, 0}, o + Vec2{0, s}, o + Vec2{s, s}};
-        attributes.texcoords.push_back(uv);
-        attributes.max_displacement.push_back(map.patch_range(uv.data()).max_abs());
-    }
+    const PatchAttributes attributes = test::random_texture_windows(patches.size(), map, 7);
     PatchRenderer r(test::context());
     r.set_patches(patches, attributes);
     r.set_displacement_map(map);

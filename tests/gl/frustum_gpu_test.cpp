@@ -293,16 +293,7 @@ TEST(GpuFrustumCull, StrictIdBufferUnchangedByCullingDisplaced) {
     const std::vector<BezierPatch> patches = test::split_teapot(2);
     const Bounds bounds = test::control_point_bounds(patches);
     const DisplacementMap map = make_procedural_displacement(64, 0.08f * length(bounds.max - bounds.min));
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
-    PatchAttributes attributes;
-    for (std::size_t p = 0; p < patches.size(); ++p) {
-        const Vec2 o{2.0f * u01(rng) - 0.5f, 2.0f * u01(rng) - 0.5f};
-        const float s = 0.05f + 0.3f * u01(rng);
-        const std::array<Vec2, 4> uv = {o, o + Vec2{s, 0}, o + Vec2{0, s}, o + Vec2{s, s}};
-        attributes.texcoords.push_back(uv);
-        attributes.max_displacement.push_back(map.patch_range(uv.data()).max_abs());
-    }
+    const PatchAttributes attributes = test::random_texture_windows(patches.size(), map, 5);
     PatchRenderer r(test::context());
     r.set_patches(patches, attributes);
     r.set_displacement_map(map);

@@ -4,11 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
+#include <random>
 #include <set>
 #include <utility>
 #include <vector>
 
+#include "patchcull/displacement.h"
 #include "patchcull/gl_passes.h"
 #include "patchcull/gl_pipeline.h"
 #include "patchcull/gl_renderer.h"
@@ -75,6 +78,23 @@ inline Bounds control_point_bounds(const std::vector<BezierPatch>& patches) {
     for (const BezierPatch& p : patches)
         for (const Vec4& c : p.cp) points.push_back(cartesian(c));
     return compute_bounds(points);
+}
+
+/// Attributes for `count` displaced patches, each sampling its own random square window of MAP
+/// (origin in [-0.5, 1.5)^2, side 0.05..0.35, drawn from SEED), with max_displacement = the
+/// window's DisplacementRange bound: the margins a displaced frustum test must honour.
+inline PatchAttributes random_texture_windows(std::size_t count, const DisplacementMap& map, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    PatchAttributes attributes;
+    for (std::size_t p = 0; p < count; ++p) {
+        const Vec2 o{2.0f * u01(rng) - 0.5f, 2.0f * u01(rng) - 0.5f};
+        const float s = 0.05f + 0.3f * u01(rng);
+        const std::array<Vec2, 4> uv = {o, o + Vec2{s, 0}, o + Vec2{0, s}, o + Vec2{s, s}};
+        attributes.texcoords.push_back(uv);
+        attributes.max_displacement.push_back(map.patch_range(uv.data()).max_abs());
+    }
+    return attributes;
 }
 
 /// Distinct non-background ids in an id buffer.
