@@ -23,7 +23,10 @@ PATCHCULL_CONST uint kBindingCullFlags = 1u;      // uint flags[patch_count]: 0 
 PATCHCULL_CONST uint kBindingMaxDisplacement = 2u; // float max_disp[patch_count], >= 0 (cull margin)
 PATCHCULL_CONST uint kBindingPatchTexcoords = 3u;  // vec2 uv[4 * patch_count]: corner texcoords (patch.h order)
 PATCHCULL_CONST uint kBindingPlaneValues = 4u;     // float values[6 * patch_count]: frustum diagnostics
-// (5 is free: it held the back-patch hook's flags, replaced by the flag chain of gl_passes.h.)
+// vec4 box[2 * box_count]: the occlusion-query proxies of gl_object_queries.h, box k's min at
+// 2k and max at 2k + 1 (xyz, world space, already widened by the caller). (5 held the back-patch
+// hook's flags before the flag chain of gl_passes.h.)
+PATCHCULL_CONST uint kBindingQueryBoxes = 5u;
 PATCHCULL_CONST uint kBindingCullCounters = 6u;    // uint counters[kCounterCount]: added by cull_status (end)
 PATCHCULL_CONST uint kBindingOccluderVertices = 7u; // vec4 v[3 * triangle_count]: triangle list, w = 1
 // vec4 t[kTangentVec4s * patch_count]: patch p's ACC tangent patches at kTangentVec4s p + (du[0..11],

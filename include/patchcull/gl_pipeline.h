@@ -86,6 +86,37 @@ struct ObjectStats {
 enum class FrustumTest { hull, aabb };
 const char* frustum_test_name(FrustumTest test);  ///< "hull", "aabb"
 
+/// What an ObjectPass draws with (CullPipeline gives it one per frame).
+class ObjectDrawer {
+public:
+    /// Draws object i of PipelineParams::objects (an index into that vector) over what is in the
+    /// frame's framebuffer: in a two-pass mode its patches tagged visible (the first pass's
+    /// selection), otherwise its patches after the frame's patch tests (the chain runs on the
+    /// object first). Object-culled spans are never drawn. A second call for the same object in
+    /// one frame does nothing.
+    virtual void draw(std::size_t object) = 0;
+    /// The renderer drawing the frame (its framebuffer, for occlusion-query proxies:
+    /// PatchRenderer::begin_depth_test_draws).
+    virtual PatchRenderer& renderer() = 0;
+
+protected:
+    ~ObjectDrawer() = default;
+};
+
+/// Object-level occlusion inside the frame (gl_object_queries.h: hardware occlusion queries,
+/// CHC, CHC++). CullPipeline calls run once per frame, after the clear and the occluders, in place
+/// of the frame's first draw of PipelineParams::objects: the pass draws the objects it finds
+/// visible through drawer.draw, in the order it chooses, issuing its queries between draws
+/// against the depth buffer drawn so far. Every object it does not draw is culled for the frame
+/// (its patches become object-culled: no patch test and no later draw). The caller answers for
+/// those objects being invisible; a pass is conservative when it only leaves out objects whose
+/// proxies are hidden behind what was already drawn (a subset of the final image).
+class ObjectPass {
+public:
+    virtual ~ObjectPass() = default;
+    virtual void run(ObjectDrawer& drawer) = 0;
+};
+
 /// Parameters of one pipeline frame: the frame and the choice of each test.
 struct PipelineParams {
     FrameParams frame;
@@ -110,6 +141,12 @@ struct PipelineParams {
     /// Occluder triangles culled by the object level (PatchRenderer::set_culled_occluders, set at
     /// the start of the frame; the unculled reference still draws them).
     std::vector<TriangleSpan> culled_occluders;
+    /// Object-level occlusion (ObjectPass), or null. Needs `objects`: it decides per object. With
+    /// a mode without occlusion each object's patch tests run when the pass draws it; with
+    /// occlusion the pass replaces draw pass 1 for the objects (the patches outside every object
+    /// are drawn after it), then the Hi-Z pyramid is built and the chain and pass 2 run on the
+    /// objects it drew. Its time counts in FrameStats::pass1_ms (one pass: the chain's too).
+    ObjectPass* object_pass = nullptr;
 };
 
 /// What one frame did. Counts are patches; each patch has exactly one of: frustum_culled,
@@ -117,7 +154,8 @@ struct PipelineParams {
 /// the next frame).
 struct FrameStats {
     std::size_t patches = 0;
-    std::size_t object_culled = 0;   ///< in PipelineParams::object_culled (no pass ran on them)
+    std::size_t object_culled = 0;   ///< in PipelineParams::object_culled, or of objects the ObjectPass left out
+    std::size_t objects_left_out = 0;  ///< objects the ObjectPass did not draw (0 without one)
     bool two_pass = false;           ///< the mode includes occlusion (seed 000 §3's pipeline)
     // Every pass issues all patches to the TCS (seed 000 §6.3's RT_0 cost per pass); "drawn" =
     // tessellated (levels > 0), the others get levels 0 there.

@@ -319,6 +319,14 @@ public:
     /// (else throws). An empty vector culls none.
     void set_culled_occluders(const std::vector<TriangleSpan>& culled);
 
+    /// For occlusion queries on the frame being drawn (gl_object_queries.h): binds the frame's
+    /// framebuffer (after begin_frame) with depth test GL_LEQUAL, neither colour nor depth
+    /// writes and no face culling, so that the caller's proxies, drawn with its own program and
+    /// vertex array, only test against the depth drawn so far. end_depth_test_draws restores the
+    /// state the renderer's draws assume and unbinds; call it before the next draw_selected.
+    void begin_depth_test_draws();
+    void end_depth_test_draws();
+
     // ---- drawing -----------------------------------------------------------------------------
     /// Clears the framebuffer (colour dark grey, id 0, depth 1), draws the occluders, then every
     /// patch whose cull reason (flag bits 0-7) is 0 (every patch when !use_cull_flags), resizing

@@ -67,6 +67,17 @@ public:
     /// Conservative as classify_aabb: equal to it for each object (see the file comment).
     void cull(const FrustumPlanes& planes, Options options, Containment* per_object, Stats& stats);
 
+    // ---- the tree itself, read-only, for traversals of their own (CHC, gl_object_queries.h) ----
+    /// Node 0 is the root (when node_count() > 0). Its box: the exact union of its objects' boxes
+    /// at the last build or refit.
+    const Bounds& node_box(std::size_t node) const { return nodes_[node].box; }
+    /// Leaves hold 1..4 objects; inner nodes have two children, node_left(node) and node_left(node) + 1.
+    bool node_is_leaf(std::size_t node) const { return nodes_[node].count != 0; }
+    std::size_t node_left(std::size_t node) const { return nodes_[node].first; }
+    /// A leaf's objects: node_object(node, k) for k < node_object_count(node) (0 for inner nodes).
+    std::size_t node_object_count(std::size_t node) const { return nodes_[node].count; }
+    std::size_t node_object(std::size_t node, std::size_t k) const { return slot_object_[nodes_[node].first + k]; }
+
 private:
     struct Node {
         Bounds box;

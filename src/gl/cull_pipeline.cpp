@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -214,15 +215,26 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     // inside is dispatched whole, its culled words pre-marked kCullObject so that every pass
     // skips them (the chain's rule). Draws issue only the patches outside the culled spans.
     std::vector<std::vector<PatchSpan>> object_spans, gap_spans;
-    std::vector<PatchSpan> drawn;
-    auto dispatch_spans = [&](const ObjectRange& o) {
-        std::vector<PatchSpan> active = active_spans(o);
-        drawn.insert(drawn.end(), active.begin(), active.end());
-        if (active.empty()) return std::vector<PatchSpan>{};
-        return std::vector<PatchSpan>{{o.first, o.count}};
+    std::vector<PatchSpan> drawn, gaps_drawn;
+    // (Re)plans the dispatch and draw spans from `culled` (again after an ObjectPass added to it).
+    auto plan_spans = [&] {
+        object_spans.clear();
+        gap_spans.clear();
+        drawn.clear();
+        gaps_drawn.clear();
+        auto dispatch_spans = [&](const ObjectRange& o, std::vector<PatchSpan>* also_drawn) {
+            std::vector<PatchSpan> active = active_spans(o);
+            drawn.insert(drawn.end(), active.begin(), active.end());
+            if (also_drawn) also_drawn->insert(also_drawn->end(), active.begin(), active.end());
+            if (active.empty()) return std::vector<PatchSpan>{};
+            return std::vector<PatchSpan>{{o.first, o.count}};
+        };
+        for (const ObjectRange& o : objects) object_spans.push_back(dispatch_spans(o, nullptr));
+        for (const ObjectRange& g : gaps) gap_spans.push_back(dispatch_spans(g, &gaps_drawn));
     };
-    for (const ObjectRange& o : objects) object_spans.push_back(dispatch_spans(o));
-    for (const ObjectRange& g : gaps) gap_spans.push_back(dispatch_spans(g));
+    plan_spans();
+    if (params.object_pass && params.objects.empty())
+        throw Error("render_frame: an object pass needs PipelineParams::objects");
     auto buffers_of = [&chain](const PatchSpan& s) {
         PatchBuffers b = chain;
         b.first = s.first;
@@ -237,21 +249,40 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     clock.mark();
     // The flag chain (gl_passes.h) per culled object, in three timed parts: begin + frustum,
     // back-patch, the rest.
-    auto run_chain = [&](const HiZTexture* hiz) {
-        for (const auto* list : {&object_spans, &gap_spans})
-            for (const std::vector<PatchSpan>& spans : *list)
-                for (const PatchSpan& s : spans) m.status.begin(buffers_of(s));
-        // The culled spans' words: kFlagObject, status cleared (a buffer clear after begin's
-        // shader writes, no pass).
-        if (!culled.empty()) glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    // The culled spans' words within [first, end): kFlagObject, status cleared (a buffer clear
+    // after begin's shader writes, no pass).
+    auto mark_culled = [&](std::size_t first, std::size_t end) {
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         const std::uint32_t object_word = sh::kCullObject;
-        for (const PatchSpan& s : culled)
-            if (s.count)
-                glClearNamedBufferSubData(r.flag_buffer(), GL_R32UI, static_cast<GLintptr>(s.first * sizeof(std::uint32_t)),
-                                          static_cast<GLsizeiptr>(s.count * sizeof(std::uint32_t)), GL_RED_INTEGER,
+        for (const PatchSpan& s : culled) {
+            const std::size_t a = std::max(s.first, first), b = std::min(s.first + s.count, end);
+            if (a < b)
+                glClearNamedBufferSubData(r.flag_buffer(), GL_R32UI, static_cast<GLintptr>(a * sizeof(std::uint32_t)),
+                                          static_cast<GLsizeiptr>((b - a) * sizeof(std::uint32_t)), GL_RED_INTEGER,
                                           GL_UNSIGNED_INT, &object_word);
+        }
+    };
+    // The chain on the objects `only` names (every object and every gap when it is null),
+    // marking the clock between its parts when timed.
+    auto run_chain = [&](const HiZTexture* hiz, const std::vector<std::size_t>* only = nullptr, bool timed = true) {
+        std::vector<std::size_t> all_objects;
+        if (!only) {
+            for (std::size_t i = 0; i < objects.size(); ++i) all_objects.push_back(i);
+            only = &all_objects;
+        }
+        const bool with_gaps = only == &all_objects;
+        for (std::size_t i : *only)
+            for (const PatchSpan& s : object_spans[i]) m.status.begin(buffers_of(s));
+        if (with_gaps)
+            for (const std::vector<PatchSpan>& spans : gap_spans)
+                for (const PatchSpan& s : spans) m.status.begin(buffers_of(s));
+        if (with_gaps) {
+            if (!culled.empty()) mark_culled(0, count);
+        } else {
+            for (std::size_t i : *only) mark_culled(objects[i].first, objects[i].first + objects[i].count);
+        }
         const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
-        for (std::size_t i = 0; i < objects.size(); ++i)
+        for (std::size_t i : *only)
             if (objects[i].cull && (tests & sh::kCullFrustum))
                 for (const PatchSpan& s : object_spans[i]) {
                     if (aabb)
@@ -259,8 +290,8 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
                     else
                         m.frustum.run(buffers_of(s), planes);
                 }
-        clock.mark();
-        for (std::size_t i = 0; i < objects.size(); ++i) {
+        if (timed) clock.mark();
+        for (std::size_t i : *only) {
             if (!objects[i].cull || !(tests & sh::kCullBackPatch)) continue;
             for (const PatchSpan& s : object_spans[i]) {
                 if (params.backpatch == BackpatchMethod::ptp)
@@ -269,7 +300,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
                     m.cones.run(buffers_of(s), params.backpatch, eye);
             }
         }
-        clock.mark();
+        if (timed) clock.mark();
         // The frustum pass ran first when the mode has it: the occlusion pass only tests Hi-Z.
         const HiZTexture* occluding = (tests & sh::kCullOcclusion) ? hiz : nullptr;
         // The displaced pass runs when either test is asked for, with the bound's frustum test
@@ -279,20 +310,86 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         const bool bounds = ranges && (aabb ? occluding != nullptr : (tests & (sh::kCullFrustum | sh::kCullOcclusion)) != 0);
         const DisplacedCullView view =
             bounds ? make_displaced_cull_view(rp.view, rp.projection, ClipDepth::zero_to_one) : DisplacedCullView{};
-        for (std::size_t i = 0; i < objects.size(); ++i) {
+        for (std::size_t i : *only) {
             if (!objects[i].cull) continue;
             for (const PatchSpan& s : object_spans[i]) {
                 if (occluding) m.occlusion.run(buffers_of(s), object_to_clip, ClipDepth::zero_to_one, *occluding, false);
                 if (bounds) m.displaced.run(buffers_of(s), ranges, params.bound, params.cone, view, occluding, true);
             }
         }
-        for (std::size_t i = 0; i < objects.size(); ++i)
+        for (std::size_t i : *only)
             for (const PatchSpan& s : object_spans[i]) m.status.end(buffers_of(s), m.counters, i * m.counter_stride);
+        if (with_gaps)
+            for (const std::vector<PatchSpan>& spans : gap_spans)
+                for (const PatchSpan& s : spans) m.status.end(buffers_of(s), m.counters, objects.size() * m.counter_stride);
+        if (timed) clock.mark();
+    };
+    // The object pass (PipelineParams::object_pass): its drawer draws an object's first-pass
+    // patches (two-pass) or runs the chain on it and draws what passed (one pass); the objects
+    // it leaves out become object-culled spans.
+    struct Drawer final : ObjectDrawer {
+        std::function<void(std::size_t)> draw_object;
+        PatchRenderer* target = nullptr;
+        std::vector<std::uint8_t> done;
+        void draw(std::size_t object) override {
+            if (object >= done.size()) throw Error("ObjectDrawer::draw: object " + std::to_string(object) + " out of range");
+            if (done[object]) return;
+            done[object] = 1;
+            draw_object(object);
+        }
+        PatchRenderer& renderer() override { return *target; }
+    };
+    auto run_object_pass = [&](bool chain_per_object) {
+        Drawer drawer;
+        drawer.target = &r;
+        drawer.done.assign(objects.size(), 0);
+        drawer.draw_object = [&](std::size_t i) {
+            if (chain_per_object) {
+                const std::vector<std::size_t> one{i};
+                run_chain(nullptr, &one, false);
+            }
+            const std::vector<PatchSpan> active = active_spans(objects[i]);
+            if (!active.empty()) r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, active);
+        };
+        params.object_pass->run(drawer);
+        for (std::size_t i = 0; i < objects.size(); ++i) {
+            if (drawer.done[i]) continue;
+            ++stats.objects_left_out;
+            for (const PatchSpan& s : active_spans(objects[i])) culled.push_back(s);
+        }
+        std::sort(culled.begin(), culled.end(), [](const PatchSpan& a, const PatchSpan& b) { return a.first < b.first; });
+        plan_spans();
+    };
+    if (two_pass && params.object_pass) {
+        // 1. occluders, then the object pass (each drawn object's patches tagged visible), then
+        // the patches outside every object tagged visible.
+        r.begin_frame(rp);
+        run_object_pass(false);
+        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, gaps_drawn);
+        clock.mark();
+        m.ensure_hiz();
+        m.hiz_build.run(r.depth_texture(), m.hiz);
+        clock.mark();
+        run_chain(&m.hiz);
+        if (!frame.aggressive) r.draw_selected(sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass, drawn);
+        clock.mark();
+    } else if (params.object_pass) {
+        // One pass: the object pass runs the chain on each object it draws; the objects it left
+        // out get their culled words; then the gaps. Every part counts as pass 1.
+        clock.mark();
+        clock.mark();
+        clock.mark();
+        r.begin_frame(rp);
+        run_object_pass(true);
+        for (std::size_t i = 0; i < objects.size(); ++i)
+            if (object_spans[i].empty()) mark_culled(objects[i].first, objects[i].first + objects[i].count);
+        for (const std::vector<PatchSpan>& spans : gap_spans)
+            for (const PatchSpan& s : spans) m.status.begin(buffers_of(s));
         for (const std::vector<PatchSpan>& spans : gap_spans)
             for (const PatchSpan& s : spans) m.status.end(buffers_of(s), m.counters, objects.size() * m.counter_stride);
+        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, gaps_drawn);
         clock.mark();
-    };
-    if (two_pass) {
+    } else if (two_pass) {
         // 1. occluders + patches tagged visible.
         r.begin_frame(rp);
         r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, drawn);

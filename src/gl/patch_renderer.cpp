@@ -171,6 +171,23 @@ void PatchRenderer::begin_frame_drawing(const RenderParams& params, bool honour_
     check_gl("begin_frame");
 }
 
+void PatchRenderer::begin_depth_test_draws() {
+    Impl& m = *impl_;
+    m.bind_target(m.fbo, m.width, m.height);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    check_gl("begin_depth_test_draws");
+}
+
+void PatchRenderer::end_depth_test_draws() {
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    check_gl("end_depth_test_draws");
+}
+
 void PatchRenderer::draw_selected(std::uint32_t mask, std::uint32_t value) {
     Impl& m = *impl_;
     m.bind_target(m.fbo, m.width, m.height);
