@@ -28,9 +28,9 @@
 //
 // Conservative: every node box is the exact union (float min / max, no rounding) of the boxes of
 // the pieces under it, and a cut holds, for every leaf with a non-empty piece, exactly one of its
-// ancestors or the leaf itself, so every piece box lies inside one selected box: whatever the pieces draw lies in the union of
-// the selection, and a query on that union that sees no pixel proves the object hidden. Where
-// the pieces are far from the origin this stays exact (min / max never round).
+// ancestors or the leaf itself, so every piece box lies inside one selected box: whatever the
+// pieces draw lies in the union of the selection, and a query on that union that sees no pixel
+// proves the object hidden. Far from the origin this stays exact (min / max never round).
 //
 // Degenerate pieces: an empty piece (min > max on some axis) holds nothing and is skipped by the
 // unions (a node of only empty pieces is empty and never selected; an object of only empty pieces
