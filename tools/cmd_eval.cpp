@@ -22,6 +22,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "eval_displaced.h"
+#include "eval_scene.h"
 #include "eval_temporal.h"
 #include "patchcull/error.h"
 #include "patchcull/gl_backpatch.h"
@@ -134,7 +135,7 @@ int run_occlusion(const OcclusionOptions& o) {
 }  // namespace
 
 Runner add_eval_command(CLI::App& app) {
-    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion, eval displaced, eval temporal)");
+    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion, eval displaced, eval temporal, eval scene)");
     // At most one; none is reported by the runner ("eval: expected a subcommand ..."), which names
     // the command, unlike CLI11's own message.
     eval->require_subcommand(0, 1);
@@ -189,12 +190,31 @@ Runner add_eval_command(CLI::App& app) {
     add_size_option(*temporal_command, "--size", temporal->size, "framebuffer size");
     add_int_option(*temporal_command, "--tess", temporal->tess, 1, 64, "uniform tessellation level");
     temporal_command->add_flag("--json", temporal->json, "print one JSON object");
-    return [command, occlusion, displaced_command, displaced, temporal_command, temporal]() {
+
+    auto scene = std::make_shared<SceneEvalOptions>();
+    CLI::App* scene_command = eval->add_subcommand(
+        "scene", "Issue 12: object-level occlusion (queries, CHC, CHC++, horizon, portals) beside per-patch Hi-Z on a scene's path");
+    add_text_option(*scene_command, "SCENE", scene->scene, "city, building, default, or a scene file (.json)")->required();
+    add_choice_option(*scene_command, "--scheme", scene->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
+    add_int_option(*scene_command, "--frames", scene->frames, 1, 10000, "frames of the scene's camera path");
+    add_size_option(*scene_command, "--size", scene->size, "framebuffer size");
+    add_int_option(*scene_command, "--tess", scene->tess, 1, 64, "uniform tessellation level");
+    add_text_option(*scene_command, "--methods", scene->methods,
+                    "comma list of methods (default: all the scene allows; 'none' is always run)");
+    add_int_option(*scene_command, "--batch", scene->batch, 1, 1024, "batched and CHC++ I-queue batch size b");
+    add_float_option(*scene_command, "--sigma", scene->sigma, 1, 16, "CHC++ tight bounding volumes' area factor");
+    add_int_option(*scene_command, "--max-tight-boxes", scene->max_tight_boxes, 1, 256, "CHC++ tight boxes per object");
+    add_float_option(*scene_command, "--c1", scene->c1, 0, 100, "CHC++ multiquery cost per object, C(M) = 1 + c1 |M|");
+    add_int_option(*scene_command, "--visible-interval", scene->visible_interval, 1, 100,
+                   "CHC++: previously visible objects queried every N frames");
+    scene_command->add_flag("--json", scene->json, "print one JSON object");
+    return [command, occlusion, displaced_command, displaced, temporal_command, temporal, scene_command, scene]() {
         if (command->parsed()) return run_occlusion(*occlusion);
         if (displaced_command->parsed()) return run_displaced_eval(*displaced);
         if (temporal_command->parsed()) return run_temporal_eval(*temporal);
-        throw Error("eval: expected a subcommand: occlusion, displaced or temporal (e.g. patchcull eval occlusion MODEL "
-                    "--json)");
+        if (scene_command->parsed()) return run_scene_eval(*scene);
+        throw Error("eval: expected a subcommand: occlusion, displaced, temporal or scene (e.g. patchcull eval occlusion "
+                    "MODEL --json)");
     };
 }
 

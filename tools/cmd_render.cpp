@@ -156,9 +156,12 @@ Runner add_render_command(CLI::App& app) {
         const bool backpatch_applied = (static_cast<std::uint32_t>(applied) & gl::kFlagBackPatch) != 0;
         const bool one_sided = scene_is_one_sided(scene);
         ObjectLevelRun object_level(state->objects, scene, one_sided);  // before the occluders go up
+        if (automatic && object_level.sets_objects())
+            throw Error("--object-occlusion: a query method decides per object itself; not with --cull auto");
 
         gl::GlContext context = gl::GlContext::create_headless();
         gl::CullPipeline pipeline(context);
+        GlReleaseGuard release_object_level(object_level);
         ScenePoser poser(scene);
         const std::vector<BezierPatch>& first_pose = poser.pose(0);  // before pose_attributes reads it
         pipeline.set_patches(first_pose, pose_attributes(poser));
@@ -191,7 +194,7 @@ Runner add_render_command(CLI::App& app) {
             params.bound = displace_bound(state->displace);
             params.cone = displace_cone(state->displace);
             params.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
-            object_level.apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height, params);
+            object_level.apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height, params, width);
             if (automatic) {
                 policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
                 params.objects = policy.objects();
@@ -260,6 +263,7 @@ Runner add_render_command(CLI::App& app) {
                     o["false_culled_objects"] = object_check.false_culled_objects;
                     o["false_culled_triangles"] = object_check.false_culled_triangles;
                     o["detail_pixels"] = object_check.detail_pixels;
+                    o["aggressive_pixels"] = object_check.aggressive_pixels;
                 }
             }
             if (!state->json) {
@@ -299,6 +303,7 @@ Runner add_render_command(CLI::App& app) {
             out["cone"] = state->displace.cone;
             out["frustum"] = state->frustum;
             out["objects_method"] = object_level.method_name();
+            out["object_occlusion"] = object_level.occlusion_name();
             out["detail_cull"] = state->objects.detail_pixels;
             out["environment_objects"] = scene.environment.size();
             out["renderer"] = context.renderer();

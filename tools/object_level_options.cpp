@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "cli_options.h"
+#include "render_support.h"
 #include "patchcull/error.h"
 
 namespace patchcull::cli {
@@ -33,6 +34,17 @@ void add_object_level_options(CLI::App& command, ObjectLevelOptions& options) {
                    "normal masks: screen sectors per side (an object inside one uses that sector's mask)");
     options.given["--cluster-cost"] = add_float_option(command, "--cluster-cost", options.cluster_cost, 0, 1e6,
                      "tC/r of the triangle cluster hierarchy: a cluster test's cost in triangles drawn");
+    add_choice_option(command, "--object-occlusion", options.occlusion,
+                      {"none", "stop-and-wait", "batched", "chc", "chc++", "horizon", "portals"},
+                      "object-level occlusion after --objects: hardware occlusion queries (stop-and-wait, batched, "
+                      "CHC, CHC++), the occlusion horizon (box occluders) or cells and portals (scenes with cells)");
+    options.given["--query-batch"] = add_int_option(command, "--query-batch", options.query_batch, 1, 1024,
+                   "batched and chc++: queries issued b at a time (CHC++'s I-queue)");
+    options.given["--query-threshold"] = add_int_option(command, "--query-threshold", options.query_threshold, 0, 1 << 24,
+                   "aggressive approximate culling: an object is drawn only when its query passes more samples "
+                   "(not conservative; --verify reports the pixels it changes)");
+    options.given["--tight-sigma"] = add_float_option(command, "--tight-sigma", options.tight_sigma, 1, 16,
+                     "chc++ tight bounding volumes: refine while the boxes' area stays below sigma times the parent's");
     options.given["--patch-cluster-cost"] = add_float_option(command, "--patch-cluster-cost", options.patch_cluster_cost, 0, 1e6,
                      "tC/r of the patch cluster hierarchy: a cluster test's cost in patches drawn");
 }
@@ -67,6 +79,30 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
     if (!parse_triangle_backface(options.backface_triangles, options_.triangle_backface))
         throw Error("--backface-triangles: unknown variant '" + options.backface_triangles + "'");
     options_.mask_sectors = options.mask_sectors;
+    if (options.occlusion != "none") {
+        gl::QueryMethod q{};
+        SceneOcclusionMethod m{};
+        if (gl::parse_query_method(options.occlusion, q))
+            query_method_ = q;
+        else if (parse_scene_occlusion_method(options.occlusion, m))
+            scene_method_ = m;
+        else
+            throw Error("--object-occlusion: unknown method '" + options.occlusion + "'");
+        if (method_ == ObjectCullMethod::none)
+            throw Error("--object-occlusion: needs --objects frustum, bvh or bvh+backface (the objects' boxes come from "
+                        "the object level)");
+    }
+    if (given("--query-threshold") && !query_method_)
+        throw Error("--query-threshold: needs --object-occlusion stop-and-wait, batched, chc or chc++");
+    if (given("--query-batch") && !(query_method_ == gl::QueryMethod::batched || query_method_ == gl::QueryMethod::chcpp))
+        throw Error("--query-batch: needs --object-occlusion batched or chc++");
+    if (given("--tight-sigma") && query_method_ != gl::QueryMethod::chcpp)
+        throw Error("--tight-sigma: needs --object-occlusion chc++");
+    if (query_method_) query_options_.method = *query_method_;
+    query_options_.batch_size = static_cast<unsigned>(options.query_batch);
+    query_options_.pixel_threshold = static_cast<std::uint32_t>(options.query_threshold);
+    tight_sigma_ = options.tight_sigma;
+    scene_ = &scene;
     empty_.stats.total = scene.instances.size() + scene.environment.size();  // --objects none: nothing culled
     if (!enabled()) return;
     ObjectLevelSetup setup;
@@ -75,15 +111,46 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
     setup.tc_over_r = options.cluster_cost;
     setup.patch_tc_over_r = options.patch_cluster_cost;
     level_ = std::make_unique<SceneObjectLevel>(scene, setup);
+    if (scene_method_) scene_occlusion_ = std::make_unique<SceneOcclusion>(scene, *level_, *scene_method_);
+    for (const SceneObject& o : scene_objects(scene)) {
+        instance_ranges_.push_back(o.range);
+        instance_patches_.push_back(static_cast<std::uint32_t>(o.range.count));
+    }
+}
+
+std::string ObjectLevelRun::occlusion_name() const {
+    if (query_method_) return gl::query_method_name(*query_method_);
+    if (scene_method_) return scene_occlusion_method_name(*scene_method_);
+    return "none";
 }
 
 void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatch>& pose, float time_seconds,
-                           const Camera& camera, int viewport_height, gl::PipelineParams& params) {
+                           const Camera& camera, int viewport_height, gl::PipelineParams& params, int viewport_width) {
     params.object_culled.clear();
     params.culled_occluders.clear();
     if (!enabled()) return;
     const auto start = std::chrono::steady_clock::now();
     result_ = &level_->cull(pose, poser.displacement_ranges(), time_seconds, camera, viewport_height, options_);
+    if (viewport_width <= 0) viewport_width = std::max(1, static_cast<int>(std::lround(camera.aspect * float(viewport_height))));
+    if (scene_occlusion_) result_ = &scene_occlusion_->cull(*result_, camera, viewport_width, viewport_height);
+    if (query_method_) {
+        if (!queries_) queries_ = std::make_unique<gl::ObjectQueries>();  // on the current context
+        gl::FrameObjects objects;
+        objects.world_to_clip = camera.view_projection();
+        objects.eye = camera.eye;
+        objects.boxes = level_->boxes().data();
+        objects.count = instance_ranges_.size();
+        objects.patches = instance_patches_.data();
+        if (*query_method_ == gl::QueryMethod::chcpp && query_options_.tight_bounds) {
+            if (!tight_) tight_ = std::make_unique<SceneTightBounds>(*scene_, pose, poser.displacement_ranges());
+            tight_->update(pose, poser.displacement_ranges(), tight_sigma_, 16);
+            objects.tight = tight_->boxes().data();
+            objects.tight_first = tight_->first().data();
+        }
+        queries_->set_frame(objects, query_options_);
+        params.objects = instance_ranges_;
+        params.object_pass = queries_.get();
+    }
     const auto culled = std::chrono::steady_clock::now();
     object_level_ms_ = std::chrono::duration<double, std::milli>(culled - start).count();
     for (const IndexSpan& s : result_->culled_patches) params.object_culled.push_back({s.first, s.count});
@@ -131,6 +198,12 @@ ObjectVerification ObjectLevelRun::verify(const std::vector<std::uint32_t>& refe
                                    [](std::size_t i, const IndexSpan& s) { return i < s.first; });
         return it != spans.begin() && index < std::prev(it)->first + std::prev(it)->count;
     };
+    // An instance an aggressive query left out (--query-threshold > 0): its pixels are what the
+    // approximation changes, not false culls. Instances come first in the object order.
+    auto left_out_aggressively = [&](std::size_t object) {
+        return queries_ && query_options_.pixel_threshold > 0 && object < queries_->drawn().size() &&
+               !queries_->drawn()[object];
+    };
     std::vector<std::uint8_t> false_object(culler.object_count(), 0);
     std::vector<std::uint8_t> triangle_counted;  // per triangle index: already counted
     const ObjectCullResult& r = *result_;
@@ -144,6 +217,10 @@ ObjectVerification ObjectLevelRun::verify(const std::vector<std::uint32_t>& refe
             ++v.detail_pixels;
             continue;
         }
+        if (left_out_aggressively(object)) {
+            ++v.aggressive_pixels;
+            continue;
+        }
         if (!triangle || !culled(r.culled_triangles, index)) continue;
         false_object[object] = 1;
         if (index >= triangle_counted.size()) triangle_counted.resize(index + 1, 0);
@@ -152,7 +229,8 @@ ObjectVerification ObjectLevelRun::verify(const std::vector<std::uint32_t>& refe
     }
     for (std::uint32_t p : patch_false_culls) {
         const std::size_t object = object_of(patch_objects, p);
-        if (object != ~std::size_t{0} && r.verdicts[object] == ObjectVerdict::detail) continue;
+        if (object != ~std::size_t{0} && (r.verdicts[object] == ObjectVerdict::detail || left_out_aggressively(object)))
+            continue;
         v.patch_false_culls.push_back(p);
         if (object != ~std::size_t{0} && culled(r.culled_patches, p)) false_object[object] = 1;
     }
@@ -176,7 +254,32 @@ nlohmann::json ObjectLevelRun::frame_json() const {
             {"meta_rejected", s.meta_rejected},
             {"volume_rejected", s.volume_rejected},
             {"cpu_patch_tests", cpu_patch_tests_},
-            {"cpu_frustum_culled", cpu_frustum_culled_}};
+            {"cpu_frustum_culled", cpu_frustum_culled_},
+            {"occlusion", occlusion_json()}};
+}
+
+nlohmann::json ObjectLevelRun::occlusion_json() const {
+    if (queries_ && query_method_) {
+        const gl::QueryStats& q = queries_->stats();
+        return {{"method", occlusion_name()},      {"objects", q.objects},           {"frustum_culled", q.frustum_culled},
+                {"occlusion_culled", q.occlusion_culled}, {"drawn", q.drawn},     {"queries", q.queries},
+                {"multiqueries", q.multiqueries},  {"multiqueries_passed", q.multiquery_passed},
+                {"proxy_boxes", q.proxy_boxes},    {"waits", q.waits},             {"unqueryable", q.unqueryable},
+                {"aggressive", query_options_.pixel_threshold > 0}};
+    }
+    if (scene_occlusion_) {
+        const SceneOcclusionStats& st = scene_occlusion_->stats();
+        return {{"method", occlusion_name()},
+                {"objects_tested", st.objects_tested},
+                {"objects_culled", st.objects_culled},
+                {"patches_culled", st.patches_culled},
+                {"triangles_culled", st.triangles_culled},
+                {"eye_in_cell", st.eye_in_cell},
+                {"cells_reached", st.portals.cells_reached},
+                {"portals_passed", st.portals.portals_passed},
+                {"occluders_inserted", st.horizon.occluders_inserted}};
+    }
+    return {{"method", "none"}};
 }
 
 }  // namespace patchcull::cli

@@ -116,6 +116,11 @@ int run_viewer(ViewerConfig& config) {
     world.build(settings, 0);  // before the window: a bad object-level flag is an error without one
     gl::GlContext context = gl::GlContext::create_window(width, height, "patchcull view: " + scene_name);
     gl::CullPipeline pipeline(context);
+    // The object level's query objects (--object-occlusion) go before the context does.
+    struct ReleaseWorldGl {
+        ViewerWorld& world;
+        ~ReleaseWorldGl() { world.object_level().release_gl(); }
+    } release_world_gl{world};
     world.upload(pipeline);
     // One lap of the camera path, repeated (the same cameras as `render --frames lap`).
     const int lap = !config.interactive && config.frames > 0 ? config.frames : 72;

@@ -119,8 +119,10 @@ struct FrameObjects {
 
 class ObjectQueries final : public ObjectPass {
 public:
-    /// Compiles the proxy program on ctx (current).
+    /// Compiles the proxy program on ctx (made current).
     explicit ObjectQueries(const GlContext& ctx);
+    /// The same on the OpenGL 4.5 context current on the calling thread (an engine's own).
+    ObjectQueries();
     ObjectQueries(ObjectQueries&&) noexcept;
     ObjectQueries& operator=(ObjectQueries&&) noexcept;
     ObjectQueries(const ObjectQueries&) = delete;
@@ -142,6 +144,8 @@ public:
     const std::vector<std::uint8_t>& drawn() const;
 
 private:
+    struct Current {};
+    explicit ObjectQueries(Current);
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };

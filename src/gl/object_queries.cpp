@@ -454,8 +454,10 @@ struct ObjectQueries::Impl {
     }
 };
 
-ObjectQueries::ObjectQueries(const GlContext& ctx) : impl_(std::make_unique<Impl>()) {
-    ctx.make_current();
+ObjectQueries::ObjectQueries(const GlContext& ctx) : ObjectQueries((ctx.make_current(), Current{})) {}
+ObjectQueries::ObjectQueries() : ObjectQueries(Current{}) {}
+
+ObjectQueries::ObjectQueries(Current) : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.program = link_program({{"object_queries.vert.glsl", GL_VERTEX_SHADER}, {"object_queries.frag.glsl", GL_FRAGMENT_SHADER}},
                              "object queries");

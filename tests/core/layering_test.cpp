@@ -17,9 +17,11 @@ const std::set<std::string> kCoreHeaders = {"math.h", "patch.h", "mesh.h", "disp
                                             "frustum.h", "ground_truth.h", "parallel.h", "teapot.h", "error.h",
                                             "hiz.h", "cones.h", "backpatch.h", "displaced_bounds.h",
                                             "clip_space.h", "bounding_volumes.h", "object_bvh.h", "backface.h",
-                                            "backface_clusters.h", "object_culling.h"};
+                                            "backface_clusters.h", "object_culling.h", "occlusion_horizon.h",
+                                            "portal_culling.h", "tight_bounds.h"};
 const std::set<std::string> kImportHeaders = {"obj.h", "subdivision.h", "image.h", "animation.h", "scene.h",
-                                              "default_scene.h", "scene_file.h", "scene_object_level.h"};
+                                              "default_scene.h", "scene_file.h", "scene_object_level.h",
+                                              "scene_occlusion.h"};
 
 std::vector<std::pair<std::string, std::string>> includes_under(const std::string& dir) {
     std::vector<std::pair<std::string, std::string>> found;

@@ -1,0 +1,28 @@
+// `patchcull eval scene` (tools/eval_scene.cpp): the object-level occlusion methods of issue 12
+// (hardware occlusion queries stop-and-wait and batched, CHC, CHC++, the occlusion horizon, cells
+// and portals) side by side with patchcull's per-patch Hi-Z culling on one scene's camera path,
+// registered by tools/cmd_eval.cpp.
+#pragma once
+
+#include <string>
+
+namespace patchcull::cli {
+
+struct SceneEvalOptions {
+    std::string scene;            ///< "city", "building", "default" or a scene file
+    std::string scheme = "acc";
+    int frames = 24;
+    std::string size = "640x360";
+    int tess = 8;
+    std::string methods;          ///< comma list of method names; empty: every one the scene allows
+    int batch = 16;               ///< b: batched and CHC++'s I-queue
+    float sigma = 1.4f;           ///< CHC++ tight bounding volumes
+    int max_tight_boxes = 16;
+    float c1 = 0.1f;              ///< CHC++ multiquery cost per object
+    int visible_interval = 1;     ///< CHC++: previously visible objects queried every n frames
+    bool json = false;
+};
+
+int run_scene_eval(const SceneEvalOptions& options);
+
+}  // namespace patchcull::cli
