@@ -21,7 +21,7 @@
 // Times: wall clock around glFinish() per pass (gl_pipeline.h; serialises the passes, as on
 // llvmpipe), plus the method's CPU work before the frame (object boxes, horizon or portal
 // traversal, tight boxes); frame_ratio = the method's mean frame time over none's.
-// Output (--json): {"scene","scheme","objects","patches","frames","size":[w,h],"tess","batch",
+// Output (--json): {"scene","scheme","objects","characters","patches","frames","size":[w,h],"tess","batch",
 //   "sigma","c1","visible_interval","methods":[{"name","object_method","patch_hiz",
 //   "objects_culled","patches_culled","patches_object_culled","patches_frustum_culled",
 //   "patches_occlusion_culled","queries","multiqueries","multiqueries_passed","proxy_boxes",
@@ -58,7 +58,7 @@ using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
 
 struct Method {
-    std::string name;
+    std::string name;  // the row's name: the object method's, + "+hiz" when followed by the patch passes
     std::optional<gl::QueryMethod> queries;
     std::optional<SceneOcclusionMethod> scene_method;
     bool patch_hiz = false;
@@ -276,7 +276,9 @@ int run_scene_eval(const SceneEvalOptions& o) {
         if (method.name == "none") none_frame_ms = frame_ms;
         conservative_false += t.false_culls;
         rows.push_back({{"name", method.name},
-                        {"object_method", method.object_level() ? method.name.substr(0, method.name.find('+')) : "none"},
+                        {"object_method", method.queries ? gl::query_method_name(*method.queries)
+                                          : method.scene_method ? scene_occlusion_method_name(*method.scene_method)
+                                                                : "none"},
                         {"patch_hiz", method.patch_hiz},
                         {"objects_culled", t.objects_culled / n},
                         {"patches_culled", t.patches_culled / n},

@@ -111,7 +111,13 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
     setup.tc_over_r = options.cluster_cost;
     setup.patch_tc_over_r = options.patch_cluster_cost;
     level_ = std::make_unique<SceneObjectLevel>(scene, setup);
-    if (scene_method_) scene_occlusion_ = std::make_unique<SceneOcclusion>(scene, *level_, *scene_method_);
+    if (scene_method_) {
+        try {
+            scene_occlusion_ = std::make_unique<SceneOcclusion>(scene, *level_, *scene_method_);
+        } catch (const Error& e) {
+            throw Error(std::string("--object-occlusion: ") + e.what());
+        }
+    }
     for (const SceneObject& o : scene_objects(scene)) {
         instance_ranges_.push_back(o.range);
         instance_patches_.push_back(static_cast<std::uint32_t>(o.range.count));

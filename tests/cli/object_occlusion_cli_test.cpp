@@ -148,11 +148,7 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
         const std::string object = without_hiz(name);
         const bool hiz = name == "hiz" || object != name;
         EXPECT_EQ(row["patch_hiz"], hiz) << what;
-        // chc++ is left out here: its rows say "chc"
-        // (ObjectOcclusionCli.DISABLED_EvalSceneNamesChcPlusPlusAndRenderNamesTheFlag).
-        if (object.rfind("chc++", 0) != 0) {
-            EXPECT_EQ(row["object_method"], name == "none" || name == "hiz" ? "none" : object) << what;
-        }
+        EXPECT_EQ(row["object_method"], name == "none" || name == "hiz" ? "none" : object) << what;
         const double culled = row["patches_culled"].get<double>(),
                      by_objects = row["patches_object_culled"].get<double>();
         EXPECT_LE(culled, double(facts.patches)) << what;
@@ -399,12 +395,9 @@ TEST(ObjectOcclusionCli, BadFlagsAreOneLineErrors) {
                           "has no box occluders");
 }
 
-// Known gaps in tools/ (not this file's to fix); enable when fixed:
-// - eval scene's object_method is the row name up to its first '+', so "chc++" and "chc+++hiz" say
-//   "chc" (tools/eval_scene.cpp, the rows' "object_method");
-// - render --object-occlusion portals on a scene without cells (horizon without box occluders)
-//   names the method, not the flag: "portals: scene 'city_small' has no cells".
-TEST(ObjectOcclusionCli, DISABLED_EvalSceneNamesChcPlusPlusAndRenderNamesTheFlag) {
+// chc++'s rows name their object method whole; render names the flag when the scene lacks what
+// the method needs.
+TEST(ObjectOcclusionCli, EvalSceneNamesChcPlusPlusAndRenderNamesTheFlag) {
     const json j =
         run_json("eval scene " + two_rooms() + " --size 32x18 --tess 1 --frames 1 --methods chc++,chc+++hiz --json");
     ASSERT_TRUE(j.contains("methods") && j["methods"].size() == 3u) << j.dump();
