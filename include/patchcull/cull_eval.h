@@ -47,11 +47,13 @@ struct CullEvalOptions {
     /// evaluate_cull throws patchcull::Error naming the bound for a range outside its contract.
     std::optional<DistanceViews> distance;
     std::vector<std::string> methods{"frustum", "frustum-disp"};
-    int ground_truth_grid = 17;   ///< samples per side for false-cull checks
+    int ground_truth_grid = 17;   ///< samples per side for false-cull checks, 1..1024
     float aspect = 1.0f;
-    /// Called on the calling thread after each view with the views done so far (1..views),
-    /// between views, never inside a kernel or the ground-truth check; empty: nothing is called.
-    /// For progress reports (the CLI's `cull` draws one on a terminal); it cannot change results.
+    /// Called on the calling thread after each block of views with the views done so far
+    /// (increasing, the last call with views), between blocks, never inside a kernel or the
+    /// ground-truth check; empty: nothing is called. Views are judged in blocks of 16 to 256
+    /// (fewer for more patches; see evaluate_cull). For progress reports (the CLI's `cull` draws
+    /// one on a terminal); it cannot change results.
     std::function<void(int views_done)> on_view_done;
 };
 
@@ -73,7 +75,15 @@ struct CullEvalResult {
 };
 
 /// Runs options.methods over options.views views of frame (a static frame; displacement may be
-/// null). Throws patchcull::Error for an unknown method name.
+/// null). Throws patchcull::Error for an unknown method name or a grid outside 1..1024.
+///
+/// Memory does not grow with the patch count beyond the batch and a few bytes per patch (issue
+/// 14): the dense samples of the ground truth (12.7 KB per patch at grid 17) are never held for
+/// every patch. Views go in blocks (about 2^22 patch-views each, 16..256 views); each block is
+/// judged chunk by chunk of 64 patches on all cores, a chunk's samples made in per-thread
+/// scratch (PatchTruthWindow, ground_truth.h) when one of its patches is first culled in the
+/// block, and dropped with the chunk. A patch culled in several blocks is sampled once per block;
+/// the counts are those of judging every pair against samples made once.
 CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* displacement,
                              const CullEvalOptions& options);
 

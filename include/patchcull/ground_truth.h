@@ -6,9 +6,17 @@
 // when given, else from the patch's own derivatives; a degenerate normal leaves the sample
 // undisplaced). A sample inside the clip volume means the patch is visible to the frustum test:
 // culling it is a false cull. Clip tests run in double precision, independently of the kernels.
+//
+// Memory (issue 14): the samples are large (grid^2 * 12 bytes of surface points and grid^2 * 32
+// bytes of tangent planes per patch: 12.7 KB at grid 17), so a judge of many patches keeps them
+// for a small window of patches at a time (PatchTruthWindow below) and computes them again when
+// the window comes back to a patch; the answers are those of the functions above, whatever the
+// window's size.
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "patchcull/displacement.h"
 #include "patchcull/math.h"
@@ -70,5 +78,59 @@ SampleSphere bounding_sphere(const Vec3* points, std::size_t count);
 /// the points it holds can be in the clip volume. A fast, exact pre-check for
 /// any_point_in_clip_volume (double precision, with a relative safety margin).
 bool sphere_outside_clip_volume(const Mat4& object_to_clip, const SampleSphere& sphere);
+
+// ---- streamed ground truth (issue 14) --------------------------------------------------------
+
+/// One patch's inputs to the dense samples: what sample_displaced_patch and sample_tangent_planes
+/// take. tangents may be null; uv (4 corner texcoords, patch.h order) is read only when the
+/// window displaces.
+struct PatchTruthInput {
+    const BezierPatch* patch = nullptr;
+    const TangentPatches* tangents = nullptr;
+    const Vec2* uv = nullptr;
+};
+
+/// The ground truth of up to `capacity` patches at a time (slots 0..capacity-1), each patch's
+/// samples computed on the first question about it after clear() and kept until the next clear():
+/// memory is capacity * grid^2 * (12 + 32) bytes (only the kinds asked for at construction),
+/// allocated once, whatever the number of patches judged through the window. The answers equal
+/// the eager functions' on the same inputs: in_clip_volume is
+/// !sphere_outside_clip_volume(m, bounding_sphere(S)) && any_point_in_clip_volume(m, S) with S the
+/// sample_displaced_patch samples, and faces_eye is any_plane_faces_eye on the
+/// sample_tangent_planes planes (the shortcut is exact, so both are "some sample inside").
+/// Not thread-safe: one window per thread. No allocation after construction.
+class PatchTruthWindow {
+public:
+    /// clip: in_clip_volume may be asked; facing: faces_eye may be asked. displacement (may be
+    /// null or empty) must outlive the window. Throws patchcull::Error for capacity 0 or a grid
+    /// outside 1..1024.
+    PatchTruthWindow(std::size_t capacity, int grid, const DisplacementMap* displacement, bool clip, bool facing);
+
+    std::size_t capacity() const { return capacity_; }
+    int grid() const { return grid_; }
+    /// Forgets every slot's samples (capacity flags; nothing is freed). Call it before a slot
+    /// holds another patch: a slot's samples are those of the input given when they were made.
+    void clear();
+    /// Whether a sample of the (displaced) patch in slot lies inside the clip volume of
+    /// object_to_clip. Throws patchcull::Error for slot >= capacity or a window built without clip.
+    bool in_clip_volume(std::size_t slot, const PatchTruthInput& input, const Mat4& object_to_clip);
+    /// Whether a sampled tangent plane of the patch in slot faces eye (any_plane_faces_eye).
+    /// Throws patchcull::Error for slot >= capacity or a window built without facing.
+    bool faces_eye(std::size_t slot, const PatchTruthInput& input, Vec3 eye);
+    /// Sample computations since construction, one per patch and kind (points with their sphere,
+    /// or planes): how often the window sampled, for tests and measurements.
+    std::uint64_t samplings() const { return samplings_; }
+
+private:
+    std::size_t capacity_;
+    int grid_;
+    std::size_t per_patch_;
+    const DisplacementMap* displacement_;
+    std::vector<Vec3> points_;          ///< clip: capacity * per_patch_
+    std::vector<SampleSphere> spheres_;  ///< clip: capacity
+    std::vector<PlaneD> planes_;        ///< facing: capacity * per_patch_
+    std::vector<std::uint8_t> ready_;   ///< per slot: bit 0 points, bit 1 planes
+    std::uint64_t samplings_ = 0;
+};
 
 }  // namespace patchcull

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "patchcull/error.h"
 
 namespace patchcull {
 
@@ -195,6 +198,58 @@ bool sphere_outside_clip_volume(const Mat4& m, const SampleSphere& sphere) {
             return true;
     }
     return false;
+}
+
+// ---- PatchTruthWindow ------------------------------------------------------------------------
+
+namespace {
+constexpr std::uint8_t kPointsReady = 1, kPlanesReady = 2;
+}  // namespace
+
+PatchTruthWindow::PatchTruthWindow(std::size_t capacity, int grid, const DisplacementMap* displacement, bool clip,
+                                   bool facing)
+    : capacity_(capacity), grid_(grid), per_patch_(0), displacement_(displacement) {
+    if (capacity == 0) throw Error("ground truth window: capacity 0 (at least one patch)");
+    if (grid < 1 || grid > 1024) throw Error("ground truth grid " + std::to_string(grid) + " is not in 1..1024");
+    per_patch_ = static_cast<std::size_t>(grid) * static_cast<std::size_t>(grid);
+    if (clip) {
+        points_.resize(capacity * per_patch_);
+        spheres_.resize(capacity);
+    }
+    if (facing) planes_.resize(capacity * per_patch_);
+    ready_.assign(capacity, 0);
+}
+
+void PatchTruthWindow::clear() { std::fill(ready_.begin(), ready_.end(), std::uint8_t{0}); }
+
+bool PatchTruthWindow::in_clip_volume(std::size_t slot, const PatchTruthInput& input, const Mat4& object_to_clip) {
+    if (slot >= capacity_ || spheres_.empty())
+        throw Error("ground truth window: in_clip_volume on slot " + std::to_string(slot) + " of a window of " +
+                    std::to_string(capacity_) + (spheres_.empty() ? " built without clip samples" : ""));
+    Vec3* points = &points_[slot * per_patch_];
+    if (!(ready_[slot] & kPointsReady)) {
+        sample_displaced_patch(*input.patch, input.tangents, input.uv, displacement_, grid_, points);
+        spheres_[slot] = bounding_sphere(points, per_patch_);
+        ready_[slot] |= kPointsReady;
+        ++samplings_;
+    }
+    // The sphere test is exact (every sample is inside the sphere), and cheap: most culled
+    // patches are far outside a plane.
+    return !sphere_outside_clip_volume(object_to_clip, spheres_[slot]) &&
+           any_point_in_clip_volume(object_to_clip, points, per_patch_);
+}
+
+bool PatchTruthWindow::faces_eye(std::size_t slot, const PatchTruthInput& input, Vec3 eye) {
+    if (slot >= capacity_ || planes_.empty())
+        throw Error("ground truth window: faces_eye on slot " + std::to_string(slot) + " of a window of " +
+                    std::to_string(capacity_) + (planes_.empty() ? " built without tangent planes" : ""));
+    PlaneD* planes = &planes_[slot * per_patch_];
+    if (!(ready_[slot] & kPlanesReady)) {
+        sample_tangent_planes(*input.patch, grid_, planes);
+        ready_[slot] |= kPlanesReady;
+        ++samplings_;
+    }
+    return any_plane_faces_eye(planes, per_patch_, eye);
 }
 
 }  // namespace patchcull

@@ -1,9 +1,11 @@
 // Cull-method evaluation over random views with dense-sample ground truth (patchcull/cull_eval.h).
-// The methods run as an engine would run them: SIMD kernels over all cores, per view.
+// The methods run as an engine would run them: SIMD kernels over all cores, per view. The truth
+// is streamed (issue 14): views go in blocks, and each block is judged chunk by chunk of patches
+// with the chunk's samples made in per-thread scratch and dropped, so memory does not grow with
+// the patch count beyond the batch and a byte per patch.
 #include "patchcull/cull_eval.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -15,6 +17,8 @@
 #include "patchcull/ground_truth.h"
 #include "patchcull/parallel.h"
 #include "patchcull/scene.h"
+
+#include <tbb/enumerable_thread_specific.h>
 
 namespace patchcull {
 namespace {
@@ -134,6 +138,66 @@ const Method* find_method(const std::string& name) {
     return nullptr;
 }
 
+/// Patches judged together: their samples (64 * 289 * 44 bytes, 0.8 MB, at grid 17) stay in a
+/// core's cache while every view of a block is judged. A multiple of 16 (SIMD groups).
+constexpr std::size_t kChunk = 64;
+
+/// Views judged per pass over the patches. A pass samples each culled patch once, so more views
+/// per pass spread that cost over more views; fewer report progress more often (on_view_done).
+/// About 2^22 patch-views per block, 16 to 256 views: 16 for 262k patches and more, 256 below
+/// 16k patches.
+int views_per_block(std::size_t patches, int views) {
+    const std::size_t target = std::size_t{1} << 22;
+    const std::size_t by_work = patches > 0 ? target / patches : 256;
+    return static_cast<int>(std::min<std::size_t>(std::clamp<std::size_t>(by_work, 16, 256),
+                                                   static_cast<std::size_t>(std::max(views, 1))));
+}
+
+/// One thread's scratch for judging chunks: the window of dense samples, the chunk's decisions
+/// for one view and method, and counts per method.
+struct ChunkJudge {
+    PatchTruthWindow window;
+    std::vector<std::uint8_t> decisions;
+    std::vector<std::uint64_t> culled_count, false_count;
+
+    ChunkJudge(int grid, const DisplacementMap* displacement, bool frustum, bool backface, std::size_t methods)
+        : window(kChunk, grid, displacement, frustum, backface),
+          decisions(kChunk),
+          culled_count(methods),
+          false_count(methods) {}
+
+    void reset_counts() {
+        std::fill(culled_count.begin(), culled_count.end(), 0);
+        std::fill(false_count.begin(), false_count.end(), 0);
+    }
+
+    /// Runs every method of every view in block on patches [first, first + count) and judges
+    /// each culled patch against its dense samples.
+    void judge(const PatchFrame& frame, const PatchBatchView& batch, const float* disp,
+               const std::vector<const Method*>& methods, const std::vector<ViewContext>& block,
+               std::size_t first, std::size_t count) {
+        window.clear();
+        const PatchBatchView chunk = batch.subrange(first, count);
+        for (const ViewContext& ctx : block)
+            for (std::size_t m = 0; m < methods.size(); ++m) {
+                methods[m]->kernel(chunk, disp ? disp + first : nullptr, ctx, decisions.data());
+                const bool backface = methods[m]->truth == Truth::backface;
+                for (std::size_t i = 0; i < count; ++i) {
+                    if (!decisions[i]) continue;
+                    ++culled_count[m];
+                    const std::size_t p = first + i;
+                    const PatchInfo& info = frame.info[p];
+                    const PatchTruthInput input{&frame.patches[p],
+                                                info.tangent_index >= 0 ? &frame.tangents[info.tangent_index] : nullptr,
+                                                info.uv};
+                    const bool visible = backface ? window.faces_eye(i, input, ctx.eye)
+                                                  : window.in_clip_volume(i, input, ctx.object_to_clip);
+                    false_count[m] += visible ? 1 : 0;
+                }
+            }
+    }
+};
+
 }  // namespace
 
 std::vector<std::string> cull_method_names() {
@@ -157,34 +221,20 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
     if (needs_backface_truth && displacement && !displacement->empty())
         throw Error("--displace: back-patch methods (tcone, ncone, ptp) do not bound displaced patches (seed 001 §8)");
     if (options.distance) check_distance_views(*options.distance);
+    const int grid = options.ground_truth_grid;
+    if (grid < 1 || grid > 1024) throw Error("ground truth grid " + std::to_string(grid) + " is not in 1..1024");
     const std::size_t n = frame.patches.size();
     const PatchBatch batch = make_batch(frame.patches);
-    const std::vector<DisplacementRange> ranges = displacement_ranges(frame, displacement);
     std::vector<float> max_disp(n);
     float largest = 0;
-    for (std::size_t p = 0; p < n; ++p) {
-        max_disp[p] = ranges[p].max_abs();
-        largest = std::max(largest, max_disp[p]);
+    {
+        const std::vector<DisplacementRange> ranges = displacement_ranges(frame, displacement);
+        for (std::size_t p = 0; p < n; ++p) {
+            max_disp[p] = ranges[p].max_abs();
+            largest = std::max(largest, max_disp[p]);
+        }
     }
     const float* disp_ptr = largest > 0 ? max_disp.data() : nullptr;
-
-    // Ground-truth samples of every patch, computed once (the frame is static): surface points
-    // for the frustum truth, tangent planes for the back-facing truth.
-    const int grid = options.ground_truth_grid;
-    const std::size_t per_patch = static_cast<std::size_t>(grid) * grid;
-    std::vector<Vec3> samples(needs_frustum_truth ? n * per_patch : 0);
-    std::vector<SampleSphere> spheres(needs_frustum_truth ? n : 0);
-    std::vector<PlaneD> planes(needs_backface_truth ? n * per_patch : 0);
-    parallel_for_ranges(n, 64, [&](std::size_t first, std::size_t last) {
-        for (std::size_t p = first; p < last; ++p) {
-            if (needs_backface_truth) sample_tangent_planes(frame.patches[p], grid, &planes[p * per_patch]);
-            if (!needs_frustum_truth) continue;
-            const PatchInfo& info = frame.info[p];
-            const TangentPatches* t = info.tangent_index >= 0 ? &frame.tangents[info.tangent_index] : nullptr;
-            sample_displaced_patch(frame.patches[p], t, info.uv, displacement, grid, &samples[p * per_patch]);
-            spheres[p] = bounding_sphere(&samples[p * per_patch], per_patch);
-        }
-    });
 
     Bounds bounds = patch_bounds(frame);
     bounds.min = bounds.min - Vec3{largest, largest, largest};
@@ -200,49 +250,74 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
     result.patches = n;
     result.views = options.views;
     result.methods.resize(selected.size());
-    std::vector<double> seconds(selected.size(), 0.0);
+    const std::size_t method_count = selected.size();
+    std::vector<double> seconds(method_count, 0.0);
+    std::vector<std::uint64_t> timed_culled(method_count), judged_culled(method_count), judged_false(method_count);
     std::vector<std::uint8_t> culled(n);
-    for (int view = 0; view < options.views; ++view) {
-        const Camera camera = distance_views ? distance_views->next() : views.next();
-        eye_distance_sum += length(camera.eye - centre) / radius;
-        ViewContext ctx;
-        ctx.object_to_clip = camera.view_projection();
-        ctx.planes = make_frustum_planes(ctx.object_to_clip, ClipDepth::zero_to_one);
-        ctx.eye = camera.eye;
-        ctx.alpha = clip_space_eye_alpha(camera.projection());
-        for (std::size_t m = 0; m < selected.size(); ++m) {
-            const auto start = std::chrono::steady_clock::now();
-            parallel_for_ranges(n, kGrain, [&](std::size_t first, std::size_t last) {
-                selected[m]->kernel(batch.view().subrange(first, last - first), disp_ptr ? disp_ptr + first : nullptr,
-                                    ctx, culled.data() + first);
-            });
-            seconds[m] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-            // Judge every culled patch against the ground truth, in parallel (the truth costs far
-            // more than the kernel).
-            const bool backface = selected[m]->truth == Truth::backface;
-            std::atomic<std::uint64_t> culled_count{0}, false_count{0};
-            parallel_for_ranges(n, 256, [&](std::size_t first, std::size_t last) {
-                std::uint64_t local_culled = 0, local_false = 0;
-                for (std::size_t p = first; p < last; ++p) {
-                    if (!culled[p]) continue;
-                    ++local_culled;
-                    if (backface) {
-                        local_false += any_plane_faces_eye(&planes[p * per_patch], per_patch, ctx.eye) ? 1 : 0;
-                    } else if (!sphere_outside_clip_volume(ctx.object_to_clip, spheres[p])) {  // exact shortcut
-                        local_false += any_point_in_clip_volume(ctx.object_to_clip, &samples[p * per_patch], per_patch) ? 1 : 0;
-                    }
-                }
-                culled_count += local_culled;
-                false_count += local_false;
-            });
-            result.methods[m].culled += culled_count;
-            result.methods[m].false_culls += false_count;
+    tbb::enumerable_thread_specific<ChunkJudge> judges([&] {
+        return ChunkJudge(grid, displacement, needs_frustum_truth, needs_backface_truth, method_count);
+    });
+    const int block_views = views_per_block(n, options.views);
+    std::vector<ViewContext> block;
+    block.reserve(static_cast<std::size_t>(std::max(block_views, 0)));
+    for (int done = 0; done < options.views;) {
+        const int count = std::min(block_views, options.views - done);
+        // The block's views, and the timed kernel passes: each method over the whole batch on
+        // all cores, as an engine runs it (ns_per_patch), its culls counted.
+        block.clear();
+        std::fill(timed_culled.begin(), timed_culled.end(), 0);
+        for (int k = 0; k < count; ++k) {
+            const Camera camera = distance_views ? distance_views->next() : views.next();
+            eye_distance_sum += length(camera.eye - centre) / radius;
+            ViewContext ctx;
+            ctx.object_to_clip = camera.view_projection();
+            ctx.planes = make_frustum_planes(ctx.object_to_clip, ClipDepth::zero_to_one);
+            ctx.eye = camera.eye;
+            ctx.alpha = clip_space_eye_alpha(camera.projection());
+            block.push_back(ctx);
+            for (std::size_t m = 0; m < method_count; ++m) {
+                const auto start = std::chrono::steady_clock::now();
+                parallel_for_ranges(n, kGrain, [&](std::size_t first, std::size_t last) {
+                    selected[m]->kernel(batch.view().subrange(first, last - first), disp_ptr ? disp_ptr + first : nullptr,
+                                        ctx, culled.data() + first);
+                });
+                seconds[m] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                timed_culled[m] += static_cast<std::uint64_t>(std::count_if(culled.begin(), culled.end(), [](std::uint8_t c) { return c != 0; }));
+            }
         }
-        if (options.on_view_done) options.on_view_done(view + 1);
+        // The judgement, chunk by chunk on all cores: a chunk's dense samples are made when one of
+        // its patches is first culled in this block, judged against every view and method of the
+        // block, and dropped with the chunk. The kernels run again on the chunk (they are pure:
+        // a patch's decision does not depend on the range it is run in), so no decision array
+        // outlives a view; the counts must match the timed passes'.
+        for (ChunkJudge& j : judges) j.reset_counts();
+        parallel_for_ranges(n, kChunk, [&](std::size_t first, std::size_t last) {
+            ChunkJudge& judge = judges.local();
+            for (std::size_t chunk = first; chunk < last; chunk += kChunk)
+                judge.judge(frame, batch.view(), disp_ptr, selected, block, chunk, std::min(kChunk, last - chunk));
+        });
+        std::fill(judged_culled.begin(), judged_culled.end(), 0);
+        std::fill(judged_false.begin(), judged_false.end(), 0);
+        for (const ChunkJudge& j : judges)
+            for (std::size_t m = 0; m < method_count; ++m) {
+                judged_culled[m] += j.culled_count[m];
+                judged_false[m] += j.false_count[m];
+            }
+        for (std::size_t m = 0; m < method_count; ++m) {
+            if (judged_culled[m] != timed_culled[m])
+                throw Error(std::string("cull evaluation: ") + selected[m]->name + " culled " +
+                            std::to_string(timed_culled[m]) + " patch-views in the timed pass but " +
+                            std::to_string(judged_culled[m]) + " when judged chunk by chunk (a kernel whose "
+                            "decisions depend on the range it runs in)");
+            result.methods[m].culled += judged_culled[m];
+            result.methods[m].false_culls += judged_false[m];
+        }
+        done += count;
+        if (options.on_view_done) options.on_view_done(done);
     }
     const double pairs = static_cast<double>(n) * std::max(1, options.views);
     result.mean_eye_distance_radii = options.views > 0 ? eye_distance_sum / options.views : 0.0;
-    for (std::size_t m = 0; m < selected.size(); ++m) {
+    for (std::size_t m = 0; m < method_count; ++m) {
         CullMethodResult& r = result.methods[m];
         r.name = selected[m]->name;
         r.cull_rate = options.views > 0 ? r.culled / pairs : 0.0;

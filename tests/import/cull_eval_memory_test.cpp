@@ -1,0 +1,109 @@
+// evaluate_cull's memory does not grow with the ground truth (issue 14): the heap's high-water
+// mark during a run over N patches stays within a few hundred bytes per patch (the batch, the
+// displacement bounds, a decision byte) plus a fixed amount per thread, where the eager truth it
+// replaced held N * 289 * (12 + 32) bytes of samples (12.7 KB per patch at grid 17) for the whole
+// run. The heap is measured by counting every operator new and delete of this test program (this
+// file replaces them; malloc_usable_size gives the sizes, under ASan too).
+#include <gtest/gtest.h>
+
+#include <malloc.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#include "patchcull/cull_eval.h"
+#include "patchcull/parallel.h"
+#include "patchcull/teapot.h"
+
+namespace {
+
+std::atomic<std::int64_t> g_live_bytes{0};
+std::atomic<std::int64_t> g_peak_bytes{0};
+
+void count_allocation(void* p) {
+    const auto size = static_cast<std::int64_t>(malloc_usable_size(p));
+    const std::int64_t live = g_live_bytes.fetch_add(size, std::memory_order_relaxed) + size;
+    std::int64_t peak = g_peak_bytes.load(std::memory_order_relaxed);
+    while (live > peak && !g_peak_bytes.compare_exchange_weak(peak, live, std::memory_order_relaxed)) {
+    }
+}
+
+}  // namespace
+
+void* operator new(std::size_t size) {
+    void* p = std::malloc(size > 0 ? size : 1);
+    if (!p) throw std::bad_alloc();
+    count_allocation(p);
+    return p;
+}
+void* operator new[](std::size_t size) { return ::operator new(size); }
+void operator delete(void* p) noexcept {
+    if (!p) return;
+    g_live_bytes.fetch_sub(static_cast<std::int64_t>(malloc_usable_size(p)), std::memory_order_relaxed);
+    std::free(p);
+}
+void operator delete[](void* p) noexcept { ::operator delete(p); }
+void operator delete(void* p, std::size_t) noexcept { ::operator delete(p); }
+void operator delete[](void* p, std::size_t) noexcept { ::operator delete(p); }
+
+using namespace patchcull;
+
+namespace {
+
+// copies teapots (32 patches each) on a cubic lattice 4 units apart: N = 32 * copies patches,
+// undisplaced, without tangent patches.
+PatchFrame teapot_lattice(int copies) {
+    const std::vector<BezierPatch> teapot = teapot_patches();
+    PatchFrame frame;
+    const int side = static_cast<int>(std::ceil(std::cbrt(double(copies))));
+    for (int c = 0; c < copies; ++c) {
+        const Vec4 offset{4.0f * float(c % side), 4.0f * float((c / side) % side), 4.0f * float(c / (side * side)), 0};
+        for (BezierPatch p : teapot) {
+            for (Vec4& q : p.cp) q = q + offset;
+            frame.patches.push_back(p);
+        }
+    }
+    frame.info.resize(frame.patches.size());
+    return frame;
+}
+
+}  // namespace
+
+TEST(CullEvalMemory, PeakHeapGrowsByHundredsOfBytesPerPatchNotByTheSamples) {
+    // 12,000 patches (187 full chunks of 64 and a partial one) up to 8 threads; more patches with
+    // more threads, so that the per-thread scratch stays small beside the eager samples.
+    const int threads = hardware_threads();
+    const PatchFrame frame = teapot_lattice(375 * std::max(1, threads / 8));
+    const std::int64_t n = static_cast<std::int64_t>(frame.patches.size());
+    CullEvalOptions options;
+    options.views = 2;
+    options.mode = ViewMode::free;
+    options.methods = {"frustum", "ptp"};  // both truths: surface samples and tangent planes
+    const std::int64_t before = g_live_bytes.load();
+    g_peak_bytes.store(before);
+    const CullEvalResult r = evaluate_cull(frame, nullptr, options);
+    const std::int64_t growth = g_peak_bytes.load() - before;
+    // The batch is 64 floats a patch (256 bytes) padded to 16 patches; the rest is bytes per
+    // patch. Each thread's window: 64 patches * 289 samples * 44 bytes (0.8 MB).
+    const std::int64_t bound = 512 * n + std::int64_t{threads} * (1 << 20) + (4 << 20);
+    const std::int64_t eager_samples = n * 289 * (12 + 32);
+    std::printf("[          ] peak heap growth %.1f MB for %lld patches (%.0f bytes a patch; bound %.1f MB; the eager "
+                "samples alone %.1f MB)\n",
+                growth / 1048576.0, static_cast<long long>(n), double(growth) / double(n), bound / 1048576.0,
+                eager_samples / 1048576.0);
+    EXPECT_LT(growth, bound);
+    // The bound can fail: the eager truth's samples alone exceed it several times over.
+    EXPECT_GT(eager_samples, 3 * bound);
+    // The truth was consulted: both methods culled patches, and judged them all visible-free.
+    ASSERT_EQ(r.methods.size(), 2u);
+    for (const CullMethodResult& m : r.methods) {
+        EXPECT_GT(m.culled, static_cast<std::uint64_t>(n) / 10) << m.name;
+        EXPECT_EQ(m.false_culls, 0u) << m.name;
+    }
+}
