@@ -281,6 +281,7 @@ nlohmann::json ObjectLevelRun::occlusion_json() const {
                 {"patches_culled", st.patches_culled},
                 {"triangles_culled", st.triangles_culled},
                 {"eye_in_cell", st.eye_in_cell},
+                {"near_geometry", st.near_geometry},
                 {"cells_reached", st.portals.cells_reached},
                 {"portals_passed", st.portals.portals_passed},
                 {"occluders_inserted", st.horizon.occluders_inserted}};

@@ -6,7 +6,9 @@
 //            objects every instance and environment object, tested front to back;
 //   portals  cells and portals (portal_culling.h; Luebke & Georges, "Portals and Mirrors"): the
 //            scene's cells and portals, an object drawn when its box may be seen through the
-//            portal sequence from the eye's cell (every object when the eye is in no cell).
+//            portal sequence from the eye's cell (every object when the eye is in no cell, or
+//            when an environment object reaches between the eye and the near plane: clipped
+//            there, or seen from inside, a wall is no wall).
 // Both only add culls to what the object level (SceneObjectLevel::cull) left: the result is the
 // level's culled spans plus the spans of the objects these methods hide, merged (ascending,
 // disjoint), for PipelineParams::object_culled / culled_occluders.
@@ -34,11 +36,11 @@
 
 namespace patchcull {
 
-/// The environment objects that are closed axis-aligned boxes: every vertex of their triangles a
-/// corner of their AABB, every triangle in one of its faces, and the triangles' areas summing to
-/// its surface (so the faces are covered), with non-zero extent on every axis. Drawn, such an
-/// object covers every pixel of its box's projection (one-sided ones from outside, as they are
-/// seen: a box outside the eye shows its front faces).
+/// The environment objects that are closed axis-aligned boxes: non-zero extent on every axis,
+/// every vertex of their triangles a corner of their AABB, every triangle in one of its faces, and
+/// every face covered by two of them that split it along one diagonal (for one-sided objects, two
+/// that face outwards). Drawn, such an object covers every pixel of its box's projection from
+/// outside. (Areas alone do not tell: a doubled triangle makes up for a missing one.)
 std::vector<std::size_t> box_environment_objects(const Scene& scene);
 
 enum class SceneOcclusionMethod : std::uint8_t { horizon, portals };
@@ -54,6 +56,9 @@ struct SceneOcclusionStats {
     HorizonStats horizon;
     PortalStats portals;
     bool eye_in_cell = false;  ///< portals: the eye was in a cell (else nothing is culled)
+    /// portals: an environment object's box reached into the pyramid between the eye and the near
+    /// plane (clipped walls are no walls): nothing was culled.
+    bool near_geometry = false;
 };
 
 class SceneOcclusion {
@@ -74,6 +79,7 @@ public:
     std::size_t occluder_count() const { return occluder_objects_.size(); }
 
 private:
+    bool near_pyramid_touches_environment(const Mat4& world_to_clip, Vec3 eye) const;
     const Scene* scene_;
     const SceneObjectLevel* level_;
     SceneOcclusionMethod method_;

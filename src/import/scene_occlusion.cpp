@@ -26,25 +26,23 @@ bool parse_scene_occlusion_method(const std::string& text, SceneOcclusionMethod&
 
 namespace {
 
-bool on_face(const Bounds& box, Vec3 a, Vec3 b, Vec3 c) {
+// The corner index of v in the box (bit 4: x at max, 2: y, 1: z), or -1 when v is no corner.
+int corner_index(const Bounds& box, Vec3 v) {
+    auto side = [](float x, float lo, float hi) { return x == lo ? 0 : x == hi ? 1 : -1; };
+    const int x = side(v.x, box.min.x, box.max.x), y = side(v.y, box.min.y, box.max.y), z = side(v.z, box.min.z, box.max.z);
+    return x < 0 || y < 0 || z < 0 ? -1 : 4 * x + 2 * y + z;
+}
+
+// The six faces as (axis bit, side): face f = 2 * axis + side, axis 0 x (bit 4), 1 y (bit 2), 2 z (bit 1).
+int face_of(int a, int b, int c) {
     for (int axis = 0; axis < 3; ++axis) {
-        auto get = [axis](Vec3 v) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; };
-        for (float side : {get(box.min), get(box.max)})
-            if (get(a) == side && get(b) == side && get(c) == side) return true;
+        const int bit = 4 >> axis;
+        for (int side = 0; side < 2; ++side) {
+            const int want = side ? bit : 0;
+            if ((a & bit) == want && (b & bit) == want && (c & bit) == want) return 2 * axis + side;
+        }
     }
-    return false;
-}
-
-bool is_corner(const Bounds& box, Vec3 v) {
-    return (v.x == box.min.x || v.x == box.max.x) && (v.y == box.min.y || v.y == box.max.y) &&
-           (v.z == box.min.z || v.z == box.max.z);
-}
-
-double triangle_area(Vec3 a, Vec3 b, Vec3 c) {
-    const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
-    const double vx = double(c.x) - a.x, vy = double(c.y) - a.y, vz = double(c.z) - a.z;
-    const double x = uy * vz - uz * vy, y = uz * vx - ux * vz, z = ux * vy - uy * vx;
-    return 0.5 * std::sqrt(x * x + y * y + z * z);
+    return -1;
 }
 
 float rounding_margin(const Bounds& b) {
@@ -73,19 +71,38 @@ std::vector<std::size_t> box_environment_objects(const Scene& scene) {
         if (!is_finite(box.min) || !is_finite(box.max) || !(box.min.x < box.max.x) || !(box.min.y < box.max.y) ||
             !(box.min.z < box.max.z))
             continue;
+        // Per face, which of its 4 corners each covering triangle leaves out: a face is covered when
+        // two of its triangles leave out opposite corners (the two halves of one diagonal split).
+        // One-sided objects must show each such triangle from outside (counter-clockwise seen from
+        // outside), else drawn with back faces culled that face is open from outside.
+        std::uint8_t left_out[6] = {};  // bit k: a triangle of the face leaves out its k-th corner (corner index order)
         bool ok = true;
-        double area = 0;
         for (std::size_t t = object.first_triangle; ok && t < object.first_triangle + object.triangle_count; ++t) {
             const Vec3 a = vertex(t, 0), b = vertex(t, 1), c = vertex(t, 2);
-            ok = is_corner(box, a) && is_corner(box, b) && is_corner(box, c) && on_face(box, a, b, c);
-            area += triangle_area(a, b, c);
+            const int ia = corner_index(box, a), ib = corner_index(box, b), ic = corner_index(box, c);
+            ok = ia >= 0 && ib >= 0 && ic >= 0 && ia != ib && ib != ic && ia != ic;
+            const int f = ok ? face_of(ia, ib, ic) : -1;
+            ok = ok && f >= 0;
+            if (!ok) break;
+            const int axis = f / 2, bit = 4 >> axis;
+            if (object.one_sided) {
+                const Vec3 n = cross(b - a, c - a);
+                const float outward = (axis == 0 ? n.x : axis == 1 ? n.y : n.z) * (f % 2 ? 1.0f : -1.0f);
+                if (!(outward > 0)) continue;  // faces inwards: drawn from inside only, covers nothing seen from outside
+            }
+            // The face's corners in a fixed order: the two other axes' bits, lexicographic.
+            int others[2], n_others = 0;
+            for (int k = 0; k < 3; ++k)
+                if ((4 >> k) != bit) others[n_others++] = 4 >> k;
+            const int in_face[3] = {ia, ib, ic};
+            int present = 0;
+            for (int v : in_face) present |= 1 << (((v & others[0]) ? 2 : 0) + ((v & others[1]) ? 1 : 0));
+            const int missing = 0xf & ~present;  // exactly one bit: the corner the triangle leaves out
+            left_out[f] |= static_cast<std::uint8_t>(missing);
         }
-        const double dx = double(box.max.x) - box.min.x, dy = double(box.max.y) - box.min.y,
-                     dz = double(box.max.z) - box.min.z;
-        const double surface = 2 * (dx * dy + dy * dz + dz * dx);
-        // Corner triangles on faces tile a face exactly when their areas add up to it (two per
-        // face); a missing face leaves the sum short, a doubled one (two-sided copies) is allowed.
-        if (ok && area >= surface * (1 - 1e-5)) out.push_back(e);
+        // Opposite corners in the face's order: 0 (00) with 3 (11), 1 (01) with 2 (10).
+        for (int f = 0; ok && f < 6; ++f) ok = (left_out[f] & 0x9) == 0x9 || (left_out[f] & 0x6) == 0x6;
+        if (ok) out.push_back(e);
     }
     return out;
 }
@@ -128,6 +145,36 @@ SceneOcclusion::SceneOcclusion(const Scene& scene, const SceneObjectLevel& level
     }
 }
 
+// Portal culling assumes that walls are opaque along every line of sight from the eye. The
+// near plane breaks that: a wall (or floor, or any environment box) between the eye and the near
+// plane is clipped away, and one-sided walls seen from inside (an eye in a wall) draw nothing, so
+// the eye then sees into cells no portal leads to. So when the pyramid from the eye to the near
+// plane's rectangle touches an environment object's box, nothing is culled by portals (found by
+// probing: an eye 0.03 from a wall with z_near 0.05, or inside a wall, showed the next room).
+bool SceneOcclusion::near_pyramid_touches_environment(const Mat4& world_to_clip, Vec3 eye) const {
+    Mat4 clip_to_world;
+    if (!invert(world_to_clip, clip_to_world)) return true;
+    Bounds pyramid{eye, eye};
+    for (float x : {-1.0f, 1.0f})
+        for (float y : {-1.0f, 1.0f}) {
+            const Vec4 h = clip_to_world * Vec4{x, y, 0, 1};  // zero-to-one depth: z = 0 on the near plane
+            if (!(std::fabs(h.w) > 0)) return true;
+            const Vec3 p = cartesian(h);
+            if (!is_finite(p)) return true;
+            pyramid.min = {std::min(pyramid.min.x, p.x), std::min(pyramid.min.y, p.y), std::min(pyramid.min.z, p.z)};
+            pyramid.max = {std::max(pyramid.max.x, p.x), std::max(pyramid.max.y, p.y), std::max(pyramid.max.z, p.z)};
+        }
+    pyramid = grow_bounds(pyramid, static_cast<float>(portals_->margin()) + rounding_margin(pyramid));
+    const std::vector<Bounds>& boxes = level_->boxes();
+    for (std::size_t i = scene_->instances.size(); i < boxes.size(); ++i) {
+        const Bounds& b = boxes[i];
+        if (b.min.x <= pyramid.max.x && b.max.x >= pyramid.min.x && b.min.y <= pyramid.max.y && b.max.y >= pyramid.min.y &&
+            b.min.z <= pyramid.max.z && b.max.z >= pyramid.min.z)
+            return true;
+    }
+    return false;
+}
+
 const ObjectCullResult& SceneOcclusion::cull(const ObjectCullResult& result, const Camera& camera, int width, int height) {
     const std::vector<Bounds>& boxes = level_->boxes();
     const ObjectCuller& culler = level_->culler();
@@ -164,10 +211,12 @@ const ObjectCullResult& SceneOcclusion::cull(const ObjectCullResult& result, con
             }
         horizon_.cull(world_to_clip, ClipDepth::zero_to_one, width, height, occluder_boxes_.data(), occluder_boxes_.size(),
                       tested_boxes_.data(), tested_boxes_.size(), occluded_.data(), stats_.horizon);
-    } else {
+    } else if (!near_pyramid_touches_environment(world_to_clip, camera.eye)) {
         const FrustumPlanes planes = make_frustum_planes(world_to_clip, ClipDepth::zero_to_one);
         stats_.eye_in_cell = portals_->traverse(camera.eye, planes, stats_.portals);
         for (std::size_t k = 0; k < tested_boxes_.size(); ++k) occluded_[k] = !portals_->box_visible(tested_boxes_[k]);
+    } else {
+        stats_.near_geometry = true;  // nothing culled this frame
     }
     for (std::size_t k = 0; k < tested_objects_.size(); ++k) {
         if (!occluded_[k]) continue;
