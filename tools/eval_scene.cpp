@@ -219,6 +219,7 @@ int run_scene_eval(const SceneEvalOptions& o) {
                     const ObjectCullResult& culled = scene_method->cull(result, camera, width, height);
                     for (const IndexSpan& s : culled.culled_patches) params.object_culled.push_back({s.first, s.count});
                     for (const IndexSpan& s : culled.culled_triangles) params.culled_occluders.push_back({s.first, s.count});
+                    params.objects = ranges;  // an instance culled whole is then not dispatched at all
                     t.objects_culled += double(culled.stats.frustum_culled + scene_method->stats().objects_culled);
                 } else {
                     gl::QueryOptions q = query_options;

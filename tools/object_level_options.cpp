@@ -139,6 +139,9 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
     result_ = &level_->cull(pose, poser.displacement_ranges(), time_seconds, camera, viewport_height, options_);
     if (viewport_width <= 0) viewport_width = std::max(1, static_cast<int>(std::lround(camera.aspect * float(viewport_height))));
     if (scene_occlusion_) result_ = &scene_occlusion_->cull(*result_, camera, viewport_width, viewport_height);
+    // One pipeline object per instance: an instance culled whole is then never dispatched (with
+    // the whole set as one object, a span culled inside it still costs its dispatch).
+    params.objects = instance_ranges_;
     if (query_method_) {
         if (!queries_) queries_ = std::make_unique<gl::ObjectQueries>();  // on the current context
         gl::FrameObjects objects;
@@ -154,7 +157,6 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
             objects.tight_first = tight_->first().data();
         }
         queries_->set_frame(objects, query_options_);
-        params.objects = instance_ranges_;
         params.object_pass = queries_.get();
     }
     const auto culled = std::chrono::steady_clock::now();
