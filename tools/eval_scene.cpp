@@ -23,12 +23,14 @@
 // traversal, tight boxes); frame_ratio = the method's mean frame time over none's.
 // Output (--json): {"scene","scheme","objects","characters","patches","frames","size":[w,h],"tess","batch",
 //   "sigma","c1","visible_interval","methods":[{"name","object_method","patch_hiz",
-//   "objects_culled","patches_culled","patches_object_culled","patches_frustum_culled",
+//   "objects_culled","objects_hidden","patches_hidden","patches_culled","patches_object_culled","patches_frustum_culled",
 //   "patches_occlusion_culled","queries","multiqueries","multiqueries_passed","proxy_boxes",
 //   "wait_frames","waits","ms":{"object_cpu","pass1","hiz","cull","pass2","frame"},
 //   "frame_ratio","false_culls"}]} with per-frame means (wait_frames and false_culls: totals;
 //   objects_culled: the characters (queries) or all objects (horizon, portals) left out by the
-//   object level; patches_culled: every patch not drawn, object level and patch passes together).
+//   object level, frustum included; objects_hidden / patches_hidden: those the occlusion method
+//   itself hid (inside the frustum) and their patches; patches_culled: every patch not drawn,
+//   object level and patch passes together).
 #include "eval_scene.h"
 
 #include <algorithm>
@@ -43,7 +45,9 @@
 
 #include "cli_options.h"
 #include "commands.h"
+#include "patchcull/bounding_volumes.h"
 #include "patchcull/error.h"
+#include "patchcull/frustum.h"
 #include "patchcull/gl_object_queries.h"
 #include "patchcull/scene_object_level.h"
 #include "patchcull/scene_occlusion.h"
@@ -107,7 +111,7 @@ std::vector<Method> chosen_methods(const std::string& list, const std::vector<Me
 }
 
 struct Totals {
-    double objects_culled = 0, patches_culled = 0, patches_object = 0, patches_frustum = 0, patches_occlusion = 0;
+    double objects_culled = 0, objects_hidden = 0, patches_hidden = 0, patches_culled = 0, patches_object = 0, patches_frustum = 0, patches_occlusion = 0;
     double queries = 0, multiqueries = 0, multiqueries_passed = 0, proxy_boxes = 0, waits = 0;
     double object_cpu = 0, pass1 = 0, hiz = 0, cull = 0, pass2 = 0, frame = 0;
     std::size_t wait_frames = 0, false_culls = 0;
@@ -221,6 +225,8 @@ int run_scene_eval(const SceneEvalOptions& o) {
                     for (const IndexSpan& s : culled.culled_triangles) params.culled_occluders.push_back({s.first, s.count});
                     params.objects = ranges;  // an instance culled whole is then not dispatched at all
                     t.objects_culled += double(culled.stats.frustum_culled + scene_method->stats().objects_culled);
+                    t.objects_hidden += double(scene_method->stats().objects_culled);
+                    t.patches_hidden += double(scene_method->stats().patches_culled);
                 } else {
                     gl::QueryOptions q = query_options;
                     q.method = *method.queries;
@@ -243,6 +249,17 @@ int run_scene_eval(const SceneEvalOptions& o) {
             }
             const gl::FrameStats stats = pipeline.render_frame(params);
             if (method.queries) {
+                // The objects the queries hid (not drawn, inside the frustum: the pass's own box test).
+                const FrustumPlanes planes =
+                    make_frustum_planes(params.frame.render.projection * params.frame.render.view, ClipDepth::zero_to_one);
+                for (std::size_t i = 0; i < instances; ++i) {
+                    if (queries.drawn()[i]) continue;
+                    PlaneCullState state;
+                    std::uint32_t plane_tests = 0;
+                    if (classify_aabb(planes, level.boxes()[i], state, plane_tests) == Containment::outside) continue;
+                    t.objects_hidden += 1;
+                    t.patches_hidden += double(object_patches[i]);
+                }
                 const gl::QueryStats& q = queries.stats();
                 t.objects_culled += double(q.frustum_culled + q.occlusion_culled);
                 t.queries += q.queries;
@@ -282,6 +299,8 @@ int run_scene_eval(const SceneEvalOptions& o) {
                                                                 : "none"},
                         {"patch_hiz", method.patch_hiz},
                         {"objects_culled", t.objects_culled / n},
+                        {"objects_hidden", t.objects_hidden / n},
+                        {"patches_hidden", t.patches_hidden / n},
                         {"patches_culled", t.patches_culled / n},
                         {"patches_object_culled", t.patches_object / n},
                         {"patches_frustum_culled", t.patches_frustum / n},

@@ -108,6 +108,8 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
                                          "object_method",
                                          "patch_hiz",
                                          "objects_culled",
+                                         "objects_hidden",
+                                         "patches_hidden",
                                          "patches_culled",
                                          "patches_object_culled",
                                          "patches_frustum_culled",
@@ -167,8 +169,12 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
             EXPECT_EQ(ratio, 1.0) << what << ": the ratios' denominator";
             EXPECT_EQ(culled, 0) << what;
         }
+        // What the occlusion method itself hid is part of what the object level culled.
+        EXPECT_LE(row["objects_hidden"].get<double>(), row["objects_culled"].get<double>() + 1e-9) << what;
+        EXPECT_LE(row["patches_hidden"].get<double>(), by_objects + 1e-6) << what;
         if (name == "none" || name == "hiz") {
             EXPECT_EQ(row["objects_culled"], 0) << what;
+            EXPECT_EQ(row["objects_hidden"], 0) << what;
             EXPECT_EQ(by_objects, 0) << what;
             EXPECT_EQ(row["ms"]["object_cpu"], 0) << what;
         }
@@ -232,6 +238,7 @@ TEST(ObjectOcclusionCli, EvalSceneCitySmallContract) {
         // The street's buildings hide characters of the other streets: every object method leaves
         // some out (objects_culled counts the frustum's too, patches_object_culled the patches).
         EXPECT_GT((*r)["objects_culled"].get<double>(), 0) << m;
+        EXPECT_GT((*r)["objects_hidden"].get<double>(), 0) << m;
         EXPECT_GT((*r)["patches_object_culled"].get<double>(), 0) << m;
     }
     // CHC++ merges the hidden characters' queries into multiqueries.
@@ -253,6 +260,7 @@ TEST(ObjectOcclusionCli, EvalSceneTwoRoomsEveryMethod) {
         const json* r = row_named(rows, m);
         if (!r) continue;
         EXPECT_GT((*r)["objects_culled"].get<double>(), 0) << m;
+        EXPECT_GT((*r)["objects_hidden"].get<double>(), 0) << m;
         // Per frame mean: the hidden BigGuy and frog of the first frames.
         EXPECT_GT((*r)["patches_object_culled"].get<double>(), 0) << m;
     }
