@@ -54,8 +54,10 @@
 #include <utility>
 #include <vector>
 
+#include "import/huge_pages.h"
 #include "import/quad_topology.h"
 #include "patchcull/error.h"
+#include "patchcull/parallel.h"
 #include "patchcull/subdivision.h"
 
 namespace patchcull {
@@ -64,6 +66,7 @@ namespace {
 
 using acc_detail::QuadTopology;
 using acc_detail::VertexRing;
+using detail::advise_huge_pages;
 
 // A stencil under construction: weights over vertex indices, in double (build time only).
 using Terms = std::vector<std::pair<std::uint32_t, double>>;
@@ -78,55 +81,96 @@ Terms scaled(double w, const Terms& src) {
     return out;
 }
 
-// Sorts by vertex and merges duplicates, so rows stay short and deterministic.
-Terms compact(Terms t) {
+// Sorts t by vertex and merges duplicates into out, so rows stay short and deterministic. The
+// duplicates' sum order is std::sort's on t's sequence: every row is built as the same sequence
+// of terms as before issue 14's rework, so every weight keeps its bits (tested).
+void compact_into(Terms& t, Terms& out) {
     std::sort(t.begin(), t.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    Terms out;
+    out.clear();
     for (const auto& [index, weight] : t) {
         if (!out.empty() && out.back().first == index) out.back().second += weight;
         else out.emplace_back(index, weight);
     }
     std::erase_if(out, [](const auto& p) { return p.second == 0.0; });
-    return out;
 }
-
-// Everything the patches need from one vertex's one-ring (see the file comment for the masks).
-struct VertexRule {
-    bool regular = false;
-    double edge_cos = 0;          // c in t_{i-1} + t_{i+1} = 2 c t_i, for interior edges
-    Terms limit;                  // limit position
-    std::vector<Terms> interior;  // per ring face
-    std::vector<Terms> edge;      // per ring edge: Bezier point next to v on that edge
-    std::vector<Terms> tangent;   // per ring edge: limit tangent pointing along that edge
-};
 
 constexpr double kPi = std::numbers::pi;
 
-Terms interior_point(std::uint32_t v, const VertexRing& r, std::size_t i, double n) {
-    const std::size_t ne = r.edge_vertices.size();
-    return {{v, n / (n + 5)},
-            {r.edge_vertices[i], 2 / (n + 5)},
-            {r.edge_vertices[(i + 1) % ne], 2 / (n + 5)},
-            {r.face_vertices[i], 1 / (n + 5)}};
+// ---- Point rows of one vertex (see the file comment for the masks) ------------------------------
+// Each appends the row's terms to out in a fixed order (the order the rows had before issue 14's
+// rework, so their sums keep their bits). Called per patch corner with reused buffers: computing
+// them again for each of a vertex's faces costs less than storing them per vertex (~400 bytes).
+
+// Valence used by the interior and edge masks: n for an interior vertex, 2k for a boundary vertex
+// with k > 1 faces, 4 for a corner (its patch is the B-spline patch with extrapolated phantoms).
+double mask_valence(const VertexRing& r) {
+    const std::size_t k = r.face_count();
+    if (!r.boundary) return static_cast<double>(k);
+    return k == 1 ? 4.0 : 2 * static_cast<double>(k);
 }
 
-VertexRule interior_rule(std::uint32_t v, const VertexRing& r) {
+void interior_point(std::uint32_t v, const VertexRing& r, std::size_t i, double n, Terms& out) {
+    const std::size_t ne = r.edge_vertices.size();
+    out.emplace_back(v, n / (n + 5));
+    out.emplace_back(r.edge_vertices[i], 2 / (n + 5));
+    out.emplace_back(r.edge_vertices[(i + 1) % ne], 2 / (n + 5));
+    out.emplace_back(r.face_vertices[i], 1 / (n + 5));
+}
+
+void limit_point(std::uint32_t v, const VertexRing& r, Terms& out) {
+    const std::size_t n = r.face_count();
+    if (r.boundary) {
+        if (n == 1) {
+            out.emplace_back(v, 1.0);  // a corner is interpolated
+        } else {
+            out.emplace_back(r.edge_vertices.front(), 1.0 / 6);
+            out.emplace_back(v, 4.0 / 6);
+            out.emplace_back(r.edge_vertices.back(), 1.0 / 6);
+        }
+        return;
+    }
+    const double dn = static_cast<double>(n);
+    out.emplace_back(v, dn / (dn + 5));
+    for (std::size_t j = 0; j < n; ++j) {
+        out.emplace_back(r.edge_vertices[j], 4 / (dn * (dn + 5)));
+        out.emplace_back(r.face_vertices[j], 1 / (dn * (dn + 5)));
+    }
+}
+
+// Bezier point next to v on ring edge i: on a boundary edge (2v + m)/3, else the mean of the two
+// interior points beside the edge.
+void edge_point(std::uint32_t v, const VertexRing& r, std::size_t i, Terms& out) {
+    const std::size_t n = r.face_count();
+    if (r.boundary && (i == 0 || i == n)) {
+        out.emplace_back(v, 2.0 / 3);
+        out.emplace_back(r.edge_vertices[i], 1.0 / 3);
+        return;
+    }
+    const std::size_t before = r.boundary ? i - 1 : (i + n - 1) % n;
+    const double valence = mask_valence(r);
+    const std::size_t first = out.size();
+    interior_point(v, r, before, valence, out);
+    interior_point(v, r, i, valence, out);
+    for (std::size_t k = first; k < out.size(); ++k) out[k].second = 0.5 * out[k].second;
+}
+
+// Whether v's patches are exact B-spline patches at v: interior valence 4, or a boundary vertex
+// with 2 faces, or a corner.
+bool regular_vertex(const VertexRing& r) {
+    return r.boundary ? r.face_count() <= 2 : r.face_count() == 4;
+}
+
+// What an extraordinary patch needs from one vertex's one-ring beyond its point rows.
+struct VertexRule {
+    double edge_cos = 0;          // c in t_{i-1} + t_{i+1} = 2 c t_i, for interior edges
+    std::vector<Terms> tangent;   // per ring edge: limit tangent pointing along that edge
+};
+
+VertexRule interior_rule(const VertexRing& r) {
     VertexRule rule;
     const std::size_t n = r.face_count();
     const double dn = static_cast<double>(n);
-    rule.regular = n == 4;
     rule.edge_cos = std::cos(2 * kPi / dn);
-    rule.limit.emplace_back(v, dn / (dn + 5));
-    for (std::size_t j = 0; j < n; ++j) {
-        rule.limit.emplace_back(r.edge_vertices[j], 4 / (dn * (dn + 5)));
-        rule.limit.emplace_back(r.face_vertices[j], 1 / (dn * (dn + 5)));
-    }
-    for (std::size_t i = 0; i < n; ++i) rule.interior.push_back(interior_point(v, r, i, dn));
-    for (std::size_t i = 0; i < n; ++i) {
-        Terms e = scaled(0.5, rule.interior[(i + n - 1) % n]);
-        axpy(e, 0.5, rule.interior[i]);
-        rule.edge.push_back(std::move(e));
-    }
     const double cp = std::cos(kPi / dn);
     const double b = 1 / (dn * std::sqrt(4 + cp * cp));
     const double a = 1 / dn + cp * b;
@@ -146,29 +190,12 @@ VertexRule boundary_rule(std::uint32_t v, const VertexRing& r) {
     VertexRule rule;
     const std::size_t k = r.face_count();  // edges 0..k, edges 0 and k on the boundary
     const std::uint32_t m0 = r.edge_vertices.front(), mk = r.edge_vertices.back();
-    const Terms along0 = {{v, 2.0 / 3}, {m0, 1.0 / 3}};
-    const Terms alongk = {{v, 2.0 / 3}, {mk, 1.0 / 3}};
     if (k == 1) {
-        // Corner: interpolated, its patch is the exact B-spline patch with extrapolated phantoms.
-        rule.regular = true;
-        rule.limit = {{v, 1.0}};
-        rule.interior.push_back(interior_point(v, r, 0, 4));
-        rule.edge = {along0, alongk};
         rule.tangent = {{{m0, 1.0}, {v, -1.0}}, {{mk, 1.0}, {v, -1.0}}};
         return rule;
     }
     const double dk = static_cast<double>(k);
-    rule.regular = k == 2;
     rule.edge_cos = std::cos(kPi / dk);
-    rule.limit = {{m0, 1.0 / 6}, {v, 4.0 / 6}, {mk, 1.0 / 6}};
-    for (std::size_t i = 0; i < k; ++i) rule.interior.push_back(interior_point(v, r, i, 2 * dk));
-    rule.edge.push_back(along0);
-    for (std::size_t i = 1; i < k; ++i) {
-        Terms e = scaled(0.5, rule.interior[i - 1]);
-        axpy(e, 0.5, rule.interior[i]);
-        rule.edge.push_back(std::move(e));
-    }
-    rule.edge.push_back(alongk);
 
     // r0: derivative of the boundary B-spline towards m0; r1: cross-boundary tangent.
     const Terms r0 = {{m0, 0.5}, {mk, -0.5}};
@@ -228,42 +255,129 @@ constexpr EdgeFrame kEdges[4] = {
      {{du_row(0, 3), 1}, {du_row(0, 2), 1}, {du_row(0, 1), 1}, {du_row(0, 0), 1}}},
 };
 
-// The models built on an all-quad mesh, before any composition with refinement stencils.
-struct QuadPatches {
-    std::vector<Terms> points;    // 16 per patch
-    std::vector<Terms> tangents;  // 24 per extraordinary patch
-    std::vector<PatchInfo> info;
-};
+// Appends a compacted double row to a stencil table as PointStencils::add_row appends a sorted row
+// without duplicates: each weight rounded to float (add_row's merge sum 0.0f + w, bit for bit),
+// zeros dropped.
+void append_row(PointStencils& table, const Terms& row) {
+    for (const auto& [index, weight] : row) {
+        const float w = 0.0f + static_cast<float>(weight);
+        if (w == 0.0f) continue;
+        table.indices.push_back(index);
+        table.weights.push_back(w);
+    }
+    table.offsets.push_back(static_cast<std::uint32_t>(table.indices.size()));
+}
 
-QuadPatches build_quad_patches(const ControlMesh& mesh) {
-    const QuadTopology topo = acc_detail::build_quad_topology(mesh);
-    std::vector<VertexRule> rules(topo.rings.size());
-    for (std::uint32_t v = 0; v < topo.rings.size(); ++v) {
-        const VertexRing& r = topo.rings[v];
-        if (r.faces.empty()) continue;
-        rules[v] = r.boundary ? boundary_rule(v, r) : interior_rule(v, r);
+// compact_into followed by append_row, without the intermediate row: the same sort, the same
+// sums in the same order, the same zeros dropped.
+void append_compacted(Terms& t, PointStencils& table) {
+    std::sort(t.begin(), t.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t k = 0; k < t.size();) {
+        const std::uint32_t index = t[k].first;
+        double weight = t[k].second;
+        for (++k; k < t.size() && t[k].first == index; ++k) weight += t[k].second;
+        if (weight == 0.0) continue;
+        const float w = 0.0f + static_cast<float>(weight);
+        if (w == 0.0f) continue;
+        table.indices.push_back(index);
+        table.weights.push_back(w);
+    }
+    table.offsets.push_back(static_cast<std::uint32_t>(table.indices.size()));
+}
+
+// Writes rows to a table, composed through the refinement stencils first when there are any
+// (a row over refined vertices becomes a row over the original ones).
+class RowWriter {
+public:
+    RowWriter(PointStencils& table, const PointStencils* through) : table_(table), through_(through) {}
+    /// A compacted row.
+    void write(const Terms& row) {
+        if (!through_) return append_row(table_, row);
+        composed_.clear();
+        for (const auto& [r, w] : row)
+            for (std::uint32_t k = through_->offsets[r]; k < through_->offsets[r + 1]; ++k)
+                composed_.emplace_back(through_->indices[k], w * static_cast<double>(through_->weights[k]));
+        compact_into(composed_, compacted_);
+        append_row(table_, compacted_);
+    }
+    /// A row as built (compacted here; raw is sorted in place).
+    void write_raw(Terms& raw) {
+        if (!through_) return append_compacted(raw, table_);
+        compact_into(raw, row_);
+        write(row_);
     }
 
-    QuadPatches out;
-    const std::size_t nf = mesh.face_count();
-    out.points.reserve(16 * nf);
-    out.info.reserve(nf);
-    for (std::size_t f = 0; f < nf; ++f) {
-        Terms net[16];
+private:
+    PointStencils& table_;
+    const PointStencils* through_;
+    Terms composed_, compacted_, row_;
+};
+
+// Terms a patch's 16 point rows can have before merging: an upper bound of what they write.
+std::size_t raw_point_terms(const VertexRing& r) {
+    const std::size_t n = r.face_count();
+    const std::size_t limit = r.boundary ? (n == 1 ? 1 : 3) : 1 + 2 * n;
+    const std::size_t edge = r.boundary && n == 1 ? 2 : 8;  // a boundary edge row has 2
+    return limit + 2 * edge + 4;
+}
+
+// What one worker builds for a run of consecutive faces: the rows of their patches (offsets from
+// 0), their records (tangent_index counted from the run's first tangent block).
+struct PatchRun {
+    PointStencils points, tangents;
+    std::vector<PatchInfo> info;
+    void clear() {
+        points.offsets.assign(1, 0);
+        points.indices.clear();
+        points.weights.clear();
+        tangents.offsets.assign(1, 0);
+        tangents.indices.clear();
+        tangents.weights.clear();
+        info.clear();
+    }
+};
+
+// Appends a run's rows to a table (its offsets shifted by the table's terms so far).
+void append_run(PointStencils& table, const PointStencils& run) {
+    const std::uint32_t base = static_cast<std::uint32_t>(table.indices.size());
+    table.indices.insert(table.indices.end(), run.indices.begin(), run.indices.end());
+    table.weights.insert(table.weights.end(), run.weights.begin(), run.weights.end());
+    for (std::size_t r = 1; r < run.offsets.size(); ++r) table.offsets.push_back(base + run.offsets[r]);
+}
+
+// The patches of the faces [first, last) of an all-quad mesh. rule_index/rules hold the rules of
+// every vertex of an extraordinary patch (built before, read only here).
+void build_run(const ControlMesh& mesh, const QuadTopology& topo, const PointStencils* through,
+               const std::vector<std::uint32_t>& rule_index, const std::vector<VertexRule>& rules, std::size_t first,
+               std::size_t last, PatchRun& run) {
+    run.clear();
+    run.info.reserve(last - first);
+    RowWriter points(run.points, through), tangents(run.tangents, through);
+    Terms raw, net[16];
+    for (std::size_t f = first; f < last; ++f) {
         bool regular = true;
         std::uint32_t corner_vertex[4];
         std::uint32_t slot[4];
         for (int q = 0; q < 4; ++q) {
             corner_vertex[q] = mesh.face_vertices[4 * f + q];
             slot[q] = topo.corner_ring_slot[4 * f + q];
-            const VertexRule& rule = rules[corner_vertex[q]];
-            const std::size_t edges = rule.edge.size();
+            regular = regular && regular_vertex(topo.ring(corner_vertex[q]));
+        }
+        // Point rows: each ring mask once, in the Bezier net's order 4*j + i. A regular patch
+        // writes them as they are built; an extraordinary one keeps them (compacted, in double)
+        // for its tangent rows.
+        for (int q = 0; q < 4; ++q) {
+            const std::uint32_t v = corner_vertex[q];
+            const VertexRing r = topo.ring(v);
+            const std::size_t s = slot[q];
             const CornerFrame& c = kCorners[q];
-            net[4 * c.j + c.i] = rule.limit;
-            net[4 * (c.j + c.nj) + c.i + c.ni] = rule.edge[slot[q]];
-            net[4 * (c.j + c.pj) + c.i + c.pi] = rule.edge[(slot[q] + 1) % edges];
-            net[4 * (c.j + c.nj + c.pj) + c.i + c.ni + c.pi] = rule.interior[slot[q]];
-            regular = regular && rule.regular;
+            const int at[4] = {4 * c.j + c.i, 4 * (c.j + c.nj) + c.i + c.ni, 4 * (c.j + c.pj) + c.i + c.pi,
+                               4 * (c.j + c.nj + c.pj) + c.i + c.ni + c.pi};
+            for (int k = 0; k < 4; ++k) net[at[k]].clear();
+            limit_point(v, r, net[at[0]]);
+            edge_point(v, r, s, net[at[1]]);
+            edge_point(v, r, (s + 1) % r.edge_vertices.size(), net[at[2]]);
+            interior_point(v, r, s, mask_valence(r), net[at[3]]);
         }
         PatchInfo info;
         info.base_face = static_cast<std::uint32_t>(f);
@@ -275,72 +389,124 @@ QuadPatches build_quad_patches(const ControlMesh& mesh) {
             info.uv[2] = tc(3);
             info.uv[3] = tc(2);
         }
-        for (Terms& t : net) out.points.push_back(compact(std::move(t)));
-
-        if (!regular) {
-            const Terms* b = &out.points[out.points.size() - 16];
-            Terms rows[24];
-            for (int j = 0; j < 4; ++j)
-                for (int i = 0; i < 3; ++i) {
-                    rows[du_row(i, j)] = scaled(3, b[4 * j + i + 1]);
-                    axpy(rows[du_row(i, j)], -3, b[4 * j + i]);
-                }
-            for (int j = 0; j < 3; ++j)
-                for (int i = 0; i < 4; ++i) {
-                    rows[dv_row(i, j)] = scaled(3, b[4 * (j + 1) + i]);
-                    axpy(rows[dv_row(i, j)], -3, b[4 * j + i]);
-                }
-            // Corners: limit tangents along the two edges of each corner (signed to +u / +v).
-            // Corner q: along-edge row of edge q (start) and of edge q-1 (end).
-            for (int q = 0; q < 4; ++q) {
-                const VertexRule& rule = rules[corner_vertex[q]];
-                const std::size_t edges = rule.tangent.size();
-                const SignedRow to_next = kEdges[q].along[0];
-                const SignedRow to_prev = kEdges[(q + 3) % 4].along[2];
-                rows[to_next.row] = scaled(to_next.sign, rule.tangent[slot[q]]);
-                rows[to_prev.row] = scaled(-to_prev.sign, rule.tangent[(slot[q] + 1) % edges]);
-            }
-            // Interior edges: split lambda(u) d(u) evenly between the two cross tangents.
-            for (int q = 0; q < 4; ++q) {
-                const VertexRing& r0 = topo.rings[corner_vertex[q]];
-                if (r0.boundary && slot[q] == 0) continue;  // edge 0 of a boundary ring: no neighbour
-                const double c0 = rules[corner_vertex[q]].edge_cos;
-                const double c1 = rules[corner_vertex[(q + 1) % 4]].edge_cos;
-                if (c0 == 0 && c1 == 0) continue;
-                const EdgeFrame& e = kEdges[q];
-                Terms d[3];
-                for (int k = 0; k < 3; ++k) d[k] = scaled(e.along[k].sign, rows[e.along[k].row]);
-                Terms x1 = scaled(2 * c0 / 3, d[1]);
-                axpy(x1, -c1 / 3, d[0]);
-                Terms x2 = scaled(c0 / 3, d[2]);
-                axpy(x2, -2 * c1 / 3, d[1]);
-                axpy(rows[e.cross[1].row], e.cross[1].sign, x1);
-                axpy(rows[e.cross[2].row], e.cross[2].sign, x2);
-            }
-            info.tangent_index = static_cast<std::int32_t>(out.tangents.size() / 24);
-            for (Terms& t : rows) out.tangents.push_back(compact(std::move(t)));
+        if (regular) {
+            for (Terms& t : net) points.write_raw(t);
+            run.info.push_back(info);
+            continue;
         }
-        out.info.push_back(info);
+
+        Terms b[16];
+        for (int k = 0; k < 16; ++k) {
+            compact_into(net[k], b[k]);
+            points.write(b[k]);
+        }
+        const VertexRule* rule[4];
+        for (int q = 0; q < 4; ++q) rule[q] = &rules[rule_index[corner_vertex[q]]];
+        Terms rows[24];
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 3; ++i) {
+                rows[du_row(i, j)] = scaled(3, b[4 * j + i + 1]);
+                axpy(rows[du_row(i, j)], -3, b[4 * j + i]);
+            }
+        for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 4; ++i) {
+                rows[dv_row(i, j)] = scaled(3, b[4 * (j + 1) + i]);
+                axpy(rows[dv_row(i, j)], -3, b[4 * j + i]);
+            }
+        // Corners: limit tangents along the two edges of each corner (signed to +u / +v).
+        // Corner q: along-edge row of edge q (start) and of edge q-1 (end).
+        for (int q = 0; q < 4; ++q) {
+            const std::size_t edges = rule[q]->tangent.size();
+            const SignedRow to_next = kEdges[q].along[0];
+            const SignedRow to_prev = kEdges[(q + 3) % 4].along[2];
+            rows[to_next.row] = scaled(to_next.sign, rule[q]->tangent[slot[q]]);
+            rows[to_prev.row] = scaled(-to_prev.sign, rule[q]->tangent[(slot[q] + 1) % edges]);
+        }
+        // Interior edges: split lambda(u) d(u) evenly between the two cross tangents.
+        for (int q = 0; q < 4; ++q) {
+            if (topo.boundary[corner_vertex[q]] && slot[q] == 0) continue;  // edge 0 of a boundary ring: no neighbour
+            const double c0 = rule[q]->edge_cos;
+            const double c1 = rule[(q + 1) % 4]->edge_cos;
+            if (c0 == 0 && c1 == 0) continue;
+            const EdgeFrame& e = kEdges[q];
+            Terms d[3];
+            for (int k = 0; k < 3; ++k) d[k] = scaled(e.along[k].sign, rows[e.along[k].row]);
+            Terms x1 = scaled(2 * c0 / 3, d[1]);
+            axpy(x1, -c1 / 3, d[0]);
+            Terms x2 = scaled(c0 / 3, d[2]);
+            axpy(x2, -2 * c1 / 3, d[1]);
+            axpy(rows[e.cross[1].row], e.cross[1].sign, x1);
+            axpy(rows[e.cross[2].row], e.cross[2].sign, x2);
+        }
+        info.tangent_index = static_cast<std::int32_t>(run.tangents.rows() / 24);
+        for (Terms& t : rows) tangents.write_raw(t);
+        run.info.push_back(info);
     }
-    return out;
 }
 
-void add_rows(PointStencils& table, const std::vector<Terms>& rows, const PointStencils* through) {
-    std::vector<std::pair<std::uint32_t, float>> row;
-    Terms composed;
-    for (const Terms& t : rows) {
-        const Terms* src = &t;
-        if (through) {
-            composed.clear();
-            for (const auto& [r, w] : t)
-                for (std::uint32_t k = through->offsets[r]; k < through->offsets[r + 1]; ++k)
-                    composed.emplace_back(through->indices[k], w * static_cast<double>(through->weights[k]));
-            composed = compact(std::move(composed));
-            src = &composed;
+// Faces per run: big enough that a run's rows (~100 terms per patch) amortise a task, small
+// enough that the runs in flight stay a few megabytes.
+constexpr std::size_t kFacesPerRun = 4096;
+
+// Builds the patches of an all-quad mesh into model (patch_points, tangent_points, patches),
+// each row composed through `through` when the mesh is a refinement of model.mesh.
+//
+// Speed and memory (issue 14): nothing is stored per vertex except the rules of the vertices of
+// extraordinary patches; each patch's rows are built in reused buffers. Runs of consecutive faces
+// are built in parallel, a few at a time, and appended in face order, so the tables are exactly
+// the sequential ones. The point table is reserved for an upper bound of its terms: on Linux the
+// reserved but untouched tail costs address space, not memory.
+void build_quad_patches(const ControlMesh& mesh, const PointStencils* through, SubdivisionModel& model) {
+    const QuadTopology topo = acc_detail::build_quad_topology(mesh);
+    const std::size_t nf = mesh.face_count();
+
+    model.patch_points.offsets.reserve(16 * nf + 1);
+    advise_huge_pages(model.patch_points.offsets.data(), (16 * nf + 1) * sizeof(std::uint32_t));
+    model.patches.reserve(nf);
+    if (!through) {
+        std::size_t bound = 0;
+        for (std::size_t c = 0; c < 4 * nf; ++c) bound += raw_point_terms(topo.ring(mesh.face_vertices[c]));
+        model.patch_points.indices.reserve(bound);
+        model.patch_points.weights.reserve(bound);
+        advise_huge_pages(model.patch_points.indices.data(), bound * sizeof(std::uint32_t));
+        advise_huge_pages(model.patch_points.weights.data(), bound * sizeof(float));
+    }
+
+    // Rules of the vertices of extraordinary patches, before the parallel part reads them.
+    constexpr std::uint32_t kNone = ~std::uint32_t{0};
+    std::vector<std::uint32_t> rule_index(topo.vertex_count(), kNone);
+    std::vector<VertexRule> rules;
+    for (std::size_t f = 0; f < nf; ++f) {
+        const std::uint32_t* corners = &mesh.face_vertices[4 * f];
+        if (std::all_of(corners, corners + 4, [&](std::uint32_t v) { return regular_vertex(topo.ring(v)); })) continue;
+        for (int q = 0; q < 4; ++q) {
+            const std::uint32_t v = corners[q];
+            if (rule_index[v] != kNone) continue;
+            const VertexRing r = topo.ring(v);
+            rule_index[v] = static_cast<std::uint32_t>(rules.size());
+            rules.push_back(r.boundary ? boundary_rule(v, r) : interior_rule(r));
         }
-        row.clear();
-        for (const auto& [index, weight] : *src) row.emplace_back(index, static_cast<float>(weight));
-        table.add_row(row);
+    }
+
+    const std::size_t runs_at_once = static_cast<std::size_t>(std::max(1, hardware_threads())) * 2;
+    std::vector<PatchRun> runs(std::min(runs_at_once, (nf + kFacesPerRun - 1) / kFacesPerRun));
+    for (std::size_t first = 0; first < nf; first += runs.size() * kFacesPerRun) {
+        const std::size_t count = std::min(runs.size(), (nf - first + kFacesPerRun - 1) / kFacesPerRun);
+        parallel_for_ranges(count, 1, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t k = begin; k < end; ++k) {
+                const std::size_t f0 = first + k * kFacesPerRun;
+                build_run(mesh, topo, through, rule_index, rules, f0, std::min(nf, f0 + kFacesPerRun), runs[k]);
+            }
+        });
+        for (std::size_t k = 0; k < count; ++k) {
+            const std::int32_t tangent_base = static_cast<std::int32_t>(model.tangent_points.rows() / 24);
+            append_run(model.patch_points, runs[k].points);
+            append_run(model.tangent_points, runs[k].tangents);
+            for (PatchInfo info : runs[k].info) {
+                if (info.tangent_index >= 0) info.tangent_index += tangent_base;
+                model.patches.push_back(info);
+            }
+        }
     }
 }
 
@@ -354,26 +520,20 @@ SubdivisionModel build_acc_model(const ControlMesh& mesh) {
     if (mesh.face_count() == 0) throw Error(mesh.name + ": mesh has no faces");
     check_preprocessing_limits(mesh);  // rules and rows below cost ~valence^2 per vertex
 
-    QuadPatches quads;
     if (mesh.all_quads()) {
-        quads = build_quad_patches(mesh);
-        add_rows(model.patch_points, quads.points, nullptr);
-        add_rows(model.tangent_points, quads.tangents, nullptr);
+        build_quad_patches(mesh, nullptr, model);
     } else {
         // Far numbers the children of face f consecutively, one per corner of f.
         RefinedMesh refined = refine_uniform_once(mesh);
-        quads = build_quad_patches(refined.mesh);
+        build_quad_patches(refined.mesh, &refined.stencils, model);
         std::vector<std::uint32_t> parent;
         parent.reserve(refined.mesh.face_count());
         for (std::size_t f = 0; f < mesh.face_count(); ++f) parent.insert(parent.end(), mesh.face_size(f), static_cast<std::uint32_t>(f));
-        if (parent.size() != quads.info.size())
+        if (parent.size() != model.patches.size())
             throw Error(mesh.name + ": unexpected face count after Catmull-Clark refinement");
-        for (PatchInfo& p : quads.info) p.base_face = parent[p.base_face];
-        add_rows(model.patch_points, quads.points, &refined.stencils);
-        add_rows(model.tangent_points, quads.tangents, &refined.stencils);
+        for (PatchInfo& p : model.patches) p.base_face = parent[p.base_face];
         model.mesh.warnings = refined.mesh.warnings;
     }
-    model.patches = std::move(quads.info);
     if (!mesh.creases.empty() || !mesh.corners.empty())
         model.mesh.warnings.push_back(mesh.name + ": the acc scheme ignores " + std::to_string(mesh.creases.size()) +
                                       " crease(s) and " + std::to_string(mesh.corners.size()) +

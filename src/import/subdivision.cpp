@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <string>
 
+#include "import/huge_pages.h"
 #include "patchcull/error.h"
+#include "patchcull/parallel.h"
 
 namespace patchcull {
 
@@ -18,8 +20,23 @@ bool parse_scheme(const std::string& text, Scheme& scheme) {
 }
 
 void PointStencils::add_row(const std::vector<std::pair<std::uint32_t, float>>& terms) {
-    // Sorted merge (O(k log k), no per-row node allocations: rows next to a high-valence vertex
-    // have hundreds of terms).
+    // Rows that come sorted without duplicates (Far's and the acc rows are) are appended as they
+    // are; others take a sorted merge (O(k log k), no per-row node allocations: rows next to a
+    // high-valence vertex have hundreds of terms). Both sum each weight as 0.0f + w, so either
+    // path stores the same bits.
+    const bool sorted_unique = std::adjacent_find(terms.begin(), terms.end(), [](const auto& a, const auto& b) {
+                                   return a.first >= b.first;
+                               }) == terms.end();
+    if (sorted_unique) {
+        for (const auto& [index, w] : terms) {
+            const float weight = 0.0f + w;
+            if (weight == 0.0f) continue;
+            indices.push_back(index);
+            weights.push_back(weight);
+        }
+        offsets.push_back(static_cast<std::uint32_t>(indices.size()));
+        return;
+    }
     thread_local std::vector<std::pair<std::uint32_t, float>> sorted;
     sorted.assign(terms.begin(), terms.end());
     std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -34,20 +51,30 @@ void PointStencils::add_row(const std::vector<std::pair<std::uint32_t, float>>& 
     offsets.push_back(static_cast<std::uint32_t>(indices.size()));
 }
 
+namespace {
+
+// Row r of a stencil table applied to vertices (double accumulation: extraordinary stencils have
+// dozens of terms of both signs).
+inline Vec3 apply_row(const PointStencils& s, std::size_t r, const Vec3* vertices) {
+    double x = 0, y = 0, z = 0;
+    for (std::uint32_t k = s.offsets[r]; k < s.offsets[r + 1]; ++k) {
+        const Vec3 v = vertices[s.indices[k]];
+        const double w = s.weights[k];
+        x += w * v.x;
+        y += w * v.y;
+        z += w * v.z;
+    }
+    return {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)};
+}
+
+// Patches per task of evaluate_patches (~100 us each).
+constexpr std::size_t kEvaluateGrain = 1024;
+
+}  // namespace
+
 void PointStencils::apply(const Vec3* vertices, Vec3* out) const {
     const std::size_t n = rows();
-    for (std::size_t r = 0; r < n; ++r) {
-        // Double accumulation: extraordinary stencils have dozens of terms of both signs.
-        double x = 0, y = 0, z = 0;
-        for (std::uint32_t k = offsets[r]; k < offsets[r + 1]; ++k) {
-            const Vec3 v = vertices[indices[k]];
-            const double w = weights[k];
-            x += w * v.x;
-            y += w * v.y;
-            z += w * v.z;
-        }
-        out[r] = {static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)};
-    }
+    for (std::size_t r = 0; r < n; ++r) out[r] = apply_row(*this, r, vertices);
 }
 
 std::size_t SubdivisionModel::extraordinary_count() const {
@@ -113,21 +140,32 @@ void split_frame(const PatchFrame& in, PatchFrame& out) {
 
 void evaluate_patches(const SubdivisionModel& model, const std::vector<Vec3>& positions, int split_levels,
                       PatchFrame& out) {
+    // Straight into the frame (no array of all points in between: 192 MB at 1M patches), in
+    // parallel: every control point is its own row, so the result does not depend on the split.
     const std::size_t n = model.patch_count();
-    std::vector<Vec3> points(model.patch_points.rows());
-    model.patch_points.apply(positions.data(), points.data());
+    if (model.patch_points.rows() < n * kPatchPoints)
+        throw Error(model.name + ": stencil table has fewer rows than its patches need");
+    if (out.patches.capacity() < n) {
+        out.patches = {};
+        out.patches.reserve(n);
+        detail::advise_huge_pages(out.patches.data(), n * sizeof(BezierPatch));
+    }
     out.patches.resize(n);
-    for (std::size_t p = 0; p < n; ++p)
-        for (int k = 0; k < kPatchPoints; ++k) out.patches[p].cp[k] = homogeneous(points[kPatchPoints * p + k]);
-
-    std::vector<Vec3> tangent_points(model.tangent_points.rows());
-    model.tangent_points.apply(positions.data(), tangent_points.data());
-    out.tangents.resize(tangent_points.size() / 24);
-    for (std::size_t t = 0; t < out.tangents.size(); ++t)
-        for (int k = 0; k < 12; ++k) {
-            out.tangents[t].du[k] = tangent_points[24 * t + k];
-            out.tangents[t].dv[k] = tangent_points[24 * t + 12 + k];
-        }
+    const std::size_t nt = model.tangent_points.rows() / 24;
+    out.tangents.resize(nt);
+    const Vec3* vertices = positions.data();
+    parallel_for_ranges(n, kEvaluateGrain, [&](std::size_t first, std::size_t last) {
+        for (std::size_t p = first; p < last; ++p)
+            for (int k = 0; k < kPatchPoints; ++k)
+                out.patches[p].cp[k] = homogeneous(apply_row(model.patch_points, kPatchPoints * p + k, vertices));
+    });
+    parallel_for_ranges(nt, kEvaluateGrain, [&](std::size_t first, std::size_t last) {
+        for (std::size_t t = first; t < last; ++t)
+            for (int k = 0; k < 12; ++k) {
+                out.tangents[t].du[k] = apply_row(model.tangent_points, 24 * t + k, vertices);
+                out.tangents[t].dv[k] = apply_row(model.tangent_points, 24 * t + 12 + k, vertices);
+            }
+    });
     out.info = model.patches;
 
     PatchFrame scratch;
