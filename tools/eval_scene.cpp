@@ -331,8 +331,9 @@ int run_scene_eval(const SceneEvalOptions& o) {
                           {"size", {width, height}},
                           {"tess", o.tess},
                           {"batch", o.batch},
-                          {"sigma", o.sigma},
-                          {"c1", o.c1},
+                          // The float flags as given (1.4, not 1.39999997...).
+                          {"sigma", std::round(double(o.sigma) * 1e6) / 1e6},
+                          {"c1", std::round(double(o.c1) * 1e6) / 1e6},
                           {"visible_interval", o.visible_interval},
                           {"methods", rows}};
     if (o.json) {
