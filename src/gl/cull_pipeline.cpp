@@ -360,17 +360,24 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         std::sort(culled.begin(), culled.end(), [](const PatchSpan& a, const PatchSpan& b) { return a.first < b.first; });
         plan_spans();
     };
-    if (two_pass && params.object_pass) {
-        // 1. occluders, then the object pass (each drawn object's patches tagged visible), then
-        // the patches outside every object tagged visible.
+    if (two_pass) {
+        // 1. occluders + patches tagged visible: with an object pass, the pass draws each object
+        // it finds visible (its patches tagged visible), then the patches outside every object.
         r.begin_frame(rp);
-        run_object_pass(false);
-        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, gaps_drawn);
+        if (params.object_pass) {
+            run_object_pass(false);
+            r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, gaps_drawn);
+        } else {
+            r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, drawn);
+        }
         clock.mark();
+        // 2. Hi-Z from that depth.
         m.ensure_hiz();
         m.hiz_build.run(r.depth_texture(), m.hiz);
         clock.mark();
+        // 3. test every patch (of the objects drawn), update statuses.
         run_chain(&m.hiz);
+        // 4. newly visible patches (seed 000 §3.1: skipped when aggressive).
         if (!frame.aggressive) r.draw_selected(sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass, drawn);
         clock.mark();
     } else if (params.object_pass) {
@@ -388,20 +395,6 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         for (const std::vector<PatchSpan>& spans : gap_spans)
             for (const PatchSpan& s : spans) m.status.end(buffers_of(s), m.counters, objects.size() * m.counter_stride);
         r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, gaps_drawn);
-        clock.mark();
-    } else if (two_pass) {
-        // 1. occluders + patches tagged visible.
-        r.begin_frame(rp);
-        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, drawn);
-        clock.mark();
-        // 2. Hi-Z from that depth.
-        m.ensure_hiz();
-        m.hiz_build.run(r.depth_texture(), m.hiz);
-        clock.mark();
-        // 3. test every patch, update statuses.
-        run_chain(&m.hiz);
-        // 4. newly visible patches (seed 000 §3.1: skipped when aggressive).
-        if (!frame.aggressive) r.draw_selected(sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass, drawn);
         clock.mark();
     } else {
         run_chain(nullptr);
