@@ -194,7 +194,7 @@ Runner add_eval_command(CLI::App& app) {
     auto scene = std::make_shared<SceneEvalOptions>();
     CLI::App* scene_command = eval->add_subcommand(
         "scene", "Issue 12: object-level occlusion (queries, CHC, CHC++, horizon, portals) beside per-patch Hi-Z on a scene's path");
-    add_text_option(*scene_command, "SCENE", scene->scene, "city, building, default, or a scene file (.json)")->required();
+    add_text_option(*scene_command, "SCENE", scene->scene, "a built-in scene (city, building, default), a scene file (.json), or a model (OBJ or teapot) as render takes it")->required();
     add_choice_option(*scene_command, "--scheme", scene->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*scene_command, "--frames", scene->frames, 1, 10000, "frames of the scene's camera path");
     add_size_option(*scene_command, "--size", scene->size, "framebuffer size");

@@ -5,7 +5,8 @@
 // al.'s occlusion horizons; Luebke & Georges' portals) with patchcull's per-patch Hi-Z culling
 // (Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation").
 //
-// SCENE is a built-in scene (city, building, default) or a scene file. Every method runs the
+// SCENE is a built-in scene (city, building, default), a scene file, or a model as `render` takes it
+// (make_model_scene: the model on a ground quad, no box occluders). Every method runs the
 // scene's camera path (frames 0..N-1, the animation at kSecondsPerFrame) from a first frame:
 //   none                the unculled frame (the ratios' denominator);
 //   hiz                 patchcull alone: cull mode occlusion (frustum + Hi-Z per patch), no object level;
