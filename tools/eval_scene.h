@@ -6,6 +6,8 @@
 
 #include <string>
 
+#include "patchcull/scene_occlusion.h"
+
 namespace patchcull::cli {
 
 struct SceneEvalOptions {
@@ -17,7 +19,7 @@ struct SceneEvalOptions {
     std::string methods;          ///< comma list of method names; empty: every one the scene allows
     int batch = 16;               ///< b: batched and CHC++'s I-queue
     float sigma = 1.4f;           ///< CHC++ tight bounding volumes
-    int max_tight_boxes = 16;
+    int max_tight_boxes = static_cast<int>(kDefaultMaxTightBoxes);
     float c1 = 0.1f;              ///< CHC++ multiquery cost per object
     int visible_interval = 1;     ///< CHC++: previously visible objects queried every n frames
     bool json = false;

@@ -152,7 +152,7 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
         objects.patches = instance_patches_.data();
         if (*query_method_ == gl::QueryMethod::chcpp && query_options_.tight_bounds) {
             if (!tight_) tight_ = std::make_unique<SceneTightBounds>(*scene_, pose, poser.displacement_ranges());
-            tight_->update(pose, poser.displacement_ranges(), tight_sigma_, 16);
+            tight_->update(pose, poser.displacement_ranges(), tight_sigma_, kDefaultMaxTightBoxes);
             objects.tight = tight_->boxes().data();
             objects.tight_first = tight_->first().data();
         }

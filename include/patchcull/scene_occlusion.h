@@ -102,6 +102,10 @@ void merge_spans(std::vector<IndexSpan>& spans);
 /// points' AABB, grown by the patch's max |D| where displaced; built from the first pose given),
 /// refitted to each pose. Each instance's selected boxes hold all its patches' boxes, so
 /// everything it draws.
+/// Tight boxes per object when no count is asked for (render's chc++, eval scene's
+/// --max-tight-boxes default): the cap the sigma rule stops at.
+inline constexpr std::size_t kDefaultMaxTightBoxes = 16;
+
 class SceneTightBounds {
 public:
     /// pose: a pose of every instance (ScenePoser::pose), ranges: its displacement ranges (empty:
