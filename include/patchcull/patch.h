@@ -1,5 +1,5 @@
 // patchcull/patch.h: bicubic Bezier patches, their evaluation and 1-to-4 split, and the
-// structure-of-arrays batches the cull kernels read.
+// batches the cull kernels read (plain structure of arrays, or blocked in 16-patch blocks).
 //
 // Control point (i, j) of a patch, i along u and j along v, is cp[4*j + i]; B(u,v) =
 // sum_ij B_i(u) B_j(v) cp[4*j+i] with cubic Bernstein polynomials B_i. Control points are
@@ -7,7 +7,9 @@
 // positive weights w (seed 001 §3 allows rational patches; the kernels assume w > 0).
 #pragma once
 
+#include <cassert>
 #include <cstddef>
+#include <new>
 #include <cstdint>
 #include <vector>
 
@@ -57,22 +59,81 @@ void split_patch(const BezierPatch& patch, BezierPatch out[4]);
 /// Splits tangent patches the same way; derivatives are rescaled to the child's parameters.
 void split_tangents(const TangentPatches& tangents, TangentPatches out[4]);
 
-/// Structure-of-arrays patches: component c (0..3 = x,y,z,w) of control point k of patch p is
-/// data[(4*k + c) * stride + p]. stride is a multiple of kBatchAlignment and >= count, so SIMD
-/// kernels may load whole vectors past count (padding is zero).
+inline constexpr std::size_t kBatchAlignment = 16;  ///< floats; covers AVX-512 lanes
+
+/// Patches per block of the blocked layout (see PatchBatchView). Every x86 SIMD width Highway
+/// targets (4, 8 or 16 float lanes) divides it, so a SIMD group never straddles two blocks.
+inline constexpr std::size_t kBlockPatches = 16;
+/// Floats in one full block: 16 points x 4 components x kBlockPatches lanes (4 KiB).
+inline constexpr std::size_t kBlockFloats = 4 * kPatchPoints * kBlockPatches;
+
+/// A batch of patches as the cull kernels read it, in one of two layouts:
+///
+/// - plain structure of arrays (block_stride == 0, what PatchBatch holds): component c
+///   (0..3 = x,y,z,w) of control point k of patch p is data[(4*k + c) * stride + p]. stride is a
+///   multiple of kBatchAlignment and >= count, so SIMD kernels may load whole vectors past count
+///   (padding is zero). A group of 16 patches touches 64 arrays a whole stride apart: 64 memory
+///   streams, more than the hardware prefetchers follow, so large plain batches run far below the
+///   memory bandwidth (docs/PERFORMANCE.md, "Batches at the memory roof").
+/// - blocked, "array of structures of arrays" (block_stride != 0, what PatchBlocks holds): patches
+///   in blocks of kBlockPatches; block b starts at data + b * block_stride and, inside it,
+///   component (k, c) of lane j (patch b * kBlockPatches + j) is at (4*k + c) * stride + j, with
+///   stride == kBlockPatches. block_stride >= kBlockFloats (== packs the blocks). A block is one
+///   contiguous 4 KiB run, so a kernel reads one sequential stream. The last block is padded to
+///   kBlockPatches lanes (PatchBlocks zeroes the padding).
+///
+/// at() reads either layout; component() is the plain layout's array and must not be called on a
+/// blocked view. Kernels outside src/core (GL upload, evaluation, posing) take plain views only.
 struct PatchBatchView {
     const float* data = nullptr;
     std::size_t count = 0;
     std::size_t stride = 0;
+    std::size_t block_stride = 0;  ///< 0: plain SoA; else blocked (see above)
 
-    const float* component(int point, int c) const { return data + (4 * point + c) * stride; }
-    /// Patches [first, first + n) of this view (same stride).
-    PatchBatchView subrange(std::size_t first, std::size_t n) const { return {data + first, n, stride}; }
+    bool blocked() const { return block_stride != 0; }
+
+    /// Component c of control point `point` of every patch: plain views only (block_stride == 0).
+    const float* component(int point, int c) const {
+        assert(block_stride == 0 && "component() on a blocked view: use at()");
+        return data + (4 * point + c) * stride;
+    }
+
+    /// Component c of control point k of patch p (p < count), in either layout.
+    float at(std::size_t p, int k, int c) const {
+        const std::size_t a = static_cast<std::size_t>(4 * k + c) * stride;
+        if (block_stride == 0) return data[a + p];
+        return data[(p / kBlockPatches) * block_stride + a + p % kBlockPatches];
+    }
+
+    /// Patches [first, first + n) of this view (same layout and strides). For a blocked view first
+    /// must be a multiple of kBlockPatches (asserted in debug builds): a view starts at a block.
+    PatchBatchView subrange(std::size_t first, std::size_t n) const {
+        if (block_stride == 0) return {data + first, n, stride, 0};
+        assert(first % kBlockPatches == 0 && "blocked subrange must start at a block");
+        return {data + first / kBlockPatches * block_stride, n, stride, block_stride};
+    }
 };
 
-inline constexpr std::size_t kBatchAlignment = 16;  ///< floats; covers AVX-512 lanes
+namespace detail {
+/// Allocator for batch storage: 64-byte (cache line) aligned, so each SoA array and each block
+/// starts on a line and a 16-lane group reads exactly one line per component.
+template <class T>
+struct CacheAlignedAllocator {
+    using value_type = T;
+    static constexpr std::align_val_t kAlign{64};
+    CacheAlignedAllocator() = default;
+    template <class U>
+    CacheAlignedAllocator(const CacheAlignedAllocator<U>&) {}
+    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlign)); }
+    void deallocate(T* p, std::size_t) { ::operator delete(p, kAlign); }
+    template <class U>
+    bool operator==(const CacheAlignedAllocator<U>&) const { return true; }
+};
+using AlignedFloats = std::vector<float, CacheAlignedAllocator<float>>;
+}  // namespace detail
 
-/// Owning structure-of-arrays patch batch (see PatchBatchView for the layout).
+/// Owning plain structure-of-arrays patch batch (see PatchBatchView for the layout). Storage is
+/// 64-byte aligned.
 class PatchBatch {
 public:
     PatchBatch() = default;
@@ -88,15 +149,52 @@ public:
 
     void set(std::size_t index, const BezierPatch& patch);
     BezierPatch get(std::size_t index) const;
-    PatchBatchView view() const { return {data_.data(), count_, stride_}; }
+    PatchBatchView view() const { return {data_.data(), count_, stride_, 0}; }
 
 private:
-    std::vector<float> data_;
+    detail::AlignedFloats data_;
     std::size_t count_ = 0;
     std::size_t stride_ = 0;
 };
 
+/// Owning blocked patch batch (the blocked layout of PatchBatchView, blocks packed:
+/// block_stride == kBlockFloats). Storage is 64-byte aligned; ceil(count / kBlockPatches) blocks,
+/// the last one's unused lanes zero. Same interface as PatchBatch, plus a copy of any view.
+class PatchBlocks {
+public:
+    PatchBlocks() = default;
+    explicit PatchBlocks(std::size_t count) { resize(count); }
+    /// A blocked copy of `patches` (either layout), patch for patch.
+    explicit PatchBlocks(const PatchBatchView& patches);
+
+    /// Sets the patch count; contents are zeroed.
+    void resize(std::size_t count);
+    std::size_t size() const { return count_; }
+    std::size_t blocks() const { return (count_ + kBlockPatches - 1) / kBlockPatches; }
+
+    void set(std::size_t index, const BezierPatch& patch);
+    BezierPatch get(std::size_t index) const;
+    PatchBatchView view() const { return {data_.data(), count_, kBlockPatches, kBlockFloats}; }
+
+private:
+    detail::AlignedFloats data_;
+    std::size_t count_ = 0;
+};
+
+/// Patch p of a view (either layout).
+BezierPatch get_patch(const PatchBatchView& patches, std::size_t p);
+
+/// Process-wide software prefetch distance of the SIMD kernels on plain views, in patches ahead
+/// of the group being read (0 = off; the default is the distance measured best in
+/// docs/PERFORMANCE.md, "Batches at the memory roof"). Read once per kernel call; blocked views
+/// never prefetch (one sequential stream the hardware follows). Meant for benchmarks.
+void set_plain_prefetch_distance(std::size_t patches);
+std::size_t plain_prefetch_distance();
+
 /// Builds a batch from an array of patches.
 PatchBatch make_batch(const std::vector<BezierPatch>& patches);
+
+/// A plain copy of `patches` (either layout), patch for patch.
+PatchBatch copy_to_batch(const PatchBatchView& patches);
 
 }  // namespace patchcull

@@ -1,7 +1,8 @@
-// Bezier patch evaluation, de Casteljau split and SoA batches (patchcull/patch.h).
+// Bezier patch evaluation, de Casteljau split, plain (SoA) and blocked batches (patchcull/patch.h).
 #include "patchcull/patch.h"
 
 #include <algorithm>
+#include <atomic>
 
 namespace patchcull {
 namespace {
@@ -158,5 +159,55 @@ PatchBatch make_batch(const std::vector<BezierPatch>& patches) {
     for (std::size_t i = 0; i < patches.size(); ++i) batch.set(i, patches[i]);
     return batch;
 }
+
+PatchBatch copy_to_batch(const PatchBatchView& patches) {
+    PatchBatch batch(patches.count);
+    for (std::size_t i = 0; i < patches.count; ++i) batch.set(i, get_patch(patches, i));
+    return batch;
+}
+
+BezierPatch get_patch(const PatchBatchView& v, std::size_t p) {
+    BezierPatch patch;
+    for (int k = 0; k < kPatchPoints; ++k) patch.cp[k] = {v.at(p, k, 0), v.at(p, k, 1), v.at(p, k, 2), v.at(p, k, 3)};
+    return patch;
+}
+
+// ---- blocked batches ---------------------------------------------------------------------------
+
+PatchBlocks::PatchBlocks(const PatchBatchView& patches) {
+    resize(patches.count);
+    for (std::size_t p = 0; p < patches.count; ++p) {
+        float* lane = data_.data() + (p / kBlockPatches) * kBlockFloats + p % kBlockPatches;
+        for (int a = 0; a < 4 * kPatchPoints; ++a) lane[a * kBlockPatches] = patches.at(p, a / 4, a % 4);
+    }
+}
+
+void PatchBlocks::resize(std::size_t count) {
+    count_ = count;
+    data_.assign(blocks() * kBlockFloats, 0.0f);
+}
+
+void PatchBlocks::set(std::size_t index, const BezierPatch& patch) {
+    float* lane = data_.data() + (index / kBlockPatches) * kBlockFloats + index % kBlockPatches;
+    for (int k = 0; k < kPatchPoints; ++k) {
+        lane[(4 * k + 0) * kBlockPatches] = patch.cp[k].x;
+        lane[(4 * k + 1) * kBlockPatches] = patch.cp[k].y;
+        lane[(4 * k + 2) * kBlockPatches] = patch.cp[k].z;
+        lane[(4 * k + 3) * kBlockPatches] = patch.cp[k].w;
+    }
+}
+
+BezierPatch PatchBlocks::get(std::size_t index) const { return get_patch(view(), index); }
+
+// ---- prefetch distance -------------------------------------------------------------------------
+
+namespace {
+// Measured on a 2-core Sapphire Rapids VM (docs/PERFORMANCE.md, "Batches at the memory roof").
+constexpr std::size_t kDefaultPrefetchDistance = 0;
+std::atomic<std::size_t> g_prefetch_distance{kDefaultPrefetchDistance};
+}  // namespace
+
+void set_plain_prefetch_distance(std::size_t patches) { g_prefetch_distance.store(patches, std::memory_order_relaxed); }
+std::size_t plain_prefetch_distance() { return g_prefetch_distance.load(std::memory_order_relaxed); }
 
 }  // namespace patchcull

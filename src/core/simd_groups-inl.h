@@ -2,10 +2,16 @@
 // backpatch_cones_simd.cpp, ptp_simd.cpp, hiz_simd.cpp); private to patchcull.
 //
 // Lanes are patches: lane j of a vector holds patch i + j, loaded straight from a PatchBatchView's
-// SoA arrays (unaligned loads, so subranges at any offset work). The last partial group of a call
-// is copied to a stack buffer whose unused lanes repeat the last patch (finite values with the
-// caller's weights), so no load ever leaves the caller's arrays (a subrange's padding may belong
-// to other patches or lie past the allocation) and only valid decisions are written.
+// arrays (unaligned loads, so plain subranges at any offset work), in either layout (GroupAt): a
+// plain view's 64 component arrays, or a blocked view's 16-patch block, where a group of
+// Lanes(d) <= 16 patches never straddles two blocks. The last partial group of a call is copied
+// (through PatchBatchView::at) to a stack buffer whose unused lanes repeat the last patch (finite
+// values with the caller's weights), so no load ever leaves the caller's arrays (a subrange's
+// padding may belong to other patches or lie past the allocation) and only valid decisions are
+// written.
+//
+// Plain views may prefetch (PrefetchGroup, distance from plain_prefetch_distance()): each group
+// reads 64 arrays a stride apart, more streams than the hardware prefetchers track.
 //
 // Exact arithmetic: Fma, NegFma and FmaSub round once, like std::fma, on every target. Targets
 // without an FMA instruction (HWY_NATIVE_FMA == 0: SSSE3, SSE4, emulated, i.e. pre-2013 CPUs)
@@ -26,6 +32,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include <hwy/cache_control.h>
 #include <hwy/highway.h>
 
 #include "patchcull/patch.h"
@@ -87,15 +94,31 @@ struct Group {
     }
 };
 
+// The full group of patches starting at first (a multiple of Lanes(d), or any index for a plain
+// view), read in place in either layout. Lanes(d) divides kBlockPatches on every x86 target, so a
+// blocked group lies inside one block.
+HWY_INLINE Group GroupAt(const PatchBatchView& patches, std::size_t first) {
+    static_assert(kBlockPatches % kMaxLanes == 0, "a SIMD group must not straddle two blocks");
+    if (patches.block_stride == 0) return Group{patches.data + first, patches.stride};
+    return Group{patches.data + (first / kBlockPatches) * patches.block_stride + first % kBlockPatches, patches.stride};
+}
+
+// Prefetches the 64 cache lines that patch `first` of a plain view lies on (one per component
+// array; a 16-patch group reads one line per array when the arrays are 64-byte aligned). No-op
+// past the view's end; prefetches never fault.
+HWY_INLINE void PrefetchGroup(const PatchBatchView& patches, std::size_t first) {
+    if (first >= patches.count) return;
+    const float* p = patches.data + first;
+    for (int a = 0; a < kComponents; ++a) hwy::Prefetch(p + static_cast<std::size_t>(a) * patches.stride);
+}
+
 // The group of patches [first, first + valid) of patches, valid < Lanes(d), copied to buf
 // (kComponents * kMaxLanes floats) with the unused lanes repeating the last patch.
 HWY_INLINE Group CopyPartialGroup(DF d, const PatchBatchView& patches, std::size_t first, std::size_t valid,
                                   float* buf) {
     const std::size_t N = hn::Lanes(d);
-    for (int a = 0; a < kComponents; ++a) {
-        const float* src = patches.data + static_cast<std::size_t>(a) * patches.stride + first;
-        for (std::size_t j = 0; j < N; ++j) buf[a * N + j] = src[j < valid ? j : valid - 1];
-    }
+    for (int a = 0; a < kComponents; ++a)
+        for (std::size_t j = 0; j < N; ++j) buf[a * N + j] = patches.at(first + (j < valid ? j : valid - 1), a / 4, a % 4);
     return Group{buf, N};
 }
 
@@ -123,19 +146,25 @@ HWY_INLINE void StoreDecisions(DF d, MF culled, std::uint8_t* out, std::size_t n
     }
 }
 
-// culled[i] = group_fn(d, group, first, valid) for every group of patches: full groups in place,
-// the last partial one from a padded stack copy. group_fn returns the culled mask of its lanes;
-// first is the index of its lane 0 and valid the number of real patches in it (for side inputs,
-// see LoadPadded).
+// culled[i] = group_fn(d, group, first, valid) for every group of patches: full groups in place
+// (GroupAt), the last partial one from a padded stack copy. group_fn returns the culled mask of its
+// lanes; first is the index of its lane 0 and valid the number of real patches in it (for side
+// inputs, see LoadPadded). Plain views prefetch plain_prefetch_distance() patches ahead, once per
+// 16 patches (one cache line of each array); blocked views are one sequential stream and do not.
 template <class GroupFn>
 HWY_INLINE void ForEachGroup(const PatchBatchView& patches, std::uint8_t* culled, const GroupFn& group_fn) {
     const DF d;
     const std::size_t N = hn::Lanes(d);
     const std::size_t count = patches.count;
     std::size_t i = 0;
-    for (; i + N <= count; i += N) {
-        const Group g{patches.data + i, patches.stride};
-        StoreDecisions(d, group_fn(d, g, i, N), culled + i, N);
+    if (patches.block_stride != 0) {
+        for (; i + N <= count; i += N) StoreDecisions(d, group_fn(d, GroupAt(patches, i), i, N), culled + i, N);
+    } else {
+        const std::size_t ahead = plain_prefetch_distance();
+        for (; i + N <= count; i += N) {
+            if (ahead != 0 && i % kBlockPatches == 0) PrefetchGroup(patches, i + ahead);
+            StoreDecisions(d, group_fn(d, GroupAt(patches, i), i, N), culled + i, N);
+        }
     }
     if (i == count) return;
     const std::size_t n = count - i;
