@@ -268,8 +268,7 @@ PATCHCULL_DISPLACED_INLINE DisplacedBound oobb_bound(const Vec3 p[kPatchPoints],
 PATCHCULL_DISPLACED_INLINE BezierPatch gather(const PatchBatchView& v, std::size_t index) {
     BezierPatch patch;
     for (int k = 0; k < kPatchPoints; ++k)
-        patch.cp[k] = {v.component(k, 0)[index], v.component(k, 1)[index], v.component(k, 2)[index],
-                       v.component(k, 3)[index]};
+        patch.cp[k] = {v.at(index, k, 0), v.at(index, k, 1), v.at(index, k, 2), v.at(index, k, 3)};
     return patch;
 }
 

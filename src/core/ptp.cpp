@@ -250,8 +250,8 @@ void cull_ptp_scalar(const PatchBatchView& patches, const Mat4& object_to_clip, 
     for (std::size_t p = 0; p < patches.count; ++p) {
         float X[16], Y[16], Z[16], W[16];
         for (int k = 0; k < 16; ++k) {
-            X[k] = patches.component(k, 0)[p], Y[k] = patches.component(k, 1)[p];
-            Z[k] = patches.component(k, 2)[p], W[k] = patches.component(k, 3)[p];
+            X[k] = patches.at(p, k, 0), Y[k] = patches.at(p, k, 1);
+            Z[k] = patches.at(p, k, 2), W[k] = patches.at(p, k, 3);
         }
         culled[p] = decide(X, Y, Z, W, rows, pcnt) ? 1 : 0;
     }
