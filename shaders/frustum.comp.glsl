@@ -19,7 +19,7 @@ layout(std430, binding = kBindingPlaneValues) writeonly buffer PlaneValues {
 };
 
 // frustum_test.h's names.
-#define u_plane_rows frustum.plane_rows
+#define u_clip_rows frustum.clip_rows
 #define u_plane_normal_length frustum.plane_normal_length
 #include "frustum_test.h"
 
@@ -28,7 +28,7 @@ void main() {
     if (gl_GlobalInvocationID.x >= frustum.patch_count || pc_chain_culled(p)) return;
     const float d = pc_margin(p, frustum.has_margins);
     float mx[6];
-    if (pc_frustum_culled(p, d, mx)) pc_chain_cull(p, kCullFrustum);
+    if (pc_frustum_culled(p, frustum.has_margins != 0u, d, mx)) pc_chain_cull(p, kCullFrustum);
     if (frustum.write_plane_values != 0u)
         for (int q = 0; q < 6; ++q) plane_values[6u * p + uint(q)] = mx[q];
 }

@@ -1,34 +1,61 @@
 // shaders/frustum_test.h (GLSL only): the frustum decision of cull_frustum_scalar
-// (include/patchcull/frustum.h) for one patch, shared by frustum.comp.glsl and
-// occlusion.comp.glsl so that both passes make the same decisions.
+// (include/patchcull/frustum.h) for one patch, shared by frustum.comp.glsl, occlusion.comp.glsl
+// and the fused pass, so that they all make the same decisions.
 //
-// For each clip plane q with row r and margin c = fma(D, |r.xyz|, r.w),
-// value_k = fma(c, W, fma(r.z, Z, fma(r.y, Y, r.x * X))) for control point k = (X, Y, Z, W); the
-// patch is culled when the maximum over the 16 points is < 0 for some plane. `precise` keeps the
-// compiler from contracting or reassociating; max is written as the CPU's `a > b ? a : b`; pc_fma
-// is exactly rounded also on llvmpipe (exact_fma.h).
+// For each control point k = (X, Y, Z, W): clip coordinates once,
+// c_r = fma(M(r,3), W, fma(M(r,2), Z, fma(M(r,1), Y, M(r,0) * X))) (hiz.h's step 2), then the plane
+// values w + x, w - x, w + y, w - y, z, w - z, and with margins fma(d * |plane row xyz|, W, value)
+// (frustum_plane_values / add_frustum_margins in frustum.h); the patch is culled when the maximum
+// over the 16 points is < 0 for some plane. `precise` keeps the compiler from contracting or
+// reassociating; max is written as the CPU's `a > b ? a : b`; pc_fma is exactly rounded also on
+// llvmpipe (exact_fma.h).
 //
 // The including shader declares, before including this file: exact_fma.h, the buffer
-// control_points[] (kBindingControlPoints) and the names u_plane_rows (vec4[6], FrustumPlanes::rows)
+// control_points[] (kBindingControlPoints) and the names u_clip_rows (vec4[4], FrustumPlanes::clip_rows)
 // and u_plane_normal_length (vec4[2]: FrustumPlanes::normal_length[q] at [q >> 2][q & 3]), #defines
 // onto its parameter block (pass_params.h).
 
-// True when patch p with displacement margin d lies outside one plane; mx receives the six maxima.
-bool pc_frustum_culled(uint p, float d, out float mx[6]) {
-    precise float c[6];
+// Plane values of clip-space point c (before margins).
+void pc_frustum_plane_values(const vec4 c, out float v[6]) {
+    precise float s[6];
+    s[0] = c.w + c.x;
+    s[1] = c.w - c.x;
+    s[2] = c.w + c.y;
+    s[3] = c.w - c.y;
+    s[4] = c.z;
+    s[5] = c.w - c.z;
+    v = s;
+}
+
+// Clip coordinates of object-space point P (hiz.h's step 2).
+vec4 pc_clip_point(const vec4 P) {
+    precise vec4 c;
+    for (int r = 0; r < 4; ++r) {
+        const vec4 m = u_clip_rows[r];
+        precise float t = m.x * P.x;
+        t = pc_fma(m.y, P.y, t);
+        t = pc_fma(m.z, P.z, t);
+        c[r] = pc_fma(m.w, P.w, t);
+    }
+    return c;
+}
+
+// True when patch p, with displacement margin d when with_margins, lies outside one plane; mx
+// receives the six maxima.
+bool pc_frustum_culled(uint p, bool with_margins, float d, out float mx[6]) {
+    precise float margin[6];
     precise float m[6];
     for (int q = 0; q < 6; ++q) {
-        c[q] = pc_fma(d, u_plane_normal_length[q >> 2][q & 3], u_plane_rows[q].w);
+        margin[q] = d * u_plane_normal_length[q >> 2][q & 3];
         m[q] = uintBitsToFloat(0xFF800000u);  // -infinity
     }
     for (uint k = 0u; k < 16u; ++k) {
         const vec4 point = control_points[16u * p + k];
+        float v[6];
+        pc_frustum_plane_values(pc_clip_point(point), v);
         for (int q = 0; q < 6; ++q) {
-            const vec4 r = u_plane_rows[q];
-            precise float value = r.x * point.x;
-            value = pc_fma(r.y, point.y, value);
-            value = pc_fma(r.z, point.z, value);
-            value = pc_fma(c[q], point.w, value);
+            precise float value = v[q];
+            if (with_margins) value = pc_fma(margin[q], point.w, value);
             m[q] = m[q] > value ? m[q] : value;
         }
     }

@@ -22,7 +22,7 @@ layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
 layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 
 // frustum_test.h's and hiz_box_test.h's names.
-#define u_plane_rows occlusion.plane_rows
+#define u_clip_rows occlusion.clip_rows
 #define u_plane_normal_length occlusion.plane_normal_length
 #define u_screen ivec2(occlusion.screen_width, occlusion.screen_height)
 #define u_hiz_levels occlusion.hiz_levels
@@ -95,7 +95,7 @@ void main() {
     const float d = pc_margin(p, occlusion.has_margins);
     if (occlusion.with_frustum != 0u) {
         float mx[6];
-        if (pc_frustum_culled(p, d, mx)) {
+        if (pc_frustum_culled(p, occlusion.has_margins != 0u, d, mx)) {
             pc_chain_cull(p, kCullFrustum);
             return;
         }

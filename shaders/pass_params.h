@@ -46,7 +46,7 @@ struct vec4 {
 
 // frustum.comp.glsl (FrustumPass): cull_frustum_scalar's test.
 PC_PARAMS(FrustumParams, kUniformPassParams) {
-    PC_VEC4(plane_rows[6]);            // FrustumPlanes::rows
+    PC_VEC4(clip_rows[4]);             // FrustumPlanes::clip_rows
     PC_VEC4(plane_normal_length[2]);   // FrustumPlanes::normal_length[q] at [q >> 2][q & 3]
     PC_UINT(first_patch);
     PC_UINT(patch_count);
@@ -66,7 +66,7 @@ PC_PARAMS(FrustumDispParams, kUniformPassParams) {
 // occlusion.comp.glsl (OcclusionPass): cull_occlusion_scalar's test against a Hi-Z pyramid.
 PC_PARAMS(OcclusionParams, kUniformPassParams) {
     PC_MAT4(object_to_clip);           // column-major, as Mat4::m
-    PC_VEC4(plane_rows[6]);            // make_frustum_planes(object_to_clip, zero_to_one)
+    PC_VEC4(clip_rows[4]);             // make_frustum_planes(object_to_clip, zero_to_one)
     PC_VEC4(plane_normal_length[2]);
     PC_UINT(first_patch);
     PC_UINT(patch_count);
@@ -147,6 +147,23 @@ PC_PARAMS(CullStatusParams, kUniformPassParams) {
     PC_UINT(has_margins);
     PC_UINT(mode);                     // kStatusBegin or kStatusEnd
 } PC_END(status);
+
+// fused_cull.comp.glsl (FusedCullPass): the frustum, back-patch cone and Hi-Z tests of one patch in
+// one invocation, in the chain's order (tcone, or ncone with PATCHCULL_NCONE).
+PC_PARAMS(FusedCullParams, kUniformPassParams) {
+    PC_VEC4(clip_rows[4]);             // FrustumPlanes::clip_rows of to_zero_to_one(object_to_clip): the
+                                       // frustum planes' and the Hi-Z test's clip transform (hiz.h step 2)
+    PC_VEC4(plane_normal_length[2]);   // FrustumPlanes::normal_length[q] at [q >> 2][q & 3]
+    PC_VEC4(eye);                      // object space, w unused (the cone test)
+    PC_UINT(first_patch);
+    PC_UINT(patch_count);
+    PC_UINT(has_margins);
+    PC_UINT(tests);                    // kCullFrustum | kCullBackPatch | kCullOcclusion: the tests run
+    PC_INT(screen_width);              // the pyramid's depth buffer W x H (with kCullOcclusion)
+    PC_INT(screen_height);
+    PC_INT(hiz_levels);                // HiZPyramid::level_count(W, H)
+    PC_FLOAT(zero);                    // 0.0 at run time (see BackpatchConeParams::zero)
+} PC_END(fused);
 
 #undef PC_PARAMS
 #undef PC_END

@@ -98,10 +98,12 @@
 // hiz_rect_from_window_box + hiz_rect_max + `h < zmin`, shared by both. The kernels below take no
 // displacement yet.
 //
-// SIMD: cull_occlusion_simd runs steps 1-6 (frustum test, 16x3 divisions per patch: the bulk of
-// the work) over Highway vectors, one patch per lane, and steps 7-9 (data-dependent level and up to
-// 4 texel loads: an irregular gather that vectors do not speed up) per patch with the same code as
-// the scalar reference. Decisions are identical to cull_occlusion_scalar (tested on every target).
+// SIMD: cull_occlusion_simd is the fused kernel (fused_cull.h) with the plan {frustum, occlusion}:
+// steps 1-6 (clip coordinates once for the frustum planes and the screen box, 16x3 divisions per
+// patch: the bulk of the work) over Highway vectors, one patch per lane, a group leaving once all
+// its lanes are frustum-culled, and steps 7-9 (data-dependent level and up to 4 texel loads: an
+// irregular gather that vectors do not speed up) per patch with the same code as the scalar
+// reference. Decisions are identical to cull_occlusion_scalar (tested on every target).
 //
 // Contracts: decision must hold patches.count bytes; the pyramid must be built; kernels never
 // allocate or throw. HiZPyramid::build allocates only when the size changes.

@@ -46,6 +46,10 @@ FrustumPlanes make_frustum_planes(const Mat4& any_object_to_clip, ClipDepth dept
     planes.rows[3] = w - y;  // top:    w - y >= 0
     planes.rows[4] = z;      // near:   z >= 0
     planes.rows[5] = w - z;  // far:    w - z >= 0
+    planes.clip_rows[0] = x;
+    planes.clip_rows[1] = y;
+    planes.clip_rows[2] = z;
+    planes.clip_rows[3] = w;
     for (int q = 0; q < 6; ++q) {
         const Vec4 r = planes.rows[q];
         const double xx = r.x, yy = r.y, zz = r.z;
@@ -54,33 +58,20 @@ FrustumPlanes make_frustum_planes(const Mat4& any_object_to_clip, ClipDepth dept
     return planes;
 }
 
-// frustum: culled when, for some plane q, every control point P_k has
-//   value = ((r.x*X + r.y*Y) + r.z*Z) + c*W < 0,  c = fma(D, |r.xyz|, r.w)
-// i.e. dot(r, P_k) + W_k * D * |r.xyz| < 0 (the margin scaled by the point's weight). Evaluated
-// as mul, fma, fma, fma (the SIMD kernel does exactly this).
+// frustum: culled when, for some plane q, every control point P_k has a plane value below 0
+// (frustum_plane_values, frustum.h: clip coordinates once, then w +- x, w +- y, z, w - z; with
+// margins, add_frustum_margins). The SIMD kernel does exactly these operations.
 PATCHCULL_SCALAR_CLONES
 void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement,
                          const FrustumPlanes& planes, std::uint8_t* culled) {
     for (std::size_t p = 0; p < patches.count; ++p) {
-        const float d = max_displacement ? max_displacement[p] : 0.0f;
-        float c[6], mx[6];
-        for (int q = 0; q < 6; ++q) {
-            c[q] = std::fma(d, planes.normal_length[q], planes.rows[q].w);
-            mx[q] = -std::numeric_limits<float>::infinity();
-        }
+        float mx[6], v[6];
+        for (int q = 0; q < 6; ++q) mx[q] = -std::numeric_limits<float>::infinity();
         for (int k = 0; k < kPatchPoints; ++k) {
-            const float X = comp(patches, k, 0)[p];
-            const float Y = comp(patches, k, 1)[p];
-            const float Z = comp(patches, k, 2)[p];
-            const float W = comp(patches, k, 3)[p];
-            for (int q = 0; q < 6; ++q) {
-                const Vec4 r = planes.rows[q];
-                float v = r.x * X;
-                v = std::fma(r.y, Y, v);
-                v = std::fma(r.z, Z, v);
-                v = std::fma(c[q], W, v);
-                mx[q] = max_like_simd(mx[q], v);
-            }
+            const float W = patches.at(p, k, 3);
+            frustum_plane_values(planes, patches.at(p, k, 0), patches.at(p, k, 1), patches.at(p, k, 2), W, v);
+            if (max_displacement) add_frustum_margins(planes, max_displacement[p], W, v);
+            for (int q = 0; q < 6; ++q) mx[q] = max_like_simd(mx[q], v[q]);
         }
         bool out = false;
         for (int q = 0; q < 6; ++q) out |= mx[q] < 0.0f;

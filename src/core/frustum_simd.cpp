@@ -22,6 +22,7 @@
 #include <hwy/highway.h>
 
 #include "core/simd_groups-inl.h"
+#include "core/frustum_groups-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace patchcull {
@@ -36,30 +37,20 @@ using simd_groups::LoadPadded;
 using simd_groups::MF;
 using simd_groups::VF;
 
-// frustum (see frustum.cpp for the operation order).
+// frustum (see frustum_groups-inl.h for the operation order).
+template <bool kMargins>
 HWY_INLINE MF FrustumGroup(DF d, const Group& g, VF disp, const FrustumPlanes& planes) {
-    VF rx[6], ry[6], rz[6], c[6], mx[6];
-    for (int q = 0; q < 6; ++q) {
-        rx[q] = hn::Set(d, planes.rows[q].x);
-        ry[q] = hn::Set(d, planes.rows[q].y);
-        rz[q] = hn::Set(d, planes.rows[q].z);
-        c[q] = Fma(d, disp, hn::Set(d, planes.normal_length[q]), hn::Set(d, planes.rows[q].w));
-        mx[q] = hn::Set(d, -std::numeric_limits<float>::infinity());
-    }
+    const frustum_groups::ClipRows rows(d, planes);
+    VF margin[6];
+    if constexpr (kMargins) frustum_groups::Margins(d, disp, planes, margin);
+    frustum_groups::PlaneMaxima maxima(d);
     for (int k = 0; k < kPatchPoints; ++k) {
         const VF X = g.load(d, k, 0), Y = g.load(d, k, 1), Z = g.load(d, k, 2), W = g.load(d, k, 3);
-        for (int q = 0; q < 6; ++q) {
-            VF v = hn::Mul(rx[q], X);
-            v = Fma(d, ry[q], Y, v);
-            v = Fma(d, rz[q], Z, v);
-            v = Fma(d, c[q], W, v);
-            mx[q] = hn::Max(mx[q], v);
-        }
+        VF c[4];
+        frustum_groups::ClipPoint(d, rows, X, Y, Z, W, c);
+        maxima.add<kMargins>(d, c, W, margin);
     }
-    const VF zero = hn::Zero(d);
-    MF out = hn::Lt(mx[0], zero);
-    for (int q = 1; q < 6; ++q) out = hn::Or(out, hn::Lt(mx[q], zero));
-    return out;
+    return maxima.outside(d);
 }
 
 // Cartesian AABB of the group's control points. kPolynomial: every weight is exactly 1, so
@@ -140,8 +131,14 @@ HWY_INLINE VF GroupDisplacement(DF d, const float* max_displacement, std::size_t
 
 void CullFrustum(const PatchBatchView& patches, const float* max_displacement,
                  const FrustumPlanes& planes, std::uint8_t* culled) {
+    if (max_displacement == nullptr) {
+        ForEachGroup(patches, culled, [&](DF d, const Group& g, std::size_t, std::size_t) {
+            return FrustumGroup<false>(d, g, hn::Zero(d), planes);
+        });
+        return;
+    }
     ForEachGroup(patches, culled, [&](DF d, const Group& g, std::size_t first, std::size_t valid) {
-        return FrustumGroup(d, g, GroupDisplacement(d, max_displacement, first, valid), planes);
+        return FrustumGroup<true>(d, g, GroupDisplacement(d, max_displacement, first, valid), planes);
     });
 }
 

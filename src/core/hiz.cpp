@@ -145,8 +145,8 @@ inline bool patch_bounds(const PatchBatchView& v, std::size_t p, const ClipRows&
                          PatchScreenBounds& out) {
     float nxmin = 0, nxmax = 0, nymin = 0, nymax = 0, zmin = 0;
     for (int k = 0; k < kPatchPoints; ++k) {
-        const float X = v.component(k, 0)[p], Y = v.component(k, 1)[p];
-        const float Z = v.component(k, 2)[p], W = v.component(k, 3)[p];
+        const float X = v.at(p, k, 0), Y = v.at(p, k, 1);
+        const float Z = v.at(p, k, 2), W = v.at(p, k, 3);
         float c[4];
         for (int r = 0; r < 4; ++r) {
             float t = cr.m[r][0] * X;

@@ -15,14 +15,16 @@ using namespace detail;
 
 // The C++ structs are the GLSL std140 blocks (pass_params.h): sizes a multiple of 16, members in
 // std140 order (matrices and vec4 arrays first, then 4-byte scalars).
-static_assert(sizeof(pp::FrustumParams) == 6 * 16 + 2 * 16 + 16);
-static_assert(sizeof(pp::OcclusionParams) == 64 + 6 * 16 + 2 * 16 + 32);
+static_assert(sizeof(pp::FrustumParams) == 4 * 16 + 2 * 16 + 16);
+static_assert(sizeof(pp::OcclusionParams) == 64 + 4 * 16 + 2 * 16 + 32);
 static_assert(sizeof(pp::HiZBuildParams) == 32);
 static_assert(sizeof(pp::BackpatchConeParams) == 16 + 32);
 static_assert(sizeof(pp::BackpatchPtpParams) == 3 * 16 + 32);
 static_assert(sizeof(pp::DisplacedParams) == 64 + 6 * 16 + 3 * 16 + 5 * 16 + 48);
 static_assert(sizeof(pp::CullStatusParams) == 16);
-static_assert(offsetof(pp::OcclusionParams, first_patch) == 64 + 6 * 16 + 2 * 16);
+static_assert(sizeof(pp::FusedCullParams) == 4 * 16 + 2 * 16 + 16 + 32);
+static_assert(offsetof(pp::FusedCullParams, first_patch) == 4 * 16 + 2 * 16 + 16);
+static_assert(offsetof(pp::OcclusionParams, first_patch) == 64 + 4 * 16 + 2 * 16);
 static_assert(offsetof(pp::DisplacedParams, first_patch) == 64 + 6 * 16 + 3 * 16 + 5 * 16);
 
 PassContext::Impl::~Impl() {
@@ -245,12 +247,13 @@ void finish_pass(const char* who) {
     check_gl(who);
 }
 
-void store_planes(const FrustumPlanes& planes, pp::vec4 rows[6], pp::vec4 normal_length[2]) {
-    float nl[8] = {};
-    for (int q = 0; q < 6; ++q) {
-        rows[q] = {planes.rows[q].x, planes.rows[q].y, planes.rows[q].z, planes.rows[q].w};
-        nl[q] = planes.normal_length[q];
+void store_planes(const FrustumPlanes& planes, pp::vec4 clip_rows[4], pp::vec4 normal_length[2]) {
+    for (int r = 0; r < 4; ++r) {
+        const Vec4 m = planes.clip_rows[r];
+        clip_rows[r] = {m.x, m.y, m.z, m.w};
     }
+    float nl[8] = {};
+    for (int q = 0; q < 6; ++q) nl[q] = planes.normal_length[q];
     normal_length[0] = {nl[0], nl[1], nl[2], nl[3]};
     normal_length[1] = {nl[4], nl[5], nl[6], nl[7]};
 }

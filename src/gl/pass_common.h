@@ -91,8 +91,8 @@ void bind_patch_buffers(const PatchBuffers& patches);
 /// The end of every run(): no program, the barrier of the state contract, GL error check.
 void finish_pass(const char* who);
 
-/// Copies a FrustumPlanes into a parameter block's plane_rows / plane_normal_length.
-void store_planes(const FrustumPlanes& planes, pp::vec4 rows[6], pp::vec4 normal_length[2]);
+/// Copies a FrustumPlanes into a parameter block's clip_rows / plane_normal_length.
+void store_planes(const FrustumPlanes& planes, pp::vec4 clip_rows[4], pp::vec4 normal_length[2]);
 
 }  // namespace detail
 }  // namespace patchcull::gl

@@ -59,25 +59,18 @@ RandomCase random_case(std::uint32_t seed, std::size_t count) {
     return c;
 }
 
-// cull_frustum_scalar's arithmetic (src/core/frustum.cpp), returning the per-plane maxima the
-// decision compares with 0: what the GPU pass reports through plane_values.
+// cull_frustum_scalar's arithmetic (frustum_plane_values / add_frustum_margins, frustum.h),
+// returning the per-plane maxima the decision compares with 0: what the GPU pass reports through
+// plane_values.
 std::vector<float> cpu_plane_values(const std::vector<BezierPatch>& patches, const float* disp,
                                     const FrustumPlanes& planes) {
-    std::vector<float> out(6 * patches.size());
+    std::vector<float> out(6 * patches.size(), -std::numeric_limits<float>::infinity());
     for (std::size_t p = 0; p < patches.size(); ++p) {
-        const float d = disp ? disp[p] : 0.0f;
-        for (int q = 0; q < 6; ++q) {
-            const Vec4 r = planes.rows[q];
-            const float c = std::fma(d, planes.normal_length[q], r.w);
-            float mx = -std::numeric_limits<float>::infinity();
-            for (const Vec4& P : patches[p].cp) {
-                float v = r.x * P.x;
-                v = std::fma(r.y, P.y, v);
-                v = std::fma(r.z, P.z, v);
-                v = std::fma(c, P.w, v);
-                mx = mx > v ? mx : v;
-            }
-            out[6 * p + q] = mx;
+        for (const Vec4& P : patches[p].cp) {
+            float v[6];
+            frustum_plane_values(planes, P.x, P.y, P.z, P.w, v);
+            if (disp) add_frustum_margins(planes, disp[p], P.w, v);
+            for (int q = 0; q < 6; ++q) out[6 * p + q] = out[6 * p + q] > v[q] ? out[6 * p + q] : v[q];
         }
     }
     return out;
@@ -136,23 +129,19 @@ TEST(GpuFrustumCull, SameDecisionsAsCpuKernelOnRandomInputs) {
 }
 
 TEST(GpuFrustumCull, MultiplyAddIsRoundedOnceOnHardCases) {
-    // Planes built by hand (not from a matrix) so that plane q's value for a patch whose 16 points
-    // are all (C, 0, 0, B) is exactly fma(A_q, B, C): rows (1, 0, 0, A_q), no margin. With
-    // A = 2^-24 (1 + 2^-23), B = 1 - 2^-23, C = 1 + 2^-23, A*B + C lies 2^-70 below the midpoint
-    // between C and its upper neighbour: the once-rounded result is C; rounding twice (through
-    // float or double) ties to the even neighbour 1 + 2^-22. Variants: mirrored signs, powers of
-    // two, and random triples.
+    // Clip rows built by hand (not from a matrix) so that the near plane's value (the clip z) for a
+    // patch whose 16 points are all (C, 0, 0, B) is exactly fma(A, B, C): z row (1, 0, 0, A), no
+    // margin. With A = 2^-24 (1 + 2^-23), B = 1 - 2^-23, C = 1 + 2^-23, A*B + C lies 2^-70 below the
+    // midpoint between C and its upper neighbour: the once-rounded result is C; rounding twice
+    // (through float or double) ties to the even neighbour 1 + 2^-22. Variants: mirrored signs,
+    // powers of two (one pass per A), and random triples; the other planes' values are checked
+    // against the CPU's bit for bit as well.
     const float A = std::ldexp(1.0f + std::ldexp(1.0f, -23), -24);
     const float B = 1.0f - std::ldexp(1.0f, -23);
     const float C = 1.0f + std::ldexp(1.0f, -23);
     ASSERT_EQ(std::fma(A, B, C), C);
     ASSERT_NE(static_cast<float>(static_cast<double>(A) * B + C), C);  // the double-rounding trap
-    FrustumPlanes planes;
     const float a_values[6] = {A, -A, 2 * A, A / 2, -2 * A, 0.75f};
-    for (int q = 0; q < 6; ++q) {
-        planes.rows[q] = {1, 0, 0, a_values[q]};
-        planes.normal_length[q] = 0;
-    }
     std::vector<std::pair<float, float>> bc;  // (B, C) per patch
     for (int k = -20; k <= 20; k += 4) {
         bc.push_back({std::ldexp(B, k), std::ldexp(C, k)});
@@ -168,22 +157,34 @@ TEST(GpuFrustumCull, MultiplyAddIsRoundedOnceOnHardCases) {
 
     PatchRenderer r(test::context());
     r.set_patches(patches);
-    std::vector<float> values;
-    test::cull_frustum(r, planes, &values);
-    ASSERT_EQ(values.size(), 6 * patches.size());
     std::size_t wrong = 0;
-    for (std::size_t p = 0; p < patches.size(); ++p)
-        for (int q = 0; q < 6; ++q) {
-            const float expected = std::fma(a_values[q], bc[p].first, bc[p].second);
-            if (bits(values[6 * p + q]) != bits(expected) && ++wrong <= 5)
-                ADD_FAILURE() << "fma(" << a_values[q] << ", " << bc[p].first << ", " << bc[p].second << "): GPU "
-                              << values[6 * p + q] << " expected " << expected;
+    for (const float a : a_values) {
+        FrustumPlanes planes;
+        planes.clip_rows[0] = {1, 0, 0, -a};
+        planes.clip_rows[1] = {0.5f, 0, 0, a};
+        planes.clip_rows[2] = {1, 0, 0, a};
+        planes.clip_rows[3] = {1, 0, 0, 2 * a};
+        for (float& n : planes.normal_length) n = 0;
+        std::vector<float> values;
+        test::cull_frustum(r, planes, &values);
+        ASSERT_EQ(values.size(), 6 * patches.size());
+        const std::vector<float> cpu_values = cpu_plane_values(patches, nullptr, planes);
+        for (std::size_t p = 0; p < patches.size(); ++p) {
+            const float expected = std::fma(a, bc[p].first, bc[p].second);
+            if (bits(values[6 * p + 4]) != bits(expected) && ++wrong <= 5)
+                ADD_FAILURE() << "fma(" << a << ", " << bc[p].first << ", " << bc[p].second << "): GPU "
+                              << values[6 * p + 4] << " expected " << expected;
+            for (int q = 0; q < 6; ++q)
+                if (bits(values[6 * p + q]) != bits(cpu_values[6 * p + q]) && ++wrong <= 5)
+                    ADD_FAILURE() << "plane " << q << " patch " << p << ": GPU " << values[6 * p + q] << " CPU "
+                                  << cpu_values[6 * p + q];
         }
+        const auto flags = r.read_cull_flags();
+        std::vector<std::uint8_t> cpu(patches.size());
+        cull_frustum_scalar(make_batch(patches).view(), nullptr, planes, cpu.data());
+        for (std::size_t p = 0; p < patches.size(); ++p) ASSERT_EQ(flags[p] != 0, cpu[p] != 0) << "patch " << p;
+    }
     EXPECT_EQ(wrong, 0u) << (test::passes().fma_via_double() ? "double-precision emulation" : "native GLSL fma");
-    const auto flags = r.read_cull_flags();
-    std::vector<std::uint8_t> cpu(patches.size());
-    cull_frustum_scalar(make_batch(patches).view(), nullptr, planes, cpu.data());
-    for (std::size_t p = 0; p < patches.size(); ++p) ASSERT_EQ(flags[p] != 0, cpu[p] != 0) << "patch " << p;
 }
 
 TEST(GpuFrustumCull, MarginIsUsedAndBeginClearsStaleReasons) {
