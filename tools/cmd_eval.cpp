@@ -22,6 +22,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "eval_displaced.h"
+#include "eval_fused.h"
 #include "eval_scene.h"
 #include "eval_temporal.h"
 #include "patchcull/error.h"
@@ -135,7 +136,7 @@ int run_occlusion(const OcclusionOptions& o) {
 }  // namespace
 
 Runner add_eval_command(CLI::App& app) {
-    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion, eval displaced, eval temporal, eval scene)");
+    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion, eval displaced, eval temporal, eval scene, eval fused)");
     // At most one; none is reported by the runner ("eval: expected a subcommand ..."), which names
     // the command, unlike CLI11's own message.
     eval->require_subcommand(0, 1);
@@ -208,13 +209,29 @@ Runner add_eval_command(CLI::App& app) {
     add_int_option(*scene_command, "--visible-interval", scene->visible_interval, 1, 100,
                    "CHC++: previously visible objects queried every N frames");
     scene_command->add_flag("--json", scene->json, "print one JSON object");
-    return [command, occlusion, displaced_command, displaced, temporal_command, temporal, scene_command, scene]() {
+
+    auto fused = std::make_shared<FusedEvalOptions>();
+    CLI::App* fused_command = eval->add_subcommand(
+        "fused", "Issue 14: the fused CPU cull kernel's fixed plans against its cost model on a scene's path");
+    add_text_option(*fused_command, "SCENE", fused->scene, "a built-in scene (city, building, default), a scene file (.json), or a model (OBJ or teapot) as render takes it")->required();
+    add_choice_option(*fused_command, "--scheme", fused->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
+    add_int_option(*fused_command, "--frames", fused->frames, 1, 10000, "frames of the scene's camera path");
+    add_size_option(*fused_command, "--size", fused->size, "framebuffer size (the depth that feeds the Hi-Z pyramid)");
+    add_int_option(*fused_command, "--tess", fused->tess, 1, 64, "uniform tessellation level of the depth render");
+    add_int_option(*fused_command, "--repeats", fused->repeats, 1, 1000, "timed runs per object, plan and frame (minimum kept)");
+    add_int_option(*fused_command, "--profile-interval", fused->profile_interval, 1, 10000,
+                   "frames between an object's profiling runs (cost model)");
+    add_choice_option(*fused_command, "--cone", fused->cone, {"tcone", "ncone"}, "the back-patch cone test");
+    fused_command->add_flag("--json", fused->json, "print one JSON object");
+    return [command, occlusion, displaced_command, displaced, temporal_command, temporal, scene_command, scene,
+            fused_command, fused]() {
         if (command->parsed()) return run_occlusion(*occlusion);
         if (displaced_command->parsed()) return run_displaced_eval(*displaced);
         if (temporal_command->parsed()) return run_temporal_eval(*temporal);
         if (scene_command->parsed()) return run_scene_eval(*scene);
-        throw Error("eval: expected a subcommand: occlusion, displaced, temporal or scene (e.g. patchcull eval occlusion "
-                    "MODEL --json)");
+        if (fused_command->parsed()) return run_fused_eval(*fused);
+        throw Error("eval: expected a subcommand: occlusion, displaced, temporal, scene or fused (e.g. patchcull eval "
+                    "occlusion MODEL --json)");
     };
 }
 

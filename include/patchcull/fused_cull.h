@@ -116,6 +116,8 @@ struct FusedProfile {
     /// decided[S]: groups all of whose patches some stage of S culls (S a bit per FusedStage,
     /// only subsets of the plan's stages are counted; decided[0] stays 0).
     std::uint64_t decided[1u << kFusedStages] = {};
+    /// patches_culled_by[S]: patches that some stage of S culls (same subsets as decided).
+    std::uint64_t patches_culled_by[1u << kFusedStages] = {};
     std::uint64_t ticks[kFusedStages] = {};  ///< time-stamp-counter ticks spent in each stage
     double seconds = 0;                      ///< wall time of the calls
     /// Seconds per group of stage s, the call's wall time split by the stages' ticks.

@@ -34,7 +34,7 @@ int fused_plans_of(unsigned stages, FusedPlan out[6]) {
         if (stages & (1u << static_cast<unsigned>(s))) chosen[n++] = s;
     int written = 0;
     if (n == 0) return 0;
-    std::sort(chosen, chosen + n);
+    // chosen is in enum order (kAll's), the first permutation.
     do {
         FusedPlan plan;
         plan.count = n;

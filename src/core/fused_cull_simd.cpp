@@ -226,13 +226,14 @@ HWY_INLINE void FusedGroup(DF d, const Group& g, std::size_t valid, const FusedC
         for (int pos = 0; pos < plan.count; ++pos) in_plan |= 1u << static_cast<unsigned>(plan.stages[pos]);
         for (unsigned subset = 1; subset < (1u << kFusedStages); ++subset) {
             if ((subset & ~in_plan) != 0) continue;
-            bool all = true;
-            for (std::size_t j = 0; j < valid && all; ++j) {
+            std::uint64_t culled = 0;
+            for (std::size_t j = 0; j < valid; ++j) {
                 bool any = false;
                 for (int si = 0; si < kFusedStages; ++si) any = any || ((subset >> si) & 1u && stage_culled[si][j]);
-                all = any;
+                culled += any ? 1 : 0;
             }
-            if (all) ++profile->decided[subset];
+            profile->patches_culled_by[subset] += culled;
+            if (culled == valid) ++profile->decided[subset];
         }
     }
 }

@@ -274,8 +274,9 @@ TEST(FusedCull, StatisticsAndProfileAreConsistent) {
                 continue;
             }
             EXPECT_LE(profile.decided[s], profile.groups);
-            for (unsigned sub = 1; sub < 8; ++sub)
+            for (unsigned sub = 1; sub < 8; ++sub) {
                 if ((sub & s) == sub) EXPECT_LE(profile.decided[sub], profile.decided[s]);  // more stages decide more
+            }
         }
         // The groups that leave after stage i of the real run are those the prefix decides.
         unsigned prefix = 0;

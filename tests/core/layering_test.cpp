@@ -18,7 +18,8 @@ const std::set<std::string> kCoreHeaders = {"math.h", "patch.h", "mesh.h", "disp
                                             "hiz.h", "cones.h", "backpatch.h", "displaced_bounds.h",
                                             "clip_space.h", "bounding_volumes.h", "object_bvh.h", "backface.h",
                                             "backface_clusters.h", "object_culling.h", "occlusion_horizon.h",
-                                            "portal_culling.h", "tight_bounds.h"};
+                                            "portal_culling.h", "tight_bounds.h", "fused_cull.h",
+                                            "fused_cost_model.h"};
 const std::set<std::string> kImportHeaders = {"obj.h", "subdivision.h", "image.h", "animation.h", "scene.h",
                                               "default_scene.h", "scene_file.h", "scene_object_level.h",
                                               "scene_occlusion.h"};

@@ -1,0 +1,24 @@
+// `patchcull eval fused` (tools/eval_fused.cpp): issue 14's comparison of the fused CPU cull
+// kernel's plans (fused_cull.h) and of its cost model (fused_cost_model.h) on a scene's camera
+// path, registered by tools/cmd_eval.cpp.
+#pragma once
+
+#include <string>
+
+namespace patchcull::cli {
+
+struct FusedEvalOptions {
+    std::string scene;          ///< "city", "building", "default", a scene file or a model
+    std::string scheme = "acc";
+    int frames = 24;
+    std::string size = "640x360";
+    int tess = 4;               ///< only for the depth render that feeds the Hi-Z pyramid
+    int repeats = 5;            ///< timed runs per object, plan and frame (the minimum is kept)
+    int profile_interval = 16;  ///< FusedCostModel::Config::profile_interval
+    std::string cone = "tcone";
+    bool json = false;
+};
+
+int run_fused_eval(const FusedEvalOptions& options);
+
+}  // namespace patchcull::cli
