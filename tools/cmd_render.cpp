@@ -44,6 +44,14 @@
 // "object_level" and "cpu_frustum_after_objects", CPU wall-clock times outside "total"), and
 // "false_culls" counts object-level false culls too (culled patches and environment triangles
 // in the unculled id buffer); --detail-cull's changes are reported as detail_pixels, not false culls.
+// --pose cpu|gpu (issue 14; render_support.h's PoseWhere): where each frame's animated patches
+// are evaluated: cpu (the default: ScenePoser on the CPU, every patch and attribute re-uploaded)
+// or gpu (only the control meshes go up, gl_posing.h's StencilPoser evaluates the stencils into
+// the renderer's buffers, bit-identical). "pose" in the JSON is the flag; every frame gains
+//   "pose":{"where","cpu_patches","cpu_ms","done_ms","bytes_uploaded"}
+// (cpu_patches: the CPU posed patches this frame, which gpu does only for a CPU reader: the object
+// level, --cull auto, --draw-bounds, and frame 0, whose upload brings the attributes; cpu_ms: CPU
+// time of posing and uploading; done_ms: until glFinish returns; bytes_uploaded: bytes copied to GL).
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -89,6 +97,7 @@ Runner add_render_command(CLI::App& app) {
         std::string cull = "all";
         std::string backpatch = "tcone";
         std::string frustum = "hull";
+        std::string pose = "cpu";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -113,6 +122,8 @@ Runner add_render_command(CLI::App& app) {
                       "back-patch test of backpatch/all");
     add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
                       "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
+    add_choice_option(*command, "--pose", state->pose, {"cpu", "gpu"},
+                      "where animated patches are evaluated: cpu, or gpu (stencils in a compute pass, bit-identical)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
     add_displace_options(*command, state->displace);
@@ -163,8 +174,11 @@ Runner add_render_command(CLI::App& app) {
         gl::CullPipeline pipeline(context);
         GlReleaseGuard release_object_level(object_level);
         ScenePoser poser(scene);
-        const std::vector<BezierPatch>& first_pose = poser.pose(0);  // before pose_attributes reads it
-        pipeline.set_patches(first_pose, pose_attributes(poser));
+        // The CPU readers of posed patches (object level, --cull auto, --draw-bounds) keep a CPU
+        // pose under --pose gpu: their bounds stay the CPU's, exactly.
+        const bool cpu_patches = object_level.enabled() || automatic || !bounds_patches.empty();
+        FramePoser frame_poser(context, poser, pipeline.renderer(), parse_pose_where("--pose", state->pose), cpu_patches);
+        const std::vector<BezierPatch>* pose = frame_poser.pose(0);  // a CPU pose (frame 0 uploads the attributes)
         pipeline.renderer().set_displacement_map(scene.displacement);
         upload_scene_occluders(pipeline.renderer(), scene);
         const std::vector<Camera> cameras = scene.camera_path(state->frames, float(width) / float(height));
@@ -175,15 +189,14 @@ Runner add_render_command(CLI::App& app) {
         for (const SceneObject& o : objects) names.push_back(o.name);
         CullAutoPolicy policy(ranges, scene.patch_count());
 
-        const std::vector<BezierPatch>* pose = &first_pose;
         nlohmann::json frames = nlohmann::json::array();
         std::size_t total_false = 0;
         nlohmann::json hiz_dump, drawn_bounds;
         for (int f = 0; f < state->frames; ++f) {
-            if (f > 0) {
-                pose = &poser.pose(f * kSecondsPerFrame);
-                pipeline.update_patches(*pose, pose_attributes(poser));
-            }
+            // gpu without a CPU reader: no CPU pose; `pose` keeps frame 0's, which nothing reads.
+            if (f > 0)
+                if (const std::vector<BezierPatch>* posed = frame_poser.pose(f * kSecondsPerFrame)) pose = posed;
+            const PoseCost& pose_cost = frame_poser.last();
             gl::PipelineParams params;
             params.frame.render =
                 render_params(cameras[static_cast<std::size_t>(f)], width, height, state->tess, one_sided);
@@ -253,6 +266,11 @@ Runner add_render_command(CLI::App& app) {
                               {"visible", stats.visible},
                               {"newly_visible", stats.newly_visible},
                               {"ms", ms},
+                              {"pose", {{"where", pose_where_name(pose_cost.where)},
+                                        {"cpu_patches", pose_cost.cpu_patches},
+                                        {"cpu_ms", pose_cost.cpu_ms},
+                                        {"done_ms", pose_cost.done_ms},
+                                        {"bytes_uploaded", pose_cost.bytes_uploaded}}},
                               {"false_culls", false_culls},
                               {"depth_ties", depth_ties}});
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
@@ -302,6 +320,7 @@ Runner add_render_command(CLI::App& app) {
             out["bound"] = state->displace.bound;
             out["cone"] = state->displace.cone;
             out["frustum"] = state->frustum;
+            out["pose"] = state->pose;
             out["objects_method"] = object_level.method_name();
             out["object_occlusion"] = object_level.occlusion_name();
             out["detail_cull"] = state->objects.detail_pixels;

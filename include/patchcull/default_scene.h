@@ -269,9 +269,29 @@ Scene make_builtin_scene(const std::string& name, Scheme scheme = Scheme::acc);
 /// its depth and displacement range are the model patch's. The eye-facing test of a transposed
 /// world patch equals the model-space test of the model patch with the eye moved into model space
 /// by the inverse transform, so model-space patch clusters stay valid for mirrored instances.
+/// One model's stencil tables for posing on the GPU (ScenePoser::gpu_tables; gl_posing.h's
+/// PosingModel is the same data as plain arrays: the import layer does not depend on GL).
+struct PoseModelTables {
+    const PointStencils* patch_points = nullptr;    ///< 16 rows per patch (patch.h order)
+    const PointStencils* tangent_points = nullptr;  ///< 24 rows per tangent block (may have no rows)
+    std::vector<std::int32_t> tangent_index;        ///< per patch: PatchInfo::tangent_index
+    std::uint32_t vertex_count = 0;                 ///< vertices of the control mesh the rows index
+};
+
+/// The linear inputs of one pose (ScenePoser::gpu_meshes): the control meshes of every (model,
+/// effective time) group, concatenated, and each instance's place in them and transform.
+struct PoseMeshes {
+    std::vector<Vec3> vertices;
+    std::vector<std::size_t> first_vertex;  ///< per instance: its group's first vertex
+    std::vector<Mat4> to_world;             ///< per instance: instance_to_world at the pose's time
+    std::vector<std::uint8_t> mirrored;     ///< per instance: instance_mirrors
+};
+
 class ScenePoser {
 public:
     explicit ScenePoser(const Scene& scene);
+    /// The scene posed (the constructor's; it must outlive the poser).
+    const Scene& scene() const { return *scene_; }
     /// World-space patches of every instance at time_seconds, instance by instance (each
     /// instance's patches in its model's order): instance_to_world times the (animated) model
     /// patch, transposed for mirrored instances (see above). The reference stays valid until the
@@ -293,7 +313,31 @@ public:
     const std::vector<std::array<Vec2, 4>>& texcoords() const { return texcoords_; }
     const std::vector<DisplacementRange>& displacement_ranges() const { return ranges_; }
 
+    // ---- posing on the GPU (gl_posing.h's StencilPoser; issue 14) --------------------------
+    /// The stencil tables whose rows, applied to gpu_meshes()'s vertices and mapped by each
+    /// instance's transform (transposed for mirrored instances), give exactly pose()'s patches and
+    /// tangents(), per model (Scene::models order). A subdivision model's own tables
+    /// (SubdivisionModel::patch_points, tangent_points: pointers into the scene, valid while it
+    /// lives); a model without a control mesh (the teapot) gets identity rows over its rest
+    /// control points (one term of weight 1 each: exact), made once and kept here. Throws
+    /// patchcull::Error naming the model when its patches were split (LoadedModel::split_levels
+    /// > 0: splits are not stencil rows here) or a rest control point has w != 1.
+    const std::vector<PoseModelTables>& gpu_tables();
+    /// The control meshes of the pose at time_seconds, grouped as pose() groups them (one
+    /// animate() per model and effective time; rigid instances share their model's rest mesh:
+    /// the teapot's rest control points), plus each instance's group, transform and mirroring.
+    /// Evaluates no patch. The reference stays valid until the next call; no allocation after
+    /// the first call on the same scene.
+    const PoseMeshes& gpu_meshes(float time_seconds);
+
 private:
+    // Instances sorted by (model, effective time) into order_, effective times into times_.
+    void group_instances(float time_seconds);
+    std::vector<PoseModelTables> gpu_tables_;
+    std::vector<PointStencils> identity_tables_;  ///< per model: the teapot's identity rows
+    PointStencils no_tangents_;
+    PoseMeshes meshes_;
+
     const Scene* scene_;
     std::vector<Vec3> positions_;
     PatchFrame frame_;

@@ -272,6 +272,13 @@ public:
     std::uint32_t margin_buffer() const;
     std::uint32_t range_buffer() const;
     std::uint32_t depth_texture() const;
+    /// The ACC tangent vectors the TES shades with: 24 vec4 per patch (shaders/shared.h's
+    /// kBindingPatchTangents layout) when the set was given tangents (PatchAttributes::tangent_index
+    /// not empty), else a 16-byte placeholder. For writers that pose on the GPU (gl_posing.h).
+    std::uint32_t tangent_buffer() const;
+    /// Bytes the last set_patches / update_patches copied to GL (control points and every
+    /// attribute buffer): what re-posing on the CPU uploads per frame.
+    std::size_t last_upload_bytes() const;
     /// {patch_buffer, flag_buffer, margin_buffer, 0, patch_count()}: the whole set for a pass.
     PatchBuffers patch_buffers() const;
     /// True while a displacement map is set (set_displacement_map with a non-empty map).
@@ -400,6 +407,7 @@ public:
 private:
     void begin_frame_drawing(const RenderParams& params, bool honour_occluder_culls);
     std::unique_ptr<Impl> impl_;
+    std::size_t last_upload_bytes_ = 0;
 };
 
 /// One frame as --verify compares it: id and depth buffers (read_ids, read_depth) and one byte

@@ -65,7 +65,24 @@ PatchRenderer::PatchRenderer(PatchRenderer&&) noexcept = default;
 PatchRenderer& PatchRenderer::operator=(PatchRenderer&&) noexcept = default;
 PatchRenderer::~PatchRenderer() = default;
 
+namespace {
+
+// The bytes Impl::set_patches (renderer_internal.h) copies to GL for n patches: control points,
+// margins (given, or the ranges' max |D|), ranges, corner texcoords (always, defaults included),
+// tangents (24 vec4 per patch, or a 16-byte placeholder) and tessellation scales (at least one).
+// Flags and marks are cleared or allocated on the GPU, not copied.
+std::size_t patch_upload_bytes(std::size_t n, const PatchAttributes& a) {
+    const bool margins = !a.max_displacement.empty() || !a.displacement_ranges.empty();
+    return n * sizeof(BezierPatch) + (margins ? n * sizeof(float) : 0) +
+           (a.displacement_ranges.empty() ? 0 : n * sizeof(DisplacementRange)) + n * 4 * sizeof(Vec2) +
+           (a.tangent_index.empty() ? sizeof(Vec4) : n * sh::kTangentVec4s * sizeof(Vec4)) +
+           std::max<std::size_t>(n, 1) * sizeof(float);
+}
+
+}  // namespace
+
 void PatchRenderer::set_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes) {
+    last_upload_bytes_ = patch_upload_bytes(patches.size(), attributes);
     static_assert(sizeof(BezierPatch) == kPatchPoints * 4 * sizeof(float), "BezierPatch must be 16 packed float4");
     impl_->set_patches(patches.empty() ? nullptr : &patches[0].cp[0].x, patches.size(), attributes);
 }
@@ -76,10 +93,12 @@ void PatchRenderer::set_patches(const PatchBatchView& patches, const PatchAttrib
         for (int k = 0; k < kPatchPoints; ++k)
             for (int c = 0; c < 4; ++c) aos[(p * kPatchPoints + k) * 4 + c] = patches.component(k, c)[p];
     impl_->set_patches(aos.data(), patches.count, attributes);
+    last_upload_bytes_ = patch_upload_bytes(patches.count, attributes);
 }
 
 void PatchRenderer::update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes) {
     impl_->set_patches(patches.empty() ? nullptr : &patches[0].cp[0].x, patches.size(), attributes, true);
+    last_upload_bytes_ = patch_upload_bytes(patches.size(), attributes);
 }
 
 std::size_t PatchRenderer::patch_count() const { return impl_->count; }
@@ -88,6 +107,8 @@ std::uint32_t PatchRenderer::flag_buffer() const { return impl_->cull_flags; }
 std::uint32_t PatchRenderer::margin_buffer() const { return impl_->has_max_displacement ? impl_->max_displacement : 0; }
 std::uint32_t PatchRenderer::range_buffer() const { return impl_->has_ranges ? impl_->ranges : 0; }
 std::uint32_t PatchRenderer::depth_texture() const { return impl_->depth; }
+std::uint32_t PatchRenderer::tangent_buffer() const { return impl_->tangents; }
+std::size_t PatchRenderer::last_upload_bytes() const { return last_upload_bytes_; }
 PatchBuffers PatchRenderer::patch_buffers() const {
     return {impl_->control_points, impl_->cull_flags, margin_buffer(), 0, impl_->count};
 }

@@ -298,6 +298,102 @@ ScenePoser::ScenePoser(const Scene& scene) : scene_(&scene) {
     }
 }
 
+void ScenePoser::group_instances(float time_seconds) {
+    const Scene& scene = *scene_;
+    const std::size_t n = scene.instances.size();
+    order_.resize(n);
+    times_.resize(n);
+    const float rest_time = -std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i < n; ++i) {
+        const SceneInstance& instance = scene.instances[i];
+        const bool animated = instance.deforms && scene.models.at(instance.model).subdiv.has_value();
+        times_[i] = animated ? time_seconds + instance.time_offset : rest_time;
+        order_[i] = i;
+    }
+    std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) {
+        const std::size_t ma = scene.instances[a].model, mb = scene.instances[b].model;
+        if (ma != mb) return ma < mb;
+        if (times_[a] != times_[b]) return times_[a] < times_[b];
+        return a < b;
+    });
+}
+
+const std::vector<PoseModelTables>& ScenePoser::gpu_tables() {
+    const Scene& scene = *scene_;
+    if (gpu_tables_.size() == scene.models.size()) return gpu_tables_;
+    std::vector<PoseModelTables> tables(scene.models.size());
+    identity_tables_.assign(scene.models.size(), PointStencils{});
+    for (std::size_t m = 0; m < scene.models.size(); ++m) {
+        const LoadedModel& model = scene.models[m];
+        if (model.split_levels > 0)
+            throw Error(model.name + ": posing by stencils needs unsplit patches (--split " +
+                        std::to_string(model.split_levels) + " splits them after the stencils)");
+        PoseModelTables& t = tables[m];
+        for (const PatchInfo& info : model.rest.info) t.tangent_index.push_back(info.tangent_index);
+        if (model.subdiv) {
+            t.patch_points = &model.subdiv->patch_points;
+            t.tangent_points = &model.subdiv->tangent_points;
+            t.vertex_count = static_cast<std::uint32_t>(model.subdiv->mesh.positions.size());
+            continue;
+        }
+        // No control mesh: the rest control points are the "vertices", each row one of them
+        // with weight 1 (1 * v is exact in double, and so is its rounding back to float).
+        PointStencils& identity = identity_tables_[m];
+        std::uint32_t v = 0;
+        for (const BezierPatch& patch : model.rest.patches)
+            for (const Vec4& c : patch.cp) {
+                if (c.w != 1.0f)
+                    throw Error(model.name + ": posing by stencils needs control points with w = 1 (a rational patch)");
+                identity.add_row({{v++, 1.0f}});
+            }
+        t.patch_points = &identity;
+        t.tangent_points = &no_tangents_;
+        t.vertex_count = v;
+        for (std::int32_t index : t.tangent_index)
+            if (index >= 0) throw Error(model.name + ": tangent patches without a control mesh");
+    }
+    gpu_tables_ = std::move(tables);
+    return gpu_tables_;
+}
+
+const PoseMeshes& ScenePoser::gpu_meshes(float time_seconds) {
+    const Scene& scene = *scene_;
+    const std::size_t n = scene.instances.size();
+    group_instances(time_seconds);
+    meshes_.vertices.clear();
+    meshes_.first_vertex.resize(n);
+    meshes_.to_world.resize(n);
+    meshes_.mirrored.resize(n);
+    const float rest_time = -std::numeric_limits<float>::infinity();
+    bool have_group = false;
+    std::size_t group_model = 0, group_first = 0;
+    float group_time = 0;
+    for (std::size_t i : order_) {
+        const SceneInstance& instance = scene.instances[i];
+        const LoadedModel& model = scene.models.at(instance.model);
+        if (!have_group || group_model != instance.model || !(group_time == times_[i])) {
+            group_first = meshes_.vertices.size();
+            if (!model.subdiv) {
+                for (const BezierPatch& patch : model.rest.patches)
+                    for (const Vec4& c : patch.cp) meshes_.vertices.push_back({c.x, c.y, c.z});
+            } else if (times_[i] == rest_time) {
+                const std::vector<Vec3>& rest = model.subdiv->mesh.positions;
+                meshes_.vertices.insert(meshes_.vertices.end(), rest.begin(), rest.end());
+            } else {
+                animate(model.subdiv->mesh.positions, times_[i], scene.animation, positions_);
+                meshes_.vertices.insert(meshes_.vertices.end(), positions_.begin(), positions_.end());
+            }
+            have_group = true;
+            group_model = instance.model;
+            group_time = times_[i];
+        }
+        meshes_.first_vertex[i] = group_first;
+        meshes_.to_world[i] = instance_to_world(instance, time_seconds);
+        meshes_.mirrored[i] = instance_mirrors(instance) ? 1 : 0;
+    }
+    return meshes_;
+}
+
 const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
     const Scene& scene = *scene_;
     const std::size_t n = scene.instances.size();
@@ -323,18 +419,7 @@ const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
     tangents_.resize(total_tangents);
     // Group the instances by (model, effective time): each group's frame is evaluated once.
     const float rest_time = -std::numeric_limits<float>::infinity();
-    for (std::size_t i = 0; i < n; ++i) {
-        const SceneInstance& instance = scene.instances[i];
-        const bool animated = instance.deforms && scene.models.at(instance.model).subdiv.has_value();
-        times_[i] = animated ? time_seconds + instance.time_offset : rest_time;
-        order_[i] = i;
-    }
-    std::sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) {
-        const std::size_t ma = scene.instances[a].model, mb = scene.instances[b].model;
-        if (ma != mb) return ma < mb;
-        if (times_[a] != times_[b]) return times_[a] < times_[b];
-        return a < b;
-    });
+    group_instances(time_seconds);
     const PatchFrame* frame = nullptr;
     std::size_t frame_model = 0;
     float frame_time = 0;

@@ -1,0 +1,237 @@
+// StencilPoser (patchcull/gl_posing.h): stencil tables uploaded once, posed control meshes per
+// frame, shaders/pose_stencils.comp.glsl writing the renderer's control points and tangents.
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "gl_util.h"
+#include "patchcull/error.h"
+#include "patchcull/gl_posing.h"
+#include "patchcull/gl_renderer.h"
+
+namespace patchcull::gl {
+
+namespace {
+
+// Binding points of pose_stencils.comp.glsl.
+constexpr GLuint kOutPoints = 0, kOutTangents = 10, kVertices = 13, kInstances = 14, kPatchTable = 15,
+                 kOffsets = 16, kTerms = 17;
+constexpr GLuint kGroupSize = 256;            // local_size_x of the shader
+constexpr std::uint32_t kRowsPerPatch = 40;   // 16 control points + 24 tangent vectors
+constexpr std::uint32_t kNoTangents = 0xFFFFFFFFu;
+
+struct GpuInstance {
+    float to_world[16];
+    std::uint32_t first_vertex, first_patch, mirrored, first_row;
+};
+static_assert(sizeof(GpuInstance) == 80, "std430 struct {mat4; uvec4;}");
+
+std::size_t buffer_size(GLuint buffer) {
+    GLint64 size = 0;
+    glGetNamedBufferParameteri64v(buffer, GL_BUFFER_SIZE, &size);
+    return static_cast<std::size_t>(size);
+}
+
+// Appends a table's rows (offsets rebased onto terms.size()/2) and terms; throws when malformed.
+void append_table(const StencilTableView& t, std::uint32_t vertex_count, std::size_t model, const char* what,
+                  std::vector<std::uint32_t>& offsets, std::vector<std::uint32_t>& terms) {
+    if (t.rows == 0) return;
+    if (!t.offsets || (t.offsets[t.rows] > 0 && (!t.indices || !t.weights)))
+        throw Error("GL: StencilPoser: model " + std::to_string(model) + ": " + what + " table without data");
+    if (t.offsets[0] != 0)
+        throw Error("GL: StencilPoser: model " + std::to_string(model) + ": " + what + " offsets do not start at 0");
+    const std::uint32_t base = static_cast<std::uint32_t>(terms.size() / 2);
+    for (std::size_t r = 0; r < t.rows; ++r) {
+        if (t.offsets[r + 1] < t.offsets[r])
+            throw Error("GL: StencilPoser: model " + std::to_string(model) + ": " + what + " offsets descend at row " +
+                        std::to_string(r));
+        offsets.push_back(base + t.offsets[r + 1]);
+    }
+    for (std::uint32_t k = 0; k < t.offsets[t.rows]; ++k) {
+        if (t.indices[k] >= vertex_count)
+            throw Error("GL: StencilPoser: model " + std::to_string(model) + ": " + what + " stencil index " +
+                        std::to_string(t.indices[k]) + " is past its " + std::to_string(vertex_count) + " vertices");
+        std::uint32_t bits;
+        static_assert(sizeof(bits) == sizeof(float));
+        std::memcpy(&bits, &t.weights[k], sizeof bits);
+        terms.push_back(t.indices[k]);
+        terms.push_back(bits);
+    }
+}
+
+}  // namespace
+
+struct StencilPoser::Impl {
+    GLuint program = 0;
+    GLint count_location = -1;
+    GLuint offsets = 0, terms = 0, patch_table = 0, vertices = 0, instances = 0;
+    std::size_t vertices_capacity = 0, instances_capacity = 0;  // bytes of the per-frame buffers
+    std::vector<std::uint32_t> instance_models;
+    std::vector<std::uint32_t> model_vertex_counts;
+    std::vector<std::uint32_t> model_first_row;     // first patch row of each model in offsets
+    std::vector<std::uint32_t> instance_first_patch;
+    std::vector<GpuInstance> staging;
+    std::size_t count = 0;
+    bool tangents = false;
+    std::size_t last_bytes = 0, table_bytes = 0;
+
+    ~Impl() {
+        glDeleteProgram(program);
+        const GLuint buffers[] = {offsets, terms, patch_table, vertices, instances};
+        glDeleteBuffers(5, buffers);
+    }
+
+    // Makes buffer hold at least size bytes (grows by doubling; never shrinks).
+    void reserve(GLuint buffer, std::size_t& capacity, std::size_t size) {
+        if (size <= capacity && capacity > 0) return;
+        capacity = std::max<std::size_t>({size, 2 * capacity, 256});
+        glNamedBufferData(buffer, static_cast<GLsizeiptr>(capacity), nullptr, GL_DYNAMIC_DRAW);
+    }
+};
+
+StencilPoser::StencilPoser(const GlContext& ctx) : impl_((ctx.make_current(), std::make_unique<Impl>())) {
+    Impl& m = *impl_;
+    m.program = detail::link_program({{"pose_stencils.comp.glsl", GL_COMPUTE_SHADER}}, "pose_stencils");
+    m.count_location = glGetUniformLocation(m.program, "u_patch_count");
+    GLuint buffers[5];
+    glCreateBuffers(5, buffers);
+    m.offsets = buffers[0];
+    m.terms = buffers[1];
+    m.patch_table = buffers[2];
+    m.vertices = buffers[3];
+    m.instances = buffers[4];
+    for (GLuint b : buffers) detail::upload(b, 0, nullptr);
+    detail::check_gl("StencilPoser setup");
+}
+
+StencilPoser::StencilPoser(StencilPoser&&) noexcept = default;
+StencilPoser& StencilPoser::operator=(StencilPoser&&) noexcept = default;
+StencilPoser::~StencilPoser() = default;
+
+std::size_t StencilPoser::patch_count() const { return impl_->count; }
+bool StencilPoser::has_tangents() const { return impl_->tangents; }
+std::size_t StencilPoser::last_upload_bytes() const { return impl_->last_bytes; }
+std::size_t StencilPoser::table_bytes() const { return impl_->table_bytes; }
+
+void StencilPoser::set_tables(const std::vector<PosingModel>& models, const std::vector<std::uint32_t>& instance_models) {
+    Impl& m = *impl_;
+    // One offsets table: every model's patch rows, then every model's tangent rows.
+    std::vector<std::uint32_t> offsets{0}, terms;
+    std::vector<std::uint32_t> first_row(models.size()), first_tangent_row(models.size());
+    for (std::size_t i = 0; i < models.size(); ++i) {
+        const PosingModel& model = models[i];
+        if (model.patch_points.rows % 16 != 0)
+            throw Error("GL: StencilPoser: model " + std::to_string(i) + ": " + std::to_string(model.patch_points.rows) +
+                        " patch rows is not 16 per patch");
+        if (model.tangent_index.size() != model.patch_points.rows / 16)
+            throw Error("GL: StencilPoser: model " + std::to_string(i) + ": tangent_index has " +
+                        std::to_string(model.tangent_index.size()) + " entries for " +
+                        std::to_string(model.patch_points.rows / 16) + " patches");
+        first_row[i] = static_cast<std::uint32_t>(offsets.size() - 1);
+        append_table(model.patch_points, model.vertex_count, i, "patch", offsets, terms);
+    }
+    for (std::size_t i = 0; i < models.size(); ++i) {
+        const PosingModel& model = models[i];
+        if (model.tangent_points.rows % 24 != 0)
+            throw Error("GL: StencilPoser: model " + std::to_string(i) + ": " +
+                        std::to_string(model.tangent_points.rows) + " tangent rows is not 24 per block");
+        for (std::int32_t t : model.tangent_index)
+            if (t >= 0 && static_cast<std::size_t>(t) >= model.tangent_points.rows / 24)
+                throw Error("GL: StencilPoser: model " + std::to_string(i) + ": tangent_index " + std::to_string(t) +
+                            " is past its " + std::to_string(model.tangent_points.rows / 24) + " tangent blocks");
+        first_tangent_row[i] = static_cast<std::uint32_t>(offsets.size() - 1);
+        append_table(model.tangent_points, model.vertex_count, i, "tangent", offsets, terms);
+    }
+    if (terms.size() / 2 > 0xFFFFFFFFu) throw Error("GL: StencilPoser: more than 2^32 stencil terms");
+    // Per output patch: its instance and its tangent block's first row.
+    std::vector<std::uint32_t> table;
+    std::vector<std::uint32_t> first_patch;
+    bool tangents = false;
+    for (std::size_t i = 0; i < instance_models.size(); ++i) {
+        const std::uint32_t mi = instance_models[i];
+        if (mi >= models.size())
+            throw Error("GL: StencilPoser: instance " + std::to_string(i) + " names model " + std::to_string(mi) +
+                        " of " + std::to_string(models.size()));
+        first_patch.push_back(static_cast<std::uint32_t>(table.size() / 2));
+        for (std::int32_t t : models[mi].tangent_index) {
+            table.push_back(static_cast<std::uint32_t>(i));
+            table.push_back(t < 0 ? kNoTangents : first_tangent_row[mi] + 24u * static_cast<std::uint32_t>(t));
+            tangents = tangents || t >= 0;
+        }
+        if (table.size() / 2 * kRowsPerPatch >= 0xFFFFFFFFull)
+            throw Error("GL: StencilPoser: too many patches for one pass (" + std::to_string(table.size() / 2) + ")");
+    }
+    detail::upload(m.offsets, offsets.size() * 4, offsets.data());
+    detail::upload(m.terms, terms.size() * 4, terms.data());
+    detail::upload(m.patch_table, table.size() * 4, table.data());
+    m.table_bytes = (offsets.size() + terms.size() + table.size()) * 4;
+    m.count = table.size() / 2;
+    m.tangents = tangents;
+    m.instance_models = instance_models;
+    m.instance_first_patch = std::move(first_patch);
+    m.model_first_row = std::move(first_row);
+    m.model_vertex_counts.clear();
+    for (const PosingModel& model : models) m.model_vertex_counts.push_back(model.vertex_count);
+    detail::check_gl("StencilPoser::set_tables");
+}
+
+void StencilPoser::pose(const std::vector<Vec3>& vertices, const std::vector<PosingInstance>& instances,
+                        std::uint32_t patch_buffer, std::uint32_t tangent_buffer) {
+    Impl& m = *impl_;
+    if (instances.size() != m.instance_models.size())
+        throw Error("GL: StencilPoser::pose: " + std::to_string(instances.size()) + " instances for tables of " +
+                    std::to_string(m.instance_models.size()));
+    if (!glIsBuffer(patch_buffer) || buffer_size(patch_buffer) < m.count * sizeof(BezierPatch))
+        throw Error("GL: StencilPoser::pose: patch buffer " + std::to_string(patch_buffer) + " does not hold " +
+                    std::to_string(m.count) + " patches");
+    if (m.tangents && (!glIsBuffer(tangent_buffer) || buffer_size(tangent_buffer) < m.count * 24 * 16))
+        throw Error("GL: StencilPoser::pose: tangent buffer " + std::to_string(tangent_buffer) + " does not hold " +
+                    std::to_string(m.count) + " patches' tangents");
+    m.staging.resize(instances.size());
+    for (std::size_t i = 0; i < instances.size(); ++i) {
+        const PosingInstance& in = instances[i];
+        const std::uint32_t model = m.instance_models[i];
+        if (in.first_vertex > vertices.size() || m.model_vertex_counts[model] > vertices.size() - in.first_vertex)
+            throw Error("GL: StencilPoser::pose: instance " + std::to_string(i) + "'s vertices run past the " +
+                        std::to_string(vertices.size()) + " given");
+        GpuInstance& out = m.staging[i];
+        std::copy_n(in.to_world.m, 16, out.to_world);
+        out.first_vertex = static_cast<std::uint32_t>(in.first_vertex);
+        out.first_patch = m.instance_first_patch[i];
+        out.mirrored = in.mirrored ? 1u : 0u;
+        out.first_row = m.model_first_row[model];
+    }
+    detail::check_gl("(pending before StencilPoser::pose)");
+    const std::size_t vertex_bytes = vertices.size() * sizeof(Vec3);
+    const std::size_t instance_bytes = m.staging.size() * sizeof(GpuInstance);
+    m.reserve(m.vertices, m.vertices_capacity, vertex_bytes);
+    m.reserve(m.instances, m.instances_capacity, instance_bytes);
+    if (vertex_bytes) glNamedBufferSubData(m.vertices, 0, static_cast<GLsizeiptr>(vertex_bytes), vertices.data());
+    if (instance_bytes) glNamedBufferSubData(m.instances, 0, static_cast<GLsizeiptr>(instance_bytes), m.staging.data());
+    m.last_bytes = vertex_bytes + instance_bytes;
+    if (m.count == 0) return;
+    glUseProgram(m.program);
+    glUniform1ui(m.count_location, static_cast<GLuint>(m.count));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOutPoints, patch_buffer);
+    // Without tangents nothing is written at kOutTangents; a buffer of ours keeps the binding valid.
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOutTangents, m.tangents ? tangent_buffer : m.instances);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertices, m.vertices);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kInstances, m.instances);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPatchTable, m.patch_table);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOffsets, m.offsets);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTerms, m.terms);
+    // 40 invocations per patch; more than 65535 groups go into a second dimension (the shader
+    // flattens gl_GlobalInvocationID).
+    const std::uint64_t groups = (std::uint64_t{m.count} * kRowsPerPatch + kGroupSize - 1) / kGroupSize;
+    const std::uint64_t x = std::min<std::uint64_t>(groups, 65535);
+    const std::uint64_t y = (groups + x - 1) / x;
+    glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
+    glUseProgram(0);
+    detail::check_gl("StencilPoser::pose");
+}
+
+}  // namespace patchcull::gl

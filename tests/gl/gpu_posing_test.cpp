@@ -1,0 +1,283 @@
+// Posing on the GPU (issue 14; gl_posing.h's StencilPoser, ScenePoser::gpu_tables/gpu_meshes,
+// render --pose): the control points and ACC tangent vectors the compute pass writes into the
+// renderer's buffers are BIT-IDENTICAL to ScenePoser::pose() (read back, compared as bytes), for
+// both schemes, over several frames, with a mirrored, a walking and a rigid instance; the teapot
+// poses through identity rows; the cull pipeline's id buffer and flag words with GPU posing equal
+// those with CPU posing; `render --pose gpu --verify` has no false culls and the same per-frame
+// statistics as --pose cpu (default scene both schemes, city_small with its displaced frogs);
+// `--pose foo` is a one-line error. llvmpipe, small sizes.
+#include <epoxy/gl.h>
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/cli_test_util.h"
+#include "gl_test_util.h"
+#include "patchcull/default_scene.h"
+#include "patchcull/error.h"
+#include "patchcull/gl_pipeline.h"
+#include "patchcull/gl_posing.h"
+#include "patchcull/gl_renderer.h"
+#include "patchcull/scene.h"
+
+using namespace patchcull;
+using namespace patchcull::gl;
+
+namespace {
+
+template <class T>
+std::vector<T> read_buffer(std::uint32_t buffer, std::size_t count) {
+    std::vector<T> out(count);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(count * sizeof(T)), out.data());
+    return out;
+}
+
+StencilTableView view_of(const PointStencils& s) { return {s.offsets.data(), s.rows(), s.indices.data(), s.weights.data()}; }
+
+// A StencilPoser over the scene's tables (ScenePoser::gpu_tables), as tools/render_support.cpp
+// makes it.
+StencilPoser make_poser(ScenePoser& poser) {
+    std::vector<PosingModel> models;
+    for (const PoseModelTables& t : poser.gpu_tables())
+        models.push_back({view_of(*t.patch_points), view_of(*t.tangent_points), t.tangent_index, t.vertex_count});
+    std::vector<std::uint32_t> instance_models;
+    for (const SceneInstance& i : poser.scene().instances) instance_models.push_back(static_cast<std::uint32_t>(i.model));
+    StencilPoser gpu(test::context());
+    gpu.set_tables(models, instance_models);
+    return gpu;
+}
+
+void gpu_pose(StencilPoser& gpu, ScenePoser& poser, float t, PatchRenderer& r) {
+    const PoseMeshes& meshes = poser.gpu_meshes(t);
+    std::vector<PosingInstance> instances;
+    for (std::size_t i = 0; i < meshes.first_vertex.size(); ++i)
+        instances.push_back({meshes.first_vertex[i], meshes.to_world[i], meshes.mirrored[i] != 0});
+    gpu.pose(meshes.vertices, instances, r.patch_buffer(), r.tangent_buffer());
+}
+
+// The renderer's tangent layout of a CPU pose (renderer_internal.h's set_patches).
+std::vector<Vec4> tangent_layout(const ScenePoser& poser, std::size_t patches) {
+    std::vector<Vec4> out(patches * 24);
+    for (std::size_t p = 0; p < patches; ++p) {
+        const std::int32_t t = poser.tangent_index()[p];
+        if (t < 0) continue;
+        const TangentPatches& tp = poser.tangents()[static_cast<std::size_t>(t)];
+        for (int k = 0; k < 12; ++k) out[24 * p + k] = {tp.du[k].x, tp.du[k].y, tp.du[k].z, 0.0f};
+        for (int k = 0; k < 12; ++k) out[24 * p + 12 + k] = {tp.dv[k].x, tp.dv[k].y, tp.dv[k].z, 0.0f};
+        out[24 * p].w = 1.0f;
+    }
+    return out;
+}
+
+// The default scene with a mirrored (x -> -x) BigGuy, a walking frog and a rigid BigGuy: every
+// path of ScenePoser at once.
+Scene varied_default_scene(Scheme scheme) {
+    Scene scene = make_default_scene(scheme);
+    Mat4 mirror;
+    mirror.at(0, 0) = -1;
+    scene.instances[0].object_to_world = mirror * scene.instances[0].object_to_world;
+    scene.instances[1].deforms = false;
+    scene.instances[4].velocity = {0.2f, 0, -0.1f};
+    return scene;
+}
+
+// Poses `scene` at each time on the CPU and on the GPU and compares the buffers bit for bit.
+// small_upload: the scene's models have control meshes, so the per-frame upload must be a small
+// fraction of the patches' (the teapot's identity rows upload its control points as Vec3).
+void expect_identical_poses(const Scene& scene, const std::vector<float>& times, bool small_upload = true) {
+    ScenePoser cpu(scene), gpu_side(scene);
+    const std::vector<BezierPatch>& first = cpu.pose(times.front());
+    PatchAttributes a;
+    a.tangent_index = cpu.tangent_index();
+    a.tangents = cpu.tangents();
+    PatchRenderer r(test::context());
+    // Zeros in the patch buffer (the tangent buffer gets the layout's size): everything compared
+    // below was written by the pass.
+    r.set_patches(std::vector<BezierPatch>(first.size(), BezierPatch{}), a);
+    StencilPoser gpu = make_poser(gpu_side);
+    ASSERT_EQ(gpu.patch_count(), first.size());
+    for (float t : times) {
+        const std::vector<BezierPatch>& posed = cpu.pose(t);
+        gpu_pose(gpu, gpu_side, t, r);
+        const std::vector<BezierPatch> back = read_buffer<BezierPatch>(r.patch_buffer(), posed.size());
+        std::size_t differing = 0;
+        for (std::size_t p = 0; p < posed.size(); ++p)
+            differing += std::memcmp(&back[p], &posed[p], sizeof(BezierPatch)) != 0 ? 1 : 0;
+        EXPECT_EQ(differing, 0u) << scene.name << " t=" << t << ": patches differing from the CPU pose";
+        if (gpu.has_tangents()) {
+            const std::vector<Vec4> expected = tangent_layout(cpu, posed.size());
+            const std::vector<Vec4> got = read_buffer<Vec4>(r.tangent_buffer(), expected.size());
+            EXPECT_EQ(std::memcmp(got.data(), expected.data(), expected.size() * sizeof(Vec4)), 0)
+                << scene.name << " t=" << t << ": tangent vectors differ";
+        }
+    }
+    EXPECT_GT(gpu.last_upload_bytes(), 0u);
+    if (small_upload)
+        EXPECT_LT(gpu.last_upload_bytes(), first.size() * sizeof(BezierPatch) / 10) << "the pose upload is not small";
+}
+
+const std::vector<float> kTimes = {0.0f, 1.0f / 12, 5.0f / 12, 1.3f};
+
+}  // namespace
+
+TEST(GpuPosing, BitIdenticalToCpuPoseAcc) {
+    const Scene scene = varied_default_scene(Scheme::acc);
+    ScenePoser probe(scene);
+    probe.pose(0);
+    ASSERT_FALSE(probe.tangents().empty()) << "acc must have tangent patches to compare";
+    expect_identical_poses(scene, kTimes);
+}
+
+TEST(GpuPosing, BitIdenticalToCpuPoseOsd) { expect_identical_poses(varied_default_scene(Scheme::osd), kTimes); }
+
+TEST(GpuPosing, TeapotPosesThroughIdentityRows) {
+    Scene scene = make_model_scene(load_model("teapot", Scheme::acc, 0));
+    scene.instances[0].velocity = {0.1f, 0, 0};
+    expect_identical_poses(scene, {0.0f, 0.5f}, false);
+}
+
+TEST(GpuPosing, SplitModelsAreRefused) {
+    Scene scene = make_model_scene(load_model("teapot", Scheme::acc, 1));
+    ScenePoser poser(scene);
+    try {
+        poser.gpu_tables();
+        FAIL() << "a split model was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("split"), std::string::npos) << e.what();
+    }
+}
+
+TEST(GpuPosing, MalformedTablesAreRefused) {
+    StencilPoser gpu(test::context());
+    std::vector<std::uint32_t> offs(17);
+    for (std::uint32_t r = 0; r <= 16; ++r) offs[r] = r;
+    const std::vector<std::uint32_t> indices(16, 3);  // vertex 3 of a 2-vertex mesh
+    const std::vector<float> weights(16, 1.0f);
+    PosingModel model{{offs.data(), 16, indices.data(), weights.data()}, {}, {-1}, 2};
+    EXPECT_THROW(gpu.set_tables({model}, {0}), Error);
+    model.vertex_count = 4;
+    EXPECT_THROW(gpu.set_tables({model}, {1}), Error);  // no model 1
+    gpu.set_tables({model}, {0, 0});
+    EXPECT_EQ(gpu.patch_count(), 2u);
+    test::ScratchBuffer small(100);
+    PosingInstance inst;
+    EXPECT_THROW(gpu.pose(std::vector<Vec3>(4), {inst, inst}, small.name(), 0), Error);  // 100 bytes < 2 patches
+    test::ScratchBuffer enough(2 * sizeof(BezierPatch));
+    EXPECT_THROW(gpu.pose(std::vector<Vec3>(3), {inst, inst}, enough.name(), 0), Error);  // 3 < 4 vertices
+    EXPECT_THROW(gpu.pose(std::vector<Vec3>(4), {inst}, enough.name(), 0), Error);        // one instance short
+    gpu.pose(std::vector<Vec3>(4, Vec3{1, 2, 3}), {inst, inst}, enough.name(), 0);
+    const std::vector<float> back = enough.read_floats(2 * 64);
+    for (int k = 0; k < 32; ++k) {
+        EXPECT_EQ(back[4 * k], 1.0f);
+        EXPECT_EQ(back[4 * k + 3], 1.0f);
+    }
+}
+
+TEST(GpuPosing, PipelineIdsAndFlagsEqualCpuPosing) {
+    const Scene scene = varied_default_scene(Scheme::acc);
+    const std::vector<Camera> cameras = scene.camera_path(3, 160.0f / 90.0f);
+    std::vector<std::vector<std::uint32_t>> ids[2], flags[2];
+    for (int mode = 0; mode < 2; ++mode) {
+        ScenePoser poser(scene);
+        CullPipeline pipeline(test::context());
+        const std::vector<BezierPatch>& first = poser.pose(0);
+        PatchAttributes a;
+        a.tangent_index = poser.tangent_index();
+        a.tangents = poser.tangents();
+        a.depth = poser.depth();
+        a.texcoords = poser.texcoords();
+        a.displacement_ranges = poser.displacement_ranges();
+        pipeline.set_patches(first, a);
+        pipeline.renderer().set_displacement_map(scene.displacement);
+        pipeline.renderer().set_occluders(scene.occluder_vertices, scene.occluder_indices);
+        ScenePoser gpu_side(scene);
+        StencilPoser gpu = make_poser(gpu_side);
+        for (int f = 0; f < 3; ++f) {
+            const float t = f / 12.0f;
+            if (f > 0) {
+                if (mode == 0) {
+                    const std::vector<BezierPatch>& posed = poser.pose(t);
+                    a.tangents = poser.tangents();
+                    pipeline.update_patches(posed, a);
+                } else {
+                    gpu_pose(gpu, gpu_side, t, pipeline.renderer());
+                }
+            }
+            PipelineParams params;
+            params.frame.render.view = cameras[static_cast<std::size_t>(f)].view();
+            params.frame.render.projection = cameras[static_cast<std::size_t>(f)].projection();
+            params.frame.render.width = 160;
+            params.frame.render.height = 90;
+            params.frame.render.tess_level = 4;
+            params.frame.render.discard_back_facing = true;
+            params.frame.cull = CullMode::all;
+            const FrameStats stats = pipeline.render_frame(params);
+            EXPECT_GT(stats.frustum_culled + stats.occlusion_culled + stats.backpatch_culled, 0u);
+            ids[mode].push_back(pipeline.renderer().read_ids());
+            flags[mode].push_back(pipeline.renderer().read_cull_flags());
+        }
+    }
+    for (int f = 0; f < 3; ++f) {
+        EXPECT_EQ(ids[0][f], ids[1][f]) << "frame " << f << ": id buffers differ";
+        EXPECT_EQ(flags[0][f], flags[1][f]) << "frame " << f << ": flag words differ";
+    }
+}
+
+namespace {
+
+using namespace patchcull::cli_test;
+
+// Runs render with --pose cpu and gpu; both verified without false culls, with the same
+// per-frame statistics; gpu uploads far fewer bytes after frame 0.
+void expect_gpu_like_cpu(const std::string& args) {
+    nlohmann::json runs[2];
+    const char* modes[2] = {"cpu", "gpu"};
+    for (int m = 0; m < 2; ++m) {
+        const CliRun r = run(args + " --verify --json --pose " + modes[m]);
+        ASSERT_EQ(r.status, 0) << args << " --pose " << modes[m] << ": " << r.err;
+        runs[m] = nlohmann::json::parse(r.out);
+        EXPECT_EQ(runs[m]["pose"], modes[m]);
+        EXPECT_EQ(runs[m]["false_culls"], 0) << args;
+    }
+    ASSERT_EQ(runs[0]["frames"].size(), runs[1]["frames"].size());
+    for (std::size_t f = 0; f < runs[0]["frames"].size(); ++f) {
+        const auto& c = runs[0]["frames"][f];
+        const auto& g = runs[1]["frames"][f];
+        for (const char* key : {"pass1_drawn", "pass2_drawn", "frustum_culled", "backpatch_culled", "occlusion_culled",
+                                "displaced_occlusion_culled", "visible", "newly_visible", "false_culls"})
+            EXPECT_EQ(c[key], g[key]) << args << " frame " << f << " " << key;
+        EXPECT_EQ(g["pose"]["where"], "gpu");
+        if (f > 0) {
+            EXPECT_EQ(g["pose"]["cpu_patches"], false);
+            EXPECT_LT(g["pose"]["bytes_uploaded"].get<double>() * 10, c["pose"]["bytes_uploaded"].get<double>())
+                << args << " frame " << f;
+        }
+    }
+}
+
+}  // namespace
+
+TEST(GpuPosingCli, VerifiesLikeCpuOnTheDefaultSceneAcc) {
+    expect_gpu_like_cpu("render default --scheme acc --size 96x54 --tess 4 --frames 3");
+}
+
+TEST(GpuPosingCli, VerifiesLikeCpuOnTheDefaultSceneOsd) {
+    // Level 1: osd's deepest patches are tessellated 2^depth times finer (PatchAttributes::depth).
+    expect_gpu_like_cpu("render default --scheme osd --size 96x54 --tess 1 --frames 2");
+}
+
+TEST(GpuPosingCli, VerifiesLikeCpuOnCitySmall) {
+    expect_gpu_like_cpu("render " + std::string(PATCHCULL_SOURCE_DIR) +
+                        "/data/scenes/city_small.json --size 96x54 --tess 2 --frames 2");
+}
+
+TEST(GpuPosingCli, BadValueIsAOneLineError) {
+    expect_one_line_error(run("render default --frames 1 --size 8x8 --pose foo"), "--pose");
+    expect_one_line_error(run("render teapot --split 1 --frames 1 --size 8x8 --pose gpu"), "split");
+}
