@@ -44,6 +44,10 @@
 // "object_level" and "cpu_frustum_after_objects", CPU wall-clock times outside "total"), and
 // "false_culls" counts object-level false culls too (culled patches and environment triangles
 // in the unculled id buffer); --detail-cull's changes are reported as detail_pixels, not false culls.
+// --fused-pass (issue 14): the frustum, back-patch and Hi-Z tests in one FusedCullPass dispatch per
+// object (gl_pipeline.h's PipelineParams::fused_pass; same decisions); "fused_pass" in the JSON is
+// the flag, each frame's "fused_pass" whether the fused pass ran (not with --backpatch ptp or
+// --frustum aabb, which keep the separate passes).
 // --pose cpu|gpu (issue 14; render_support.h's PoseWhere): where each frame's animated patches
 // are evaluated: cpu (the default: ScenePoser on the CPU, every patch and attribute re-uploaded)
 // or gpu (only the control meshes go up, gl_posing.h's StencilPoser evaluates the stencils into
@@ -98,6 +102,7 @@ Runner add_render_command(CLI::App& app) {
         std::string backpatch = "tcone";
         std::string frustum = "hull";
         std::string pose = "cpu";
+        bool fused_pass = false;
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -122,6 +127,8 @@ Runner add_render_command(CLI::App& app) {
                       "back-patch test of backpatch/all");
     add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
                       "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
+    command->add_flag("--fused-pass", state->fused_pass,
+                      "frustum, back-patch (tcone/ncone) and Hi-Z tests in one compute pass (issue 14)");
     add_choice_option(*command, "--pose", state->pose, {"cpu", "gpu"},
                       "where animated patches are evaluated: cpu, or gpu (stencils in a compute pass, bit-identical)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
@@ -207,6 +214,7 @@ Runner add_render_command(CLI::App& app) {
             params.bound = displace_bound(state->displace);
             params.cone = displace_cone(state->displace);
             params.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
+            params.fused_pass = state->fused_pass;
             object_level.apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height, params, width);
             if (automatic) {
                 policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
@@ -272,7 +280,8 @@ Runner add_render_command(CLI::App& app) {
                                         {"done_ms", pose_cost.done_ms},
                                         {"bytes_uploaded", pose_cost.bytes_uploaded}}},
                               {"false_culls", false_culls},
-                              {"depth_ties", depth_ties}});
+                              {"depth_ties", depth_ties},
+                              {"fused_pass", stats.fused_pass}});
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
             if (automatic) frames.back()["auto_objects"] = auto_objects_json(objects, policy.decisions());
             {
@@ -321,6 +330,7 @@ Runner add_render_command(CLI::App& app) {
             out["cone"] = state->displace.cone;
             out["frustum"] = state->frustum;
             out["pose"] = state->pose;
+            out["fused_pass"] = state->fused_pass;
             out["objects_method"] = object_level.method_name();
             out["object_occlusion"] = object_level.occlusion_name();
             out["detail_cull"] = state->objects.detail_pixels;

@@ -11,6 +11,7 @@
 //   back-patch tcone/ncone cull_tcone/ncone_scalar        BackpatchConePass  backpatch_cones.comp.glsl
 //   back-patch ptp         cull_ptp_scalar                BackpatchPtpPass   backpatch_ptp.comp.glsl
 //   displaced bounds       cull_displaced_frustum/_occlusion DisplacedPass   displaced.comp.glsl
+//   frustum + cone + Hi-Z  (the three above, in one)      FusedCullPass      fused_cull.comp.glsl
 //   (ends of the chain)    -                              CullStatusPass     cull_status.comp.glsl
 // Each makes the same decisions as its CPU kernel on the same inputs (the arithmetic notes are
 // in gl_backpatch.h, gl_displaced.h and the shaders; tests/gl/*_gpu_test.cpp check it).
@@ -300,6 +301,37 @@ public:
     /// ndc_ymax, depth_near, depth_far, status, 0) at 8p.
     void run(const PatchBuffers& patches, std::uint32_t ranges, DisplacedBoundKind bound, NormalConeKind cone,
              const DisplacedCullView& view, const HiZTexture* hiz, bool only_displaced, std::uint32_t bounds = 0);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// FrustumPass, BackpatchConePass and OcclusionPass (with_frustum = false) in one dispatch, one
+/// invocation per patch (issue 14's fused pass): the control points are read once, and the tests
+/// of `tests` run in the chain's order (frustum, back-patch cone, Hi-Z), stopping at the first that
+/// culls. Each patch gets exactly the reason (and the flag word) that the chain begin ->
+/// FrustumPass(make_frustum_planes(M, zero_to_one)) -> BackpatchConePass(method, eye) ->
+/// OcclusionPass(M, hiz, with_frustum = false) gives it, M = to_zero_to_one(object_to_clip,
+/// depth): the shader uses the same GLSL tests (frustum_test.h, backpatch_cones.h, hiz_box_test.h
+/// and occlusion.comp.glsl's steps 2-4), and tests/gl/fused_cull_pass_test.cpp checks it. As in
+/// the chain, displaced patches (margin > 0) get the frustum test with their margin only (leave
+/// them to DisplacedPass), and patches whose reason is already set are skipped. Not fused: ptp
+/// (16 invocations per patch, BackpatchPtpPass), FrustumDispPass's box, DisplacedPass's bounds.
+class FusedCullPass {
+public:
+    explicit FusedCullPass(PassContext& context);
+    FusedCullPass(FusedCullPass&&) noexcept;
+    FusedCullPass& operator=(FusedCullPass&&) noexcept;
+    ~FusedCullPass();
+    /// tests: a mask of kCullFrustum, kCullBackPatch, kCullOcclusion (shared.h; gl_renderer.h's
+    /// kFlag* are equal); 0 runs nothing. method: tcone or ncone, used with kCullBackPatch (ptp:
+    /// throws). eye: object space, for the cone test. hiz: the built pyramid, required with
+    /// kCullOcclusion (see OcclusionPass for its conventions), else ignored (may be null). depth:
+    /// the convention of object_to_clip. Throws patchcull::Error for other bits, ptp, or a
+    /// missing pyramid.
+    void run(const PatchBuffers& patches, std::uint32_t tests, const Mat4& object_to_clip, ClipDepth depth,
+             BackpatchMethod method, Vec3 eye, const HiZTexture* hiz);
 
 private:
     struct Impl;

@@ -11,7 +11,8 @@
 //      FrustumDispPass, PipelineParams::frustum);
 //      the back-patch pass of PipelineParams::backpatch (BackpatchConePass or BackpatchPtpPass;
 //      displaced patches skipped); OcclusionPass (control-point boxes; displaced patches
-//      skipped); DisplacedPass (seed 000 §4.2's bound of each displaced patch, against the frustum
+//      skipped) - or those three as one FusedCullPass (PipelineParams::fused_pass);
+//      DisplacedPass (seed 000 §4.2's bound of each displaced patch, against the frustum
 //      and the same pyramid); CullStatusPass::end (statuses, counters);
 //   4. the newly visible patches (draw pass 2; skipped when aggressive).
 // Without occlusion: the chain (without the Hi-Z passes; the displaced pass then tests the
@@ -128,6 +129,15 @@ struct PipelineParams {
     NormalConeKind cone = NormalConeKind::acon;
     /// The frustum test of the chain (FrustumTest; hull is the pipeline's original behaviour).
     FrustumTest frustum = FrustumTest::hull;
+    /// Issue 14's fused pass: FusedCullPass (gl_passes.h) runs the frame's frustum, back-patch and
+    /// Hi-Z tests in one dispatch per object in place of FrustumPass, BackpatchConePass and
+    /// OcclusionPass, with the same decisions, so the frame (flag words, statuses, counts, image)
+    /// is the same. Used where the choices allow it: frustum hull and back-patch tcone or ncone (or
+    /// a mode without the back-patch test); with ptp or frustum aabb the separate passes run
+    /// (FrameStats::fused_pass says which). Displaced patches keep their separate pass
+    /// (DisplacedPass, after the fused one; the fused pass gives them the frustum test with their
+    /// margin, as FrustumPass does). Its time is in FrameStats::cull_ms; backpatch_ms is 0.
+    bool fused_pass = false;
     /// The objects (disjoint ranges, in any order, within the set), or empty: one object of every
     /// patch, culled. Patches outside every range are drawn unculled. Throws when a range leaves
     /// the set or two overlap.
@@ -171,8 +181,10 @@ struct FrameStats {
     /// hiz (build), cull (the whole flag chain), pass2 (newly visible). One pass (no occlusion):
     /// cull first, then pass1 draws the patches that passed; hiz = pass2 = 0.
     double pass1_ms = 0, hiz_ms = 0, cull_ms = 0, pass2_ms = 0, total_ms = 0;
-    /// Of cull_ms: the back-patch pass alone (0 when the mode has no back-patch test).
+    /// Of cull_ms: the back-patch pass alone (0 when the mode has no back-patch test, or when the
+    /// fused pass ran it).
     double backpatch_ms = 0;
+    bool fused_pass = false;  ///< FusedCullPass ran the tests (PipelineParams::fused_pass, where allowed)
     TimingMethod timing = TimingMethod::off;  ///< the method used (never automatic)
     /// Per object of PipelineParams::objects, in its order (one entry for the whole set when it
     /// is empty). An object not culled this frame counts all its patches visible.

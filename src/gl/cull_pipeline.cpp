@@ -63,7 +63,7 @@ private:
 struct CullPipeline::Impl {
     explicit Impl(const GlContext& ctx)
         : renderer(ctx), frustum(passes), frustum_disp(passes), hiz_build(passes), occlusion(passes), cones(passes), ptp(passes),
-          displaced(passes), status(passes) {
+          displaced(passes), status(passes), fused(passes) {
         glCreateBuffers(1, &counters);
         GLint alignment = 16;
         glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &alignment);
@@ -87,6 +87,7 @@ struct CullPipeline::Impl {
     BackpatchPtpPass ptp;
     DisplacedPass displaced;
     CullStatusPass status;
+    FusedCullPass fused;
     HiZTexture hiz;  // of the framebuffer's size; recreated when it changes
     GLuint counters = 0;             // kCounterCount uints per object (+ one slot for the rest)
     std::size_t counter_stride = 0;  // bytes between slots (the SSBO offset alignment)
@@ -168,6 +169,10 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     const Mat4 object_to_clip = rp.projection * rp.view;
     const Vec3 eye = eye_of_view(rp.view);
     const bool aabb = params.frustum == FrustumTest::aabb;
+    // The fused pass replaces frustum, back-patch and Hi-Z where it can run them (gl_pipeline.h).
+    const bool fused = params.fused_pass && !aabb &&
+                       !((tests & sh::kCullBackPatch) && params.backpatch == BackpatchMethod::ptp);
+    stats.fused_pass = fused;
 
     // The objects, and the ranges between them (drawn unculled, counted in the last slot).
     const std::size_t count = r.patch_count();
@@ -282,8 +287,18 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
             for (std::size_t i : *only) mark_culled(objects[i].first, objects[i].first + objects[i].count);
         }
         const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
+        if (fused) {
+            // One dispatch per span for all three tests; its time counts as chain A.
+            const std::uint32_t fused_tests =
+                (tests & (sh::kCullFrustum | sh::kCullBackPatch)) | (hiz ? (tests & sh::kCullOcclusion) : 0u);
+            for (std::size_t i : *only)
+                if (objects[i].cull)
+                    for (const PatchSpan& s : object_spans[i])
+                        m.fused.run(buffers_of(s), fused_tests, object_to_clip, ClipDepth::zero_to_one, params.backpatch,
+                                    eye, hiz);
+        }
         for (std::size_t i : *only)
-            if (objects[i].cull && (tests & sh::kCullFrustum))
+            if (!fused && objects[i].cull && (tests & sh::kCullFrustum))
                 for (const PatchSpan& s : object_spans[i]) {
                     if (aabb)
                         m.frustum_disp.run(buffers_of(s), object_to_clip, ClipDepth::zero_to_one);
@@ -292,7 +307,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
                 }
         if (timed) clock.mark();
         for (std::size_t i : *only) {
-            if (!objects[i].cull || !(tests & sh::kCullBackPatch)) continue;
+            if (fused || !objects[i].cull || !(tests & sh::kCullBackPatch)) continue;
             for (const PatchSpan& s : object_spans[i]) {
                 if (params.backpatch == BackpatchMethod::ptp)
                     m.ptp.run(buffers_of(s), object_to_clip, clip_space_eye_alpha(rp.projection), params.ptp_rule);
@@ -313,7 +328,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         for (std::size_t i : *only) {
             if (!objects[i].cull) continue;
             for (const PatchSpan& s : object_spans[i]) {
-                if (occluding) m.occlusion.run(buffers_of(s), object_to_clip, ClipDepth::zero_to_one, *occluding, false);
+                if (occluding && !fused) m.occlusion.run(buffers_of(s), object_to_clip, ClipDepth::zero_to_one, *occluding, false);
                 if (bounds) m.displaced.run(buffers_of(s), ranges, params.bound, params.cone, view, occluding, true);
             }
         }
@@ -441,7 +456,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         // back-patch | chain B | pass1.
         const std::size_t chain_first = two_pass ? 2 : 0;
         stats.cull_ms = ms[chain_first] + ms[chain_first + 1] + ms[chain_first + 2];
-        if (tests & sh::kCullBackPatch) stats.backpatch_ms = ms[chain_first + 1];
+        if ((tests & sh::kCullBackPatch) && !fused) stats.backpatch_ms = ms[chain_first + 1];
         if (two_pass) {
             stats.pass1_ms = ms[0];
             stats.hiz_ms = ms[1];

@@ -1,0 +1,50 @@
+// FusedCullPass (patchcull/gl_passes.h): the frustum, cone back-patch and Hi-Z tests in one
+// dispatch, shaders/fused_cull.comp.glsl (ncone compiled with PATCHCULL_NCONE).
+#include "pass_common.h"
+
+namespace patchcull::gl {
+
+struct FusedCullPass::Impl : detail::PassState {
+    using PassState::PassState;
+};
+
+FusedCullPass::FusedCullPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
+FusedCullPass::FusedCullPass(FusedCullPass&&) noexcept = default;
+FusedCullPass& FusedCullPass::operator=(FusedCullPass&&) noexcept = default;
+FusedCullPass::~FusedCullPass() = default;
+
+void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const Mat4& any_object_to_clip,
+                        ClipDepth depth, BackpatchMethod method, Vec3 eye, const HiZTexture* hiz) {
+    detail::begin_pass("FusedCullPass");
+    detail::check_patch_buffers("FusedCullPass", patches);
+    if (tests & ~(shared::kCullFrustum | shared::kCullBackPatch | shared::kCullOcclusion))
+        throw Error("GL: FusedCullPass: tests must be kCullFrustum, kCullBackPatch and kCullOcclusion bits");
+    const bool backpatch = (tests & shared::kCullBackPatch) != 0;
+    const bool occlusion = (tests & shared::kCullOcclusion) != 0;
+    if (backpatch && method == BackpatchMethod::ptp)
+        throw Error("GL: FusedCullPass: ptp is not fused (BackpatchPtpPass)");
+    if (occlusion && (!hiz || !glIsTexture(hiz->texture) || hiz->width < 1 || hiz->height < 1))
+        throw Error("GL: FusedCullPass: the occlusion test needs a Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
+    if (patches.count == 0 || tests == 0) return;
+    const Mat4 object_to_clip = to_zero_to_one(any_object_to_clip, depth);
+    pp::FusedCullParams params;
+    detail::store_planes(make_frustum_planes(object_to_clip, ClipDepth::zero_to_one), params.clip_rows,
+                         params.plane_normal_length);
+    params.eye = {eye.x, eye.y, eye.z, 1.0f};
+    params.has_margins = patches.margins ? 1u : 0u;
+    params.tests = tests;
+    if (occlusion) {
+        params.screen_width = hiz->width;
+        params.screen_height = hiz->height;
+        params.hiz_levels = HiZPyramid::level_count(hiz->width, hiz->height);
+    }
+    params.zero = 0.0f;
+    const bool ncone = backpatch && method == BackpatchMethod::ncone;
+    glUseProgram(impl_->context.program("fused_cull.comp.glsl", ncone ? "#define PATCHCULL_NCONE 1\n" : ""));
+    detail::bind_patch_buffers(patches);
+    if (occlusion) glBindTextureUnit(shared::kTextureUnitHiZ, hiz->texture);
+    detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kCullGroupSize);
+    detail::finish_pass("FusedCullPass");
+}
+
+}  // namespace patchcull::gl
