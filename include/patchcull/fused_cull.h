@@ -119,16 +119,19 @@ struct FusedProfile {
     /// patches_culled_by[S]: patches that some stage of S culls (same subsets as decided).
     std::uint64_t patches_culled_by[1u << kFusedStages] = {};
     std::uint64_t ticks[kFusedStages] = {};  ///< time-stamp-counter ticks spent in each stage
+    std::uint64_t call_ticks = 0;            ///< ticks of the whole calls
     double seconds = 0;                      ///< wall time of the calls
-    /// Seconds per group of stage s, the call's wall time split by the stages' ticks.
+    /// Seconds per profiled group of stage s (ticks converted at the calls' seconds per tick).
     double seconds_per_group(FusedStage s) const;
 };
 
-/// Profiling variant of cull_fused_simd: the same decisions, but every stage of the plan runs on
-/// every group (no early exit) so that profile learns each stage's time and which subsets of
-/// stages would have decided each group. Slower than cull_fused_simd by the work the early exit
-/// saves; the cost model (fused_cost_model.h) runs it on a few frames only.
+/// Profiling variant of cull_fused_simd: the same decisions, but on a sample of the groups every
+/// stage of the plan runs (no early exit) so that profile learns each stage's time and which
+/// subsets of stages would have decided each group. The sample is every k-th group with
+/// k = max(1, groups / max_profiled_groups) (max_profiled_groups 0: every group), so a profile of
+/// a large object costs about max_profiled_groups groups' worth of extra work; the other groups
+/// run as in cull_fused_simd. The cost model (fused_cost_model.h) runs it on a few frames only.
 void cull_fused_profile_simd(const PatchBatchView& patches, const FusedCullSetup& setup, const FusedPlan& plan,
-                             std::uint8_t* decision, FusedProfile& profile);
+                             std::uint8_t* decision, FusedProfile& profile, std::size_t max_profiled_groups = 32);
 
 }  // namespace patchcull

@@ -63,11 +63,9 @@ FusedCullSetup make_fused_setup(const Mat4& object_to_clip, ClipDepth depth, Vec
 }
 
 double FusedProfile::seconds_per_group(FusedStage s) const {
-    std::uint64_t total = 0;
-    for (std::uint64_t t : ticks) total += t;
-    if (total == 0 || groups == 0) return 0;
-    return seconds * static_cast<double>(ticks[static_cast<int>(s)]) / static_cast<double>(total) /
-           static_cast<double>(groups);
+    if (call_ticks == 0 || groups == 0) return 0;
+    const double seconds_per_tick = seconds / static_cast<double>(call_ticks);
+    return static_cast<double>(ticks[static_cast<int>(s)]) * seconds_per_tick / static_cast<double>(groups);
 }
 
 namespace {

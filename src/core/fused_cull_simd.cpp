@@ -17,10 +17,10 @@
 // The decision of a lane is the first stage that culls it, so it equals cull_fused_scalar's
 // (tests/core/fused_cull_test.cpp, every plan, both layouts).
 //
-// The profiling variant (FusedProfile) runs every stage of the plan on every group, no early exit,
-// so that the cost model sees each stage's full verdicts (which subsets of stages would have
-// decided each group) and its time: the time-stamp counter is read around each stage, and the
-// ticks split the call's wall time.
+// The profiling variant (FusedProfile) runs every stage of the plan, no early exit, on a sample of
+// the groups (the others run as usual), so that the cost model sees each stage's full verdicts
+// (which subsets of stages would have decided each group) and its time: the time-stamp counter is
+// read around each stage and converted to seconds at the call's own ticks per second.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -238,33 +238,41 @@ HWY_INLINE void FusedGroup(DF d, const Group& g, std::size_t valid, const FusedC
     }
 }
 
+// sample: with kProfile, every sample-th group is profiled, the others run ordinarily.
 template <bool kProfile>
 void CullFusedImpl(const PatchBatchView& patches, const FusedCullSetup& setup, const FusedPlan& plan,
-                   std::uint8_t* decision, FusedCullStats* stats, FusedProfile* profile) {
+                   std::uint8_t* decision, FusedCullStats* stats, FusedProfile* profile, std::size_t sample) {
     const DF d;
     const std::size_t N = hn::Lanes(d);
     const int width = setup.hiz ? setup.hiz->depth_width() : 1, height = setup.hiz ? setup.hiz->depth_height() : 1;
     const Consts k_(d, setup, width, height);
     Scratch s;
+    auto group = [&](const Group& g, std::size_t first, std::size_t valid) {
+        if (kProfile && (first / N) % sample == 0) {
+            FusedGroup<true>(d, g, valid, setup, plan, k_, s, decision + first, nullptr, profile);
+        } else {
+            FusedGroup<false>(d, g, valid, setup, plan, k_, s, decision + first, stats, nullptr);
+        }
+    };
     std::size_t i = 0;
-    for (; i + N <= patches.count; i += N)
-        FusedGroup<kProfile>(d, GroupAt(patches, i), N, setup, plan, k_, s, decision + i, stats, profile);
+    for (; i + N <= patches.count; i += N) group(GroupAt(patches, i), i, N);
     if (i < patches.count) {
         HWY_ALIGN float buf[kComponents * kMaxLanes];
         const std::size_t valid = patches.count - i;
-        FusedGroup<kProfile>(d, CopyPartialGroup(d, patches, i, valid, buf), valid, setup, plan, k_, s, decision + i,
-                             stats, profile);
+        group(CopyPartialGroup(d, patches, i, valid, buf), i, valid);
     }
 }
 
 void CullFused(const PatchBatchView& patches, const FusedCullSetup& setup, const FusedPlan& plan,
                std::uint8_t* decision, FusedCullStats* stats) {
-    CullFusedImpl<false>(patches, setup, plan, decision, stats, nullptr);
+    CullFusedImpl<false>(patches, setup, plan, decision, stats, nullptr, 1);
 }
 
 void CullFusedProfile(const PatchBatchView& patches, const FusedCullSetup& setup, const FusedPlan& plan,
-                      std::uint8_t* decision, FusedProfile* profile) {
-    CullFusedImpl<true>(patches, setup, plan, decision, nullptr, profile);
+                      std::uint8_t* decision, FusedProfile* profile, std::size_t max_profiled_groups) {
+    const std::size_t groups = (patches.count + hn::Lanes(DF()) - 1) / hn::Lanes(DF());
+    const std::size_t sample = max_profiled_groups == 0 ? 1 : std::max<std::size_t>(1, groups / max_profiled_groups);
+    CullFusedImpl<true>(patches, setup, plan, decision, nullptr, profile, sample);
 }
 
 }  // namespace HWY_NAMESPACE
@@ -284,10 +292,12 @@ void cull_fused_simd(const PatchBatchView& patches, const FusedCullSetup& setup,
 }
 
 void cull_fused_profile_simd(const PatchBatchView& patches, const FusedCullSetup& setup, const FusedPlan& plan,
-                             std::uint8_t* decision, FusedProfile& profile) {
+                             std::uint8_t* decision, FusedProfile& profile, std::size_t max_profiled_groups) {
     if (patches.count == 0) return;
     const auto start = std::chrono::steady_clock::now();
-    HWY_DYNAMIC_DISPATCH(CullFusedProfile)(patches, setup, plan, decision, &profile);
+    const std::uint64_t t0 = fused_detail::ticks();
+    HWY_DYNAMIC_DISPATCH(CullFusedProfile)(patches, setup, plan, decision, &profile, max_profiled_groups);
+    profile.call_ticks += fused_detail::ticks() - t0;
     profile.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

@@ -28,10 +28,11 @@ FusedProfile make_profile(double cf, double cb, double ch, double pf, double pb,
     const double cost[3] = {cf, cb, ch};
     double total = 0;
     for (int s = 0; s < 3; ++s) {
-        p.ticks[s] = static_cast<std::uint64_t>(cost[s] * 1e12);
+        p.ticks[s] = static_cast<std::uint64_t>(cost[s] * 1e12) * groups;
         total += cost[s];
     }
     p.seconds = total * static_cast<double>(groups);
+    p.call_ticks = static_cast<std::uint64_t>(total * 1e12) * groups;
     const double alone[3] = {pf, pb, ph};
     for (unsigned s = 1; s < 8; ++s) {
         // Independent stages: a group survives S when it survives each stage of S.

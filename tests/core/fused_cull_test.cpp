@@ -262,7 +262,7 @@ TEST(FusedCull, StatisticsAndProfileAreConsistent) {
 
         FusedProfile profile;
         std::vector<std::uint8_t> pd(c.patches.size());
-        cull_fused_profile_simd(batch.view(), setup, plan, pd.data(), profile);
+        cull_fused_profile_simd(batch.view(), setup, plan, pd.data(), profile, 0);
         EXPECT_EQ(pd, d);
         EXPECT_EQ(profile.groups, stats.groups);
         EXPECT_EQ(profile.decided[0], 0u);
@@ -275,7 +275,9 @@ TEST(FusedCull, StatisticsAndProfileAreConsistent) {
             }
             EXPECT_LE(profile.decided[s], profile.groups);
             for (unsigned sub = 1; sub < 8; ++sub) {
-                if ((sub & s) == sub) EXPECT_LE(profile.decided[sub], profile.decided[s]);  // more stages decide more
+                if ((sub & s) == sub) {
+                    EXPECT_LE(profile.decided[sub], profile.decided[s]);  // more stages decide more
+                }
             }
         }
         // The groups that leave after stage i of the real run are those the prefix decides.
@@ -285,5 +287,28 @@ TEST(FusedCull, StatisticsAndProfileAreConsistent) {
             EXPECT_EQ(stats.groups_entered[i + 1], profile.groups - profile.decided[prefix]);
         }
         for (int i = 0; i < plan.count; ++i) EXPECT_GT(profile.seconds_per_group(plan.stages[i]), 0.0);
+    }
+}
+
+TEST(FusedCull, ProfilingASampleOfGroupsDecidesTheSame) {
+    Case c = random_case(31, 320, 180, {0, 0, 0});
+    const Case more = random_case(32, 320, 180, {0, 0, 0});
+    for (int i = 0; i < 6; ++i) c.patches.insert(c.patches.end(), more.patches.begin(), more.patches.end());
+    const PatchBatch batch = make_batch(c.patches);
+    const FusedCullSetup setup = make_fused_setup(c.object_to_clip, ClipDepth::zero_to_one, c.eye, BackPatchCone::tcone, &c.hiz);
+    const FusedPlan plan;  // FBH
+    const std::vector<std::uint8_t> d = run(cull_fused_simd, batch.view(), setup, plan);
+    for (std::size_t max_groups : {std::size_t{1}, std::size_t{8}, std::size_t{32}}) {
+        FusedProfile profile;
+        std::vector<std::uint8_t> pd(c.patches.size());
+        cull_fused_profile_simd(batch.view(), setup, plan, pd.data(), profile, max_groups);
+        EXPECT_EQ(pd, d);
+        FusedProfile all;
+        cull_fused_profile_simd(batch.view(), setup, plan, pd.data(), all, 0);
+        // About max_groups groups profiled (every k-th, k = groups / max_groups), never all of them.
+        EXPECT_GE(profile.groups, max_groups);
+        EXPECT_LT(profile.groups, 2 * max_groups + 1);
+        EXPECT_LT(profile.groups, all.groups);
+        EXPECT_GT(profile.seconds_per_group(FusedStage::frustum), 0.0);
     }
 }
