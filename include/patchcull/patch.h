@@ -9,7 +9,6 @@
 
 #include <cassert>
 #include <cstddef>
-#include <new>
 #include <cstdint>
 #include <vector>
 
@@ -115,17 +114,21 @@ struct PatchBatchView {
 };
 
 namespace detail {
-/// Allocator for batch storage: 64-byte (cache line) aligned, so each SoA array and each block
-/// starts on a line and a 16-lane group reads exactly one line per component.
+/// Batch storage: 64-byte (cache line) aligned, so each SoA array and each block starts on a line
+/// and a 16-lane group reads exactly one line per component; from 4 MiB on, 2 MiB aligned and
+/// backed by transparent huge pages where the OS offers them (Linux madvise), so streaming a large
+/// batch does not walk a page table every 4 KiB (a nested walk under a hypervisor).
+void* allocate_batch_storage(std::size_t bytes);
+void free_batch_storage(void* p, std::size_t bytes);
+
 template <class T>
 struct CacheAlignedAllocator {
     using value_type = T;
-    static constexpr std::align_val_t kAlign{64};
     CacheAlignedAllocator() = default;
     template <class U>
     CacheAlignedAllocator(const CacheAlignedAllocator<U>&) {}
-    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlign)); }
-    void deallocate(T* p, std::size_t) { ::operator delete(p, kAlign); }
+    T* allocate(std::size_t n) { return static_cast<T*>(allocate_batch_storage(n * sizeof(T))); }
+    void deallocate(T* p, std::size_t n) { free_batch_storage(p, n * sizeof(T)); }
     template <class U>
     bool operator==(const CacheAlignedAllocator<U>&) const { return true; }
 };
@@ -184,12 +187,21 @@ private:
 /// Patch p of a view (either layout).
 BezierPatch get_patch(const PatchBatchView& patches, std::size_t p);
 
-/// Process-wide software prefetch distance of the SIMD kernels on plain views, in patches ahead
-/// of the group being read (0 = off; the default is the distance measured best in
-/// docs/PERFORMANCE.md, "Batches at the memory roof"). Read once per kernel call; blocked views
-/// never prefetch (one sequential stream the hardware follows). Meant for benchmarks.
+/// Process-wide software prefetch distances of the memory-bound SIMD kernels (those whose groups
+/// go through simd_groups' ForEachGroup with prefetching: frustum, frustum-disp), in patches ahead
+/// of the group being read; 0 = off. Plain views: the 64 lines (one per component array) of the
+/// patch `distance` ahead, every 16 patches; default kDefaultPlainPrefetch. Blocked views: the
+/// whole block holding the patch `distance` ahead, once per block; default
+/// kDefaultBlockedPrefetch. The hardware prefetchers follow neither: 64 streams are more than
+/// they track, and they stop at each 4 KiB page, which is one block. Read once per kernel call;
+/// thread-safe (relaxed atomics). Meant for benchmarks; the defaults are the distances measured
+/// in docs/PERFORMANCE.md, "Batches at the memory roof".
+inline constexpr std::size_t kDefaultPlainPrefetch = 128;
+inline constexpr std::size_t kDefaultBlockedPrefetch = kBlockPatches;
 void set_plain_prefetch_distance(std::size_t patches);
 std::size_t plain_prefetch_distance();
+void set_blocked_prefetch_distance(std::size_t patches);
+std::size_t blocked_prefetch_distance();
 
 /// Builds a batch from an array of patches.
 PatchBatch make_batch(const std::vector<BezierPatch>& patches);

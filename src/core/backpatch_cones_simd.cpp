@@ -238,14 +238,15 @@ HWY_INLINE MF BackFacing(DF d, const Group& g, const ConeV& cone, const V3& eye)
 }
 
 void CullTcone(const PatchBatchView& patches, Vec3 eye, std::uint8_t* culled) {
-    ForEachGroup(patches, culled, [&eye](DF d, const Group& g, std::size_t, std::size_t) {
+    // Compute-bound: software prefetching costs more than it saves (simd_groups-inl.h).
+    ForEachGroup<false>(patches, culled, [&eye](DF d, const Group& g, std::size_t, std::size_t) {
         const V3 e{hn::Set(d, eye.x), hn::Set(d, eye.y), hn::Set(d, eye.z)};
         return BackFacing(d, g, TangentCone(d, g), e);
     });
 }
 
 void CullNcone(const PatchBatchView& patches, Vec3 eye, std::uint8_t* culled) {
-    ForEachGroup(patches, culled, [&eye](DF d, const Group& g, std::size_t, std::size_t) {
+    ForEachGroup<false>(patches, culled, [&eye](DF d, const Group& g, std::size_t, std::size_t) {
         const V3 e{hn::Set(d, eye.x), hn::Set(d, eye.y), hn::Set(d, eye.z)};
         return BackFacing(d, g, NormalPatchCone(d, g), e);
     });

@@ -3,6 +3,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
+#include <new>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace patchcull {
 namespace {
@@ -199,15 +205,41 @@ void PatchBlocks::set(std::size_t index, const BezierPatch& patch) {
 
 BezierPatch PatchBlocks::get(std::size_t index) const { return get_patch(view(), index); }
 
-// ---- prefetch distance -------------------------------------------------------------------------
+// ---- storage -----------------------------------------------------------------------------------
 
+namespace detail {
 namespace {
-// Measured on a 2-core Sapphire Rapids VM (docs/PERFORMANCE.md, "Batches at the memory roof").
-constexpr std::size_t kDefaultPrefetchDistance = 0;
-std::atomic<std::size_t> g_prefetch_distance{kDefaultPrefetchDistance};
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+constexpr std::size_t kHugeFrom = std::size_t{4} << 20;
 }  // namespace
 
-void set_plain_prefetch_distance(std::size_t patches) { g_prefetch_distance.store(patches, std::memory_order_relaxed); }
-std::size_t plain_prefetch_distance() { return g_prefetch_distance.load(std::memory_order_relaxed); }
+void* allocate_batch_storage(std::size_t bytes) {
+    if (bytes < kHugeFrom) return ::operator new(bytes, std::align_val_t{64});
+    const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+    void* p = std::aligned_alloc(kHugePage, rounded);
+    if (!p) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    madvise(p, rounded, MADV_HUGEPAGE);  // a hint: without THP the pages stay 4 KiB
+#endif
+    return p;
+}
+
+void free_batch_storage(void* p, std::size_t bytes) {
+    if (bytes < kHugeFrom) ::operator delete(p, std::align_val_t{64});
+    else std::free(p);
+}
+}  // namespace detail
+
+// ---- prefetch distances ------------------------------------------------------------------------
+
+namespace {
+std::atomic<std::size_t> g_plain_prefetch{kDefaultPlainPrefetch};
+std::atomic<std::size_t> g_blocked_prefetch{kDefaultBlockedPrefetch};
+}  // namespace
+
+void set_plain_prefetch_distance(std::size_t patches) { g_plain_prefetch.store(patches, std::memory_order_relaxed); }
+std::size_t plain_prefetch_distance() { return g_plain_prefetch.load(std::memory_order_relaxed); }
+void set_blocked_prefetch_distance(std::size_t patches) { g_blocked_prefetch.store(patches, std::memory_order_relaxed); }
+std::size_t blocked_prefetch_distance() { return g_blocked_prefetch.load(std::memory_order_relaxed); }
 
 }  // namespace patchcull

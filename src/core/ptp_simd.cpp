@@ -183,7 +183,8 @@ HWY_INLINE MF PtpGroup(DF d, const Group& g, const ptp_detail::PtpClipRows& rows
 template <bool kPcnt>
 HWY_NOINLINE void CullGroups(const PatchBatchView& patches, const ptp_detail::PtpClipRows& rows,
                              std::uint8_t* culled) {
-    ForEachGroup(patches, culled, [&rows](DF d, const Group& g, std::size_t, std::size_t) {
+    // Compute-bound: software prefetching costs more than it saves (simd_groups-inl.h).
+    ForEachGroup<false>(patches, culled, [&rows](DF d, const Group& g, std::size_t, std::size_t) {
         return PtpGroup<kPcnt>(d, g, rows);
     });
 }

@@ -10,8 +10,9 @@
 // padding may belong to other patches or lie past the allocation) and only valid decisions are
 // written.
 //
-// Plain views may prefetch (PrefetchGroup, distance from plain_prefetch_distance()): each group
-// reads 64 arrays a stride apart, more streams than the hardware prefetchers track.
+// Memory-bound kernels prefetch (ForEachGroup<true>): on a plain view each group reads 64 arrays a
+// stride apart, more streams than the hardware prefetchers track; a blocked view is one stream,
+// but the hardware prefetchers stop at every 4 KiB page, i.e. every block.
 //
 // Exact arithmetic: Fma, NegFma and FmaSub round once, like std::fma, on every target. Targets
 // without an FMA instruction (HWY_NATIVE_FMA == 0: SSSE3, SSE4, emulated, i.e. pre-2013 CPUs)
@@ -103,13 +104,20 @@ HWY_INLINE Group GroupAt(const PatchBatchView& patches, std::size_t first) {
     return Group{patches.data + (first / kBlockPatches) * patches.block_stride + first % kBlockPatches, patches.stride};
 }
 
-// Prefetches the 64 cache lines that patch `first` of a plain view lies on (one per component
-// array; a 16-patch group reads one line per array when the arrays are 64-byte aligned). No-op
-// past the view's end; prefetches never fault.
+// Prefetches (into L1) the 64 cache lines that patch `first` of a plain view lies on, one per
+// component array; a 16-patch group reads one line per array when the arrays are 64-byte
+// aligned. No-op past the view's end; prefetches never fault.
 HWY_INLINE void PrefetchGroup(const PatchBatchView& patches, std::size_t first) {
     if (first >= patches.count) return;
     const float* p = patches.data + first;
     for (int a = 0; a < kComponents; ++a) hwy::Prefetch(p + static_cast<std::size_t>(a) * patches.stride);
+}
+
+// Prefetches the whole block (64 lines, 4 KiB) of a blocked view that patch `first` lies in.
+HWY_INLINE void PrefetchBlock(const PatchBatchView& patches, std::size_t first) {
+    if (first >= patches.count) return;
+    const float* b = patches.data + (first / kBlockPatches) * patches.block_stride;
+    for (int l = 0; l < kComponents; ++l) hwy::Prefetch(b + static_cast<std::size_t>(l) * kBlockPatches);
 }
 
 // The group of patches [first, first + valid) of patches, valid < Lanes(d), copied to buf
@@ -149,18 +157,28 @@ HWY_INLINE void StoreDecisions(DF d, MF culled, std::uint8_t* out, std::size_t n
 // culled[i] = group_fn(d, group, first, valid) for every group of patches: full groups in place
 // (GroupAt), the last partial one from a padded stack copy. group_fn returns the culled mask of its
 // lanes; first is the index of its lane 0 and valid the number of real patches in it (for side
-// inputs, see LoadPadded). Plain views prefetch plain_prefetch_distance() patches ahead, once per
-// 16 patches (one cache line of each array); blocked views are one sequential stream and do not.
-template <class GroupFn>
+// inputs, see LoadPadded).
+//
+// kPrefetch: software prefetching, once per 16 patches, plain_prefetch_distance() patches ahead
+// on plain views (PrefetchGroup) and blocked_prefetch_distance() ahead on blocked views
+// (PrefetchBlock). It pays for memory-bound kernels on batches beyond the caches (frustum: about
+// 2x at 1M patches) and costs compute-bound ones 10-20% (tcone, ncone, ptp run near their
+// instruction limit, below the memory roof, and pass false); docs/PERFORMANCE.md, "Batches at the
+// memory roof".
+template <bool kPrefetch = true, class GroupFn>
 HWY_INLINE void ForEachGroup(const PatchBatchView& patches, std::uint8_t* culled, const GroupFn& group_fn) {
     const DF d;
     const std::size_t N = hn::Lanes(d);
     const std::size_t count = patches.count;
     std::size_t i = 0;
     if (patches.block_stride != 0) {
-        for (; i + N <= count; i += N) StoreDecisions(d, group_fn(d, GroupAt(patches, i), i, N), culled + i, N);
+        const std::size_t ahead = kPrefetch ? blocked_prefetch_distance() : 0;
+        for (; i + N <= count; i += N) {
+            if (ahead != 0 && i % kBlockPatches == 0) PrefetchBlock(patches, i + ahead);
+            StoreDecisions(d, group_fn(d, GroupAt(patches, i), i, N), culled + i, N);
+        }
     } else {
-        const std::size_t ahead = plain_prefetch_distance();
+        const std::size_t ahead = kPrefetch ? plain_prefetch_distance() : 0;
         for (; i + N <= count; i += N) {
             if (ahead != 0 && i % kBlockPatches == 0) PrefetchGroup(patches, i + ahead);
             StoreDecisions(d, group_fn(d, GroupAt(patches, i), i, N), culled + i, N);

@@ -219,22 +219,30 @@ TEST(BlockedLayout, KernelsDecideTheSameOnBothLayouts) {
     for_each_simd_target([](bool fast) { check_plain_equals_blocked(fast); });
 }
 
-// Prefetching plain views (ForEachGroup) changes no decision, at distances short, long and past
+// Prefetching plain and blocked views (ForEachGroup) changes no decision, at distances short, long and past
 // the end of the batch.
 TEST(BlockedLayout, PrefetchChangesNoDecision) {
-    const std::size_t saved = plain_prefetch_distance();
+    const std::size_t saved = plain_prefetch_distance(), saved_blocked = blocked_prefetch_distance();
     const std::vector<BezierPatch> patches = random_patches(4099, 7);
     const PatchBatch batch = make_batch(patches);
     std::vector<std::vector<std::uint8_t>> want;
+    const PatchBlocks blocks(batch.view());
     set_plain_prefetch_distance(0);
+    set_blocked_prefetch_distance(0);
     const std::vector<NamedKernel> ks = kernels();
     for (const NamedKernel& k : ks) want.push_back(run(k.fn, batch.view()));
     for (std::size_t distance : {std::size_t{16}, std::size_t{128}, std::size_t{100000}}) {
         set_plain_prefetch_distance(distance);
+        set_blocked_prefetch_distance(distance);
         EXPECT_EQ(plain_prefetch_distance(), distance);
-        for (std::size_t i = 0; i < ks.size(); ++i) EXPECT_EQ(want[i], run(ks[i].fn, batch.view())) << ks[i].name;
+        EXPECT_EQ(blocked_prefetch_distance(), distance);
+        for (std::size_t i = 0; i < ks.size(); ++i) {
+            EXPECT_EQ(want[i], run(ks[i].fn, batch.view())) << ks[i].name;
+            EXPECT_EQ(want[i], run(ks[i].fn, blocks.view())) << ks[i].name;
+        }
     }
     set_plain_prefetch_distance(saved);
+    set_blocked_prefetch_distance(saved_blocked);
 }
 
 }  // namespace
