@@ -1,8 +1,9 @@
 // Stencil posing pass (gl::StencilPoser, include/patchcull/gl_posing.h, src/gl/stencil_poser.cpp):
 // the GPU twin of ScenePoser::pose (include/patchcull/default_scene.h). One invocation per output
-// row: 40 per patch, rows 0-15 its control points (patch.h order), rows 16-39 its ACC tangent
-// vectors (du[0..11], dv[0..11], shared.h's kTangentVec4s layout); tangent rows of a patch without
-// tangent patches do nothing.
+// row: first 16 per patch, its control points (patch.h order), then 24 per patch that has ACC
+// tangent patches, its tangent vectors (du[0..11], dv[0..11], shared.h's kTangentVec4s layout).
+// (Only the patches with tangents get tangent rows: with a fixed 40 rows per patch, llvmpipe ran
+// the idle lanes of the patches without them, about half of its time on ACC models.)
 //
 // Exactness (why the output is bit-identical to the CPU's):
 // - A stencil row is summed as the CPU's apply_row (src/import/subdivision.cpp) sums it: in
@@ -40,7 +41,10 @@ layout(std430, binding = 14) readonly buffer Instances {
     Instance instances[];
 };
 layout(std430, binding = 15) readonly buffer PatchTable {
-    uvec2 patch_table[];  // per output patch: instance, first tangent row (0xFFFFFFFF: none)
+    uint patch_instance[];  // per output patch: its instance
+};
+layout(std430, binding = 18) readonly buffer TangentTable {
+    uvec2 tangent_table[];  // per output patch with tangents: (patch, first row of its tangent block)
 };
 layout(std430, binding = 16) readonly buffer Offsets {
     uint offsets[];  // rows + 1: row r's terms are [offsets[r], offsets[r+1])
@@ -50,6 +54,7 @@ layout(std430, binding = 17) readonly buffer Terms {
 };
 
 uniform uint u_patch_count;
+uniform uint u_tangent_count;  // entries of tangent_table
 
 vec3 stencil_row(uint row, uint first_vertex) {
     precise dvec3 s = dvec3(0.0lf);
@@ -83,24 +88,24 @@ vec4 transform(mat4 m, vec4 p) {
 
 void main() {
     const uint index = gl_GlobalInvocationID.y * (gl_NumWorkGroups.x * gl_WorkGroupSize.x) + gl_GlobalInvocationID.x;
-    const uint p = index / 40u;
-    if (p >= u_patch_count) return;
-    const uint k = index - 40u * p;
-    const uvec2 entry = patch_table[p];
-    const Instance inst = instances[entry.x];
-    const bool mirrored = inst.info.z != 0u;
-    const uint model_patch = p - inst.info.y;
-    if (k < 16u) {
+    if (index < 16u * u_patch_count) {
+        const uint p = index / 16u, k = index % 16u;
+        const Instance inst = instances[patch_instance[p]];
+        const uint model_patch = p - inst.info.y;
         // Transposed (mirrored): world point 4j + i is the model's point 4i + j.
-        const uint source = mirrored ? 4u * (k % 4u) + k / 4u : k;
+        const uint source = inst.info.z != 0u ? 4u * (k % 4u) + k / 4u : k;
         const vec3 c = stencil_row(inst.info.w + 16u * model_patch + source, inst.info.x);
         control_points[16u * p + k] = transform(inst.to_world, vec4(c, 1.0));
         return;
     }
-    if (entry.y == 0xFFFFFFFFu) return;
-    const uint t = k - 16u;  // 0-11: du[t], 12-23: dv[t - 12]
+    const uint row = index - 16u * u_patch_count;
+    const uint q = row / 24u;
+    if (q >= u_tangent_count) return;
+    const uint t = row % 24u;  // 0-11: du[t], 12-23: dv[t - 12]
+    const uvec2 entry = tangent_table[q];
+    const Instance inst = instances[patch_instance[entry.x]];
     uint source = t;
-    if (mirrored) {
+    if (inst.info.z != 0u) {
         if (t < 12u) {
             // du'[3j + i] = dv[4i + j] (i < 3, j < 4)
             const uint j = t / 3u, i = t % 3u;
@@ -113,5 +118,5 @@ void main() {
     }
     const vec3 d = stencil_row(entry.y + source, inst.info.x);
     const vec4 mapped = transform(inst.to_world, vec4(d, 0.0));
-    tangents[24u * p + t] = vec4(mapped.xyz, t == 0u ? 1.0 : 0.0);
+    tangents[24u * entry.x + t] = vec4(mapped.xyz, t == 0u ? 1.0 : 0.0);
 }

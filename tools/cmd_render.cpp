@@ -52,10 +52,11 @@
 // are evaluated: cpu (the default: ScenePoser on the CPU, every patch and attribute re-uploaded)
 // or gpu (only the control meshes go up, gl_posing.h's StencilPoser evaluates the stencils into
 // the renderer's buffers, bit-identical). "pose" in the JSON is the flag; every frame gains
-//   "pose":{"where","cpu_patches","cpu_ms","done_ms","bytes_uploaded"}
+//   "pose":{"where","cpu_patches","cpu_ms","done_ms","meshes_ms","bytes_uploaded"}
 // (cpu_patches: the CPU posed patches this frame, which gpu does only for a CPU reader: the object
 // level, --cull auto, --draw-bounds, and frame 0, whose upload brings the attributes; cpu_ms: CPU
-// time of posing and uploading; done_ms: until glFinish returns; bytes_uploaded: bytes copied to GL).
+// time of posing and uploading; done_ms: until glFinish returns; meshes_ms: of cpu_ms, animating
+// the control meshes (gpu); bytes_uploaded: bytes copied to GL).
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -278,6 +279,7 @@ Runner add_render_command(CLI::App& app) {
                                         {"cpu_patches", pose_cost.cpu_patches},
                                         {"cpu_ms", pose_cost.cpu_ms},
                                         {"done_ms", pose_cost.done_ms},
+                                        {"meshes_ms", pose_cost.meshes_ms},
                                         {"bytes_uploaded", pose_cost.bytes_uploaded}}},
                               {"false_culls", false_culls},
                               {"depth_ties", depth_ties},

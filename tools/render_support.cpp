@@ -125,7 +125,9 @@ const std::vector<BezierPatch>* FramePoser::pose(float time_seconds) {
     if (where_ == PoseWhere::gpu) {
         // Frame 0 too: its patches are then the GPU's (equal to the upload, which brought the
         // attributes).
+        const auto meshes_start = clock::now();
         const PoseMeshes& meshes = poser_->gpu_meshes(time_seconds);
+        cost_.meshes_ms = std::chrono::duration<double, std::milli>(clock::now() - meshes_start).count();
         instances_.resize(meshes.first_vertex.size());
         for (std::size_t i = 0; i < instances_.size(); ++i)
             instances_[i] = {meshes.first_vertex[i], meshes.to_world[i], meshes.mirrored[i] != 0};

@@ -72,6 +72,10 @@ struct PoseCost {
     bool cpu_patches = false;  ///< the CPU posed patches too (gpu with a CPU reader, or cpu)
     double cpu_ms = 0;         ///< wall-clock CPU time of the posing and upload calls (no GPU wait)
     double done_ms = 0;        ///< cpu_ms plus glFinish: until the GPU has the pose (llvmpipe: its work)
+    /// Of cpu_ms, gpu: animating the control meshes (ScenePoser::gpu_meshes), the CPU work a GPU
+    /// driver leaves (llvmpipe runs the compute pass inside the dispatch call, so its cpu_ms holds
+    /// the pass too); cpu: 0.
+    double meshes_ms = 0;
     std::size_t bytes_uploaded = 0;  ///< bytes copied to GL for the pose
 };
 

@@ -22,7 +22,7 @@
 //
 // Threads and lifetime as gl_renderer.h: create, use and destroy on the context's thread.
 // State contract of pose(): it binds its program and its buffers at shader storage bindings 0, 10
-// (the outputs, shared.h's kBindingControlPoints and kBindingPatchTangents) and 13-17 (its inputs),
+// (the outputs, shared.h's kBindingControlPoints and kBindingPatchTangents) and 13-18 (its inputs),
 // leaves no program in use, and ends with glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT |
 // GL_BUFFER_UPDATE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT) so the following cull passes,
 // draws and read-backs see its writes. It does not wait for the GPU. After set_tables it allocates

@@ -18,10 +18,9 @@ namespace {
 
 // Binding points of pose_stencils.comp.glsl.
 constexpr GLuint kOutPoints = 0, kOutTangents = 10, kVertices = 13, kInstances = 14, kPatchTable = 15,
-                 kOffsets = 16, kTerms = 17;
+                 kOffsets = 16, kTerms = 17, kTangentTable = 18;
 constexpr GLuint kGroupSize = 256;            // local_size_x of the shader
-constexpr std::uint32_t kRowsPerPatch = 40;   // 16 control points + 24 tangent vectors
-constexpr std::uint32_t kNoTangents = 0xFFFFFFFFu;
+constexpr std::uint64_t kPointRows = 16, kTangentRows = 24;  // invocations per patch, per tangent block
 
 struct GpuInstance {
     float to_world[16];
@@ -66,8 +65,9 @@ void append_table(const StencilTableView& t, std::uint32_t vertex_count, std::si
 
 struct StencilPoser::Impl {
     GLuint program = 0;
-    GLint count_location = -1;
-    GLuint offsets = 0, terms = 0, patch_table = 0, vertices = 0, instances = 0;
+    GLint count_location = -1, tangent_count_location = -1;
+    GLuint offsets = 0, terms = 0, patch_table = 0, vertices = 0, instances = 0, tangent_table = 0;
+    std::size_t tangent_count = 0;  // entries of tangent_table
     std::size_t vertices_capacity = 0, instances_capacity = 0;  // bytes of the per-frame buffers
     std::vector<std::uint32_t> instance_models;
     std::vector<std::uint32_t> model_vertex_counts;
@@ -80,8 +80,8 @@ struct StencilPoser::Impl {
 
     ~Impl() {
         glDeleteProgram(program);
-        const GLuint buffers[] = {offsets, terms, patch_table, vertices, instances};
-        glDeleteBuffers(5, buffers);
+        const GLuint buffers[] = {offsets, terms, patch_table, vertices, instances, tangent_table};
+        glDeleteBuffers(6, buffers);
     }
 
     // Makes buffer hold at least size bytes (grows by doubling; never shrinks).
@@ -96,13 +96,15 @@ StencilPoser::StencilPoser(const GlContext& ctx) : impl_((ctx.make_current(), st
     Impl& m = *impl_;
     m.program = detail::link_program({{"pose_stencils.comp.glsl", GL_COMPUTE_SHADER}}, "pose_stencils");
     m.count_location = glGetUniformLocation(m.program, "u_patch_count");
-    GLuint buffers[5];
-    glCreateBuffers(5, buffers);
+    m.tangent_count_location = glGetUniformLocation(m.program, "u_tangent_count");
+    GLuint buffers[6];
+    glCreateBuffers(6, buffers);
     m.offsets = buffers[0];
     m.terms = buffers[1];
     m.patch_table = buffers[2];
     m.vertices = buffers[3];
     m.instances = buffers[4];
+    m.tangent_table = buffers[5];
     for (GLuint b : buffers) detail::upload(b, 0, nullptr);
     detail::check_gl("StencilPoser setup");
 }
@@ -146,30 +148,34 @@ void StencilPoser::set_tables(const std::vector<PosingModel>& models, const std:
         append_table(model.tangent_points, model.vertex_count, i, "tangent", offsets, terms);
     }
     if (terms.size() / 2 > 0xFFFFFFFFu) throw Error("GL: StencilPoser: more than 2^32 stencil terms");
-    // Per output patch: its instance and its tangent block's first row.
-    std::vector<std::uint32_t> table;
+    // Per output patch its instance; per output patch with tangents (patch, its block's first row).
+    std::vector<std::uint32_t> table, tangent_table;
     std::vector<std::uint32_t> first_patch;
-    bool tangents = false;
     for (std::size_t i = 0; i < instance_models.size(); ++i) {
         const std::uint32_t mi = instance_models[i];
         if (mi >= models.size())
             throw Error("GL: StencilPoser: instance " + std::to_string(i) + " names model " + std::to_string(mi) +
                         " of " + std::to_string(models.size()));
-        first_patch.push_back(static_cast<std::uint32_t>(table.size() / 2));
+        first_patch.push_back(static_cast<std::uint32_t>(table.size()));
         for (std::int32_t t : models[mi].tangent_index) {
+            if (t >= 0) {
+                tangent_table.push_back(static_cast<std::uint32_t>(table.size()));
+                tangent_table.push_back(first_tangent_row[mi] + 24u * static_cast<std::uint32_t>(t));
+            }
             table.push_back(static_cast<std::uint32_t>(i));
-            table.push_back(t < 0 ? kNoTangents : first_tangent_row[mi] + 24u * static_cast<std::uint32_t>(t));
-            tangents = tangents || t >= 0;
         }
-        if (table.size() / 2 * kRowsPerPatch >= 0xFFFFFFFFull)
-            throw Error("GL: StencilPoser: too many patches for one pass (" + std::to_string(table.size() / 2) + ")");
+        // Invocation indices are uint in the shader.
+        if (table.size() * kPointRows + tangent_table.size() / 2 * kTangentRows >= 0xFFFFFFFFull)
+            throw Error("GL: StencilPoser: too many patches for one pass (" + std::to_string(table.size()) + ")");
     }
     detail::upload(m.offsets, offsets.size() * 4, offsets.data());
     detail::upload(m.terms, terms.size() * 4, terms.data());
     detail::upload(m.patch_table, table.size() * 4, table.data());
-    m.table_bytes = (offsets.size() + terms.size() + table.size()) * 4;
-    m.count = table.size() / 2;
-    m.tangents = tangents;
+    detail::upload(m.tangent_table, tangent_table.size() * 4, tangent_table.data());
+    m.table_bytes = (offsets.size() + terms.size() + table.size() + tangent_table.size()) * 4;
+    m.count = table.size();
+    m.tangent_count = tangent_table.size() / 2;
+    m.tangents = m.tangent_count > 0;
     m.instance_models = instance_models;
     m.instance_first_patch = std::move(first_patch);
     m.model_first_row = std::move(first_row);
@@ -215,6 +221,7 @@ void StencilPoser::pose(const std::vector<Vec3>& vertices, const std::vector<Pos
     if (m.count == 0) return;
     glUseProgram(m.program);
     glUniform1ui(m.count_location, static_cast<GLuint>(m.count));
+    glUniform1ui(m.tangent_count_location, static_cast<GLuint>(m.tangent_count));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOutPoints, patch_buffer);
     // Without tangents nothing is written at kOutTangents; a buffer of ours keeps the binding valid.
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOutTangents, m.tangents ? tangent_buffer : m.instances);
@@ -223,9 +230,11 @@ void StencilPoser::pose(const std::vector<Vec3>& vertices, const std::vector<Pos
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPatchTable, m.patch_table);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOffsets, m.offsets);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTerms, m.terms);
-    // 40 invocations per patch; more than 65535 groups go into a second dimension (the shader
-    // flattens gl_GlobalInvocationID).
-    const std::uint64_t groups = (std::uint64_t{m.count} * kRowsPerPatch + kGroupSize - 1) / kGroupSize;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTangentTable, m.tangent_table);
+    // 16 invocations per patch and 24 per tangent block; more than 65535 groups go into a second
+    // dimension (the shader flattens gl_GlobalInvocationID).
+    const std::uint64_t rows = m.count * kPointRows + m.tangent_count * kTangentRows;
+    const std::uint64_t groups = (rows + kGroupSize - 1) / kGroupSize;
     const std::uint64_t x = std::min<std::uint64_t>(groups, 65535);
     const std::uint64_t y = (groups + x - 1) / x;
     glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
