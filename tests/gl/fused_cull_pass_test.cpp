@@ -22,10 +22,8 @@
 #include "patchcull/backpatch.h"
 #include "patchcull/camera.h"
 #include "patchcull/hiz.h"
-#if __has_include("patchcull/fused_cull.h")
 #include "patchcull/fused_cull.h"
-#define PATCHCULL_HAS_FUSED_CPU 1
-#endif
+#include "shared.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;
@@ -270,7 +268,6 @@ TEST(FusedCullPass, ReasonsEqualTheCpuKernels) {
             const std::vector<std::uint32_t> words =
                 run_fused(r, r.patch_buffers(), std::vector<std::uint32_t>(patches.size(), 0u), 7, method, s);
             std::size_t mismatched = 0;
-#ifdef PATCHCULL_HAS_FUSED_CPU
             // The CPU fused kernel, plan F, B, H (its default), on the same pyramid.
             std::vector<std::uint8_t> fused_cpu(patches.size(), 0xEE);
             const FusedCullSetup setup =
@@ -287,7 +284,6 @@ TEST(FusedCullPass, ReasonsEqualTheCpuKernels) {
                     ADD_FAILURE() << "round " << round << " " << backpatch_method_name(method) << ": patch " << p
                                   << " GPU " << (words[p] & kFlagReasonMask) << " cull_fused_scalar " << int(d);
             }
-#endif
             for (std::size_t p = 0; p < patches.size(); ++p) {
                 const std::uint32_t cpu = hiz_out[p] == kHiZFrustumCulled ? kFlagFrustum
                                           : cone_out[p]                   ? kFlagBackPatch
@@ -320,4 +316,45 @@ TEST(FusedCullPass, RefusesPtpMissingPyramidsAndUnknownTests) {
     // ptp is fine when the back-patch test is not asked for; no pyramid is needed without occlusion.
     EXPECT_NO_THROW(fused.run(r.patch_buffers(), kFlagFrustum, m, ClipDepth::zero_to_one, BackpatchMethod::ptp, {}, nullptr));
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+TEST(FusedCullPass, KeepsTheStateContract) {
+    // gl_passes.h: no program in use afterwards, its buffers and pyramid left bound where it bound
+    // them, and a GL error left by the caller reported as the caller's.
+    PatchRenderer r(test::context());
+    r.set_patches(test::split_teapot(1));
+    Camera cam;
+    cam.eye = {0, -6, 2};
+    cam.target = {0, 0, 1};
+    cam.up = {0, 0, 1};
+    RenderParams params;
+    params.view = cam.view();
+    params.projection = cam.projection();
+    params.width = params.height = 64;
+    params.tess_level = 2;
+    r.render(params);
+    HiZTexture hiz = create_hiz_texture(64, 64);
+    passes().hiz_build.run(r.depth_texture(), hiz);
+    const PatchBuffers b = r.patch_buffers();
+    passes().fused.run(b, 7, cam.view_projection(), ClipDepth::zero_to_one, BackpatchMethod::tcone, cam.eye, &hiz);
+    GLint program = -1, flags = -1, points = -1, texture = -1;
+    glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+    glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, shared::kBindingCullFlags, &flags);
+    glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, shared::kBindingControlPoints, &points);
+    glActiveTexture(GL_TEXTURE0 + shared::kTextureUnitHiZ);
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &texture);
+    glActiveTexture(GL_TEXTURE0);
+    EXPECT_EQ(program, 0);
+    EXPECT_EQ(static_cast<GLuint>(flags), b.flags);
+    EXPECT_EQ(static_cast<GLuint>(points), b.control_points);
+    EXPECT_EQ(static_cast<GLuint>(texture), hiz.texture);
+    glBindBuffer(GL_ARRAY_BUFFER, 0xFFFFFFu);  // not a buffer name: GL_INVALID_OPERATION
+    try {
+        passes().fused.run(b, 7, cam.view_projection(), ClipDepth::zero_to_one, BackpatchMethod::tcone, cam.eye, &hiz);
+        ADD_FAILURE() << "no error";
+    } catch (const patchcull::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("pending before FusedCullPass"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+    glDeleteTextures(1, &hiz.texture);
 }
