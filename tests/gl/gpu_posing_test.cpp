@@ -5,6 +5,7 @@
 // poses through identity rows; the cull pipeline's id buffer and flag words with GPU posing equal
 // those with CPU posing; `render --pose gpu --verify` has no false culls and the same per-frame
 // statistics as --pose cpu (default scene both schemes, city_small with its displaced frogs);
+// the CPU readers of posed patches (object level, --cull auto) keep a CPU pose under --pose gpu;
 // `--pose foo` is a one-line error. llvmpipe, small sizes.
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
@@ -275,6 +276,21 @@ TEST(GpuPosingCli, VerifiesLikeCpuOnTheDefaultSceneOsd) {
 TEST(GpuPosingCli, VerifiesLikeCpuOnCitySmall) {
     expect_gpu_like_cpu("render " + std::string(PATCHCULL_SOURCE_DIR) +
                         "/data/scenes/city_small.json --size 96x54 --tess 2 --frames 2");
+}
+
+// The CPU object level reads posed patches (its boxes): under --pose gpu it keeps a CPU pose
+// (cpu_patches) and stays exactly as conservative.
+TEST(GpuPosingCli, CpuReadersKeepACpuPose) {
+    for (const char* extra : {"--objects bvh", "--cull auto"}) {
+        const CliRun r = run(std::string("render default --size 96x54 --tess 2 --frames 3 --verify --json --pose gpu ") + extra);
+        ASSERT_EQ(r.status, 0) << extra << ": " << r.err;
+        const auto j = nlohmann::json::parse(r.out);
+        EXPECT_EQ(j["false_culls"], 0) << extra;
+        for (const auto& frame : j["frames"]) {
+            EXPECT_EQ(frame["pose"]["where"], "gpu") << extra;
+            EXPECT_EQ(frame["pose"]["cpu_patches"], true) << extra;
+        }
+    }
 }
 
 TEST(GpuPosingCli, BadValueIsAOneLineError) {
