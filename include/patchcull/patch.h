@@ -191,13 +191,13 @@ BezierPatch get_patch(const PatchBatchView& patches, std::size_t p);
 /// go through simd_groups' ForEachGroup with prefetching: frustum, frustum-disp), in patches ahead
 /// of the group being read; 0 = off. Plain views: the 64 lines (one per component array) of the
 /// patch `distance` ahead, every 16 patches; default kDefaultPlainPrefetch. Blocked views: the
-/// whole block holding the patch `distance` ahead, once per block; default
+/// head (8 lines) of the block holding the patch `distance` ahead, once per block; default
 /// kDefaultBlockedPrefetch. The hardware prefetchers follow neither: 64 streams are more than
 /// they track, and they stop at each 4 KiB page, which is one block. Read once per kernel call;
 /// thread-safe (relaxed atomics). Meant for benchmarks; the defaults are the distances measured
 /// in docs/PERFORMANCE.md, "Batches at the memory roof".
 inline constexpr std::size_t kDefaultPlainPrefetch = 128;
-inline constexpr std::size_t kDefaultBlockedPrefetch = kBlockPatches;
+inline constexpr std::size_t kDefaultBlockedPrefetch = 2 * kBlockPatches;
 void set_plain_prefetch_distance(std::size_t patches);
 std::size_t plain_prefetch_distance();
 void set_blocked_prefetch_distance(std::size_t patches);
