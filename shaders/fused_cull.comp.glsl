@@ -5,9 +5,10 @@
 // the separate passes use (frustum_test.h, backpatch_cones.h, hiz_box_test.h) and steps 2-4 of
 // occlusion.comp.glsl operation by operation, so each patch gets the reason the chain
 // begin -> FrustumPass -> BackpatchConePass -> OcclusionPass(with_frustum = false) would give it.
-// Why fuse: the chain reads every surviving patch's 16 control points (256 bytes) once per pass and
-// launches three dispatches; here they are read once and the later tests run only where the
-// earlier ones kept the patch, in registers.
+// Why fuse: the chain reads every surviving patch's 16 control points (256 bytes) once per pass,
+// transforms them to clip space twice (frustum and Hi-Z) and launches three dispatches; here one
+// loop over the points computes their clip coordinates once for the frustum planes and the Hi-Z
+// box (pc_fused_points), and the cone test runs only on what the frustum kept.
 // A link of the flag chain (flag_chain.h): patches culled earlier (e.g. kCullObject) are skipped;
 // displaced patches (margin > 0) get the frustum test with their margin only (the cone and the
 // control-point Hi-Z test bound neither a displaced surface's normals nor its depth), as in the
@@ -44,33 +45,6 @@ layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 #include "frustum_test.h"
 #include "hiz_box_test.h"
 
-// The fusion: each control point goes to clip space once (frustum_test.h's pc_clip_point, which
-// is hiz.h's step 2 in its operation order), and both the frustum planes and the Hi-Z screen box
-// read those coordinates.
-
-// pc_frustum_culled (frustum_test.h) on the clip points C of the patch's points P: the same plane
-// values, margins and maxima, without transforming the points again.
-bool pc_fused_frustum_culled(vec4 C[16], vec4 P[16], bool with_margins, float d) {
-    precise float margin[6];
-    precise float m[6];
-    for (int q = 0; q < 6; ++q) {
-        margin[q] = d * u_plane_normal_length[q >> 2][q & 3];
-        m[q] = uintBitsToFloat(0xFF800000u);  // -infinity
-    }
-    for (int k = 0; k < 16; ++k) {
-        float v[6];
-        pc_frustum_plane_values(C[k], v);
-        for (int q = 0; q < 6; ++q) {
-            precise float value = v[q];
-            if (with_margins) value = pc_fma(margin[q], P[k].w, value);
-            m[q] = m[q] > value ? m[q] : value;
-        }
-    }
-    bool culled = false;
-    for (int q = 0; q < 6; ++q) culled = culled || m[q] < 0.0;
-    return culled;
-}
-
 // occlusion.comp.glsl's pc_div (backpatch_exact.h's pc_div has the name here): a / b in double,
 // rounded once to float. Both are correctly rounded for the normal quotients of step 4, but only
 // this one is the occlusion pass's operation for every input, so the decisions match bit for bit.
@@ -82,39 +56,80 @@ float pc_div_hiz(float a, float b) {
 // 2^-20: step 3's safety factor (hiz.cpp kWSafety).
 const float kWSafety = 9.5367431640625e-07;
 
-// occlusion.comp.glsl's hiz_occluded (steps 3-9 of hiz.h) on the patch's points P and their clip
-// coordinates C (step 2).
-bool pc_fused_hiz_occluded(vec4 C[16], vec4 P[16]) {
+// The fusion: one loop over the 16 control points. Each goes to clip space once (frustum_test.h's
+// pc_clip_point, which is hiz.h's step 2 in its operation order), and those coordinates feed both
+// the frustum planes' maxima (pc_frustum_culled's arithmetic) and the Hi-Z test's NDC box and
+// front depth (occlusion.comp.glsl's steps 3-4). Only the six maxima and the box stay live, not
+// the points (the cone test reloads them, from cache, if the patch gets that far), which keeps
+// the registers low on a GPU. The price: a patch the frustum culls has had its box built too.
+struct PcFusedPoints {
+    bool frustum_culled;
+    bool projectable;  // step 3 held for every point (else the patch is not screen-tested)
+    float nxmin, nxmax, nymin, nymax, zmin;
+};
+
+PcFusedPoints pc_fused_points(uint p, bool frustum, bool hiz, bool with_margins, float d) {
+    PcFusedPoints r;
+    precise float margin[6];
+    precise float m[6];
+    for (int q = 0; q < 6; ++q) {
+        margin[q] = d * u_plane_normal_length[q >> 2][q & 3];
+        m[q] = uintBitsToFloat(0xFF800000u);  // -infinity
+    }
+    r.projectable = hiz;
     precise float nxmin = 0.0, nxmax = 0.0, nymin = 0.0, nymax = 0.0, zmin = 0.0;
-    for (int k = 0; k < 16; ++k) {
-        // Step 3: projectable (provably w > 0), else the patch is not screen-tested.
-        // (|M(3, c)| = |u_clip_rows[3][c]|: the w row.)
-        const vec4 w_row = u_clip_rows[3];
-        precise float s = abs(w_row.x) * abs(P[k].x);
-        s = pc_fma(abs(w_row.y), abs(P[k].y), s);
-        s = pc_fma(abs(w_row.z), abs(P[k].z), s);
-        s = pc_fma(abs(w_row.w), abs(P[k].w), s);
-        precise float bound = kWSafety * s;
-        if (!(C[k].w > bound)) return false;
-        // Step 4: NDC box and front plane.
-        const float nx = pc_div_hiz(C[k].x, C[k].w);
-        const float ny = pc_div_hiz(C[k].y, C[k].w);
-        const float nz = pc_div_hiz(C[k].z, C[k].w);
-        if (k == 0) {
-            nxmin = nx;
-            nxmax = nx;
-            nymin = ny;
-            nymax = ny;
-            zmin = nz;
-        } else {
-            nxmin = hiz_min(nxmin, nx);
-            nxmax = hiz_max(nxmax, nx);
-            nymin = hiz_min(nymin, ny);
-            nymax = hiz_max(nymax, ny);
-            zmin = hiz_min(zmin, nz);
+    const vec4 w_row = u_clip_rows[3];  // |M(3, c)| of step 3 = |w row|
+    for (uint k = 0u; k < 16u; ++k) {
+        const vec4 P = control_points[16u * p + k];
+        const vec4 c = pc_clip_point(P);
+        if (frustum) {
+            float v[6];
+            pc_frustum_plane_values(c, v);
+            for (int q = 0; q < 6; ++q) {
+                precise float value = v[q];
+                if (with_margins) value = pc_fma(margin[q], P.w, value);
+                m[q] = m[q] > value ? m[q] : value;
+            }
+        }
+        if (r.projectable) {
+            // Step 3: projectable (provably w > 0).
+            precise float s = abs(w_row.x) * abs(P.x);
+            s = pc_fma(abs(w_row.y), abs(P.y), s);
+            s = pc_fma(abs(w_row.z), abs(P.z), s);
+            s = pc_fma(abs(w_row.w), abs(P.w), s);
+            precise float bound = kWSafety * s;
+            if (!(c.w > bound)) {
+                r.projectable = false;
+            } else {
+                // Step 4: NDC box and front plane.
+                const float nx = pc_div_hiz(c.x, c.w);
+                const float ny = pc_div_hiz(c.y, c.w);
+                const float nz = pc_div_hiz(c.z, c.w);
+                if (k == 0u) {
+                    nxmin = nx;
+                    nxmax = nx;
+                    nymin = ny;
+                    nymax = ny;
+                    zmin = nz;
+                } else {
+                    nxmin = hiz_min(nxmin, nx);
+                    nxmax = hiz_max(nxmax, nx);
+                    nymin = hiz_min(nymin, ny);
+                    nymax = hiz_max(nymax, ny);
+                    zmin = hiz_min(zmin, nz);
+                }
+            }
         }
     }
-    return hiz_box_occluded(nxmin, nxmax, nymin, nymax, zmin);  // steps 5-9
+    r.frustum_culled = false;
+    if (frustum)
+        for (int q = 0; q < 6; ++q) r.frustum_culled = r.frustum_culled || m[q] < 0.0;
+    r.nxmin = nxmin;
+    r.nxmax = nxmax;
+    r.nymin = nymin;
+    r.nymax = nymax;
+    r.zmin = zmin;
+    return r;
 }
 
 void main() {
@@ -127,17 +142,17 @@ void main() {
     const bool frustum_tested = (fused.tests & kCullFrustum) != 0u;
     const bool cone_tested = (fused.tests & kCullBackPatch) != 0u && !(d > 0.0);
     const bool hiz_tested = (fused.tests & kCullOcclusion) != 0u && d == 0.0;
-    if (!frustum_tested && !cone_tested && !hiz_tested) return;
-    vec4 P[16];
-    for (int k = 0; k < 16; ++k) P[k] = control_points[16u * p + uint(k)];
-    vec4 C[16];
-    if (frustum_tested || hiz_tested)
-        for (int k = 0; k < 16; ++k) C[k] = pc_clip_point(P[k]);
-    if (frustum_tested && pc_fused_frustum_culled(C, P, fused.has_margins != 0u, d)) {
+    PcFusedPoints points;
+    points.frustum_culled = false;
+    points.projectable = false;
+    if (frustum_tested || hiz_tested) points = pc_fused_points(p, frustum_tested, hiz_tested, fused.has_margins != 0u, d);
+    if (points.frustum_culled) {
         pc_chain_cull(p, kCullFrustum);
         return;
     }
     if (cone_tested) {
+        vec4 P[16];
+        for (int k = 0; k < 16; ++k) P[k] = control_points[16u * p + uint(k)];
         const PcCone cone = PC_PASS_CONE(P);
         const PcSphere sphere = pc_sphere_of_points(P);
         if (pc_is_polynomial(P) && pc_back_facing(cone, sphere, fused.eye.xyz)) {
@@ -145,5 +160,8 @@ void main() {
             return;
         }
     }
-    if (hiz_tested && pc_fused_hiz_occluded(C, P)) pc_chain_cull(p, kCullOcclusion);
+    // Steps 5-9 on the box (hiz_box_test.h).
+    if (points.projectable &&
+        hiz_box_occluded(points.nxmin, points.nxmax, points.nymin, points.nymax, points.zmin))
+        pc_chain_cull(p, kCullOcclusion);
 }
