@@ -92,7 +92,13 @@ FramePoser::FramePoser(const gl::GlContext& context, ScenePoser& poser, gl::Patc
                        bool cpu_patches)
     : poser_(&poser), renderer_(&renderer), where_(where), cpu_patches_(cpu_patches) {
     if (where != PoseWhere::gpu) return;
-    const std::vector<PoseModelTables>& tables = poser.gpu_tables();
+    const std::vector<PoseModelTables>* tables_or_null = nullptr;
+    try {
+        tables_or_null = &poser.gpu_tables();
+    } catch (const Error& e) {
+        throw Error(std::string("--pose gpu: ") + e.what());  // the flag that asked for it
+    }
+    const std::vector<PoseModelTables>& tables = *tables_or_null;
     std::vector<gl::PosingModel> models;
     for (const PoseModelTables& t : tables)
         models.push_back({table_view(*t.patch_points), table_view(*t.tangent_points), t.tangent_index, t.vertex_count});
