@@ -28,8 +28,6 @@ namespace {
 inline float min_like_simd(float a, float b) { return a < b ? a : b; }
 inline float max_like_simd(float a, float b) { return a > b ? a : b; }
 
-// Index of component c of control point k (frustum.h / patch.h layout).
-inline const float* comp(const PatchBatchView& v, int k, int c) { return v.component(k, c); }
 
 }  // namespace
 
@@ -90,11 +88,11 @@ void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_di
     for (std::size_t p = 0; p < patches.count; ++p) {
         const float d = max_displacement ? max_displacement[p] : 0.0f;
         float lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) lo[a] = hi[a] = comp(patches, 0, a)[p] / comp(patches, 0, 3)[p];
+        for (int a = 0; a < 3; ++a) lo[a] = hi[a] = patches.at(p, 0, a) / patches.at(p, 0, 3);
         for (int k = 1; k < kPatchPoints; ++k) {
-            const float W = comp(patches, k, 3)[p];
+            const float W = patches.at(p, k, 3);
             for (int a = 0; a < 3; ++a) {
-                const float v = comp(patches, k, a)[p] / W;
+                const float v = patches.at(p, k, a) / W;
                 lo[a] = min_like_simd(lo[a], v);
                 hi[a] = max_like_simd(hi[a], v);
             }
