@@ -217,7 +217,7 @@ Runner add_eval_command(CLI::App& app) {
     add_choice_option(*fused_command, "--scheme", fused->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*fused_command, "--frames", fused->frames, 1, 10000, "frames of the scene's camera path");
     add_size_option(*fused_command, "--size", fused->size, "framebuffer size (the depth that feeds the Hi-Z pyramid)");
-    add_int_option(*fused_command, "--tess", fused->tess, 1, 64, "uniform tessellation level of the depth render");
+    add_int_option(*fused_command, "--tess", fused->tess, 1, 64, "uniform tessellation level of the unculled render (the check)");
     add_int_option(*fused_command, "--repeats", fused->repeats, 1, 1000, "timed runs per object, plan and frame (minimum kept)");
     add_int_option(*fused_command, "--profile-interval", fused->profile_interval, 1, 10000,
                    "frames between an object's profiling runs (cost model)");

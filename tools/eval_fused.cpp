@@ -3,10 +3,14 @@
 // cull kernel (fused_cull.h) and of the cost model that picks its plan per object and frame
 // (fused_cost_model.h), on a scene's camera path.
 //
-// Per frame: the scene is posed (the animation at kSecondsPerFrame), drawn unculled on the GPU
-// (llvmpipe here) at --size and --tess with its occluders, and the depth buffer read back becomes
-// the CPU Hi-Z pyramid (the ideal pyramid of the frame itself: the running pipeline's pass-1 depth
-// is close to it once converged). Then, for every object (an instance's patch range; displaced
+// Per frame: the scene is posed (the animation at kSecondsPerFrame), its occluders (the
+// environment's triangles: walls, pillars, buildings, ground) are drawn on the GPU (llvmpipe here)
+// at --size, and that depth becomes the CPU Hi-Z pyramid. Patches are not in it: a patch tested
+// against a depth buffer holding its own fragments can be culled by itself, since those may lie a
+// few ulps in front of its control points' zmin (hiz.h's precision note; the running pipeline
+// never draws a patch only after testing it against its own depth). So the Hi-Z stage here culls
+// what the occluders hide, not what patches hide. Then the frame is drawn unculled at --tess for
+// the id buffer. Then, for every object (an instance's patch range; displaced
 // instances are left out: the fused kernel has no displacement margins, like the cone and Hi-Z
 // kernels), on one core, each measured as the minimum of --repeats runs:
 //   plans      every fixed plan with all three tests, FBH, FHB, BFH (F frustum, B back-patch cone,
@@ -19,7 +23,8 @@
 //              cull_occlusion_simd (which runs the frustum test itself): what the fused kernel
 //              replaces.
 // Every culled patch is checked against the unculled frame's id buffer: a patch that shows there
-// but was culled is a false cull; any makes the exit status 1.
+// but was culled is a false cull (one line on stderr each, up to 10, with what the Hi-Z test saw);
+// any makes the exit status 1.
 // Output (--json), one object, times in seconds per frame (sums over the objects, mean over frames):
 //   {"scene","scheme","target","objects","fused_objects","patches","fused_patches","frames",
 //    "size":[w,h],"tess","repeats","profile_interval","cone",
@@ -36,6 +41,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <iomanip>
 #include <iostream>
 #include <map>
 
@@ -118,6 +124,7 @@ int run_fused_eval(const FusedEvalOptions& o) {
     std::vector<float> depth_bottom_up(static_cast<std::size_t>(width) * height);
     std::vector<std::uint8_t> decision, scratch, scratch2;
     std::vector<bool> shown;
+    const std::vector<std::uint8_t> all_culled(scene.patch_count(), 1);
     HiZPyramid hiz;
     Progress progress("eval fused", "frames", static_cast<std::uint64_t>(o.frames), progress_wanted(o.json));
     for (int f = 0; f < o.frames; ++f) {
@@ -125,10 +132,17 @@ int run_fused_eval(const FusedEvalOptions& o) {
         renderer.update_patches(pose, pose_attributes(poser));
         const Camera& camera = cameras[static_cast<std::size_t>(f)];
         gl::RenderParams params = render_params(camera, width, height, o.tess, one_sided);
+        // The pyramid: the occluders alone (every patch flagged culled), so that no patch is
+        // tested against its own depth (its fragments may lie a few ulps in front of its control
+        // points' zmin: hiz.h's precision note; seen once in 48 city frames).
+        renderer.set_cull_flags(all_culled.data());
+        params.use_cull_flags = true;
+        renderer.render(params);
+        const std::vector<float> depth = renderer.read_depth();  // top row first
+        // The truth: the unculled frame's id buffer.
         params.use_cull_flags = false;
         renderer.render(params);
         const std::vector<std::uint32_t> ids = renderer.read_ids();
-        const std::vector<float> depth = renderer.read_depth();  // top row first
         for (int y = 0; y < height; ++y)
             std::copy_n(depth.begin() + static_cast<std::ptrdiff_t>(y) * width, width,
                         depth_bottom_up.begin() + static_cast<std::ptrdiff_t>(height - 1 - y) * width);
@@ -158,7 +172,25 @@ int run_fused_eval(const FusedEvalOptions& o) {
             cull_fused_simd(view, setup, fixed[0], decision.data());
             for (std::size_t p = 0; p < view.count; ++p) {
                 ++culled[decision[p]];
-                if (decision[p] != kFusedVisible && shown[fused[i].first + p]) ++false_culls;
+                if (decision[p] != kFusedVisible && shown[fused[i].first + p]) {
+                    if (++false_culls <= 10) {
+                        // What the Hi-Z test saw, and the patch's own depth where the frame shows it.
+                        PatchScreenBounds b;
+                        const bool projectable = patch_screen_bounds(view, p, params.projection * params.view,
+                                                                     ClipDepth::zero_to_one, width, height, b);
+                        const std::vector<float> frame_depth = renderer.read_depth();
+                        float own = 2;
+                        for (std::size_t px = 0; px < ids.size(); ++px)
+                            if (ids[px] == fused[i].first + p + 1) own = std::min(own, frame_depth[px]);
+                        std::cerr << std::setprecision(9) << "eval fused: false cull: frame " << f << ", patch " << fused[i].first + p
+                                  << " (object " << i << "), culled by "
+                                  << (decision[p] == kFusedFrustumCulled ? "frustum"
+                                      : decision[p] == kFusedOccluded ? "occlusion" : "backpatch")
+                                  << "; zmin " << (projectable ? b.zmin : -1.0f) << ", pyramid max "
+                                  << (projectable ? hiz_rect_max(hiz, b.rect) : -1.0f) << ", its own nearest depth " << own
+                                  << "\n";
+                    }
+                }
             }
             // The model.
             const FusedPlan plan = model.choose(i, kAllFusedStages);

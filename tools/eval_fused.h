@@ -12,7 +12,7 @@ struct FusedEvalOptions {
     std::string scheme = "acc";
     int frames = 24;
     std::string size = "640x360";
-    int tess = 4;               ///< only for the depth render that feeds the Hi-Z pyramid
+    int tess = 4;               ///< of the unculled render whose id buffer checks the decisions
     int repeats = 5;            ///< timed runs per object, plan and frame (the minimum is kept)
     int profile_interval = 16;  ///< FusedCostModel::Config::profile_interval
     std::string cone = "tcone";
