@@ -45,17 +45,6 @@ layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 #include "frustum_test.h"
 #include "hiz_box_test.h"
 
-// occlusion.comp.glsl's pc_div (backpatch_exact.h's pc_div has the name here): a / b in double,
-// rounded once to float. Both are correctly rounded for the normal quotients of step 4, but only
-// this one is the occlusion pass's operation for every input, so the decisions match bit for bit.
-float pc_div_hiz(float a, float b) {
-    precise double q = double(a) / double(b);
-    return float(q);
-}
-
-// 2^-20: step 3's safety factor (hiz.cpp kWSafety).
-const float kWSafety = 9.5367431640625e-07;
-
 // The fusion: one loop over the 16 control points. Each goes to clip space once (frustum_test.h's
 // pc_clip_point, which is hiz.h's step 2 in its operation order), and those coordinates feed both
 // the frustum planes' maxima (pc_frustum_culled's arithmetic) and the Hi-Z test's NDC box and
@@ -77,8 +66,8 @@ PcFusedPoints pc_fused_points(uint p, bool frustum, bool hiz, bool with_margins,
         m[q] = uintBitsToFloat(0xFF800000u);  // -infinity
     }
     r.projectable = hiz;
-    precise float nxmin = 0.0, nxmax = 0.0, nymin = 0.0, nymax = 0.0, zmin = 0.0;
-    const vec4 w_row = u_clip_rows[3];  // |M(3, c)| of step 3 = |w row|
+    HiZPointBox box;
+    box.nxmin = box.nxmax = box.nymin = box.nymax = box.zmin = 0.0;
     for (uint k = 0u; k < 16u; ++k) {
         const vec4 P = control_points[16u * p + k];
         const vec4 c = pc_clip_point(P);
@@ -91,44 +80,17 @@ PcFusedPoints pc_fused_points(uint p, bool frustum, bool hiz, bool with_margins,
                 m[q] = m[q] > value ? m[q] : value;
             }
         }
-        if (r.projectable) {
-            // Step 3: projectable (provably w > 0).
-            precise float s = abs(w_row.x) * abs(P.x);
-            s = pc_fma(abs(w_row.y), abs(P.y), s);
-            s = pc_fma(abs(w_row.z), abs(P.z), s);
-            s = pc_fma(abs(w_row.w), abs(P.w), s);
-            precise float bound = kWSafety * s;
-            if (!(c.w > bound)) {
-                r.projectable = false;
-            } else {
-                // Step 4: NDC box and front plane.
-                const float nx = pc_div_hiz(c.x, c.w);
-                const float ny = pc_div_hiz(c.y, c.w);
-                const float nz = pc_div_hiz(c.z, c.w);
-                if (k == 0u) {
-                    nxmin = nx;
-                    nxmax = nx;
-                    nymin = ny;
-                    nymax = ny;
-                    zmin = nz;
-                } else {
-                    nxmin = hiz_min(nxmin, nx);
-                    nxmax = hiz_max(nxmax, nx);
-                    nymin = hiz_min(nymin, ny);
-                    nymax = hiz_max(nymax, ny);
-                    zmin = hiz_min(zmin, nz);
-                }
-            }
-        }
+        // Steps 3-4 (hiz_box_test.h), as occlusion.comp.glsl.
+        if (r.projectable) r.projectable = hiz_add_point(P, c, u_clip_rows[3], k == 0u, box);
     }
     r.frustum_culled = false;
     if (frustum)
         for (int q = 0; q < 6; ++q) r.frustum_culled = r.frustum_culled || m[q] < 0.0;
-    r.nxmin = nxmin;
-    r.nxmax = nxmax;
-    r.nymin = nymin;
-    r.nymax = nymax;
-    r.zmin = zmin;
+    r.nxmin = box.nxmin;
+    r.nxmax = box.nxmax;
+    r.nymin = box.nymin;
+    r.nymax = box.nymax;
+    r.zmin = box.zmin;
     return r;
 }
 

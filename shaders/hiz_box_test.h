@@ -1,8 +1,9 @@
 // Hi-Z test of a screen box: hiz.h steps 5-9 (seed 000 §4.1.1), the GPU twin of
 // hiz_rect_from_window_box, hiz_select_level and hiz_rect_max (src/core/hiz.cpp), operation by
 // operation (pc_fma = std::fma, `a < b ? a : b` min/max, floor, integer shifts), so the decisions
-// equal the CPU's. Shared by occlusion.comp.glsl (a patch's control-point box) and
-// displaced.comp.glsl (a displaced patch's bound). The including shader includes exact_fma.h
+// equal the CPU's; and steps 3-4 per control point (hiz_add_point). Shared by occlusion.comp.glsl
+// and fused_cull.comp.glsl (a patch's control-point box) and displaced.comp.glsl (a displaced
+// patch's bound). The including shader includes exact_fma.h
 // first and declares the pyramid: uniform ivec2 u_screen (W, H: its depth buffer, viewport
 // 0,0,W,H), uniform int u_hiz_levels (HiZPyramid::level_count(W, H)), sampler2D u_hiz.
 
@@ -13,6 +14,55 @@ float hiz_min(float a, float b) {
 float hiz_max(float a, float b) {
     precise float r = a > b ? a : b;
     return r;
+}
+
+// a / b correctly rounded (IEEE), as the CPU's float division. GLSL allows 2.5 ulp for float
+// division, so it is computed in double and rounded once to float: for float a, b the exact
+// quotient lies at least 2^-49 (relative) from every midpoint between two floats (a/b = midpoint
+// m would need m*b, with m's odd 25-bit significand, to fit a 24-bit significand), farther than
+// the error of any double division within 16 double ulps (2^-48 relative); so the float nearest
+// to the double quotient is the float nearest to a/b.
+float hiz_div(float a, float b) {
+    precise double q = double(a) / double(b);
+    return float(q);
+}
+
+// 2^-20: step 3's safety factor (hiz.cpp kWSafety).
+const float kHiZWSafety = 9.5367431640625e-07;
+
+// The NDC box and front plane of a patch's control points (steps 3-4), point by point.
+struct HiZPointBox {
+    float nxmin, nxmax, nymin, nymax, zmin;
+};
+
+// Steps 3-4 for control point P (object space) with clip coordinates c (step 2, pc_clip_point's
+// operations), w_row being the clip matrix's w row: false when P is not provably in front of the
+// eye (the patch is then not screen-tested: step 3); else P's NDC point joins box (starts it
+// when first). The CPU's patch_bounds (src/core/hiz.cpp), operation by operation.
+bool hiz_add_point(const vec4 P, const vec4 c, const vec4 w_row, bool first, inout HiZPointBox box) {
+    precise float s = abs(w_row.x) * abs(P.x);
+    s = pc_fma(abs(w_row.y), abs(P.y), s);
+    s = pc_fma(abs(w_row.z), abs(P.z), s);
+    s = pc_fma(abs(w_row.w), abs(P.w), s);
+    precise float bound = kHiZWSafety * s;
+    if (!(c.w > bound)) return false;
+    const float nx = hiz_div(c.x, c.w);
+    const float ny = hiz_div(c.y, c.w);
+    const float nz = hiz_div(c.z, c.w);
+    if (first) {
+        box.nxmin = nx;
+        box.nxmax = nx;
+        box.nymin = ny;
+        box.nymax = ny;
+        box.zmin = nz;
+    } else {
+        box.nxmin = hiz_min(box.nxmin, nx);
+        box.nxmax = hiz_max(box.nxmax, nx);
+        box.nymin = hiz_min(box.nymin, ny);
+        box.nymax = hiz_max(box.nymax, ny);
+        box.zmin = hiz_min(box.zmin, nz);
+    }
+    return true;
 }
 
 // True when the NDC box [ndc_xmin, ndc_xmax] x [ndc_ymin, ndc_ymax] at depth depth_near (its

@@ -3,7 +3,7 @@
 // src/core/hiz.cpp), steps numbered as in hiz.h. Operation by operation the same arithmetic, so the
 // decisions are identical: products and std::fma <-> `precise` products and pc_fma (exact_fma.h),
 // `a < b ? a : b` min/max, floor, integer shifts; the divisions of step 4 are correctly rounded
-// (pc_div below).
+// (hiz_div, hiz_box_test.h).
 // A link of the flag chain (flag_chain.h): patches culled earlier in the frame are skipped; then,
 // as the CPU kernel, the frustum test (frustum_test.h, with the margin; when with_frustum) and
 // steps 2-9 against the pyramid, only for patches whose margin is 0 (a displaced patch needs the
@@ -31,62 +31,15 @@ layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 #include "frustum_test.h"
 #include "hiz_box_test.h"
 
-float pc_min(float a, float b) { return a < b ? a : b; }
-float pc_max(float a, float b) { return a > b ? a : b; }
-
-// a / b correctly rounded (IEEE), as the CPU's float division. GLSL allows 2.5 ulp for float
-// division, so it is computed in double and rounded once to float: for float a, b the exact
-// quotient lies at least 2^-49 (relative) from every midpoint between two floats (a/b = midpoint
-// m would need m*b, with m's odd 25-bit significand, to fit a 24-bit significand), farther than
-// the error of any double division within 16 double ulps (2^-48 relative); so the float nearest
-// to the double quotient is the float nearest to a/b.
-float pc_div(float a, float b) {
-    precise double q = double(a) / double(b);
-    return float(q);
-}
-
-// 2^-20: step 3's safety factor (hiz.cpp kWSafety).
-const float kWSafety = 9.5367431640625e-07;
-
 // Steps 2-9 for patch p: true when the patch lies behind the pyramid.
 bool hiz_occluded(uint p) {
-    precise float nxmin = 0.0, nxmax = 0.0, nymin = 0.0, nymax = 0.0, zmin = 0.0;
+    HiZPointBox box;
     for (uint k = 0u; k < 16u; ++k) {
         const vec4 P = control_points[16u * p + k];
-        // Step 2: clip-space point, c_r = fma(M(r,3), W, fma(M(r,2), Z, fma(M(r,1), Y, M(r,0) * X))).
-        precise float c[4];
-        for (int r = 0; r < 4; ++r) {
-            precise float t = u_object_to_clip[0][r] * P.x;
-            t = pc_fma(u_object_to_clip[1][r], P.y, t);
-            t = pc_fma(u_object_to_clip[2][r], P.z, t);
-            c[r] = pc_fma(u_object_to_clip[3][r], P.w, t);
-        }
-        // Step 3: projectable (provably w > 0), else the patch is not screen-tested.
-        precise float s = abs(u_object_to_clip[0][3]) * abs(P.x);
-        s = pc_fma(abs(u_object_to_clip[1][3]), abs(P.y), s);
-        s = pc_fma(abs(u_object_to_clip[2][3]), abs(P.z), s);
-        s = pc_fma(abs(u_object_to_clip[3][3]), abs(P.w), s);
-        precise float bound = kWSafety * s;
-        if (!(c[3] > bound)) return false;
-        // Step 4: NDC box and front plane.
-        const float nx = pc_div(c[0], c[3]);
-        const float ny = pc_div(c[1], c[3]);
-        const float nz = pc_div(c[2], c[3]);
-        if (k == 0u) {
-            nxmin = nx;
-            nxmax = nx;
-            nymin = ny;
-            nymax = ny;
-            zmin = nz;
-        } else {
-            nxmin = pc_min(nxmin, nx);
-            nxmax = pc_max(nxmax, nx);
-            nymin = pc_min(nymin, ny);
-            nymax = pc_max(nymax, ny);
-            zmin = pc_min(zmin, nz);
-        }
+        // Step 2 (pc_clip_point, frustum_test.h), steps 3-4 (hiz_add_point, hiz_box_test.h).
+        if (!hiz_add_point(P, pc_clip_point(P), u_clip_rows[3], k == 0u, box)) return false;
     }
-    return hiz_box_occluded(nxmin, nxmax, nymin, nymax, zmin);  // steps 5-9
+    return hiz_box_occluded(box.nxmin, box.nxmax, box.nymin, box.nymax, box.zmin);  // steps 5-9
 }
 
 void main() {
