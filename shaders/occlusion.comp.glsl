@@ -26,7 +26,6 @@ layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 #define u_plane_normal_length occlusion.plane_normal_length
 #define u_screen ivec2(occlusion.screen_width, occlusion.screen_height)
 #define u_hiz_levels occlusion.hiz_levels
-#define u_object_to_clip occlusion.object_to_clip
 
 #include "frustum_test.h"
 #include "hiz_box_test.h"

@@ -65,8 +65,8 @@ PC_PARAMS(FrustumDispParams, kUniformPassParams) {
 
 // occlusion.comp.glsl (OcclusionPass): cull_occlusion_scalar's test against a Hi-Z pyramid.
 PC_PARAMS(OcclusionParams, kUniformPassParams) {
-    PC_MAT4(object_to_clip);           // column-major, as Mat4::m
-    PC_VEC4(clip_rows[4]);             // make_frustum_planes(object_to_clip, zero_to_one)
+    PC_VEC4(clip_rows[4]);             // make_frustum_planes(object_to_clip, zero_to_one): the frustum
+                                       // planes' and the Hi-Z box's clip transform (hiz.h step 2)
     PC_VEC4(plane_normal_length[2]);
     PC_UINT(first_patch);
     PC_UINT(patch_count);

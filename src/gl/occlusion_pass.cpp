@@ -22,7 +22,6 @@ void OcclusionPass::run(const PatchBuffers& patches, const Mat4& any_object_to_c
     if (patches.count == 0) return;
     const Mat4 object_to_clip = to_zero_to_one(any_object_to_clip, depth);
     pp::OcclusionParams params;
-    std::copy_n(object_to_clip.m, 16, params.object_to_clip);
     detail::store_planes(make_frustum_planes(object_to_clip, ClipDepth::zero_to_one), params.clip_rows,
                          params.plane_normal_length);
     params.has_margins = patches.margins ? 1u : 0u;

@@ -16,7 +16,7 @@ using namespace detail;
 // The C++ structs are the GLSL std140 blocks (pass_params.h): sizes a multiple of 16, members in
 // std140 order (matrices and vec4 arrays first, then 4-byte scalars).
 static_assert(sizeof(pp::FrustumParams) == 4 * 16 + 2 * 16 + 16);
-static_assert(sizeof(pp::OcclusionParams) == 64 + 4 * 16 + 2 * 16 + 32);
+static_assert(sizeof(pp::OcclusionParams) == 4 * 16 + 2 * 16 + 32);
 static_assert(sizeof(pp::HiZBuildParams) == 32);
 static_assert(sizeof(pp::BackpatchConeParams) == 16 + 32);
 static_assert(sizeof(pp::BackpatchPtpParams) == 3 * 16 + 32);
@@ -24,7 +24,7 @@ static_assert(sizeof(pp::DisplacedParams) == 64 + 6 * 16 + 3 * 16 + 5 * 16 + 48)
 static_assert(sizeof(pp::CullStatusParams) == 16);
 static_assert(sizeof(pp::FusedCullParams) == 4 * 16 + 2 * 16 + 16 + 32);
 static_assert(offsetof(pp::FusedCullParams, first_patch) == 4 * 16 + 2 * 16 + 16);
-static_assert(offsetof(pp::OcclusionParams, first_patch) == 64 + 4 * 16 + 2 * 16);
+static_assert(offsetof(pp::OcclusionParams, first_patch) == 4 * 16 + 2 * 16);
 static_assert(offsetof(pp::DisplacedParams, first_patch) == 64 + 6 * 16 + 3 * 16 + 5 * 16);
 
 PassContext::Impl::~Impl() {
