@@ -12,29 +12,15 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli/cli_test_util.h"
+#include "cli/cli_json_util.h"
 
 using namespace patchcull::cli_test;
 using nlohmann::json;
 
 namespace {
 
-std::set<std::string> keys(const json& object) {
-    std::set<std::string> out;
-    for (auto it = object.begin(); it != object.end(); ++it) out.insert(it.key());
-    return out;
-}
-
-json run_json(const std::string& args) {
-    const CliRun r = run(args);
-    EXPECT_EQ(r.status, 0) << args << "\n" << r.err << r.out.substr(0, 2000);
-    const json j = json::parse(r.out, nullptr, false);
-    EXPECT_FALSE(j.is_discarded()) << args << ": not JSON: " << r.out.substr(0, 2000) << r.err;
-    return j.is_discarded() ? json::object() : j;
-}
-
 void check_contract(const json& j, int frames) {
-    EXPECT_EQ(keys(j), (std::set<std::string>{"scene", "scheme", "target", "objects", "fused_objects", "patches",
+    EXPECT_EQ(json_keys(j), (std::set<std::string>{"scene", "scheme", "target", "objects", "fused_objects", "patches",
                                               "fused_patches", "frames", "size", "tess", "repeats", "profile_interval",
                                               "cone", "culled", "plans", "best_plan", "model", "oracle", "separate",
                                               "false_culls"}));
@@ -48,7 +34,7 @@ void check_contract(const json& j, int frames) {
     std::set<std::string> plans;
     double best = 1e30;
     for (const json& p : j["plans"]) {
-        EXPECT_EQ(keys(p), (std::set<std::string>{"plan", "seconds", "ratio_to_best"}));
+        EXPECT_EQ(json_keys(p), (std::set<std::string>{"plan", "seconds", "ratio_to_best"}));
         plans.insert(p["plan"].get<std::string>());
         EXPECT_GE(p["ratio_to_best"].get<double>(), 1.0 - 1e-12);
         best = std::min(best, p["ratio_to_best"].get<double>());
@@ -58,7 +44,7 @@ void check_contract(const json& j, int frames) {
     EXPECT_NEAR(best, 1.0, 1e-12);
     EXPECT_TRUE(plans.count(j["best_plan"].get<std::string>()));
     const json& m = j["model"];
-    EXPECT_EQ(keys(m), (std::set<std::string>{"seconds", "profile_seconds", "ratio_to_best", "ratio_to_oracle",
+    EXPECT_EQ(json_keys(m), (std::set<std::string>{"seconds", "profile_seconds", "ratio_to_best", "ratio_to_oracle",
                                               "agreement", "profiled", "choices"}));
     int chosen = 0;
     for (auto it = m["choices"].begin(); it != m["choices"].end(); ++it) {

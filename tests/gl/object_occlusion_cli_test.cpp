@@ -22,7 +22,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli/cli_test_util.h"
+#include "cli/cli_json_util.h"
 
 using namespace patchcull::cli_test;
 using nlohmann::json;
@@ -38,20 +38,6 @@ constexpr std::size_t kCityObjects = 25, kCityCharacters = 20, kCityPatches = 27
 constexpr std::size_t kRoomsObjects = 18, kRoomsCharacters = 4, kRoomsPatches = 4224;
 constexpr std::size_t kBigGuyPatches = 1450, kFrogPatches = 1292;
 
-std::set<std::string> keys(const json& object) {
-    std::set<std::string> out;
-    for (auto it = object.begin(); it != object.end(); ++it) out.insert(it.key());
-    return out;
-}
-
-// Runs the CLI and parses its JSON; a failed run (exit status not 0) or non-JSON output fails the test.
-json run_json(const std::string& args) {
-    const CliRun r = run(args);
-    EXPECT_EQ(r.status, 0) << args << "\n" << r.err << r.out.substr(0, 2000);
-    const json j = json::parse(r.out, nullptr, false);
-    EXPECT_FALSE(j.is_discarded()) << args << ": not JSON: " << r.out.substr(0, 2000) << r.err;
-    return j.is_discarded() ? json::object() : j;
-}
 
 bool is_query_method(const std::string& m) {
     return m == "stop-and-wait" || m == "batched" || m == "chc" || m == "chc++";
@@ -83,7 +69,7 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
     const json j = run_json(args);
     const std::set<std::string> top{"scene", "scheme", "objects", "characters", "patches", "frames",          "size",
                                     "tess",  "batch",  "sigma",   "c1",         "methods", "visible_interval"};
-    EXPECT_EQ(keys(j), top) << args;
+    EXPECT_EQ(json_keys(j), top) << args;
     if (!j.contains("methods") || !j["methods"].is_array()) return {};
     EXPECT_EQ(j["scene"], facts.name);
     EXPECT_EQ(j["scheme"], "acc");
@@ -127,7 +113,7 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
     const std::set<std::string> ms_keys{"object_cpu", "pass1", "hiz", "cull", "pass2", "frame"};
     for (const json& row : rows) {
         const std::string name = row.value("name", "?"), what = args + ": " + name;
-        if (keys(row) != row_keys || keys(row["ms"]) != ms_keys) {
+        if (json_keys(row) != row_keys || json_keys(row["ms"]) != ms_keys) {
             ADD_FAILURE() << what << ": keys " << row.dump();
             continue;
         }
@@ -315,9 +301,9 @@ TEST(ObjectOcclusionCli, RenderEveryOcclusionMethodHasNoFalseCulls) {
             const json& occ = o["occlusion"];
             EXPECT_EQ(occ["method"], c.occlusion) << what;
             if (c.occlusion == "none") {
-                EXPECT_EQ(keys(occ), std::set<std::string>{"method"}) << what;
+                EXPECT_EQ(json_keys(occ), std::set<std::string>{"method"}) << what;
             } else if (is_query_method(c.occlusion)) {
-                ASSERT_EQ(keys(occ), query_keys) << what << ": " << occ.dump();
+                ASSERT_EQ(json_keys(occ), query_keys) << what << ": " << occ.dump();
                 EXPECT_EQ(occ["aggressive"], false) << what;
                 // Every character is culled by the frustum, culled by a query, or drawn.
                 const std::size_t characters = c.scene == city ? kCityCharacters : kRoomsCharacters;
@@ -330,7 +316,7 @@ TEST(ObjectOcclusionCli, RenderEveryOcclusionMethodHasNoFalseCulls) {
                 occlusion_culled += occ["occlusion_culled"].get<std::size_t>();
                 queries += occ["queries"].get<std::size_t>();
             } else {
-                ASSERT_EQ(keys(occ), scene_keys) << what << ": " << occ.dump();
+                ASSERT_EQ(json_keys(occ), scene_keys) << what << ": " << occ.dump();
                 EXPECT_LE(occ["objects_culled"].get<std::size_t>(), occ["objects_tested"].get<std::size_t>()) << what;
                 occlusion_culled += occ["objects_culled"].get<std::size_t>();
                 if (c.occlusion == "horizon") {
