@@ -229,7 +229,7 @@ TEST(BlockedLayout, KernelsDecideTheSameOnBothLayouts) {
 // the end of the batch.
 TEST(BlockedLayout, PrefetchChangesNoDecision) {
     const std::size_t saved = plain_prefetch_distance(), saved_blocked = blocked_prefetch_distance();
-    const std::vector<BezierPatch> patches = random_patches(4099, 7);
+    const std::vector<BezierPatch> patches = random_patches(kSizes[std::size(kSizes) - 1], 7);
     const PatchBatch batch = make_batch(patches);
     std::vector<std::vector<std::uint8_t>> want;
     const PatchBlocks blocks(batch.view());
