@@ -109,7 +109,6 @@ HWY_INLINE void MaskToBytes(DF d, MF m, Scratch& s, std::uint8_t* out) {
 
 // Stage frustum: clip coordinates stored, lanes outside a plane returned as bytes.
 HWY_INLINE void FrustumStage(DF d, const Group& g, const Consts& k_, Scratch& s, std::uint8_t* culled) {
-    const std::size_t N = hn::Lanes(d);
     frustum_groups::PlaneMaxima maxima(d);
     for (int k = 0; k < kPatchPoints; ++k) {
         const VF X = g.load(d, k, 0), Y = g.load(d, k, 1), Z = g.load(d, k, 2), W = g.load(d, k, 3);
@@ -118,7 +117,6 @@ HWY_INLINE void FrustumStage(DF d, const Group& g, const Consts& k_, Scratch& s,
         for (int r = 0; r < 4; ++r) hn::Store(c[r], d, s.clip[k][r]);
         maxima.add<false>(d, c, W, nullptr);
     }
-    (void)N;
     MaskToBytes(d, maxima.outside(d), s, culled);
 }
 
