@@ -30,17 +30,6 @@ using namespace patchcull::gl;
 
 namespace {
 
-// Depth as hiz.h wants it (row 0 = bottom) from read_depth (row 0 = top).
-std::vector<float> depth_bottom_up(const PatchRenderer& r) {
-    const std::vector<float> top_down = r.read_depth();
-    std::vector<float> out(top_down.size());
-    const int w = r.width(), h = r.height();
-    for (int y = 0; y < h; ++y)
-        std::memcpy(&out[static_cast<std::size_t>(y) * w], &top_down[static_cast<std::size_t>(h - 1 - y) * w],
-                    static_cast<std::size_t>(w) * sizeof(float));
-    return out;
-}
-
 struct Passes {
     FrustumPass frustum{test::passes()};
     BackpatchConePass cones{test::passes()};
@@ -249,7 +238,7 @@ TEST(FusedCullPass, ReasonsEqualTheCpuKernels) {
         params.height = h;
         params.tess_level = 5;
         r.render(params);
-        const std::vector<float> depth = depth_bottom_up(r);
+        const std::vector<float> depth = test::depth_bottom_up(r);
         HiZPyramid cpu_hiz;
         cpu_hiz.build(depth.data(), w, h);
         CullView s;

@@ -1,6 +1,8 @@
 // Out-of-line helpers of gl_test_util.h (the GL calls stay out of the header).
 #include "gl_test_util.h"
 
+#include <algorithm>
+
 #include <epoxy/gl.h>
 
 namespace patchcull::gl::test {
@@ -18,6 +20,16 @@ std::vector<float> ScratchBuffer::read_floats(std::size_t count) const {
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     std::vector<float> out(count);
     if (count) glGetNamedBufferSubData(name_, 0, static_cast<GLsizeiptr>(count * sizeof(float)), out.data());
+    return out;
+}
+
+std::vector<float> depth_bottom_up(const PatchRenderer& r) {
+    const std::vector<float> top_down = r.read_depth();
+    std::vector<float> out(top_down.size());
+    const int w = r.width(), h = r.height();
+    for (int y = 0; y < h; ++y)
+        std::copy_n(top_down.begin() + static_cast<std::ptrdiff_t>(h - 1 - y) * w, w,
+                    out.begin() + static_cast<std::ptrdiff_t>(y) * w);
     return out;
 }
 

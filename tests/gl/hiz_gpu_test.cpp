@@ -22,17 +22,6 @@ using namespace patchcull::gl;
 
 namespace {
 
-// Depth as hiz.h wants it (row 0 = bottom) from read_depth (row 0 = top).
-std::vector<float> depth_bottom_up(const PatchRenderer& r) {
-    const std::vector<float> top_down = r.read_depth();
-    std::vector<float> out(top_down.size());
-    const int w = r.width(), h = r.height();
-    for (int y = 0; y < h; ++y)
-        std::memcpy(&out[static_cast<std::size_t>(y) * w], &top_down[static_cast<std::size_t>(h - 1 - y) * w],
-                    static_cast<std::size_t>(w) * sizeof(float));
-    return out;
-}
-
 Camera teapot_camera(const Bounds& b, Vec3 direction, float distance, float aspect = 1.0f) {
     Camera cam;
     cam.target = b.center();
@@ -98,7 +87,7 @@ GpuPyramid& gpu_pyramid() {
 
 // Compares the GPU pyramid with the CPU one built from the read-back depth; returns the CPU one.
 HiZPyramid check_pyramid(PatchRenderer& r, const char* what) {
-    const std::vector<float> depth = depth_bottom_up(r);
+    const std::vector<float> depth = test::depth_bottom_up(r);
     HiZPyramid cpu;
     cpu.build(depth.data(), r.width(), r.height());
     const std::vector<float> gpu = read_hiz_texture(gpu_pyramid().build(r));
