@@ -194,3 +194,24 @@ void prepare_output_dir(const std::string& flag, const std::string& dir, const s
 }
 
 }  // namespace patchcull::cli
+
+namespace patchcull::cli {
+
+std::string parse_error_message(const CLI::ParseError& error) {
+    const std::string what = error.what();
+    // CLI11 (ArgumentMismatch::AtMost): "NAME: At Most N required but received M", thrown for every
+    // option whose values, over all its occurrences, outnumber what it takes.
+    static const std::string kAtMost = ": At Most ", kReceived = " required but received ";
+    const std::size_t at = what.find(kAtMost);
+    const std::size_t received = what.find(kReceived);
+    if (dynamic_cast<const CLI::ArgumentMismatch*>(&error) == nullptr || at == std::string::npos ||
+        received == std::string::npos || received < at)
+        return what;
+    const std::string name = what.substr(0, at);
+    const std::string most = what.substr(at + kAtMost.size(), received - at - kAtMost.size());
+    const std::string given = what.substr(received + kReceived.size());
+    if (most == "1") return name + " may be given once (given " + given + " times)";
+    return name + " takes at most " + most + " values (given " + given + ")";
+}
+
+}  // namespace patchcull::cli

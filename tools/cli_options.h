@@ -74,3 +74,12 @@ CLI::Option* add_output_file_option(CLI::App& command, const std::string& flag, 
 void prepare_output_dir(const std::string& flag, const std::string& dir, const std::vector<std::string>& files);
 
 }  // namespace patchcull::cli
+
+namespace patchcull::cli {
+
+/// The one-line message for a CLI11 parse error. CLI11's own wording is kept except where it
+/// does not say what is wrong: an option given more often than it may be ("FLAG: At Most 1
+/// required but received 2") becomes "FLAG may be given once (given 2 times)".
+std::string parse_error_message(const CLI::ParseError& error);
+
+}  // namespace patchcull::cli

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <string>
 
+#include "cli_options.h"
 #include "commands.h"
 #include "patchcull/error.h"
 #include "patchcull/version.h"
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::cerr << "patchcull: error: " << patchcull::printable_line(e.what()) << "\n";
+        std::cerr << "patchcull: error: " << patchcull::printable_line(parse_error_message(e)) << "\n";
         return 2;
     } catch (const patchcull::Error& e) {
         std::cerr << "patchcull: error: " << patchcull::printable_line(e.what()) << "\n";

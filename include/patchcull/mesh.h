@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "patchcull/math.h"
@@ -29,6 +30,27 @@ inline Vec3 to_float(DVec3 a) { return {static_cast<float>(a.x), static_cast<flo
 struct Crease {
     std::uint32_t v0 = 0, v1 = 0;
     float sharpness = 0;
+    std::uint32_t line = 0;  ///< line of its tag in the source file (0: not from a file)
+};
+
+/// How boundaries are interpolated: OpenSubdiv's Sdc::Options::VtxBoundaryInterpolation. The
+/// OBJ tag "t interpolateboundary 1/0/0 n" means what OpenSubdiv's shape reader makes of it:
+/// 0 none, 1 edge_and_corner, 2 edge_only (RenderMan's numbering, not the enum's).
+enum class BoundaryInterpolation : std::uint8_t {
+    edge_and_corner,  ///< boundary edges sharp, corners (boundary vertices with one face) sharp
+    edge_only,        ///< boundary edges sharp, corners smooth
+    none,             ///< no surface over faces at a boundary vertex (unless creases sharpen all
+                      ///< of its boundary edges): OpenSubdiv makes those faces holes
+};
+
+/// Subdivision options a mesh may carry (OpenSubdiv's shape tags; obj.h). The defaults are
+/// patchcull's for every mesh: EDGE_AND_CORNER boundaries, uniform creases, Catmull-Clark
+/// weights at triangles.
+struct SubdivisionOptions {
+    BoundaryInterpolation boundary = BoundaryInterpolation::edge_and_corner;
+    bool chaikin_creases = false;   ///< Sdc CREASE_CHAIKIN ("t creasemethod 0/0/1 chaikin")
+    bool smooth_triangles = false;  ///< Sdc TRI_SUB_SMOOTH ("t smoothtriangles 0/0/1 smooth")
+    std::uint32_t boundary_line = 0;  ///< line of the interpolateboundary tag (0: none, or not from a file)
 };
 
 /// A polygon mesh in face-vertex form. Face f has corners [face_offsets[f], face_offsets[f+1]);
@@ -53,11 +75,35 @@ struct ControlMesh {
     std::vector<std::uint32_t> face_texcoords;
     std::vector<Crease> creases;  ///< edge creases (OBJ "t crease 2/1/0 v0 v1 s", 0-based here)
     std::vector<Crease> corners;  ///< vertex corners (OBJ "t corner 1/1/0 v s")
+    /// Faces with no surface of their own (OBJ "t hole n/0/0 f..", 0-based), sorted, no repeats.
+    /// A hole still shapes its neighbours (its vertices stay in their one-rings), as in
+    /// OpenSubdiv; it only produces no patches. The surface is then open whatever is_closed()
+    /// says of the faces: load_model draws it two-sided (LoadedModel::closed false).
+    std::vector<std::uint32_t> holes;
+    SubdivisionOptions options;
+    /// Source lines of the faces, for messages: runs of faces on consecutive lines, run k from
+    /// face face_line_runs[k].first at line face_line_runs[k].second. Empty when the mesh does
+    /// not come from a file.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> face_line_runs;
     std::vector<std::string> warnings;  ///< non-fatal loader notes, for the caller to show
 
     std::size_t face_count() const { return face_offsets.size() - 1; }
     std::uint32_t face_size(std::size_t f) const { return face_offsets[f + 1] - face_offsets[f]; }
     bool has_texcoords() const { return !face_texcoords.empty(); }
+    /// Line of face f in the source file, or 0 when unknown (face_line_runs).
+    std::uint32_t face_line(std::size_t f) const {
+        std::uint32_t line = 0;
+        for (std::size_t lo = 0, hi = face_line_runs.size(); lo < hi;) {  // last run starting at or before f
+            const std::size_t mid = (lo + hi) / 2;
+            if (face_line_runs[mid].first <= f) {
+                line = face_line_runs[mid].second + static_cast<std::uint32_t>(f - face_line_runs[mid].first);
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        return line;
+    }
     bool all_quads() const;
     /// True when every edge is shared by exactly two faces, used once in each direction (a closed,
     /// consistently oriented surface, and at least one face). Only on such a surface are

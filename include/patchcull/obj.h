@@ -1,15 +1,25 @@
 // patchcull/obj.h: a strict Wavefront OBJ reader for subdivision control meshes.
 //
 // Reads v, vt and f records (f with v, v/vt, v//vn or v/vt/vn corners, negative indices allowed)
-// and OpenSubdiv's "t crease 2/1/0 v0 v1 s" and "t corner n/1/0 v.. s" tags (0-based vertices);
+// and the "t" tags of OpenSubdiv's shape files, with the meaning OpenSubdiv's own shape reader
+// gives them (0-based vertex and face indices; ControlMesh, mesh.h, holds the result):
+//   t crease n/1/0 v0 v1 [v2 v3 ..] s   creases on the edges (v0,v1), (v2,v3), .. (vertex pairs)
+//   t corner n/1/0 v.. s, n/n/0 v.. s..  vertex sharpness
+//   t hole n/0/0 f..                     faces without surface (ControlMesh::holes)
+//   t interpolateboundary 1/0/0 m        0 none, 1 edges and corners (the default), 2 edges only
+//   t creasemethod 0/0/1 normal|chaikin  t smoothtriangles 0/0/1 catmark|smooth
+//   t facevaryinginterpolateboundary 1/0/0 m, t facevaryingpropagatecorners 1/0/0 b: checked
+//                                        and ignored (patchcull has no face-varying data)
 // accepts vertex weights and colours (x y z [w] or x y z r g b [a], ignored); checks vn records
 // and the normal indices that name them, then drops them; ignores o, g, s, usemtl, mtllib, l, p,
 // comments, blank lines and a UTF-8 byte-order mark. Strict by design: every malformed number,
-// non-finite coordinate, out-of-range index (vertex, texture coordinate or normal), malformed
-// corner, face with fewer than 3 corners or a repeated vertex, unknown or unsupported tag (a
-// misspelt "crease" must not drop a crease), crease from a vertex to itself or negative sharpness
-// is a patchcull::Error naming "file:line", one short printable line (offending text is quoted
+// non-finite coordinate or sharpness, out-of-range index (vertex, texture coordinate, normal,
+// tag vertex or hole face), malformed corner, face with fewer than 3 corners or a repeated
+// vertex, unknown or unsupported tag (a misspelt "crease" must not drop a crease), crease that
+// is no edge of a face, crease from a vertex to itself or negative sharpness is a
+// patchcull::Error naming "file:line", one short printable line (offending text is quoted
 // through quote_input, patchcull/error.h). Work is O(n log n) in the file size for any face size.
+// Each face's line is kept (ControlMesh::face_line) for later messages about the mesh.
 // (tinyobjloader, tried first, reads "abc" and "nan" as 0 and only warns on out-of-range indices:
 // a silently wrong mesh, so it is not used.)
 #pragma once

@@ -43,6 +43,10 @@
 // corner is regular: interior valence 4, boundary with 2 faces, or corner with 1 face. Everything
 // else is marked extraordinary and gets tangent patches.
 //
+// Holes (ControlMesh::holes) and faces that OpenSubdiv leaves without surface under
+// BoundaryInterpolation::none produce no patches; edges-only boundaries are honoured where they
+// change nothing (no corner) and refused elsewhere (faces_left_out below).
+//
 // Not handled by ACC: creases and corner sharpness (ignored, with a warning), non-manifold meshes
 // (patchcull::Error). Meshes with non-quad faces are refined once with OpenSubdiv first
 // (refine_uniform_once) and our stencils are multiplied through its stencils, so the model stays
@@ -510,6 +514,101 @@ void build_quad_patches(const ControlMesh& mesh, const PointStencils* through, S
     }
 }
 
+// Faces whose patches the acc scheme leaves out, as OpenSubdiv leaves them out: hole faces
+// (ControlMesh::holes) and, under BoundaryInterpolation::none, every face at a boundary vertex
+// that has a boundary edge not infinitely sharp (Far's TopologyRefinerFactory makes those holes).
+// A left-out face still shapes its neighbours: ACC builds every patch from the one-rings of its
+// corners, so the other patches are those of the whole mesh. Returns an empty vector when every
+// face keeps its patches. Refuses the boundary options ACC cannot honour: edges-only boundaries
+// where the mesh has a corner (a vertex with one face, which ACC's boundary rules keep sharp),
+// and no boundary interpolation where creases sharpen all boundary edges of a vertex (Far then
+// keeps its faces under crease rules ACC ignores); both name the tag's line and the osd scheme.
+std::vector<std::uint8_t> faces_left_out(const ControlMesh& mesh) {
+    const std::size_t nf = mesh.face_count();
+    std::vector<std::uint8_t> out;
+    const BoundaryInterpolation boundary = mesh.options.boundary;
+    if (mesh.holes.empty() && boundary == BoundaryInterpolation::edge_and_corner) return out;
+    out.assign(nf, 0);
+    for (const std::uint32_t f : mesh.holes)
+        if (f < nf) out[f] = 1;
+    if (boundary == BoundaryInterpolation::edge_and_corner) return out;
+
+    const std::string where = mesh.name + (mesh.options.boundary_line ? ":" + std::to_string(mesh.options.boundary_line) : std::string()) + ": ";
+    const std::size_t nv = mesh.positions.size();
+    if (boundary == BoundaryInterpolation::edge_only) {
+        std::vector<std::uint32_t> faces_at(nv, 0);
+        for (const std::uint32_t v : mesh.face_vertices)
+            if (v < nv) ++faces_at[v];
+        for (std::uint32_t v = 0; v < nv; ++v)
+            if (faces_at[v] == 1)
+                throw Error(where + "boundary interpolation 'edges only' (interpolateboundary 2) keeps corners smooth; the acc "
+                                    "scheme keeps them sharp (vertex " + std::to_string(v + 1) + " has one face): use the osd scheme");
+        return out;  // no corner: the same surface as edges and corners
+    }
+    // none: boundary edges are the edges of one face.
+    const auto key = [](std::uint32_t a, std::uint32_t b) { return std::uint64_t{std::min(a, b)} << 32 | std::max(a, b); };
+    std::vector<std::uint64_t> edges;
+    edges.reserve(mesh.face_vertices.size());
+    for (std::size_t f = 0; f < nf; ++f) {
+        const std::uint32_t b = mesh.face_offsets[f], n = mesh.face_size(f);
+        for (std::uint32_t k = 0; k < n; ++k) edges.push_back(key(mesh.face_vertices[b + k], mesh.face_vertices[b + (k + 1) % n]));
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<std::uint64_t> infinite;  // edges with an infinitely sharp crease (Sdc: sharpness >= 10)
+    for (const Crease& c : mesh.creases)
+        if (c.sharpness >= 10.0f) infinite.push_back(key(c.v0, c.v1));
+    std::sort(infinite.begin(), infinite.end());
+    std::vector<std::uint8_t> state(nv, 0);  // bit 1: on a boundary, bit 2: has a boundary edge not infinitely sharp
+    for (std::size_t i = 0; i < edges.size();) {
+        std::size_t j = i + 1;
+        while (j < edges.size() && edges[j] == edges[i]) ++j;
+        if (j - i == 1) {
+            const std::uint8_t bits = std::binary_search(infinite.begin(), infinite.end(), edges[i]) ? 1 : 3;
+            for (const std::uint64_t v : {edges[i] >> 32, edges[i] & 0xffffffffu})
+                if (v < nv) state[v] |= bits;
+        }
+        i = j;
+    }
+    for (std::uint32_t v = 0; v < nv; ++v)
+        if (state[v] == 1)
+            throw Error(where + "with no boundary interpolation (interpolateboundary 0), creases sharpen every boundary edge "
+                                "of vertex " + std::to_string(v + 1) + ", which the acc scheme ignores: use the osd scheme");
+    for (std::size_t f = 0; f < nf; ++f)
+        for (std::uint32_t c = mesh.face_offsets[f]; c < mesh.face_offsets[f + 1]; ++c)
+            if (mesh.face_vertices[c] < nv && state[mesh.face_vertices[c]] != 0) out[f] = 1;
+    return out;
+}
+
+// Removes the patches whose base face is left out (their point rows, and their tangent blocks,
+// renumbering the others').
+void drop_patches(SubdivisionModel& model, const std::vector<std::uint8_t>& left_out) {
+    PointStencils points, tangents;
+    std::vector<PatchInfo> kept;
+    const auto copy_rows = [](const PointStencils& from, std::size_t first, std::size_t count, PointStencils& to) {
+        for (std::size_t r = first; r < first + count; ++r) {
+            for (std::uint32_t k = from.offsets[r]; k < from.offsets[r + 1]; ++k) {
+                to.indices.push_back(from.indices[k]);
+                to.weights.push_back(from.weights[k]);
+            }
+            to.offsets.push_back(static_cast<std::uint32_t>(to.indices.size()));
+        }
+    };
+    for (std::size_t p = 0; p < model.patches.size(); ++p) {
+        PatchInfo info = model.patches[p];
+        if (left_out[info.base_face]) continue;
+        copy_rows(model.patch_points, 16 * p, 16, points);
+        if (info.tangent_index >= 0) {
+            copy_rows(model.tangent_points, 24 * static_cast<std::size_t>(info.tangent_index), 24, tangents);
+            info.tangent_index = static_cast<std::int32_t>(tangents.rows() / 24 - 1);
+        }
+        kept.push_back(info);
+    }
+    if (kept.empty()) throw Error(model.name + ": every face is a hole or at an uninterpolated boundary: no surface");
+    model.patch_points = std::move(points);
+    model.tangent_points = std::move(tangents);
+    model.patches = std::move(kept);
+}
+
 }  // namespace
 
 SubdivisionModel build_acc_model(const ControlMesh& mesh) {
@@ -519,6 +618,7 @@ SubdivisionModel build_acc_model(const ControlMesh& mesh) {
     model.mesh = mesh;
     if (mesh.face_count() == 0) throw Error(mesh.name + ": mesh has no faces");
     check_preprocessing_limits(mesh);  // rules and rows below cost ~valence^2 per vertex
+    const std::vector<std::uint8_t> left_out = faces_left_out(mesh);
 
     if (mesh.all_quads()) {
         build_quad_patches(mesh, nullptr, model);
@@ -534,6 +634,7 @@ SubdivisionModel build_acc_model(const ControlMesh& mesh) {
         for (PatchInfo& p : model.patches) p.base_face = parent[p.base_face];
         model.mesh.warnings = refined.mesh.warnings;
     }
+    if (!left_out.empty()) drop_patches(model, left_out);
     if (!mesh.creases.empty() || !mesh.corners.empty())
         model.mesh.warnings.push_back(mesh.name + ": the acc scheme ignores " + std::to_string(mesh.creases.size()) +
                                       " crease(s) and " + std::to_string(mesh.corners.size()) +

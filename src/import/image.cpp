@@ -7,6 +7,7 @@
 
 #include <stb/stb_image.h>
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "patchcull/error.h"
@@ -23,9 +25,35 @@ namespace patchcull {
 namespace {
 
 [[noreturn]] void fail(const std::string& name, const char* why) {
-    // stb_image's reasons are short fixed strings; printable_line keeps that true whatever the
-    // build of libstb returns (it may be compiled with STBI_NO_FAILURE_STRINGS: null).
-    throw Error(name + ": cannot read image: " + printable_line(why ? why : "unknown reason", 80));
+    // stb_image's reasons are short fixed strings (explained below); printable_line keeps that
+    // true whatever the build of libstb returns (it may be compiled with STBI_NO_FAILURE_STRINGS: null).
+    throw Error(name + ": cannot read image: " + printable_line(why ? why : "unknown reason", 160));
+}
+
+// stb_image's failure reasons are terse codes ("bad sizes", "zlib corrupt"): what each says is
+// wrong with the file, in words, followed by the code itself for a bug report.
+std::string explain_stb_failure(const char* code) {
+    const std::string why = code ? code : "";
+    static const char* const kDeflate[] = {"bad codelengths", "bad sizes", "bad huffman code", "bad dist", "bad zlib header",
+                                           "no preset dict", "bad compression", "zlib corrupt", "output buffer limit",
+                                           "read past buffer", "outofdata"};
+    static const char* const kHeader[] = {"bad ctype", "1/2/4/8/16-bit only", "bad comp method", "bad filter method",
+                                          "bad interlace method", "0-pixel image", "invalid width", "first not IHDR",
+                                          "multiple IHDR", "bad IHDR len"};
+    static const char* const kPalette[] = {"no PLTE", "invalid PLTE", "tRNS after IDAT", "tRNS before PLTE",
+                                           "bad tRNS len", "tRNS with alpha"};
+    const auto in = [&](const auto& list) { return std::find(std::begin(list), std::end(list), why) != std::end(list); };
+    std::string what;
+    if (in(kDeflate)) what = "corrupt PNG: its compressed pixel data (the zlib stream in the IDAT chunks) is damaged";
+    else if (in(kHeader)) what = "corrupt or unsupported PNG header (IHDR: size, bit depth, colour type or methods)";
+    else if (in(kPalette)) what = "corrupt PNG: bad palette or transparency chunk";
+    else if (why == "not enough pixels" || why == "too large") what = "corrupt PNG: the pixel data does not match the image size in its header";
+    else if (why == "invalid filter") what = "corrupt PNG: a row of pixels has an invalid filter type";
+    else if (why == "no IDAT") what = "corrupt PNG: no pixel data (no IDAT chunk)";
+    else if (why == "outofmem") what = "out of memory while decoding";
+    else if (why.empty()) return "unknown reason";
+    else what = "PNG decoding failed";
+    return what + " (stb_image: " + why + ")";
 }
 
 struct StbiFree {
@@ -97,14 +125,14 @@ DisplacementMap decode_displacement_png(const unsigned char* data, std::size_t s
     if (stbi_is_16_bit_from_memory(data, length)) {
         const std::unique_ptr<stbi_us, StbiFree> pixels(
             stbi_load_16_from_memory(data, length, &width, &height, &channels, 1));
-        if (!pixels) fail(name, stbi_failure_reason());
+        if (!pixels) fail(name, explain_stb_failure(stbi_failure_reason()).c_str());
         map.width = width;
         map.height = height;
         copy_flipped(pixels.get(), 65535.0f, map);
     } else {
         const std::unique_ptr<stbi_uc, StbiFree> pixels(
             stbi_load_from_memory(data, length, &width, &height, &channels, 1));
-        if (!pixels) fail(name, stbi_failure_reason());
+        if (!pixels) fail(name, explain_stb_failure(stbi_failure_reason()).c_str());
         map.width = width;
         map.height = height;
         copy_flipped(pixels.get(), 255.0f, map);

@@ -2,7 +2,7 @@
 //
 // Why not tinyobjloader: it reads malformed numbers ("abc") and "nan" as 0 and only warns on
 // out-of-range indices, i.e. it returns a silently wrong mesh. Control meshes need only v, vt, f
-// (and OpenSubdiv's "t crease/corner" tags), so a strict line-numbered reader is small.
+// (and the "t" tags of OpenSubdiv's shape files), so a strict line-numbered reader is small.
 #include "patchcull/obj.h"
 
 #include <algorithm>
@@ -39,7 +39,7 @@ void split_tokens(std::string_view s, std::vector<std::string_view>& tokens) {
     }
 }
 
-float parse_float(std::string_view token, const LineContext& ctx) {
+float parse_float(std::string_view token, const LineContext& ctx, const char* what = "coordinate") {
     float value = 0;
     const char* first = token.data();
     const char* last = token.data() + token.size();
@@ -47,7 +47,7 @@ float parse_float(std::string_view token, const LineContext& ctx) {
     auto [ptr, ec] = std::from_chars(first, last, value);
     if (ec == std::errc::result_out_of_range) ctx.fail("number out of range " + quote_input(token));
     if (ec != std::errc() || ptr != last) ctx.fail("malformed number " + quote_input(token));
-    if (!std::isfinite(value)) ctx.fail("non-finite coordinate " + quote_input(token));
+    if (!std::isfinite(value)) ctx.fail(std::string("non-finite ") + what + " " + quote_input(token));
     return value;
 }
 
@@ -114,58 +114,171 @@ void parse_tag_counts(std::string_view token, long counts[3], const LineContext&
     }
 }
 
-// OpenSubdiv's shape-format tags, 0-based vertices: "t crease 2/1/0 v0 v1 s" (one edge) and
-// "t corner n/1/0 v1..vn s" or "t corner n/n/0 v1..vn s1..sn". Every other tag is an error, not
-// ignored: a misspelt "crease" would silently drop a crease the user asked for, and OpenSubdiv's
-// other tags (interpolateboundary, hole, creasemethod, ...) change the surface in ways patchcull
-// does not model. A crease over more than two vertices is refused as well: RenderMan reads its
-// vertices as a chain, OpenSubdiv's shapes as pairs, so either reading could be the wrong one.
-void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, const LineContext& ctx) {
-    if (tokens.size() < 3) ctx.fail("malformed tag line (expected 't crease 2/1/0 v0 v1 sharpness' or 't corner 1/1/0 v sharpness')");
+// OpenSubdiv's shape-format tags: "t NAME ints/floats/strings" and then that many integers,
+// floats and strings, read with the meaning OpenSubdiv's own shape reader gives them
+// (regression/common/far_utils.h in OpenSubdiv):
+//   crease n/1/0 v0 v1 [v2 v3 ...] s   edges (v0,v1), (v2,v3), ... (pairs, not RenderMan's chain
+//                                      of edges: OpenSubdiv reads pairs), 0-based, sharpness s
+//   corner n/1/0 v.. s | n/n/0 v.. s..  vertex sharpness, one for all or one per vertex
+//   hole n/0/0 f..                     faces (0-based) with no surface of their own
+//   interpolateboundary 1/0/0 m        0 none, 1 edges and corners, 2 edges only
+//   creasemethod 0/0/1 normal|chaikin, smoothtriangles 0/0/1 catmark|smooth
+//   facevaryinginterpolateboundary 1/0/0 m (0-5), facevaryingpropagatecorners 1/0/0 0|1:
+//                                      face-varying options; patchcull has no face-varying data
+//                                      (its texture coordinates are bilinear per patch), so they
+//                                      are checked and have no effect.
+// Every other tag is an error, not ignored: a misspelt "crease" would silently drop a crease,
+// and the hierarchical edits (vertexedit, edgeedit, faceedit) are not in OpenSubdiv 3 at all.
+// A crease with several sharpness values over several edges is refused: OpenSubdiv's reader
+// indexes them inconsistently (by vertex, not by edge), so no reading is OpenSubdiv's.
+struct TagState {
+    std::uint32_t boundary_line = 0, crease_method_line = 0, triangles_line = 0;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> holes;  // (face, line), checked at the end
+};
+
+void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, TagState& state, const LineContext& ctx) {
+    if (tokens.size() < 3) ctx.fail("malformed tag line (expected 't NAME ints/floats/strings arguments...', e.g. 't crease 2/1/0 v0 v1 sharpness')");
     const std::string_view kind = tokens[1];
-    const bool crease = kind == "crease";
-    if (!crease && kind != "corner") {
-        static constexpr std::string_view kOpenSubdivTags[] = {"interpolateboundary", "facevaryinginterpolateboundary",
-                                                                "facevaryingpropagatecorners", "creasemethod",
-                                                                "smoothtriangles", "hole"};
-        for (const std::string_view known : kOpenSubdivTags)
-            if (kind == known) ctx.fail("unsupported tag " + quote_input(kind) + " (only 't crease' and 't corner' are read)");
-        ctx.fail("unknown tag " + quote_input(kind) + " (expected 't crease' or 't corner')");
+    const std::string tag = "'" + std::string(kind) + "' tag";
+    static constexpr std::string_view kKnown[] = {"crease", "corner", "hole", "interpolateboundary",
+                                                  "facevaryinginterpolateboundary", "facevaryingpropagatecorners",
+                                                  "creasemethod", "smoothtriangles"};
+    if (std::find(std::begin(kKnown), std::end(kKnown), kind) == std::end(kKnown)) {
+        if (kind == "vertexedit" || kind == "edgeedit" || kind == "faceedit")
+            ctx.fail("unsupported tag " + quote_input(kind) + " (hierarchical edits are not part of OpenSubdiv 3)");
+        ctx.fail("unknown tag " + quote_input(kind) +
+                 " (expected crease, corner, hole, interpolateboundary, creasemethod, smoothtriangles, "
+                 "facevaryinginterpolateboundary or facevaryingpropagatecorners)");
     }
     long counts[3];
     parse_tag_counts(tokens[2], counts, ctx);
     const long ints = counts[0], floats = counts[1], strings = counts[2];
-    if (crease && ints != 2)
-        ctx.fail(ints > 2 ? "crease tag over more than 2 vertices: write one 't crease 2/1/0 v0 v1 sharpness' per edge"
-                          : "malformed 'crease' tag: expected 't crease 2/1/0 v0 v1 sharpness'");
-    if (!crease && ints < 1) ctx.fail("malformed 'corner' tag: expected 't corner 1/1/0 v sharpness'");
-    if (strings != 0 || (floats != 1 && (crease || floats != ints)))
-        ctx.fail(std::string("malformed '") + std::string(kind) + "' tag: expected " +
-                 (crease ? "one sharpness ('t crease 2/1/0 v0 v1 s')" : "one sharpness or one per vertex"));
     const auto arguments = static_cast<long>(tokens.size() - 3);
-    if (ints > arguments || floats != arguments - ints)  // (not ints + floats: that can overflow)
-        ctx.fail(std::string("malformed '") + std::string(kind) + "' tag: " + std::to_string(tokens.size() - 3) +
-                 " arguments for counts " + quote_input(tokens[2]));
-    std::vector<std::uint32_t> vertices;
-    for (long k = 0; k < ints; ++k) {
-        const long v = parse_int(tokens[3 + k], ctx, "vertex index");
-        if (v < 0 || v >= static_cast<long>(mesh.positions.size()))
-            ctx.fail("tag vertex index " + std::to_string(v) + " out of range (have " +
-                     std::to_string(mesh.positions.size()) + ")");
-        vertices.push_back(static_cast<std::uint32_t>(v));
-    }
-    std::vector<float> sharpness;
-    for (long k = 0; k < floats; ++k) {
-        sharpness.push_back(parse_float(tokens[3 + ints + k], ctx));
-        if (sharpness.back() < 0) ctx.fail("negative sharpness");
-    }
-    if (crease) {
-        if (vertices[0] == vertices[1]) ctx.fail("crease from vertex " + std::to_string(vertices[0]) + " to itself");
-        mesh.creases.push_back({vertices[0], vertices[1], sharpness[0]});
+    if (ints > arguments || floats > arguments - ints || strings != arguments - ints - floats)  // (no sum: it can overflow)
+        ctx.fail("malformed " + tag + ": " + std::to_string(arguments) + " arguments for counts " + quote_input(tokens[2]));
+    const auto expect = [&](bool ok, const char* form) {
+        if (!ok) ctx.fail("malformed " + tag + ": expected " + form);
+    };
+    const auto integer = [&](long k) { return parse_int(tokens[static_cast<std::size_t>(3 + k)], ctx, "tag integer"); };
+    const auto word = [&](long k) { return tokens[static_cast<std::size_t>(3 + ints + floats + k)]; };
+
+    if (kind == "crease" || kind == "corner") {
+        const bool crease = kind == "crease";
+        if (crease) {
+            expect(ints >= 2 && strings == 0, "'t crease 2/1/0 v0 v1 sharpness' (or n/1/0 with n vertices, read as n/2 edges)");
+            if (ints % 2 != 0)
+                ctx.fail("'crease' tag over an odd number of vertices (" + std::to_string(ints) +
+                         "): OpenSubdiv's shape format lists a crease's edges as vertex pairs");
+            if (floats != 1)
+                ctx.fail(floats == 0 ? std::string("'crease' tag without a sharpness")
+                                     : "'crease' tag with " + std::to_string(floats) +
+                                           " sharpness values: give one for all its edges, or one tag per edge");
+        } else {
+            expect(ints >= 1 && strings == 0 && (floats == 1 || floats == ints),
+                   "'t corner 1/1/0 v sharpness' (or n/1/0 or n/n/0 for n vertices)");
+        }
+        std::vector<std::uint32_t> vertices;
+        for (long k = 0; k < ints; ++k) {
+            const long v = integer(k);
+            if (v < 0 || v >= static_cast<long>(mesh.positions.size()))
+                ctx.fail("tag vertex index " + std::to_string(v) + " out of range (0-based; have " +
+                         std::to_string(mesh.positions.size()) + " vertices so far)");
+            vertices.push_back(static_cast<std::uint32_t>(v));
+        }
+        std::vector<float> sharpness;
+        for (long k = 0; k < floats; ++k) {
+            sharpness.push_back(parse_float(tokens[static_cast<std::size_t>(3 + ints + k)], ctx, "sharpness"));
+            if (sharpness.back() < 0) ctx.fail("negative sharpness " + quote_input(tokens[static_cast<std::size_t>(3 + ints + k)]));
+        }
+        const auto line = static_cast<std::uint32_t>(ctx.line);
+        if (crease) {
+            for (std::size_t k = 0; k < vertices.size(); k += 2) {
+                if (vertices[k] == vertices[k + 1])
+                    ctx.fail("crease from vertex " + std::to_string(vertices[k]) + " to itself (0-based)");
+                mesh.creases.push_back({vertices[k], vertices[k + 1], sharpness[0], line});
+            }
+            return;
+        }
+        for (std::size_t k = 0; k < vertices.size(); ++k)
+            mesh.corners.push_back({vertices[k], 0, sharpness[floats == 1 ? 0 : k], line});
         return;
     }
-    for (std::size_t k = 0; k < vertices.size(); ++k)
-        mesh.corners.push_back({vertices[k], 0, sharpness[floats == 1 ? 0 : k]});
+    if (kind == "hole") {
+        expect(ints >= 1 && floats == 0 && strings == 0, "'t hole n/0/0 f1 .. fn' (0-based faces)");
+        for (long k = 0; k < ints; ++k) {
+            const long f = integer(k);
+            if (f < 0 || f > 0xfffffffel) ctx.fail("hole face index " + std::to_string(f) + " out of range (0-based)");
+            state.holes.emplace_back(static_cast<std::uint32_t>(f), static_cast<std::uint32_t>(ctx.line));
+        }
+        return;
+    }
+    const auto once = [&](std::uint32_t& seen) {
+        if (seen != 0) ctx.fail(tag + " given twice (first at line " + std::to_string(seen) + ")");
+        seen = static_cast<std::uint32_t>(ctx.line);
+    };
+    if (kind == "interpolateboundary") {
+        expect(ints == 1 && floats == 0 && strings == 0, "'t interpolateboundary 1/0/0 m' with m 0, 1 or 2");
+        const long m = integer(0);
+        if (m < 0 || m > 2)
+            ctx.fail("'interpolateboundary' " + std::to_string(m) + ": expected 0 (none), 1 (edges and corners) or 2 (edges only)");
+        once(state.boundary_line);
+        mesh.options.boundary = m == 0 ? BoundaryInterpolation::none
+                                : m == 1 ? BoundaryInterpolation::edge_and_corner
+                                         : BoundaryInterpolation::edge_only;
+        mesh.options.boundary_line = state.boundary_line;
+    } else if (kind == "creasemethod" || kind == "smoothtriangles") {
+        const bool method = kind == "creasemethod";
+        expect(ints == 0 && floats == 0 && strings == 1,
+               method ? "'t creasemethod 0/0/1 normal' or 'chaikin'" : "'t smoothtriangles 0/0/1 catmark' or 'smooth'");
+        const std::string_view value = word(0);
+        const std::string_view plain = method ? "normal" : "catmark", special = method ? "chaikin" : "smooth";
+        if (value != plain && value != special)
+            ctx.fail(tag + " " + quote_input(value) + ": expected " + std::string(plain) + " or " + std::string(special));
+        once(method ? state.crease_method_line : state.triangles_line);
+        (method ? mesh.options.chaikin_creases : mesh.options.smooth_triangles) = value == special;
+    } else {  // face-varying options: checked, no effect (see above)
+        const bool boundary = kind == "facevaryinginterpolateboundary";
+        expect(ints == 1 && floats == 0 && strings == 0,
+               boundary ? "'t facevaryinginterpolateboundary 1/0/0 m' with m 0..5"
+                        : "'t facevaryingpropagatecorners 1/0/0 0' or '1'");
+        const long m = integer(0);
+        if (m < 0 || m > (boundary ? 5 : 1))
+            ctx.fail(tag + " value " + std::to_string(m) + ": expected " + (boundary ? "0 to 5" : "0 or 1"));
+    }
+}
+
+// After the last line: hole faces exist, and every crease joins two vertices of one face edge
+// (Far would drop or refuse any other, with 0-based indices and no line).
+void check_tags(ControlMesh& mesh, TagState& state, const std::string& name) {
+    for (const auto& [face, line] : state.holes) {
+        if (face >= mesh.face_count())
+            throw Error(name + ":" + std::to_string(line) + ": hole tag names face " + std::to_string(face) +
+                        " (0-based); the file has " + std::to_string(mesh.face_count()) + " faces");
+        mesh.holes.push_back(face);
+    }
+    std::sort(mesh.holes.begin(), mesh.holes.end());
+    mesh.holes.erase(std::unique(mesh.holes.begin(), mesh.holes.end()), mesh.holes.end());
+    if (mesh.creases.empty()) return;
+    const auto key = [](std::uint32_t a, std::uint32_t b) { return std::uint64_t{std::min(a, b)} << 32 | std::max(a, b); };
+    std::vector<std::uint64_t> wanted;
+    for (const Crease& c : mesh.creases) wanted.push_back(key(c.v0, c.v1));
+    std::sort(wanted.begin(), wanted.end());
+    std::vector<std::uint8_t> found(wanted.size(), 0);
+    for (std::size_t f = 0; f < mesh.face_count(); ++f) {
+        const std::uint32_t b = mesh.face_offsets[f], n = mesh.face_size(f);
+        for (std::uint32_t k = 0; k < n; ++k) {
+            const std::uint64_t e = key(mesh.face_vertices[b + k], mesh.face_vertices[b + (k + 1) % n]);
+            const auto at = std::lower_bound(wanted.begin(), wanted.end(), e);
+            if (at != wanted.end() && *at == e) found[static_cast<std::size_t>(at - wanted.begin())] = 1;
+        }
+    }
+    for (const Crease& c : mesh.creases) {
+        const auto at = std::lower_bound(wanted.begin(), wanted.end(), key(c.v0, c.v1));
+        if (!found[static_cast<std::size_t>(at - wanted.begin())])
+            throw Error(name + ":" + std::to_string(c.line) + ": crease between vertices " + std::to_string(c.v0) +
+                        " and " + std::to_string(c.v1) + " (0-based, as tags count; OBJ vertices " +
+                        std::to_string(c.v0 + 1) + " and " + std::to_string(c.v1 + 1) + "): no face has that edge");
+    }
 }
 
 // Scratch buffers reused across faces (one allocation per mesh, not per face).
@@ -249,6 +362,7 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
     bool faces_with_uv = false, faces_without_uv = false;
     std::size_t normal_count = 0;
     FaceScratch scratch;
+    TagState tags;
     std::vector<DVec3> world_positions;  // as in the file, for recentre()
     // The whole stream at once (one copy of the file in memory while it is parsed), split at '\n'
     // as std::getline splits it: a 1M-face file has 2M lines, and a getline and a token vector
@@ -288,7 +402,9 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
             // x y z, optionally followed by a weight w (x y z w) or a vertex colour (x y z r g b
             // [a]); both are checked and ignored (control meshes are polynomial, colour unused).
             const std::size_t values = tokens.size() - 1;
-            if (values != 3 && values != 4 && values != 6 && values != 7) ctx.fail("vertex needs 3 coordinates");
+            if (values != 3 && values != 4 && values != 6 && values != 7)
+                ctx.fail("vertex has " + std::to_string(values) + (values == 1 ? " value" : " values") +
+                         "; expected 3 (x y z), 4 (x y z w), 6 (x y z r g b) or 7 (x y z r g b a)");
             world_positions.push_back({parse_coordinate(tokens[1], ctx), parse_coordinate(tokens[2], ctx),
                                        parse_coordinate(tokens[3], ctx)});
             mesh.positions.push_back(to_float(world_positions.back()));  // origin 0 until recentre()
@@ -306,8 +422,10 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
                 faces_with_uv = true;
             else
                 faces_without_uv = true;
+            const auto face = static_cast<std::uint32_t>(mesh.face_count() - 1), line = static_cast<std::uint32_t>(line_number);
+            if (mesh.face_line_runs.empty() || mesh.face_line(face - 1) + 1 != line) mesh.face_line_runs.emplace_back(face, line);
         } else if (key == "t") {
-            parse_tag(tokens, mesh, ctx);
+            parse_tag(tokens, mesh, tags, ctx);
         } else if (key == "o" || key == "g" || key == "s" || key == "usemtl" || key == "mtllib" || key == "l" ||
                    key == "p" || key == "vp" || key == "cstype" || key == "deg") {
             // Grouping, materials, points and lines: no effect on a control mesh.
@@ -317,6 +435,7 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
     }
     if (in.bad()) throw Error(name + ": read error");
     if (mesh.face_count() == 0) throw Error(name + ": no faces");
+    check_tags(mesh, tags, name);
     recentre(world_positions, mesh);
     if (faces_with_uv && faces_without_uv) {
         mesh.face_texcoords.clear();

@@ -335,6 +335,8 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh) {
             model.patches.push_back(info);
         }
     }
+    if (model.patches.empty())  // Far builds no patch for a hole (ControlMesh::holes)
+        throw Error(mesh.name + ": every face is a hole or at an uninterpolated boundary: no surface");
     return model;
 }
 

@@ -1,7 +1,8 @@
 // Internal: ControlMesh -> Far::TopologyRefiner with validation (see osd_topology.h).
 //
 // Source: OpenSubdiv 3.5 Far, TopologyDescriptor/TopologyRefinerFactory, with the subdivision
-// options of seeds 000/001 (Catmull-Clark, EDGE_AND_CORNER vertex boundaries).
+// options of seeds 000/001 (Catmull-Clark, EDGE_AND_CORNER vertex boundaries) unless the mesh
+// carries others (ControlMesh::options and holes, from OpenSubdiv's OBJ tags).
 #include "import/osd_topology.h"
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <opensubdiv/far/topologyDescriptor.h>
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
+#include "import/mesh_messages.h"
 #include "patchcull/error.h"
 
 namespace patchcull::osd_detail {
@@ -80,6 +82,66 @@ void validate(const ControlMesh& mesh) {
     for (const Crease& c : mesh.corners)
         if (c.v0 >= nv || !std::isfinite(c.sharpness) || c.sharpness < 0)
             fail(mesh, "invalid corner on vertex " + std::to_string(c.v0));
+    for (const std::uint32_t f : mesh.holes)
+        if (f >= mesh.face_count()) fail(mesh, "hole face " + std::to_string(f) + " out of range (0-based)");
+}
+
+// Position k of the edge {a, b} in face f (corner k to k+1, either direction).
+int edge_corner(const ControlMesh& mesh, std::size_t f, std::uint32_t a, std::uint32_t b) {
+    const std::uint32_t first = mesh.face_offsets[f], n = mesh.face_size(f);
+    for (std::uint32_t k = 0; k < n; ++k) {
+        const std::uint32_t u = mesh.face_vertices[first + k], w = mesh.face_vertices[first + (k + 1) % n];
+        if ((u == a && w == b) || (u == b && w == a)) return static_cast<int>(k);
+    }
+    return 0;
+}
+
+// Far accepts non-manifold topology (it sharpens it); patchcull does not (see header). Reported
+// as the acc scheme reports them (quad_topology.cpp, same words through mesh_messages.h, same
+// offender): first an edge of more than two faces, the one whose third face comes first in the
+// file (then by corner); then an edge two faces walk the same way, the one whose second face
+// comes first; then the first vertex whose faces do not form one fan.
+void check_manifold(const ControlMesh& mesh, const OSD::TopologyLevel& base) {
+    struct Offender {
+        std::size_t face = SIZE_MAX;
+        int corner = 0;
+        int edge = -1;
+        bool before(std::size_t f, int k) const { return f < face || (f == face && k < corner); }
+    };
+    Offender shared, flipped;
+    for (int e = 0; e < base.GetNumEdges(); ++e) {
+        if (!base.IsEdgeNonManifold(e)) continue;
+        const auto ev = base.GetEdgeVertices(e);
+        std::vector<int> faces(base.GetEdgeFaces(e).begin(), base.GetEdgeFaces(e).end());
+        std::sort(faces.begin(), faces.end());
+        if (faces.size() < 2) continue;
+        Offender& o = faces.size() > 2 ? shared : flipped;
+        const auto f = static_cast<std::size_t>(faces[faces.size() > 2 ? 2 : 1]);
+        const int k = edge_corner(mesh, f, static_cast<std::uint32_t>(ev[0]), static_cast<std::uint32_t>(ev[1]));
+        if (o.before(f, k)) o = {f, k, e};
+    }
+    if (shared.edge >= 0) {
+        const std::uint32_t first = mesh.face_offsets[shared.face], n = mesh.face_size(shared.face);
+        const auto k = static_cast<std::uint32_t>(shared.corner);
+        throw Error(detail::edge_shared_message(mesh, shared.face, mesh.face_vertices[first + k],
+                                                mesh.face_vertices[first + (k + 1) % n],
+                                                static_cast<std::size_t>(base.GetEdgeFaces(shared.edge).size())));
+    }
+    if (flipped.edge >= 0) {
+        std::vector<int> faces(base.GetEdgeFaces(flipped.edge).begin(), base.GetEdgeFaces(flipped.edge).end());
+        std::sort(faces.begin(), faces.end());
+        const std::uint32_t first = mesh.face_offsets[flipped.face], n = mesh.face_size(flipped.face);
+        const auto k = static_cast<std::uint32_t>(flipped.corner);
+        throw Error(detail::edge_orientation_message(mesh, static_cast<std::size_t>(faces[0]), flipped.face,
+                                                     mesh.face_vertices[first + k], mesh.face_vertices[first + (k + 1) % n]));
+    }
+    for (int v = 0; v < base.GetNumVertices(); ++v) {
+        // An unused vertex (no faces) is harmless: no stencil refers to it.
+        const auto vf = base.GetVertexFaces(v);
+        if (vf.size() == 0 || !base.IsVertexNonManifold(v)) continue;
+        throw Error(detail::vertex_fan_message(mesh, static_cast<std::size_t>(*std::min_element(vf.begin(), vf.end())),
+                                               static_cast<std::uint32_t>(v)));
+    }
 }
 
 }  // namespace
@@ -117,6 +179,9 @@ RefinerPtr create_refiner(const ControlMesh& mesh, std::vector<std::string>* war
     desc.numCorners = static_cast<int>(corner_weights.size());
     desc.cornerVertexIndices = corner_verts.data();
     desc.cornerWeights = corner_weights.data();
+    const std::vector<int> holes(mesh.holes.begin(), mesh.holes.end());
+    desc.numHoles = static_cast<int>(holes.size());
+    desc.holeIndices = holes.data();
     desc.isLeftHanded = false;  // OBJ faces are counter-clockwise
     OSD::TopologyDescriptor::FVarChannel channel;
     if (mesh.has_texcoords()) {
@@ -126,8 +191,14 @@ RefinerPtr create_refiner(const ControlMesh& mesh, std::vector<std::string>* war
         desc.fvarChannels = &channel;
     }
 
-    OpenSubdiv::Sdc::Options sdc;
-    sdc.SetVtxBoundaryInterpolation(OpenSubdiv::Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
+    // The mesh's options (mesh.h: patchcull's defaults, or the OBJ's OpenSubdiv tags).
+    using Sdc = OpenSubdiv::Sdc::Options;
+    Sdc sdc;
+    sdc.SetVtxBoundaryInterpolation(mesh.options.boundary == BoundaryInterpolation::none        ? Sdc::VTX_BOUNDARY_NONE
+                                    : mesh.options.boundary == BoundaryInterpolation::edge_only ? Sdc::VTX_BOUNDARY_EDGE_ONLY
+                                                                                                : Sdc::VTX_BOUNDARY_EDGE_AND_CORNER);
+    sdc.SetCreasingMethod(mesh.options.chaikin_creases ? Sdc::CREASE_CHAIKIN : Sdc::CREASE_UNIFORM);
+    sdc.SetTriangleSubdivision(mesh.options.smooth_triangles ? Sdc::TRI_SUB_SMOOTH : Sdc::TRI_SUB_CATMARK);
     // Texture coordinates are interpolated bilinearly (patchcull's PatchInfo::uv is bilinear).
     sdc.SetFVarLinearInterpolation(OpenSubdiv::Sdc::Options::FVAR_LINEAR_ALL);
     OSD::TopologyRefinerFactory<OSD::TopologyDescriptor>::Options options(OpenSubdiv::Sdc::SCHEME_CATMARK, sdc);
@@ -145,21 +216,7 @@ RefinerPtr create_refiner(const ControlMesh& mesh, std::vector<std::string>* war
     if (warnings)
         for (const std::string& w : warns) warnings->push_back(mesh.name + ": OpenSubdiv: " + one_line(w));
 
-    // Far accepts non-manifold topology (it sharpens it); patchcull does not (see header).
-    const OSD::TopologyLevel& base = refiner->GetLevel(0);
-    for (int e = 0; e < base.GetNumEdges(); ++e)
-        if (base.IsEdgeNonManifold(e)) {
-            const auto ev = base.GetEdgeVertices(e);
-            const int faces = base.GetEdgeFaces(e).size();
-            const std::string edge = "edge (" + std::to_string(ev[0]) + ", " + std::to_string(ev[1]) + ")";
-            fail(mesh, faces > 2 ? "non-manifold " + edge + " shared by " + std::to_string(faces) + " faces"
-                                 : "non-manifold " + edge + ": its faces are oriented inconsistently");
-        }
-    for (int v = 0; v < base.GetNumVertices(); ++v) {
-        // An unused vertex (no faces) is harmless: no stencil refers to it.
-        if (base.GetVertexFaces(v).size() == 0) continue;
-        if (base.IsVertexNonManifold(v)) fail(mesh, "non-manifold vertex " + std::to_string(v));
-    }
+    check_manifold(mesh, refiner->GetLevel(0));
     return refiner;
 }
 

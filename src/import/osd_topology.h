@@ -3,7 +3,9 @@
 //
 // Source: OpenSubdiv 3.5 Far (Far::TopologyDescriptor + TopologyRefinerFactory), set up as in
 // seeds 000/001: Catmull-Clark, vertex boundary interpolation EDGE_AND_CORNER, creases and
-// corners from the mesh, one face-varying channel for texture coordinates (linear everywhere).
+// corners from the mesh, one face-varying channel for texture coordinates (linear everywhere);
+// the mesh's SubdivisionOptions (boundary interpolation, crease method, triangle rule) and holes
+// (Far skips hole faces when it builds patches) replace the defaults where an OBJ tagged them.
 //
 // Why a validation pass of our own: Far reports topology errors through a process-wide printf
 // callback and returns nullptr, and it silently accepts non-manifold topology (it sharpens it).
@@ -34,7 +36,8 @@ using RefinerPtr = std::unique_ptr<OpenSubdiv::Far::TopologyRefiner, RefinerDele
 /// Validates mesh and builds its level-0 refiner (not yet refined). Throws patchcull::Error
 /// "<mesh.name>: <reason>" for out-of-range indices, faces with fewer than 3 corners or a
 /// repeated vertex, bad crease/corner records, Far topology errors and non-manifold edges or
-/// vertices. Far warnings (if any) are appended to warnings.
+/// vertices (worded as the acc scheme words them: import/mesh_messages.h). Far warnings (if any)
+/// are appended to warnings.
 RefinerPtr create_refiner(const ControlMesh& mesh, std::vector<std::string>* warnings = nullptr);
 
 }  // namespace patchcull::osd_detail

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <string>
 
+#include "import/mesh_messages.h"
 #include "patchcull/error.h"
 
 namespace patchcull::acc_detail {
@@ -20,15 +21,6 @@ namespace patchcull::acc_detail {
 namespace {
 
 [[noreturn]] void fail(const ControlMesh& mesh, const std::string& what) { throw Error(mesh.name + ": " + what); }
-
-std::string edge_name(std::uint32_t a, std::uint32_t b) {
-    std::string s = "(";  // built with += : GCC 12 warns falsely (-Wrestrict) on "(" + std::string
-    s += std::to_string(a);
-    s += ", ";
-    s += std::to_string(b);
-    s += ")";
-    return s;
-}
 
 }  // namespace
 
@@ -84,7 +76,13 @@ QuadTopology build_quad_topology(const ControlMesh& mesh) {
         };
         for_each_directed(a, b, count_earlier);
         for_each_directed(b, a, count_earlier);
-        if (earlier >= 2) fail(mesh, "non-manifold edge " + edge_name(a, b) + " shared by more than two faces");
+        if (earlier >= 2) {
+            std::size_t faces = 0;
+            const auto count = [&](std::uint32_t) { return ++faces, true; };
+            for_each_directed(a, b, count);
+            for_each_directed(b, a, count);
+            throw Error(detail::edge_shared_message(mesh, h / 4, a, b, faces));
+        }
     }
     // A directed edge used twice: two neighbours with opposite orientation.
     for (std::size_t h = 0; h < 4 * nf; ++h) {
@@ -94,9 +92,7 @@ QuadTopology build_quad_topology(const ControlMesh& mesh) {
             first = g;
             return false;
         });
-        if (first != h)
-            fail(mesh, "inconsistent face orientation at edge " + edge_name(a, b) + " (faces " + std::to_string(first / 4) +
-                           " and " + std::to_string(h / 4) + ")");
+        if (first != h) throw Error(detail::edge_orientation_message(mesh, first / 4, h / 4, a, b));
     }
     constexpr std::uint32_t kNone = ~std::uint32_t{0};
     std::vector<std::uint32_t> twin(4 * nf, kNone);
@@ -132,9 +128,7 @@ QuadTopology build_quad_topology(const ControlMesh& mesh) {
         std::uint32_t* const faces_out = topo.face_vertices.data() + out_begin[v];
         std::uint32_t* const edges_out = topo.edge_vertices.data() + out_begin[v] + v;
         std::uint32_t faces = 0, edges = 0;
-        const auto not_one_fan = [&] {
-            fail(mesh, "non-manifold vertex " + std::to_string(v) + " (its faces do not form a single fan)");
-        };
+        const auto not_one_fan = [&] { throw Error(detail::vertex_fan_message(mesh, out[out_begin[v]] / 4, v)); };
         std::size_t h = start;
         for (;;) {
             // A vertex whose faces form several fans (a "bowtie") is non-manifold; a walk that
@@ -152,7 +146,7 @@ QuadTopology build_quad_topology(const ControlMesh& mesh) {
             h = t;
         }
         if (faces != corner_count) not_one_fan();
-        if (boundary && edges != faces + 1) fail(mesh, "non-manifold vertex " + std::to_string(v));
+        if (boundary && edges != faces + 1) not_one_fan();
     }
     return topo;
 }

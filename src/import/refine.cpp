@@ -87,7 +87,10 @@ RefinedMesh refine_uniform_once(const ControlMesh& mesh) {
             for (int k = 0; k < ft.size(); ++k) out.mesh.face_texcoords.push_back(static_cast<std::uint32_t>(ft[k]));
         }
         out.mesh.face_offsets.push_back(static_cast<std::uint32_t>(out.mesh.face_vertices.size()));
+        if (level.IsFaceHole(f)) out.mesh.holes.push_back(static_cast<std::uint32_t>(f));  // children of holes
     }
+    out.mesh.options = mesh.options;
+    out.mesh.options.boundary_line = 0;  // no line in the refined mesh
 
     if (mesh.has_texcoords()) {
         std::vector<FVarUV> src(mesh.texcoords.size());

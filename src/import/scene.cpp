@@ -75,7 +75,9 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
     for (const std::string& w : model.subdiv->mesh.warnings)
         if (std::find(model.warnings.begin(), model.warnings.end(), w) == model.warnings.end()) model.warnings.push_back(w);
     evaluate_patches(*model.subdiv, model.subdiv->mesh.positions, split_levels, model.rest);
-    model.closed = orientation == SurfaceOrientation::outward;
+    // A hole (OBJ "t hole") opens the surface even where the control mesh is closed: through it the
+    // inside shows, so the model is drawn two-sided and back-patch culling is off.
+    model.closed = orientation == SurfaceOrientation::outward && mesh.holes.empty();
     return model;
 }
 
