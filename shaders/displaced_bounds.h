@@ -20,7 +20,7 @@
 // The including shader provides the names used here (displaced.comp.glsl: #defines onto its
 // parameter block, pass_params.h's DisplacedParams): the DisplacedCullView (u_object_to_view,
 // u_abs_row_z (4 values), u_axis_unit (vec4s, xyz used), u_axis_length (4 values, 3 used), u_proj =
-// (P00, P02, P11, P12), u_proj_z = (P22, P23, -, -), u_view_planes) and the constants (u_delta_slack, u_ext_scale,
+// (P00, P02, P11, P12), u_proj_z = (P22, P23, key_near, key_far) of the depth-key projection, u_view_planes) and the constants (u_delta_slack, u_ext_scale,
 // u_frame_pad, u_depth_safety).
 
 // DisplacedBoundStatus of displaced_bounds.h.
@@ -323,6 +323,6 @@ PcDisplacedBound pc_displaced_bound_with_cone(vec4 P[16], vec2 range, PcCone con
 bool pc_bound_outside_frustum(PcDisplacedBound b) {
     if (b.status == kPcBoundOutsidePlane) return true;
     if (b.status != kPcBoundProjected) return false;
-    return b.ndc_xmax < -1.0 || b.ndc_xmin > 1.0 || b.ndc_ymax < -1.0 || b.ndc_ymin > 1.0 || b.depth_near > 1.0 ||
-           b.depth_far < 0.0;
+    return b.ndc_xmax < -1.0 || b.ndc_xmin > 1.0 || b.ndc_ymax < -1.0 || b.ndc_ymin > 1.0 ||
+           b.depth_near > u_proj_z.w || b.depth_far < u_proj_z.z;
 }

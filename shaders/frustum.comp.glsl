@@ -21,6 +21,7 @@ layout(std430, binding = kBindingPlaneValues) writeonly buffer PlaneValues {
 // frustum_test.h's names.
 #define u_clip_rows frustum.clip_rows
 #define u_plane_normal_length frustum.plane_normal_length
+#define u_plane_depth frustum.plane_depth
 #include "frustum_test.h"
 
 void main() {

@@ -43,14 +43,19 @@ void main() {
     const float d = pc_margin(p, frustum_disp.has_margins);
 
     // The Cartesian AABB of the 16 control points.
+    // A NaN or infinite coordinate anywhere: never culled (frustum.h, "Non-finite input").
     const vec4 p0 = control_points[16u * p];
     precise float lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
         lo[a] = pc_div(p0[a], p0.w);
         hi[a] = lo[a];
     }
-    for (uint k = 1u; k < 16u; ++k) {
+    bool non_finite = false;
+    for (uint k = 0u; k < 16u; ++k) {
         const vec4 point = control_points[16u * p + k];
+        for (int a = 0; a < 4; ++a)
+            non_finite = non_finite || (floatBitsToUint(point[a]) & 0x7F800000u) == 0x7F800000u;
+        if (k == 0u) continue;
         for (int a = 0; a < 3; ++a) {
             const float v = pc_div(point[a], point.w);
             lo[a] = pc_min_like(lo[a], v);
@@ -74,13 +79,13 @@ void main() {
         v[1] = cw - cx;  // right
         v[2] = cw + cy;  // bottom
         v[3] = cw - cy;  // top
-        v[4] = cz;       // near
-        v[5] = cw - cz;  // far
+        v[4] = cz + frustum_disp.plane_depth.x * cw;  // near: k + near_w w
+        v[5] = frustum_disp.plane_depth.y * cw - cz;  // far: far_w w - k
         for (int q = 0; q < 6; ++q) mx[q] = c == 0 ? v[q] : pc_max_like(mx[q], v[q]);
     }
-    bool culled = false;
-    for (int q = 0; q < 6; ++q) culled = culled || mx[q] < 0.0;
-    if (culled) pc_chain_cull(p, kCullFrustum);
+    bool culled = mx[5] < frustum_disp.plane_depth.z;
+    for (int q = 0; q < 5; ++q) culled = culled || mx[q] < 0.0;
+    if (culled && !non_finite) pc_chain_cull(p, kCullFrustum);
     if (frustum_disp.write_plane_values != 0u)
         for (int q = 0; q < 6; ++q) plane_values[6u * p + uint(q)] = mx[q];
 }

@@ -4,15 +4,18 @@
 //
 // For each control point k = (X, Y, Z, W): clip coordinates once,
 // c_r = fma(M(r,3), W, fma(M(r,2), Z, fma(M(r,1), Y, M(r,0) * X))) (hiz.h's step 2), then the plane
-// values w + x, w - x, w + y, w - y, z, w - z, and with margins fma(d * |plane row xyz|, W, value)
-// (frustum_plane_values / add_frustum_margins in frustum.h); the patch is culled when the maximum
-// over the 16 points is < 0 for some plane. `precise` keeps the compiler from contracting or
+// values w + x, w - x, w + y, w - y, k + near_w w, far_w w - k (k: the depth-key row), and with
+// margins fma(d * |plane row xyz|, W, value) (frustum_plane_values / add_frustum_margins in
+// frustum.h); the patch is culled when the maximum over the 16 points is < 0 for some plane (<
+// far_limit for the far one) and no point's near value was NaN or infinite (FrustumVerdict's
+// probe: here a test of the exponent bits, which no compiler folds away). `precise` keeps the compiler from contracting or
 // reassociating; max is written as the CPU's `a > b ? a : b`; pc_fma is exactly rounded also on
 // llvmpipe (exact_fma.h).
 //
 // The including shader declares, before including this file: exact_fma.h, the buffer
 // control_points[] (kBindingControlPoints) and the names u_clip_rows (vec4[4], FrustumPlanes::clip_rows)
-// and u_plane_normal_length (vec4[2]: FrustumPlanes::normal_length[q] at [q >> 2][q & 3]), #defines
+// , u_plane_normal_length (vec4[2]: FrustumPlanes::normal_length[q] at [q >> 2][q & 3]) and
+// u_plane_depth (vec4: FrustumPlanes::near_w, far_w, far_limit), #defines
 // onto its parameter block (pass_params.h).
 
 // Plane values of clip-space point c (before margins).
@@ -22,9 +25,19 @@ void pc_frustum_plane_values(const vec4 c, out float v[6]) {
     s[1] = c.w - c.x;
     s[2] = c.w + c.y;
     s[3] = c.w - c.y;
-    s[4] = c.z;
-    s[5] = c.w - c.z;
+    s[4] = c.z + u_plane_depth.x * c.w;
+    s[5] = u_plane_depth.y * c.w - c.z;
     v = s;
+}
+
+// True when v is NaN or infinite (exponent bits all set).
+bool pc_non_finite(float v) { return (floatBitsToUint(v) & 0x7F800000u) == 0x7F800000u; }
+
+// The frustum verdict from the six maxima and the non-finite flag (FrustumVerdict::culled).
+bool pc_frustum_outside(const float m[6], bool non_finite) {
+    bool culled = m[5] < u_plane_depth.z;
+    for (int q = 0; q < 5; ++q) culled = culled || m[q] < 0.0;
+    return culled && !non_finite;
 }
 
 // Clip coordinates of object-space point P (hiz.h's step 2).
@@ -49,6 +62,7 @@ bool pc_frustum_culled(uint p, bool with_margins, float d, out float mx[6]) {
         margin[q] = d * u_plane_normal_length[q >> 2][q & 3];
         m[q] = uintBitsToFloat(0xFF800000u);  // -infinity
     }
+    bool non_finite = false;
     for (uint k = 0u; k < 16u; ++k) {
         const vec4 point = control_points[16u * p + k];
         float v[6];
@@ -57,12 +71,9 @@ bool pc_frustum_culled(uint p, bool with_margins, float d, out float mx[6]) {
             precise float value = v[q];
             if (with_margins) value = pc_fma(margin[q], point.w, value);
             m[q] = m[q] > value ? m[q] : value;
+            if (q == 4) non_finite = non_finite || pc_non_finite(value);
         }
     }
-    bool culled = false;
-    for (int q = 0; q < 6; ++q) {
-        culled = culled || m[q] < 0.0;
-        mx[q] = m[q];
-    }
-    return culled;
+    for (int q = 0; q < 6; ++q) mx[q] = m[q];
+    return pc_frustum_outside(m, non_finite);
 }

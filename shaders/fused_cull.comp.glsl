@@ -39,6 +39,7 @@ layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 // frustum_test.h's and hiz_box_test.h's names.
 #define u_clip_rows fused.clip_rows
 #define u_plane_normal_length fused.plane_normal_length
+#define u_plane_depth fused.plane_depth
 #define u_screen ivec2(fused.screen_width, fused.screen_height)
 #define u_hiz_levels fused.hiz_levels
 
@@ -68,6 +69,7 @@ PcFusedPoints pc_fused_points(uint p, bool frustum, bool hiz, bool with_margins,
     r.projectable = hiz;
     HiZPointBox box;
     box.nxmin = box.nxmax = box.nymin = box.nymax = box.zmin = 0.0;
+    bool non_finite = false;
     for (uint k = 0u; k < 16u; ++k) {
         const vec4 P = control_points[16u * p + k];
         const vec4 c = pc_clip_point(P);
@@ -78,14 +80,13 @@ PcFusedPoints pc_fused_points(uint p, bool frustum, bool hiz, bool with_margins,
                 precise float value = v[q];
                 if (with_margins) value = pc_fma(margin[q], P.w, value);
                 m[q] = m[q] > value ? m[q] : value;
+                if (q == 4) non_finite = non_finite || pc_non_finite(value);
             }
         }
         // Steps 3-4 (hiz_box_test.h), as occlusion.comp.glsl.
         if (r.projectable) r.projectable = hiz_add_point(P, c, u_clip_rows[3], k == 0u, box);
     }
-    r.frustum_culled = false;
-    if (frustum)
-        for (int q = 0; q < 6; ++q) r.frustum_culled = r.frustum_culled || m[q] < 0.0;
+    r.frustum_culled = frustum && pc_frustum_outside(m, non_finite);
     r.nxmin = box.nxmin;
     r.nxmax = box.nxmax;
     r.nymin = box.nymin;

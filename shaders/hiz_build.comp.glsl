@@ -5,22 +5,38 @@
 // row/column of the source is replaced by the last one (clamp), which a max ignores: exactly
 // hiz.h's "children outside the parent level skipped", in the CPU's order
 // (max(max(a0, a1), max(b0, b1)) with `a > b ? a : b`), so the texels are bit-identical to
-// HiZPyramid::build on the same depth buffer. Row 0 = bottom in both.
+// HiZPyramid::build on the same depth buffer. Row 0 = bottom in both. Level 0 stores depth keys
+// (hiz.h): d, or -d when hiz_build.reversed; from a 24-bit depth texture the far end of the depths
+// that store the same integer, widened by 1.5 / (2^24 - 1) and one ulp (HiZBuildPass::run).
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
 
 layout(local_size_x = kHiZGroupSize, local_size_y = kHiZGroupSize) in;
 
-layout(binding = kTextureUnitDepth) uniform sampler2D u_depth;  // DEPTH32F, no compare mode
+layout(binding = kTextureUnitDepth) uniform sampler2D u_depth;  // a depth format, no compare mode
 layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;      // the pyramid (source level)
 layout(binding = kImageUnitHiZOut, r32f) writeonly uniform image2D u_out;
 
 
 float pc_max(float a, float b) { return a > b ? a : b; }
 
+// The next float above x (x finite).
+float pc_next_up(float x) {
+    const uint b = floatBitsToUint(x);
+    if (x == 0.0) return uintBitsToFloat(1u);
+    return uintBitsToFloat(x > 0.0 ? b + 1u : b - 1u);
+}
+
+// The depth key of depth-buffer value d.
+float depth_key(float d) {
+    if (hiz_build.unorm24 == 0u) return hiz_build.reversed != 0u ? -d : d;
+    precise float widened = hiz_build.reversed != 0u ? kHiZUnorm24Slack - d : d + kHiZUnorm24Slack;
+    return pc_next_up(widened);
+}
+
 float source(int x, int y) {
-    return hiz_build.from_depth != 0u ? texelFetch(u_depth, ivec2(x, y), 0).r
+    return hiz_build.from_depth != 0u ? depth_key(texelFetch(u_depth, ivec2(x, y), 0).r)
                                       : texelFetch(u_hiz, ivec2(x, y), hiz_build.source_level).r;
 }
 

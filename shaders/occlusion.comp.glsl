@@ -24,6 +24,7 @@ layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 // frustum_test.h's and hiz_box_test.h's names.
 #define u_clip_rows occlusion.clip_rows
 #define u_plane_normal_length occlusion.plane_normal_length
+#define u_plane_depth occlusion.plane_depth
 #define u_screen ivec2(occlusion.screen_width, occlusion.screen_height)
 #define u_hiz_levels occlusion.hiz_levels
 

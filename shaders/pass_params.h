@@ -48,6 +48,7 @@ struct vec4 {
 PC_PARAMS(FrustumParams, kUniformPassParams) {
     PC_VEC4(clip_rows[4]);             // FrustumPlanes::clip_rows
     PC_VEC4(plane_normal_length[2]);   // FrustumPlanes::normal_length[q] at [q >> 2][q & 3]
+    PC_VEC4(plane_depth);              // FrustumPlanes::near_w, far_w, far_limit (w unused)
     PC_UINT(first_patch);
     PC_UINT(patch_count);
     PC_UINT(has_margins);
@@ -56,7 +57,8 @@ PC_PARAMS(FrustumParams, kUniformPassParams) {
 
 // frustum_disp.comp.glsl (FrustumDispPass): cull_frustum_disp_scalar's test (Sathe's displaced AABB).
 PC_PARAMS(FrustumDispParams, kUniformPassParams) {
-    PC_VEC4(clip_rows[4]);             // rows of to_zero_to_one(object_to_clip): clip_rows[r][c] = at(r, c)
+    PC_VEC4(clip_rows[4]);             // FrustumPlanes::clip_rows of make_frustum_planes(object_to_clip)
+    PC_VEC4(plane_depth);              // FrustumPlanes::near_w, far_w, far_limit (w unused)
     PC_UINT(first_patch);
     PC_UINT(patch_count);
     PC_UINT(has_margins);              // the margin is the patch's max |D| (the box grows by it on every side)
@@ -65,9 +67,10 @@ PC_PARAMS(FrustumDispParams, kUniformPassParams) {
 
 // occlusion.comp.glsl (OcclusionPass): cull_occlusion_scalar's test against a Hi-Z pyramid.
 PC_PARAMS(OcclusionParams, kUniformPassParams) {
-    PC_VEC4(clip_rows[4]);             // make_frustum_planes(object_to_clip, zero_to_one): the frustum
+    PC_VEC4(clip_rows[4]);             // make_frustum_planes(object_to_clip, depth): the frustum
                                        // planes' and the Hi-Z box's clip transform (hiz.h step 2)
     PC_VEC4(plane_normal_length[2]);
+    PC_VEC4(plane_depth);              // FrustumPlanes::near_w, far_w, far_limit (w unused)
     PC_UINT(first_patch);
     PC_UINT(patch_count);
     PC_UINT(has_margins);
@@ -86,8 +89,8 @@ PC_PARAMS(HiZBuildParams, kUniformPassParams) {
     PC_INT(source_height);
     PC_INT(out_width);                 // W_l x H_l
     PC_INT(out_height);
-    PC_UINT(pad0);
-    PC_UINT(pad1);
+    PC_UINT(reversed);                 // level 0 stores -depth (reversed conventions: clip_space.h's keys)
+    PC_UINT(unorm24);                  // level 0: the depth texture is 24-bit unsigned normalized
 } PC_END(hiz_build);
 
 // backpatch_cones.comp.glsl (BackpatchConePass): tcone, or ncone with PATCHCULL_NCONE.
@@ -124,7 +127,7 @@ PC_PARAMS(DisplacedParams, kUniformPassParams) {
     PC_VEC4(axis_length);              // xyz used
     PC_VEC4(abs_row_z);                // |V(2, c)|
     PC_VEC4(proj);                     // P00, P02, P11, P12
-    PC_VEC4(proj_z);                   // P22, P23 in xy
+    PC_VEC4(proj_z);                   // P22, P23 (depth-key projection), key_near, key_far
     PC_VEC4(constants);                // kDisplacedDeltaSlack, kDisplacedExtScale, kDisplacedFramePad, kDisplacedDepthSafety
     PC_UINT(first_patch);
     PC_UINT(patch_count);
@@ -151,9 +154,10 @@ PC_PARAMS(CullStatusParams, kUniformPassParams) {
 // fused_cull.comp.glsl (FusedCullPass): the frustum, back-patch cone and Hi-Z tests of one patch in
 // one invocation, in the chain's order (tcone, or ncone with PATCHCULL_NCONE).
 PC_PARAMS(FusedCullParams, kUniformPassParams) {
-    PC_VEC4(clip_rows[4]);             // FrustumPlanes::clip_rows of to_zero_to_one(object_to_clip): the
-                                       // frustum planes' and the Hi-Z test's clip transform (hiz.h step 2)
+    PC_VEC4(clip_rows[4]);             // FrustumPlanes::clip_rows of make_frustum_planes(object_to_clip,
+                                       // depth): the frustum planes' and the Hi-Z test's clip transform
     PC_VEC4(plane_normal_length[2]);   // FrustumPlanes::normal_length[q] at [q >> 2][q & 3]
+    PC_VEC4(plane_depth);              // FrustumPlanes::near_w, far_w, far_limit (w unused)
     PC_VEC4(eye);                      // object space, w unused (the cone test)
     PC_UINT(first_patch);
     PC_UINT(patch_count);

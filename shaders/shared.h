@@ -115,6 +115,10 @@ PATCHCULL_CONST uint kIdOccluderBit = 0x80000000u;
 PATCHCULL_CONST uint kCullGroupSize = 64u;
 // Hi-Z build work groups: kHiZGroupSize x kHiZGroupSize texels of one level.
 PATCHCULL_CONST uint kHiZGroupSize = 8u;
+// 24-bit depth textures (HiZBuildPass): a depth d read as float is widened by 1.5 / (2^24 - 1)
+// before its key is taken: half a step for GL_LEQUAL / GL_GEQUAL ties, one step for the driver's
+// conversion of the integer to float (below 2^-24).
+PATCHCULL_CONST float kHiZUnorm24Slack = 1.5f / 16777215.0f;
 
 #ifdef __cplusplus
 }  // namespace patchcull::gl::shared

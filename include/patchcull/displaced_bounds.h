@@ -3,8 +3,9 @@
 //
 // The GLSL twin is to be written from this header: every step below is defined exactly.
 // Conventions are those of math.h, frustum.h and hiz.h: column-major matrices, right-handed view
-// space looking down -z, clip space of glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) with depth z/w
-// in [0,1], larger = farther, Hi-Z storing the max depth of its footprint.
+// space looking down -z, clip space of glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) in any of
+// clip_space.h's depth conventions, depths taken as depth keys (larger = farther; the window depth,
+// negated for reversed conventions), Hi-Z storing the max key of its footprint.
 //
 // ---- What is bounded --------------------------------------------------------------------------
 // The displaced surface S(u,v) = B(u,v) + D(u,v) n(u,v) (displacement.h), n = (B_u x B_v)/|B_u x B_v|
@@ -86,7 +87,7 @@
 // value max_k q.(Q_k,1) + sum_i max(q_i ext+_i, -q_i ext-_i)) or every corner (oobb) is < 0. Such
 // a bound is never occluded.
 // For a projected bound the frustum test is: culled iff ndc_xmax < -1 or ndc_xmin > 1 or
-// ndc_ymax < -1 or ndc_ymin > 1 or depth_near > 1 or depth_far < 0 (strict: points on a clip plane
+// ndc_ymax < -1 or ndc_ymin > 1 or depth_near > key_far or depth_far < key_near (strict: points on a clip plane
 // are inside). This equals the plane test of the same boxes/corners (the side planes of both the
 // view frustum and the CAF contain the eye).
 //
@@ -150,8 +151,10 @@ inline constexpr float kDisplacedDepthSafety = 0x1p-20f;
 /// Per-frame constants of the bounds: build once per view with make_displaced_cull_view.
 struct DisplacedCullView {
     Mat4 object_to_view;   ///< V = [L | T]
-    Mat4 projection;       ///< glFrustum form (see the header)
-    FrustumPlanes view_planes;  ///< clip planes over view-space points (make_frustum_planes(projection))
+    Mat4 projection;       ///< glFrustum form (see the header), as to_depth_key(projection, depth)
+    FrustumPlanes view_planes;  ///< clip planes over view-space points (make_frustum_planes(projection, depth))
+    ClipDepth depth = ClipDepth::zero_to_one;  ///< the projection's convention
+    float key_near = 0, key_far = 1;  ///< depth keys of the near and far planes (key_far = +inf: none)
     Vec3 axis_unit[3];     ///< rows of L normalised (view x, y, z directions in object space)
     float axis_length[3];  ///< |rows of L|
     float abs_row_z[4];    ///< |V(2, c)|, for the projectability margin
@@ -160,7 +163,9 @@ struct DisplacedCullView {
 
 /// Prepares the per-frame constants. object_to_view = view * model (any affine matrix with
 /// non-degenerate rows); projection as described above, in convention depth (clip_space.h;
-/// stored converted to zero_to_one).
+/// stored as its depth-key form, so depths below are keys: window depth, negated for reversed
+/// conventions; the pyramid must be built in the same direction). Throws Error when the
+/// projection contradicts depth (check_clip_depth).
 DisplacedCullView make_displaced_cull_view(const Mat4& object_to_view, const Mat4& projection, ClipDepth depth);
 
 /// Status of a computed bound.
@@ -174,8 +179,9 @@ enum DisplacedBoundStatus : std::uint8_t {
 /// Screen-space summary of a displaced patch's bound (caf or oobb).
 struct DisplacedBound {
     float ndc_xmin = -1, ndc_xmax = 1, ndc_ymin = -1, ndc_ymax = 1;  ///< valid when projected
-    float depth_near = 0;  ///< z/w of the bound's nearest point (the CAF front plane); projected only
-    float depth_far = 1;   ///< z/w of its farthest point (CAF: the back plane); projected only
+    float depth_near = 0;  ///< depth key of the bound's nearest point (the CAF front plane); projected only
+    float depth_far = 1;   ///< depth key of its farthest point (CAF: the back plane); projected only
+    float key_near = 0, key_far = 1;  ///< the view's clip depth range in keys (DisplacedCullView)
     std::uint8_t status = kDisplacedBoundInvalid;
 };
 

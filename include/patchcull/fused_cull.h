@@ -29,7 +29,9 @@
 // coordinates the frustum stage computed; alone it would also test patches that the frustum test
 // would cull, which it may call occluded: correct, but another plan). valid_fused_plan() checks.
 // Back-patch stages apply to undisplaced polynomial patches only, like the cone kernels; callers
-// leave them out for displaced objects. Inputs must be finite (hiz.h).
+// leave them out for displaced objects. A patch with a non-finite coordinate is never culled: the
+// frustum stage's probe keeps it (frustum.h), the occlusion stage finds it not projectable (hiz.h
+// step 3) and the cone stages never cull it (backpatch.h).
 //
 // ---- Statistics --------------------------------------------------------------------------------
 // When stats is given, the kernel counts per plan position the groups that reached that stage and,
@@ -37,7 +39,8 @@
 // for the scalar reference, so the counts differ between the two (the decisions do not).
 //
 // Contracts: decision holds patches.count bytes; the plan is valid; setup.hiz is set and built
-// when the plan has occlusion. Kernels never allocate or throw.
+// when the plan has occlusion. Kernels never allocate or throw; make_fused_setup throws Error for a
+// matrix that contradicts its convention or a pyramid of the other direction.
 #pragma once
 
 #include <cstddef>

@@ -27,8 +27,10 @@
 // - displacement ranges (DisplacedPass), displaced_shared.h's kBindingDisplacementRanges:
 //   vec2 range[n] = (d_min, d_max).
 // - counters (CullStatusPass::end), kBindingCullCounters: uint c[kCounterCount] (shared.h).
-// Textures: a DEPTH32F depth texture (HiZBuildPass input: the caller's depth attachment, no
-// compare mode), and the Hi-Z pyramid, an R32F mipmapped texture made by create_hiz_texture.
+// Textures: a depth texture (HiZBuildPass input: the caller's depth attachment, no compare mode:
+// GL_DEPTH_COMPONENT32F, GL_DEPTH32F_STENCIL8, GL_DEPTH_COMPONENT24 or GL_DEPTH24_STENCIL8), and
+// the Hi-Z pyramid, an R32F mipmapped texture made by create_hiz_texture, holding hiz.h's depth
+// keys (-depth for the reversed conventions). Texture row 0 is the bottom row, as in HiZPyramid.
 //
 // The flag word (shared.h): bits 0-7 the cull reason of this frame (kCullFrustum 1,
 // kCullBackPatch 2, kCullOcclusion 4; 0 = not culled), bits 8-9 the temporal status of Niessner &
@@ -154,6 +156,7 @@ struct PatchBuffers {
 struct HiZTexture {
     std::uint32_t texture = 0;
     int width = 0, height = 0;
+    bool reversed = false;  ///< set by HiZBuildPass::run: texels are minus the depths (hiz.h's keys)
 };
 
 /// Makes an R32F texture for the pyramid of a width x height depth buffer (each in [1, 8192]):
@@ -173,8 +176,16 @@ public:
     HiZBuildPass(HiZBuildPass&&) noexcept;
     HiZBuildPass& operator=(HiZBuildPass&&) noexcept;
     ~HiZBuildPass();
-    /// Builds hiz from depth_texture (DEPTH32F, at least hiz.width x hiz.height, no compare mode;
-    /// its lower-left hiz.width x hiz.height texels: the viewport the frame was drawn with).
+    /// Builds hiz from depth_texture, written in convention (clip_space.h), and records it in
+    /// hiz.reversed. depth_texture: GL_DEPTH_COMPONENT32F or GL_DEPTH32F_STENCIL8 (texels
+    /// bit-identical to HiZPyramid::build), GL_DEPTH_COMPONENT24 or GL_DEPTH24_STENCIL8 (each depth
+    /// widened outward by 1.5 / (2^24 - 1) and one ulp, covering the driver's conversion to float
+    /// and GL_LEQUAL / GL_GEQUAL ties, as HiZPyramid::build_unorm24 does from the integers); at
+    /// least hiz.width x hiz.height, no compare mode; its lower-left hiz.width x hiz.height texels
+    /// are the viewport the frame was drawn with. Other formats: Error naming the format.
+    void run(std::uint32_t depth_texture, HiZTexture& hiz, ClipDepth convention);
+    /// run(depth_texture, hiz, zero_to_one) for a pyramid that was not built reversed (Error if
+    /// hiz.reversed: call the overload above).
     void run(std::uint32_t depth_texture, const HiZTexture& hiz);
 
 private:

@@ -2,12 +2,22 @@
 //
 // Everything below is defined exactly, so that the GLSL compute-shader mirror can reproduce the
 // pyramid bit for bit and the decisions operation by operation. Conventions are those of math.h:
-// clip space of glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), depth z/w in [0,1], larger = farther.
+// clip space of glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) in any of clip_space.h's depth
+// conventions. The pyramid and the test work on depth keys (clip_space.h): the window depth d for
+// the forward conventions and -d for the reversed ones, so that a larger key is farther in every
+// convention and "max of keys" keeps the farthest depth of a footprint (the min of d, reversed).
+// Below, "depth" means the key.
 //
 // ---- Depth buffer ----------------------------------------------------------------------------
-// W x H floats, depth[y * W + x], row 0 = bottom (what glReadPixels returns). Pixel (x, y) is the
-// window square [x, x+1) x [y, y+1); the viewport is (0, 0, W, H). Values must not be NaN (GL
-// writes values in [0,1]; the pyramid is exact for any non-NaN values).
+// W x H values, depth[y * W + x], row 0 = bottom (what glReadPixels returns; a GL texture's row 0
+// is the bottom row too, so GPU depth and the pyramid agree without flipping). Pixel (x, y) is the
+// window square [x, x+1) x [y, y+1); the viewport is (0, 0, W, H). Either floats (must not be NaN;
+// GL writes values in [0,1]; the pyramid is exact for any non-NaN values) in the declared
+// convention, or 24-bit unsigned normalized depth (GL_DEPTH24_STENCIL8, GL_DEPTH_COMPONENT24,
+// Vulkan's X8_D24) in 32-bit words: value u stands for every depth that the depth test stores as
+// u, so its key is the far end of that set, (u + 1/2) / (2^24 - 1) forward or -(u - 1/2) /
+// (2^24 - 1) reversed, rounded one ulp outward (farther): a fragment that ties with u under
+// GL_LEQUAL or GL_GEQUAL is then never hidden.
 //
 // ---- Pyramid (seed 000 §4.1) -----------------------------------------------------------------
 // The full-resolution level is skipped (seed): level 0 has half resolution. With s(l) = 2^(l+1),
@@ -37,7 +47,7 @@
 // 1. Frustum: exactly cull_frustum_scalar without displacement (frustum.h; the kernels call it,
 //    or cull_frustum_simd, whose decisions are identical). Culled -> kHiZFrustumCulled.
 // 2. Clip-space control points: for each control point P_k (object space, homogeneous) and row r of
-//    M = object_to_clip, c_r = fma(M(r,3), W, fma(M(r,2), Z, fma(M(r,1), Y, M(r,0) * X))).
+//    M = to_depth_key(object_to_clip) (row z gives the depth key), c_r = fma(M(r,3), W, fma(M(r,2), Z, fma(M(r,1), Y, M(r,0) * X))).
 // 3. Projectable: every control point has w_k > 2^-20 * s_k, with
 //    s_k = fma(|M(3,3)|, |W|, fma(|M(3,2)|, |Z|, fma(|M(3,1)|, |Y|, |M(3,0)| * |X|))).
 //    s_k bounds the terms of w_k, and the rounding error of the computed w_k is below 2^-22 s_k, so
@@ -83,7 +93,7 @@
 // the float clip transform (step 2) itself rounds (~1e-7 relative, like the frustum kernels, which
 // add no padding either), and so do the rasterizer's depth and the TES's evaluation. A fragment could
 // therefore land a few ulps in front of zmin; a patch that close to the occluder's surface is
-// z-fighting with it anyway. Inputs (control points, matrix) must be finite. Pyramid texels are
+// z-fighting with it anyway. The matrix must be finite; a control point that is not is never culled. Pyramid texels are
 // bit-exact maxima; where -0 and +0 tie, either may be stored (they compare equal, so decisions
 // cannot differ).
 // GLSL mirror notes: all steps are IEEE add/mul/fma/min/max/floor and integer ops, which GLSL
@@ -105,8 +115,10 @@
 // irregular gather that vectors do not speed up) per patch with the same code as the scalar
 // reference. Decisions are identical to cull_occlusion_scalar (tested on every target).
 //
-// Contracts: decision must hold patches.count bytes; the pyramid must be built; kernels never
-// allocate or throw. HiZPyramid::build allocates only when the size changes.
+// Contracts: decision must hold patches.count bytes; the pyramid must be built in the matrix's
+// direction; kernels never allocate, and throw Error only before their loop (a matrix that
+// contradicts its convention, a pyramid of the other direction or never built).
+// HiZPyramid::build allocates only when the size changes.
 #pragma once
 
 #include <cstddef>
@@ -138,9 +150,20 @@ public:
     /// changes. Contents are unspecified until build().
     void resize(int depth_width, int depth_height);
 
-    /// Builds every level from depth (depth_width * depth_height floats, row 0 = bottom). Calls
-    /// resize() first, so it allocates only when the size differs from the last one.
+    /// Builds every level from depth (depth_width * depth_height floats, row 0 = bottom), written in
+    /// convention (clip_space.h: texels hold its depth keys). Calls resize() first, so it
+    /// allocates only when the size differs from the last one.
+    void build(const float* depth, int depth_width, int depth_height, ClipDepth convention);
+    /// build(depth, w, h, ClipDepth::zero_to_one): a forward depth buffer (either forward
+    /// convention writes the same window depths).
     void build(const float* depth, int depth_width, int depth_height);
+    /// Builds from 24-bit unsigned normalized depth: value (word >> depth_shift) & 0xFFFFFF of each
+    /// 32-bit word (depth_shift 8 for GL_UNSIGNED_INT_24_8, i.e. GL_DEPTH24_STENCIL8 read with its
+    /// stencil; 0 for depth in the low 24 bits), keys as described at the top of this header.
+    void build_unorm24(const std::uint32_t* depth, int depth_width, int depth_height, int depth_shift,
+                       ClipDepth convention);
+    /// True when built from a reversed depth buffer (texels are minus the depths).
+    bool reversed() const { return reversed_; }
 
     int depth_width() const { return width_; }
     int depth_height() const { return height_; }
@@ -158,10 +181,16 @@ public:
     static int level_count(int depth_width, int depth_height);
 
 private:
+    void reduce_upper_levels();
     std::vector<float> data_;
     HiZLevel level_[kMaxLevels];
     int width_ = 0, height_ = 0, levels_ = 0;
+    bool reversed_ = false;
 };
+
+/// Throws Error("<what>: ...") unless hiz was built and in a convention of depth's direction
+/// (forward or reversed): the kernels call it before their loops.
+void check_hiz_convention(const HiZPyramid& hiz, ClipDepth depth, const char* what);
 
 /// Inclusive rectangle of depth pixels: x0 <= x <= x1, y0 <= y <= y1.
 struct PixelRect {
@@ -186,8 +215,8 @@ struct PatchScreenBounds {
     PixelRect rect;
     float zmin = 0;
 };
-/// object_to_clip's depth convention is depth (clip_space.h); zmin is in zero_to_one depth, the
-/// depth buffer's window depth with glDepthRange(0, 1) in either convention.
+/// object_to_clip's depth convention is depth (clip_space.h); zmin is the smallest depth key of the
+/// control points (the window depth with glDepthRange(0, 1), negated for reversed conventions).
 bool patch_screen_bounds(const PatchBatchView& patches, std::size_t index, const Mat4& object_to_clip,
                          ClipDepth depth, int width, int height, PatchScreenBounds& out);
 
@@ -200,7 +229,10 @@ enum HiZDecision : std::uint8_t {
 
 /// Frustum + occlusion test (steps 1-9), scalar reference. The screen is the pyramid's depth buffer
 /// (viewport (0, 0, W, H)). decision must hold patches.count bytes. depth: object_to_clip's
-/// convention (clip_space.h; the pyramid holds window depths in [0, 1] either way).
+/// convention (clip_space.h); the pyramid must be built from a depth buffer of the same direction
+/// (forward or reversed). Throws Error before the loop when the matrix contradicts depth or the
+/// pyramid does not match (check_clip_depth, check_hiz_convention). A patch with a non-finite
+/// coordinate is never culled (step 1 keeps it, step 3 finds it not projectable).
 void cull_occlusion_scalar(const PatchBatchView& patches, const Mat4& object_to_clip, ClipDepth depth,
                            const HiZPyramid& hiz, std::uint8_t* decision);
 /// Same decisions, steps 1-6 in SIMD (Highway, target chosen once at run time).

@@ -4,7 +4,14 @@
 // Control point (i, j) of a patch, i along u and j along v, is cp[4*j + i]; B(u,v) =
 // sum_ij B_i(u) B_j(v) cp[4*j+i] with cubic Bernstein polynomials B_i. Control points are
 // homogeneous (w*x, w*y, w*z, w): a polynomial patch has w = 1 everywhere, a rational patch has
-// positive weights w (seed 001 §3 allows rational patches; the kernels assume w > 0).
+// positive weights w (seed 001 §3 allows rational patches). Weights must be positive: the cull
+// tests rest on the convex hull of the homogeneous control points, which holds only when every
+// weight has the same sign, and test it for positive ones. PatchBatch, PatchBlocks and the GL
+// renderer's uploads refuse a weight <= 0 (check_patch_weights: Error naming the patch and point);
+// a patch whose weights are all negative is the same surface with every coordinate negated, so
+// negate it first. Views over the caller's own memory (PatchBatchView, the GPU passes' buffers)
+// are not checked: their contract is the same. A NaN or infinite coordinate (weights included) is
+// accepted and never culled by any kernel or pass.
 #pragma once
 
 #include <cassert>
@@ -150,6 +157,7 @@ public:
     float* component(int point, int c) { return data_.data() + (4 * point + c) * stride_; }
     const float* component(int point, int c) const { return data_.data() + (4 * point + c) * stride_; }
 
+    /// Writes patch index; throws Error for a weight <= 0 (check_patch_weights).
     void set(std::size_t index, const BezierPatch& patch);
     BezierPatch get(std::size_t index) const;
     PatchBatchView view() const { return {data_.data(), count_, stride_, 0}; }
@@ -203,7 +211,11 @@ std::size_t plain_prefetch_distance();
 void set_blocked_prefetch_distance(std::size_t patches);
 std::size_t blocked_prefetch_distance();
 
-/// Builds a batch from an array of patches.
+/// Throws Error("patch <index>: control point k has weight w; weights must be positive ...") when
+/// a weight of patch is <= 0 (NaN and +Inf pass: the kernels never cull them).
+void check_patch_weights(const BezierPatch& patch, std::size_t index);
+
+/// Builds a batch from an array of patches (check_patch_weights on each).
 PatchBatch make_batch(const std::vector<BezierPatch>& patches);
 
 /// A plain copy of `patches` (either layout), patch for patch.

@@ -26,6 +26,7 @@
 #include "patchcull/displaced_bounds.h"
 
 #include <cmath>
+#include <limits>
 #include <cstring>
 
 #include "core/cones_internal.h"
@@ -111,6 +112,8 @@ PATCHCULL_DISPLACED_INLINE DisplacedBound to_screen(const DisplacedCullView& vie
     b.ndc_ymax = max_f(ay, by);
     b.depth_near = min_f(df, db);
     b.depth_far = max_f(df, db);
+    b.key_near = view.key_near;
+    b.key_far = view.key_far;
     const float out[6] = {b.ndc_xmin, b.ndc_xmax, b.ndc_ymin, b.ndc_ymax, b.depth_near, b.depth_far};
     b.status = all_finite(out, 6) ? kDisplacedBoundProjected : kDisplacedBoundInvalid;
     return b;
@@ -314,7 +317,7 @@ PATCHCULL_DISPLACED_INLINE bool outside_frustum(const DisplacedBound& b) {
     if (b.status == kDisplacedBoundOutsidePlane) return true;
     if (b.status != kDisplacedBoundProjected) return false;
     return b.ndc_xmax < -1.0f || b.ndc_xmin > 1.0f || b.ndc_ymax < -1.0f || b.ndc_ymin > 1.0f ||
-           b.depth_near > 1.0f || b.depth_far < 0.0f;
+           b.depth_near > b.key_far || b.depth_far < b.key_near;
 }
 
 PATCHCULL_DISPLACED_INLINE std::uint8_t hiz_decision(const DisplacedBound& b, const HiZPyramid& hiz) {
@@ -358,10 +361,13 @@ bool parse_normal_cone(const char* text, NormalConeKind& kind) {
 
 DisplacedCullView make_displaced_cull_view(const Mat4& object_to_view, const Mat4& any_projection, ClipDepth depth) {
     DisplacedCullView v;
-    const Mat4 projection = to_zero_to_one(any_projection, depth);
+    v.view_planes = make_frustum_planes(any_projection, depth);  // refuses a contradicting matrix
+    const Mat4 projection = to_depth_key(any_projection, depth);
     v.object_to_view = object_to_view;
     v.projection = projection;
-    v.view_planes = make_frustum_planes(projection, ClipDepth::zero_to_one);
+    v.depth = depth;
+    v.key_near = is_reversed(depth) ? -1.0f : 0.0f;
+    v.key_far = !has_far_plane(depth) ? std::numeric_limits<float>::infinity() : is_reversed(depth) ? 0.0f : 1.0f;
     const Mat4& p = projection;
     const bool frustum_form = p.at(0, 1) == 0 && p.at(0, 3) == 0 && p.at(1, 0) == 0 && p.at(1, 3) == 0 &&
                               p.at(2, 0) == 0 && p.at(2, 1) == 0 && p.at(3, 0) == 0 && p.at(3, 1) == 0 &&
@@ -424,6 +430,7 @@ PATCHCULL_DISPLACED_CLONES
 void cull_displaced_occlusion(const PatchBatchView& patches, const DisplacementRange* ranges, DisplacedBoundKind kind,
                               NormalConeKind cone, const DisplacedCullView& view, const HiZPyramid& hiz,
                               std::uint8_t* decision) {
+    check_hiz_convention(hiz, view.depth, "cull_displaced_occlusion");
     for (std::size_t i = 0; i < patches.count; ++i) {
         const DisplacedBound b = bound_of(gather(patches, i), ranges ? ranges[i] : DisplacementRange{}, kind, cone, view);
         decision[i] = hiz_decision(b, hiz);

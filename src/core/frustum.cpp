@@ -32,21 +32,27 @@ inline float max_like_simd(float a, float b) { return a > b ? a : b; }
 }  // namespace
 
 FrustumPlanes make_frustum_planes(const Mat4& any_object_to_clip, ClipDepth depth) {
-    const Mat4 object_to_clip = to_zero_to_one(any_object_to_clip, depth);
+    check_clip_depth(any_object_to_clip, depth, "make_frustum_planes");
+    const Mat4 object_to_clip = to_depth_key(any_object_to_clip, depth);
     const Vec4 x = object_to_clip.row(0);
     const Vec4 y = object_to_clip.row(1);
-    const Vec4 z = object_to_clip.row(2);
+    const Vec4 k = object_to_clip.row(2);
     const Vec4 w = object_to_clip.row(3);
     FrustumPlanes planes;
+    planes.depth = depth;
+    planes.near_w = is_reversed(depth) ? 1.0f : 0.0f;
+    planes.far_w = is_reversed(depth) ? 0.0f : 1.0f;
+    planes.far_limit = has_far_plane(depth) ? 0.0f : -std::numeric_limits<float>::infinity();
     planes.rows[0] = w + x;  // left:   w + x >= 0
     planes.rows[1] = w - x;  // right:  w - x >= 0
     planes.rows[2] = w + y;  // bottom: w + y >= 0
     planes.rows[3] = w - y;  // top:    w - y >= 0
-    planes.rows[4] = z;      // near:   z >= 0
-    planes.rows[5] = w - z;  // far:    w - z >= 0
+    planes.rows[4] = is_reversed(depth) ? k + w : k;  // near: z >= 0, or w - z >= 0 (reversed)
+    planes.rows[5] = is_reversed(depth) ? Vec4{0, 0, 0, 0} - k : w - k;  // far: w - z >= 0, or z >= 0
+    if (!has_far_plane(depth)) planes.rows[5] = Vec4{0, 0, 0, 1};  // at infinity: every point passes
     planes.clip_rows[0] = x;
     planes.clip_rows[1] = y;
-    planes.clip_rows[2] = z;
+    planes.clip_rows[2] = k;
     planes.clip_rows[3] = w;
     for (int q = 0; q < 6; ++q) {
         const Vec4 r = planes.rows[q];
@@ -63,38 +69,47 @@ PATCHCULL_SCALAR_CLONES
 void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement,
                          const FrustumPlanes& planes, std::uint8_t* culled) {
     for (std::size_t p = 0; p < patches.count; ++p) {
-        float mx[6], v[6];
-        for (int q = 0; q < 6; ++q) mx[q] = -std::numeric_limits<float>::infinity();
+        FrustumVerdict verdict;
+        float v[6];
         for (int k = 0; k < kPatchPoints; ++k) {
             const float W = patches.at(p, k, 3);
             frustum_plane_values(planes, patches.at(p, k, 0), patches.at(p, k, 1), patches.at(p, k, 2), W, v);
             if (max_displacement) add_frustum_margins(planes, max_displacement[p], W, v);
-            for (int q = 0; q < 6; ++q) mx[q] = max_like_simd(mx[q], v[q]);
+            verdict.add(v);
         }
-        bool out = false;
-        for (int q = 0; q < 6; ++q) out |= mx[q] < 0.0f;
-        culled[p] = out ? 1 : 0;
+        culled[p] = verdict.culled(planes) ? 1 : 0;
     }
 }
 
 // frustum-disp: AABB of the Cartesian control points (X/W, Y/W, Z/W, exact IEEE division),
-// grown by D on every side; the 8 corners go to clip space with
+// grown by D on every side; the 8 corners go to clip space (the depth-key matrix of
+// make_frustum_planes) with
 //   clip_r = fma(m(r,0), x, fma(m(r,1), y, fma(m(r,2), z, m(r,3))))
-// and the patch is culled when all 8 corners fail the same clip-plane inequality.
+// and the patch is culled when all 8 corners fail the same clip-plane inequality (plane values as
+// frustum_plane_values forms them) and its probe over the raw coordinates X, Y, Z, W is still 0.
 PATCHCULL_SCALAR_CLONES
 void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement,
                               const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled) {
-    const Mat4 m = to_zero_to_one(object_to_clip, depth);
+    const FrustumPlanes planes = make_frustum_planes(object_to_clip, depth);
+    Mat4 m;
+    for (int r = 0; r < 4; ++r) {
+        const Vec4 row = planes.clip_rows[r];
+        m.at(r, 0) = row.x;
+        m.at(r, 1) = row.y;
+        m.at(r, 2) = row.z;
+        m.at(r, 3) = row.w;
+    }
     for (std::size_t p = 0; p < patches.count; ++p) {
         const float d = max_displacement ? max_displacement[p] : 0.0f;
         float lo[3], hi[3];
-        for (int a = 0; a < 3; ++a) lo[a] = hi[a] = patches.at(p, 0, a) / patches.at(p, 0, 3);
-        for (int k = 1; k < kPatchPoints; ++k) {
+        float probe = 0;
+        for (int k = 0; k < kPatchPoints; ++k) {
             const float W = patches.at(p, k, 3);
+            for (int a = 0; a < 4; ++a) probe = std::fma(patches.at(p, k, a), 0.0f, probe);
             for (int a = 0; a < 3; ++a) {
                 const float v = patches.at(p, k, a) / W;
-                lo[a] = min_like_simd(lo[a], v);
-                hi[a] = max_like_simd(hi[a], v);
+                lo[a] = k == 0 ? v : min_like_simd(lo[a], v);
+                hi[a] = k == 0 ? v : max_like_simd(hi[a], v);
             }
         }
         float box[3][2];  // [axis][0 = low, 1 = high]
@@ -112,14 +127,14 @@ void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_di
             for (int i = 0; i < 2; ++i)
                 for (int js = 0; js < 4; ++js) clip[r][i * 4 + js] = std::fma(m.at(r, 0), box[0][i], tyz[js]);
         }
-        auto plane_values = [&clip](int corner, float v[6]) {
+        auto plane_values = [&clip, &planes](int corner, float v[6]) {
             const float cx = clip[0][corner], cy = clip[1][corner], cz = clip[2][corner], cw = clip[3][corner];
             v[0] = cw + cx;
             v[1] = cw - cx;
             v[2] = cw + cy;
             v[3] = cw - cy;
-            v[4] = cz;
-            v[5] = cw - cz;
+            v[4] = cz + planes.near_w * cw;
+            v[5] = planes.far_w * cw - cz;
         };
         float mx[6], v[6];
         plane_values(0, mx);
@@ -127,9 +142,9 @@ void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_di
             plane_values(corner, v);
             for (int q = 0; q < 6; ++q) mx[q] = max_like_simd(mx[q], v[q]);
         }
-        bool out = false;
-        for (int q = 0; q < 6; ++q) out |= mx[q] < 0.0f;
-        culled[p] = out ? 1 : 0;
+        bool out = mx[5] < planes.far_limit;
+        for (int q = 0; q < 5; ++q) out |= mx[q] < 0.0f;
+        culled[p] = out && probe == 0.0f ? 1 : 0;
     }
 }
 

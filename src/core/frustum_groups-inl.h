@@ -32,10 +32,12 @@ using simd_groups::Group;
 using simd_groups::MF;
 using simd_groups::VF;
 
-// The clip matrix rows broadcast once per call.
+// The clip matrix rows broadcast once per call, with the near and far plane coefficients.
 struct ClipRows {
     VF m[4][4];  // m[r][c] = element (row r, column c)
-    HWY_INLINE ClipRows(DF d, const FrustumPlanes& planes) {
+    VF near_w, far_w, far_limit;
+    HWY_INLINE ClipRows(DF d, const FrustumPlanes& planes)
+        : near_w(hn::Set(d, planes.near_w)), far_w(hn::Set(d, planes.far_w)), far_limit(hn::Set(d, planes.far_limit)) {
         for (int r = 0; r < 4; ++r) {
             m[r][0] = hn::Set(d, planes.clip_rows[r].x);
             m[r][1] = hn::Set(d, planes.clip_rows[r].y);
@@ -50,27 +52,31 @@ HWY_INLINE void ClipPoint(DF d, const ClipRows& rows, VF X, VF Y, VF Z, VF W, VF
     for (int r = 0; r < 4; ++r) c[r] = Fma(d, rows.m[r][3], W, Fma(d, rows.m[r][2], Z, Fma(d, rows.m[r][1], Y, hn::Mul(rows.m[r][0], X))));
 }
 
-// Running per-plane maxima of w + x, w - x, w + y, w - y, z, w - z, with the margins when given.
+// Running per-plane maxima of w + x, w - x, w + y, w - y, k + near_w w, far_w w - k, with the
+// margins when given, and the non-finite probe (FrustumVerdict, frustum.h).
 struct PlaneMaxima {
     VF mx[6];
-    HWY_INLINE explicit PlaneMaxima(DF d) {
+    VF probe;
+    HWY_INLINE explicit PlaneMaxima(DF d) : probe(hn::Zero(d)) {
         for (int q = 0; q < 6; ++q) mx[q] = hn::Set(d, -std::numeric_limits<float>::infinity());
     }
     template <bool kMargins>
-    HWY_INLINE void add(DF d, const VF c[4], VF W, const VF margin[6]) {
-        VF v[6] = {hn::Add(c[3], c[0]), hn::Sub(c[3], c[0]), hn::Add(c[3], c[1]),
-                   hn::Sub(c[3], c[1]), c[2],                hn::Sub(c[3], c[2])};
+    HWY_INLINE void add(DF d, const ClipRows& rows, const VF c[4], VF W, const VF margin[6]) {
+        VF v[6] = {hn::Add(c[3], c[0]), hn::Sub(c[3], c[0]),
+                   hn::Add(c[3], c[1]), hn::Sub(c[3], c[1]),
+                   hn::Add(c[2], hn::Mul(rows.near_w, c[3])), hn::Sub(hn::Mul(rows.far_w, c[3]), c[2])};
         for (int q = 0; q < 6; ++q) {
             if constexpr (kMargins) v[q] = Fma(d, margin[q], W, v[q]);
             mx[q] = hn::Max(mx[q], v[q]);
         }
+        probe = Fma(d, v[4], hn::Zero(d), probe);
     }
-    // Lanes outside some plane: culled.
-    HWY_INLINE MF outside(DF d) const {
+    // Lanes outside some plane with every value finite: culled.
+    HWY_INLINE MF outside(DF d, const ClipRows& rows) const {
         const VF zero = hn::Zero(d);
-        MF out = hn::Lt(mx[0], zero);
-        for (int q = 1; q < 6; ++q) out = hn::Or(out, hn::Lt(mx[q], zero));
-        return out;
+        MF out = hn::Lt(mx[5], rows.far_limit);
+        for (int q = 0; q < 5; ++q) out = hn::Or(out, hn::Lt(mx[q], zero));
+        return hn::And(out, hn::Eq(probe, zero));
     }
 };
 

@@ -48,9 +48,9 @@ HWY_INLINE MF FrustumGroup(DF d, const Group& g, VF disp, const FrustumPlanes& p
         const VF X = g.load(d, k, 0), Y = g.load(d, k, 1), Z = g.load(d, k, 2), W = g.load(d, k, 3);
         VF c[4];
         frustum_groups::ClipPoint(d, rows, X, Y, Z, W, c);
-        maxima.add<kMargins>(d, c, W, margin);
+        maxima.add<kMargins>(d, rows, c, W, margin);
     }
-    return maxima.outside(d);
+    return maxima.outside(d, rows);
 }
 
 // Cartesian AABB of the group's control points. kPolynomial: every weight is exactly 1, so
@@ -73,12 +73,17 @@ HWY_INLINE void CartesianBounds(DF d, const Group& g, VF lo[3], VF hi[3]) {
 }
 
 struct ClipMatrix {
-    float m[4][4];  // m[r][c] = element (row r, column c)
+    float m[4][4];  // m[r][c] = element (row r, column c): FrustumPlanes::clip_rows
+    float near_w, far_w, far_limit;
 };
 
 // frustum-disp (see frustum.cpp for the operation order).
 HWY_INLINE MF FrustumDispGroup(DF d, const Group& g, VF disp, const ClipMatrix& cm) {
     const VF one = hn::Set(d, 1.0f);
+    const VF zero = hn::Zero(d);
+    VF probe = zero;  // non-finite probe over the raw coordinates (frustum.h)
+    for (int k = 0; k < kPatchPoints; ++k)
+        for (int a = 0; a < 4; ++a) probe = Fma(d, g.load(d, k, a), zero, probe);
     MF all_one = hn::Eq(g.load(d, 0, 3), one);
     for (int k = 1; k < kPatchPoints; ++k) all_one = hn::And(all_one, hn::Eq(g.load(d, k, 3), one));
     VF lo[3], hi[3];
@@ -103,14 +108,15 @@ HWY_INLINE MF FrustumDispGroup(DF d, const Group& g, VF disp, const ClipMatrix& 
         for (int i = 0; i < 2; ++i)
             for (int js = 0; js < 4; ++js) clip[r][i * 4 + js] = Fma(d, m0, box[0][i], tyz[js]);
     }
-    auto plane_values = [&clip](int corner, VF v[6]) {
+    const VF near_w = hn::Set(d, cm.near_w), far_w = hn::Set(d, cm.far_w);
+    auto plane_values = [&](int corner, VF v[6]) {
         const VF cx = clip[0][corner], cy = clip[1][corner], cz = clip[2][corner], cw = clip[3][corner];
         v[0] = hn::Add(cw, cx);
         v[1] = hn::Sub(cw, cx);
         v[2] = hn::Add(cw, cy);
         v[3] = hn::Sub(cw, cy);
-        v[4] = cz;
-        v[5] = hn::Sub(cw, cz);
+        v[4] = hn::Add(cz, hn::Mul(near_w, cw));
+        v[5] = hn::Sub(hn::Mul(far_w, cw), cz);
     };
     VF mx[6], v[6];
     plane_values(0, mx);
@@ -118,10 +124,9 @@ HWY_INLINE MF FrustumDispGroup(DF d, const Group& g, VF disp, const ClipMatrix& 
         plane_values(corner, v);
         for (int q = 0; q < 6; ++q) mx[q] = hn::Max(mx[q], v[q]);
     }
-    const VF zero = hn::Zero(d);
-    MF out = hn::Lt(mx[0], zero);
-    for (int q = 1; q < 6; ++q) out = hn::Or(out, hn::Lt(mx[q], zero));
-    return out;
+    MF out = hn::Lt(mx[5], hn::Set(d, cm.far_limit));
+    for (int q = 0; q < 5; ++q) out = hn::Or(out, hn::Lt(mx[q], zero));
+    return hn::And(out, hn::Eq(probe, zero));
 }
 
 // A group's per-patch displacement margins (zero without them).
@@ -143,10 +148,18 @@ void CullFrustum(const PatchBatchView& patches, const float* max_displacement,
 }
 
 void CullFrustumDisp(const PatchBatchView& patches, const float* max_displacement,
-                     const Mat4& object_to_clip, std::uint8_t* culled) {
+                     const FrustumPlanes& planes, std::uint8_t* culled) {
     ClipMatrix cm;
-    for (int r = 0; r < 4; ++r)
-        for (int c = 0; c < 4; ++c) cm.m[r][c] = object_to_clip.at(r, c);
+    for (int r = 0; r < 4; ++r) {
+        const Vec4 row = planes.clip_rows[r];
+        cm.m[r][0] = row.x;
+        cm.m[r][1] = row.y;
+        cm.m[r][2] = row.z;
+        cm.m[r][3] = row.w;
+    }
+    cm.near_w = planes.near_w;
+    cm.far_w = planes.far_w;
+    cm.far_limit = planes.far_limit;
     ForEachGroup(patches, culled, [&](DF d, const Group& g, std::size_t first, std::size_t valid) {
         return FrustumDispGroup(d, g, GroupDisplacement(d, max_displacement, first, valid), cm);
     });
@@ -173,8 +186,9 @@ void cull_frustum_simd(const PatchBatchView& patches, const float* max_displacem
 
 void cull_frustum_disp_simd(const PatchBatchView& patches, const float* max_displacement,
                             const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled) {
+    const FrustumPlanes planes = make_frustum_planes(object_to_clip, depth);  // may throw: before the loop
     if (patches.count == 0) return;
-    HWY_DYNAMIC_DISPATCH(CullFrustumDisp)(patches, max_displacement, to_zero_to_one(object_to_clip, depth), culled);
+    HWY_DYNAMIC_DISPATCH(CullFrustumDisp)(patches, max_displacement, planes, culled);
 }
 
 const char* simd_target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }

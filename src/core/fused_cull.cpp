@@ -54,6 +54,7 @@ std::string fused_plan_name(const FusedPlan& plan) {
 
 FusedCullSetup make_fused_setup(const Mat4& object_to_clip, ClipDepth depth, Vec3 eye, BackPatchCone cone,
                                 const HiZPyramid* hiz) {
+    if (hiz) check_hiz_convention(*hiz, depth, "make_fused_setup");
     FusedCullSetup setup;
     setup.planes = make_frustum_planes(object_to_clip, depth);
     setup.eye = eye;
@@ -72,15 +73,13 @@ namespace {
 
 // The separate frustum kernel's verdict on patch p (no displacement).
 bool frustum_culled(const PatchBatchView& v, std::size_t p, const FrustumPlanes& planes) {
-    float mx[6], value[6];
-    std::fill(mx, mx + 6, -std::numeric_limits<float>::infinity());
+    FrustumVerdict verdict;
+    float value[6];
     for (int k = 0; k < kPatchPoints; ++k) {
         frustum_plane_values(planes, v.at(p, k, 0), v.at(p, k, 1), v.at(p, k, 2), v.at(p, k, 3), value);
-        for (int q = 0; q < 6; ++q) mx[q] = mx[q] > value[q] ? mx[q] : value[q];
+        verdict.add(value);
     }
-    for (float m : mx)
-        if (m < 0.0f) return true;
-    return false;
+    return verdict.culled(planes);
 }
 
 // The separate cone kernel's verdict on patch p: the patch copied to a one-patch batch on the stack.

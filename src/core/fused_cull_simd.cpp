@@ -115,9 +115,9 @@ HWY_INLINE void FrustumStage(DF d, const Group& g, const Consts& k_, Scratch& s,
         VF c[4];
         frustum_groups::ClipPoint(d, k_.rows, X, Y, Z, W, c);
         for (int r = 0; r < 4; ++r) hn::Store(c[r], d, s.clip[k][r]);
-        maxima.add<false>(d, c, W, nullptr);
+        maxima.add<false>(d, k_.rows, c, W, nullptr);
     }
-    MaskToBytes(d, maxima.outside(d), s, culled);
+    MaskToBytes(d, maxima.outside(d, k_.rows), s, culled);
 }
 
 // Stage backpatch: the cone kernel on the group itself (a plain view of its valid lanes).
@@ -301,6 +301,7 @@ void cull_fused_profile_simd(const PatchBatchView& patches, const FusedCullSetup
 
 void cull_occlusion_simd(const PatchBatchView& patches, const Mat4& object_to_clip, ClipDepth depth,
                          const HiZPyramid& hiz, std::uint8_t* decision) {
+    check_hiz_convention(hiz, depth, "cull_occlusion_simd");
     FusedCullSetup setup;
     setup.planes = make_frustum_planes(object_to_clip, depth);
     setup.hiz = &hiz;

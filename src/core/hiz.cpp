@@ -4,6 +4,11 @@
 // division, floor; the build is ISO C++ (no -ffast-math, no contraction of a*b+c).
 #include "patchcull/hiz.h"
 
+#include <limits>
+#include <string>
+
+#include "patchcull/error.h"
+
 #include <algorithm>
 #include <bit>
 #include <cassert>
@@ -48,7 +53,36 @@ void reduce_max(const float* src, int src_w, int src_h, float* dst) {
     }
 }
 
+// Level 0 from a depth buffer of any element type: texel = max of key(pixel) over its children.
+template <class T, class Key>
+void reduce_first(const T* src, int src_w, int src_h, float* dst, Key key) {
+    const int dst_w = half_up(src_w), dst_h = half_up(src_h);
+    const int full_w = src_w / 2;
+    for (int ty = 0; ty < dst_h; ++ty) {
+        const T* a = src + static_cast<std::size_t>(2 * ty) * src_w;
+        const T* b = 2 * ty + 1 < src_h ? a + src_w : a;
+        float* out = dst + static_cast<std::size_t>(ty) * dst_w;
+        for (int tx = 0; tx < full_w; ++tx) {
+            const float m0 = max_like_simd(key(a[2 * tx]), key(a[2 * tx + 1]));
+            const float m1 = max_like_simd(key(b[2 * tx]), key(b[2 * tx + 1]));
+            out[tx] = max_like_simd(m0, m1);
+        }
+        if (full_w < dst_w) out[full_w] = max_like_simd(key(a[2 * full_w]), key(b[2 * full_w]));
+    }
+}
+
 inline float clamp_like_simd(float v, float lo, float hi) { return min_like_simd(max_like_simd(v, lo), hi); }
+
+// The key of 24-bit unsigned depth u (hiz.h): the far end of the depths that store u, rounded outward.
+float unorm24_key(std::uint32_t u, bool reversed) {
+    constexpr double kMax = 16777215.0;  // 2^24 - 1
+    if (!reversed) {
+        const float d = static_cast<float>((static_cast<double>(u) + 0.5) / kMax);
+        return std::nextafter(d, std::numeric_limits<float>::infinity());
+    }
+    const float d = static_cast<float>((static_cast<double>(u) - 0.5) / kMax);
+    return -std::nextafter(d, -std::numeric_limits<float>::infinity());
+}
 
 }  // namespace
 
@@ -79,8 +113,31 @@ void HiZPyramid::resize(int depth_width, int depth_height) {
 }
 
 void HiZPyramid::build(const float* depth, int depth_width, int depth_height) {
+    build(depth, depth_width, depth_height, ClipDepth::zero_to_one);
+}
+
+void HiZPyramid::build(const float* depth, int depth_width, int depth_height, ClipDepth convention) {
     resize(depth_width, depth_height);
-    reduce_max(depth, width_, height_, data_.data() + level_[0].offset);
+    reversed_ = is_reversed(convention);
+    if (reversed_)
+        reduce_first(depth, width_, height_, data_.data() + level_[0].offset, [](float d) { return -d; });
+    else
+        reduce_max(depth, width_, height_, data_.data() + level_[0].offset);
+    reduce_upper_levels();
+}
+
+void HiZPyramid::build_unorm24(const std::uint32_t* depth, int depth_width, int depth_height, int depth_shift,
+                               ClipDepth convention) {
+    resize(depth_width, depth_height);
+    reversed_ = is_reversed(convention);
+    const bool reversed = reversed_;
+    reduce_first(depth, width_, height_, data_.data() + level_[0].offset, [depth_shift, reversed](std::uint32_t v) {
+        return unorm24_key((v >> depth_shift) & 0xFFFFFFu, reversed);
+    });
+    reduce_upper_levels();
+}
+
+void HiZPyramid::reduce_upper_levels() {
     for (int l = 1; l < levels_; ++l) {
         const HiZLevel& src = level_[l - 1];
         reduce_max(data_.data() + src.offset, src.width, src.height, data_.data() + level_[l].offset);
@@ -186,15 +243,24 @@ constexpr std::size_t kChunk = 256;  // patches per frustum pass (64 KiB of cont
 PATCHCULL_HIZ_CLONES
 bool patch_screen_bounds(const PatchBatchView& patches, std::size_t index, const Mat4& object_to_clip, ClipDepth depth,
                          int width, int height, PatchScreenBounds& out) {
-    return patch_bounds(patches, index, make_clip_rows(to_zero_to_one(object_to_clip, depth), width, height), width,
+    return patch_bounds(patches, index, make_clip_rows(to_depth_key(object_to_clip, depth), width, height), width,
                         height, out);
+}
+
+void check_hiz_convention(const HiZPyramid& hiz, ClipDepth depth, const char* what) {
+    if (hiz.levels() == 0) throw Error(std::string(what) + ": the Hi-Z pyramid was never built");
+    if (hiz.reversed() != is_reversed(depth))
+        throw Error(std::string(what) + ": the matrix is declared " + clip_depth_name(depth) +
+                    " but the Hi-Z pyramid was built from a " + (hiz.reversed() ? "reversed" : "forward") +
+                    " depth buffer; build it with the same convention");
 }
 
 PATCHCULL_HIZ_CLONES
 void cull_occlusion_scalar(const PatchBatchView& patches, const Mat4& any_object_to_clip, ClipDepth depth,
                            const HiZPyramid& hiz, std::uint8_t* decision) {
-    const Mat4 object_to_clip = to_zero_to_one(any_object_to_clip, depth);
-    const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
+    check_hiz_convention(hiz, depth, "cull_occlusion_scalar");
+    const FrustumPlanes planes = make_frustum_planes(any_object_to_clip, depth);
+    const Mat4 object_to_clip = to_depth_key(any_object_to_clip, depth);
     const int width = hiz.depth_width(), height = hiz.depth_height();
     const ClipRows cr = make_clip_rows(object_to_clip, width, height);
     for (std::size_t first = 0; first < patches.count; first += kChunk) {

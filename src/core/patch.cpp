@@ -1,6 +1,11 @@
 // Bezier patch evaluation, de Casteljau split, plain (SoA) and blocked batches (patchcull/patch.h).
 #include "patchcull/patch.h"
 
+#include <cstdio>
+#include <string>
+
+#include "patchcull/error.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
@@ -143,7 +148,19 @@ void PatchBatch::resize(std::size_t count) {
     data_.assign(stride_ * 4 * kPatchPoints, 0.0f);
 }
 
+void check_patch_weights(const BezierPatch& patch, std::size_t index) {
+    for (int k = 0; k < kPatchPoints; ++k) {
+        if (!(patch.cp[k].w <= 0.0f)) continue;  // positive, or NaN / +Inf (never culled: frustum.h)
+        char weight[32];
+        std::snprintf(weight, sizeof weight, "%g", static_cast<double>(patch.cp[k].w));
+        throw Error("patch " + std::to_string(index) + ": control point " + std::to_string(k) + " has weight " +
+                    weight + "; weights must be positive (negate every coordinate of a patch whose weights "
+                             "are all negative: the same surface)");
+    }
+}
+
 void PatchBatch::set(std::size_t index, const BezierPatch& patch) {
+    check_patch_weights(patch, index);
     for (int k = 0; k < kPatchPoints; ++k) {
         component(k, 0)[index] = patch.cp[k].x;
         component(k, 1)[index] = patch.cp[k].y;
@@ -183,6 +200,7 @@ BezierPatch get_patch(const PatchBatchView& v, std::size_t p) {
 PatchBlocks::PatchBlocks(const PatchBatchView& patches) {
     resize(patches.count);
     for (std::size_t p = 0; p < patches.count; ++p) {
+        check_patch_weights(get_patch(patches, p), p);
         float* lane = data_.data() + (p / kBlockPatches) * kBlockFloats + p % kBlockPatches;
         for (int a = 0; a < 4 * kPatchPoints; ++a) lane[a * kBlockPatches] = patches.at(p, a / 4, a % 4);
     }
@@ -194,6 +212,7 @@ void PatchBlocks::resize(std::size_t count) {
 }
 
 void PatchBlocks::set(std::size_t index, const BezierPatch& patch) {
+    check_patch_weights(patch, index);
     float* lane = data_.data() + (index / kBlockPatches) * kBlockFloats + index % kBlockPatches;
     for (int k = 0; k < kPatchPoints; ++k) {
         lane[(4 * k + 0) * kBlockPatches] = patch.cp[k].x;

@@ -41,6 +41,10 @@ void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, Displ
     if (bounds) detail::check_buffer_size("DisplacedPass", "bound", bounds, end * ds::kDisplacedBoundValues * sizeof(float));
     if (hiz && (!glIsTexture(hiz->texture) || hiz->width < 1 || hiz->height < 1))
         throw Error("GL: DisplacedPass: no Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
+    if (hiz && hiz->reversed != is_reversed(view.depth))
+        throw Error(std::string("GL: DisplacedPass: the view is ") + clip_depth_name(view.depth) +
+                    " but the Hi-Z pyramid was built from a " + (hiz->reversed ? "reversed" : "forward") +
+                    " depth buffer (HiZBuildPass::run's convention)");
     if (patches.count == 0) return;
     pp::DisplacedParams params;
     std::copy_n(view.object_to_view.m, 16, params.object_to_view);
@@ -53,7 +57,7 @@ void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, Displ
     params.abs_row_z = {view.abs_row_z[0], view.abs_row_z[1], view.abs_row_z[2], view.abs_row_z[3]};
     const Mat4& pr = view.projection;
     params.proj = {pr.at(0, 0), pr.at(0, 2), pr.at(1, 1), pr.at(1, 2)};
-    params.proj_z = {pr.at(2, 2), pr.at(2, 3), 0, 0};
+    params.proj_z = {pr.at(2, 2), pr.at(2, 3), view.key_near, view.key_far};
     params.constants = {kDisplacedDeltaSlack, kDisplacedExtScale, kDisplacedFramePad, kDisplacedDepthSafety};
     params.has_ranges = ranges ? 1u : 0u;
     params.only_displaced = only_displaced ? 1u : 0u;

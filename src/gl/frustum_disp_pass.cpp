@@ -5,8 +5,8 @@
 namespace patchcull::gl {
 
 // The std140 block of pass_params.h: four vec4 rows, then four uints.
-static_assert(sizeof(pp::FrustumDispParams) == 4 * 16 + 16);
-static_assert(offsetof(pp::FrustumDispParams, first_patch) == 4 * 16);
+static_assert(sizeof(pp::FrustumDispParams) == 5 * 16 + 16);
+static_assert(offsetof(pp::FrustumDispParams, first_patch) == 5 * 16);
 
 struct FrustumDispPass::Impl : detail::PassState {
     using PassState::PassState;
@@ -24,11 +24,15 @@ void FrustumDispPass::run(const PatchBuffers& patches, const Mat4& object_to_cli
     if (plane_values)
         detail::check_buffer_size("FrustumDispPass", "plane-value", plane_values,
                                   (patches.first + patches.count) * 6 * sizeof(float));
+    // The CPU kernel's planes (frustum.cpp): the same matrix, so the same corners.
+    const FrustumPlanes planes = make_frustum_planes(object_to_clip, depth);  // refuses a contradiction
     if (patches.count == 0) return;
-    // The CPU kernel converts first too (frustum.cpp): the same matrix, so the same corners.
-    const Mat4 m = to_zero_to_one(object_to_clip, depth);
     pp::FrustumDispParams params;
-    for (int r = 0; r < 4; ++r) params.clip_rows[r] = {m.at(r, 0), m.at(r, 1), m.at(r, 2), m.at(r, 3)};
+    for (int r = 0; r < 4; ++r) {
+        const Vec4 m = planes.clip_rows[r];
+        params.clip_rows[r] = {m.x, m.y, m.z, m.w};
+    }
+    params.plane_depth = {planes.near_w, planes.far_w, planes.far_limit, 0.0f};
     params.has_margins = patches.margins ? 1u : 0u;
     params.write_plane_values = plane_values ? 1u : 0u;
     glUseProgram(impl_->context.program("frustum_disp.comp.glsl"));

@@ -20,7 +20,7 @@ void FrustumPass::run(const PatchBuffers& patches, const FrustumPlanes& planes, 
                                   (patches.first + patches.count) * 6 * sizeof(float));
     if (patches.count == 0) return;
     pp::FrustumParams params;
-    detail::store_planes(planes, params.clip_rows, params.plane_normal_length);
+    detail::store_planes(planes, params.clip_rows, params.plane_normal_length, params.plane_depth);
     params.has_margins = patches.margins ? 1u : 0u;
     params.write_plane_values = plane_values ? 1u : 0u;
     glUseProgram(impl_->context.program("frustum.comp.glsl"));

@@ -25,11 +25,14 @@ void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const 
         throw Error("GL: FusedCullPass: ptp is not fused (BackpatchPtpPass)");
     if (occlusion && (!hiz || !glIsTexture(hiz->texture) || hiz->width < 1 || hiz->height < 1))
         throw Error("GL: FusedCullPass: the occlusion test needs a Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
+    if (occlusion && hiz->reversed != is_reversed(depth))
+        throw Error(std::string("GL: FusedCullPass: the matrix is declared ") + clip_depth_name(depth) +
+                    " but the Hi-Z pyramid was built from a " + (hiz->reversed ? "reversed" : "forward") +
+                    " depth buffer (HiZBuildPass::run's convention)");
+    const FrustumPlanes planes = make_frustum_planes(any_object_to_clip, depth);  // refuses a contradiction
     if (patches.count == 0 || tests == 0) return;
-    const Mat4 object_to_clip = to_zero_to_one(any_object_to_clip, depth);
     pp::FusedCullParams params;
-    detail::store_planes(make_frustum_planes(object_to_clip, ClipDepth::zero_to_one), params.clip_rows,
-                         params.plane_normal_length);
+    detail::store_planes(planes, params.clip_rows, params.plane_normal_length, params.plane_depth);
     params.eye = {eye.x, eye.y, eye.z, 1.0f};
     params.has_margins = patches.margins ? 1u : 0u;
     params.tests = tests;

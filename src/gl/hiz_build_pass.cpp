@@ -2,6 +2,9 @@
 // one dispatch per level.
 #include "pass_common.h"
 
+#include <cstdio>
+#include <string>
+
 namespace patchcull::gl {
 
 struct HiZBuildPass::Impl : detail::PassState {
@@ -14,10 +17,33 @@ HiZBuildPass& HiZBuildPass::operator=(HiZBuildPass&&) noexcept = default;
 HiZBuildPass::~HiZBuildPass() = default;
 
 void HiZBuildPass::run(std::uint32_t depth_texture, const HiZTexture& hiz) {
+    if (hiz.reversed)
+        throw Error("GL: HiZBuildPass: the pyramid was built reversed; pass its convention to run()");
+    HiZTexture forward = hiz;
+    run(depth_texture, forward, ClipDepth::zero_to_one);
+}
+
+void HiZBuildPass::run(std::uint32_t depth_texture, HiZTexture& hiz, ClipDepth convention) {
     detail::begin_pass("HiZBuildPass");
     if (!glIsTexture(depth_texture)) throw Error("GL: HiZBuildPass: " + std::to_string(depth_texture) + " is not a texture");
     if (!glIsTexture(hiz.texture) || hiz.width < 1 || hiz.height < 1)
         throw Error("GL: HiZBuildPass: no Hi-Z texture (create_hiz_texture)");
+    GLint format = 0;
+    glGetTextureLevelParameteriv(depth_texture, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
+    bool unorm24 = false;
+    switch (format) {
+        case GL_DEPTH_COMPONENT32F:
+        case GL_DEPTH32F_STENCIL8: break;
+        case GL_DEPTH_COMPONENT24:
+        case GL_DEPTH24_STENCIL8: unorm24 = true; break;
+        default: {
+            char hex[16];
+            std::snprintf(hex, sizeof hex, "0x%04X", static_cast<unsigned>(format));
+            throw Error(std::string("GL: HiZBuildPass: depth texture format ") + hex +
+                        " is not GL_DEPTH_COMPONENT32F, GL_DEPTH32F_STENCIL8, GL_DEPTH_COMPONENT24 or GL_DEPTH24_STENCIL8");
+        }
+    }
+    hiz.reversed = is_reversed(convention);
     glUseProgram(impl_->context.program("hiz_build.comp.glsl"));
     glBindTextureUnit(shared::kTextureUnitDepth, depth_texture);
     glBindTextureUnit(shared::kTextureUnitHiZ, hiz.texture);
@@ -32,6 +58,8 @@ void HiZBuildPass::run(std::uint32_t depth_texture, const HiZTexture& hiz) {
         params.source_height = source_h;
         params.out_width = out_w;
         params.out_height = out_h;
+        params.reversed = hiz.reversed ? 1u : 0u;
+        params.unorm24 = unorm24 ? 1u : 0u;
         impl_->block.upload(params);
         glBindImageTexture(shared::kImageUnitHiZOut, hiz.texture, l, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
         glDispatchCompute((static_cast<GLuint>(out_w) + shared::kHiZGroupSize - 1) / shared::kHiZGroupSize,

@@ -19,11 +19,14 @@ void OcclusionPass::run(const PatchBuffers& patches, const Mat4& any_object_to_c
     detail::check_patch_buffers("OcclusionPass", patches);
     if (!glIsTexture(hiz.texture) || hiz.width < 1 || hiz.height < 1)
         throw Error("GL: OcclusionPass: no Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
+    if (hiz.reversed != is_reversed(depth))
+        throw Error(std::string("GL: OcclusionPass: the matrix is declared ") + clip_depth_name(depth) +
+                    " but the Hi-Z pyramid was built from a " + (hiz.reversed ? "reversed" : "forward") +
+                    " depth buffer (HiZBuildPass::run's convention)");
+    const FrustumPlanes planes = make_frustum_planes(any_object_to_clip, depth);  // refuses a contradiction
     if (patches.count == 0) return;
-    const Mat4 object_to_clip = to_zero_to_one(any_object_to_clip, depth);
     pp::OcclusionParams params;
-    detail::store_planes(make_frustum_planes(object_to_clip, ClipDepth::zero_to_one), params.clip_rows,
-                         params.plane_normal_length);
+    detail::store_planes(planes, params.clip_rows, params.plane_normal_length, params.plane_depth);
     params.has_margins = patches.margins ? 1u : 0u;
     params.with_frustum = with_frustum ? 1u : 0u;
     params.screen_width = hiz.width;

@@ -15,15 +15,15 @@ using namespace detail;
 
 // The C++ structs are the GLSL std140 blocks (pass_params.h): sizes a multiple of 16, members in
 // std140 order (matrices and vec4 arrays first, then 4-byte scalars).
-static_assert(sizeof(pp::FrustumParams) == 4 * 16 + 2 * 16 + 16);
-static_assert(sizeof(pp::OcclusionParams) == 4 * 16 + 2 * 16 + 32);
+static_assert(sizeof(pp::FrustumParams) == 4 * 16 + 3 * 16 + 16);
+static_assert(sizeof(pp::OcclusionParams) == 4 * 16 + 3 * 16 + 32);
 static_assert(sizeof(pp::HiZBuildParams) == 32);
 static_assert(sizeof(pp::BackpatchConeParams) == 16 + 32);
 static_assert(sizeof(pp::BackpatchPtpParams) == 3 * 16 + 32);
 static_assert(sizeof(pp::DisplacedParams) == 64 + 6 * 16 + 3 * 16 + 5 * 16 + 48);
 static_assert(sizeof(pp::CullStatusParams) == 16);
-static_assert(sizeof(pp::FusedCullParams) == 4 * 16 + 2 * 16 + 16 + 32);
-static_assert(offsetof(pp::FusedCullParams, first_patch) == 4 * 16 + 2 * 16 + 16);
+static_assert(sizeof(pp::FusedCullParams) == 4 * 16 + 3 * 16 + 16 + 32);
+static_assert(offsetof(pp::FusedCullParams, first_patch) == 4 * 16 + 3 * 16 + 16);
 static_assert(offsetof(pp::OcclusionParams, first_patch) == 4 * 16 + 2 * 16);
 static_assert(offsetof(pp::DisplacedParams, first_patch) == 64 + 6 * 16 + 3 * 16 + 5 * 16);
 
@@ -247,7 +247,8 @@ void finish_pass(const char* who) {
     check_gl(who);
 }
 
-void store_planes(const FrustumPlanes& planes, pp::vec4 clip_rows[4], pp::vec4 normal_length[2]) {
+void store_planes(const FrustumPlanes& planes, pp::vec4 clip_rows[4], pp::vec4 normal_length[2], pp::vec4& depth) {
+    depth = {planes.near_w, planes.far_w, planes.far_limit, 0.0f};
     for (int r = 0; r < 4; ++r) {
         const Vec4 m = planes.clip_rows[r];
         clip_rows[r] = {m.x, m.y, m.z, m.w};

@@ -92,7 +92,7 @@ void bind_patch_buffers(const PatchBuffers& patches);
 void finish_pass(const char* who);
 
 /// Copies a FrustumPlanes into a parameter block's clip_rows / plane_normal_length.
-void store_planes(const FrustumPlanes& planes, pp::vec4 clip_rows[4], pp::vec4 normal_length[2]);
+void store_planes(const FrustumPlanes& planes, pp::vec4 clip_rows[4], pp::vec4 normal_length[2], pp::vec4& depth);
 
 }  // namespace detail
 }  // namespace patchcull::gl
