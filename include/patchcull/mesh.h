@@ -116,25 +116,40 @@ struct ControlMesh {
     /// sits). Positive when the faces are oriented outward (counter-clockwise seen from outside),
     /// negative for an inside-out mesh (every winding reversed, or mirrored). Meaningful for a
     /// closed mesh (is_closed); for self-intersecting ones it is the winding-weighted volume, so
-    /// its sign is that of the larger part.
+    /// its sign is that of the larger part. For a mesh of several shells it is their sum (an
+    /// outward hollow solid: the outer shell's volume less its cavities'); orientation is decided
+    /// shell by shell (classify_orientation), not from this sum.
     double signed_volume() const;
     /// Reverses every face's corner order (and its texcoords): flips the surface's orientation.
     void reverse_faces();
 };
 
 /// How a control mesh's surface may be drawn and back-patch culled (README: "What contributes
-/// a pixel"). Orientation comes from geometry (the signed volume), not from topology alone.
+/// a pixel"). Orientation comes from geometry, not from topology alone, and shell by shell: a
+/// shell is a connected component of the faces over shared edges. The solid is the region
+/// inside an odd number of shells (nesting parity, decided in double by rays from up to 64 of
+/// each shell's vertices, or the winding number where a ray grazes an edge), and a mesh is oriented outward when every
+/// shell's faces are counter-clockwise seen from outside the solid: a shell inside an even number
+/// of others (0: an outer surface, 2: an island in a cavity) has positive signed volume, one
+/// inside an odd number (the wall of a cavity) negative, facing into the cavity. Shells that
+/// touch or intersect count as not nested (each oriented on its own, as their union), and a
+/// self-intersecting shell keeps the orientation of its larger part.
 enum class SurfaceOrientation {
-    open,     ///< not closed (is_closed false): drawn two-sided, no back-patch culling
-    flat,     ///< closed but encloses no volume (|V| <= 1e-9 A^1.5, A the faces' area)
-    outward,  ///< closed, positive volume: one-sided, back-patch culling conservative
-    inward,   ///< closed, negative volume: inside out (reverse_faces makes it outward)
+    open,       ///< not closed (is_closed false): drawn two-sided, no back-patch culling
+    flat,       ///< closed, but a shell encloses no volume (|V| <= 1e-9 A^1.5, V and A the
+                ///< shell's signed volume and area): its orientation is noise, drawn two-sided
+    outward,    ///< closed, every shell oriented as above: one-sided, back-patch culling conservative
+    inward,     ///< closed, some shell inside out for its nesting (orient_outward reverses those)
+    undecided,  ///< closed, but so many shells' bounds nest that deciding their nesting would take
+                ///< more than ~2e8 ray-triangle tests (about a second): drawn two-sided, no
+                ///< back-patch culling
 };
 SurfaceOrientation classify_orientation(const ControlMesh& mesh);
 
-/// Makes a closed inside-out mesh outward (reverse_faces) and returns its orientation after
-/// that: outward, open or flat (never inward). Appends a one-line note to mesh.warnings when it
-/// reversed the faces or found a closed mesh without volume.
+/// Makes a closed mesh outward by reversing the faces of each shell that is inside out for its
+/// nesting (an inward single-shell mesh: all its faces), and returns its orientation after that:
+/// outward, open, flat or undecided (never inward). Appends a one-line note to mesh.warnings
+/// when it reversed faces or found the mesh flat or undecided.
 SurfaceOrientation orient_outward(ControlMesh& mesh);
 
 /// Axis-aligned bounds of a point set.

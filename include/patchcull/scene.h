@@ -19,8 +19,8 @@ struct LoadedModel {
     int split_levels = 0;
     PatchFrame rest;                         ///< patches at rest, after split_levels splits
     std::vector<std::string> warnings;
-    /// A closed surface with positive volume (orient_outward: an inside-out mesh was reversed at
-    /// load, a flat one is not closed): drawn one-sided (RenderParams::discard_back_facing), and
+    /// A closed surface whose every shell faces out of the solid (orient_outward: inside-out
+    /// shells were reversed at load, a flat or undecided one is not closed): drawn one-sided (RenderParams::discard_back_facing), and
     /// back-patch culling is conservative for it. False for open meshes and the teapot (its lid
     /// sits loose in the rim).
     bool closed = false;

@@ -1,6 +1,8 @@
-// ControlMesh::is_closed (patchcull/mesh.h): closed, consistently oriented meshes only.
+// ControlMesh::is_closed (patchcull/mesh.h): closed, consistently oriented meshes only, of one
+// shell or several.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "patchcull/mesh.h"
@@ -43,4 +45,25 @@ TEST(ControlMesh, OpenFlippedDuplicatedAndEmptyMeshesAreNotClosed) {
     doubled.face_offsets.push_back(static_cast<std::uint32_t>(doubled.face_vertices.size()));
     EXPECT_FALSE(doubled.is_closed());
     EXPECT_FALSE(ControlMesh{}.is_closed());
+}
+
+TEST(ControlMesh, SeveralShellsAreClosedWhenEachIsClosedAndConsistent) {
+    // Two disjoint cubes, the second inside out: closed (each edge once each way, in its own
+    // shell); orientation is decided per shell (orientation_test.cpp), not by is_closed.
+    ControlMesh two = cube();
+    const ControlMesh second = cube();
+    const auto base = static_cast<std::uint32_t>(two.positions.size());
+    for (const Vec3& p : second.positions) two.positions.push_back({p.x + 3, p.y, p.z});
+    for (std::size_t f = 0; f < second.face_count(); ++f) {
+        for (std::uint32_t c = second.face_offsets[f + 1]; c-- > second.face_offsets[f];)
+            two.face_vertices.push_back(base + second.face_vertices[c]);
+        two.face_offsets.push_back(static_cast<std::uint32_t>(two.face_vertices.size()));
+    }
+    EXPECT_TRUE(two.is_closed());
+    // One face of the second shell wound against its neighbours: that shell, so the mesh, is not
+    // consistently oriented.
+    ControlMesh inconsistent = two;
+    std::reverse(inconsistent.face_vertices.end() - 4, inconsistent.face_vertices.end());
+    EXPECT_FALSE(inconsistent.is_closed());
+    EXPECT_EQ(classify_orientation(inconsistent), SurfaceOrientation::open);
 }

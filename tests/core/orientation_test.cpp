@@ -1,7 +1,12 @@
 // Orientation from geometry (patchcull/mesh.h): the signed volume of closed control meshes, and
 // orient_outward reversing inside-out ones, so that back-patch culling and one-sided drawing use
 // the side that faces out (issue 9, class 2: topology alone cannot tell inside from outside).
+// Meshes of several shells are oriented shell by shell, by nesting parity.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
 
 #include "patchcull/mesh.h"
 
@@ -88,6 +93,213 @@ TEST(Orientation, ReverseFacesKeepsTexcoordsWithTheirCorners) {
             EXPECT_EQ(m.face_vertices[4 * f + i], vertices[4 * f + 3 - i]);
             EXPECT_EQ(m.face_texcoords[4 * f + i], texcoords[4 * f + 3 - i]);
         }
+}
+
+// ---- meshes of several shells -----------------------------------------------------------------
+
+// A sphere: a cube of n x n quads per side pushed onto the sphere, counter-clockwise seen from
+// outside (inside out when reversed), vertices shared along the cube's edges.
+ControlMesh sphere(Vec3 c, float radius, bool reversed = false, int n = 3) {
+    ControlMesh m;
+    m.name = "sphere";
+    std::vector<int> index((n + 1) * (n + 1) * (n + 1), -1);
+    auto vertex = [&](const int g[3]) {
+        int& i = index[(g[0] * (n + 1) + g[1]) * (n + 1) + g[2]];
+        if (i < 0) {
+            const Vec3 q{2.0f * g[0] / n - 1, 2.0f * g[1] / n - 1, 2.0f * g[2] / n - 1};
+            i = static_cast<int>(m.positions.size());
+            m.positions.push_back(c + q * (radius / length(q)));
+        }
+        return static_cast<std::uint32_t>(i);
+    };
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side : {0, n})
+            for (int i = 0; i < n; ++i)
+                for (int j = 0; j < n; ++j) {
+                    std::uint32_t q[4];
+                    const int corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+                    for (int k = 0; k < 4; ++k) {
+                        int g[3];
+                        g[axis] = side, g[(axis + 1) % 3] = i + corner[k][0], g[(axis + 2) % 3] = j + corner[k][1];
+                        q[k] = vertex(g);
+                    }
+                    const bool flip = (side == 0) != reversed;
+                    for (int k = 0; k < 4; ++k) m.face_vertices.push_back(q[flip ? 3 - k : k]);
+                    m.face_offsets.push_back(static_cast<std::uint32_t>(m.face_vertices.size()));
+                }
+    return m;
+}
+
+// A torus around the z axis through c (radii major, minor), counter-clockwise seen from outside.
+ControlMesh torus(Vec3 c, float major, float minor, bool reversed = false, int nu = 8, int nv = 4) {
+    ControlMesh m;
+    m.name = "torus";
+    const float two_pi = 6.28318531f;
+    for (int i = 0; i < nu; ++i)
+        for (int j = 0; j < nv; ++j) {
+            const float t = two_pi * float(i) / float(nu), p = two_pi * float(j) / float(nv);
+            const float r = major + minor * std::cos(p);
+            m.positions.push_back(c + Vec3{r * std::cos(t), r * std::sin(t), minor * std::sin(p)});
+        }
+    for (int i = 0; i < nu; ++i)
+        for (int j = 0; j < nv; ++j) {
+            const int i1 = (i + 1) % nu, j1 = (j + 1) % nv;
+            std::uint32_t q[4] = {std::uint32_t(i * nv + j), std::uint32_t(i1 * nv + j), std::uint32_t(i1 * nv + j1),
+                                  std::uint32_t(i * nv + j1)};
+            for (int k = 0; k < 4; ++k) m.face_vertices.push_back(q[reversed ? 3 - k : k]);
+            m.face_offsets.push_back(static_cast<std::uint32_t>(m.face_vertices.size()));
+        }
+    return m;
+}
+
+// The shells one after the other in one mesh (shell s: faces [first_face[s], first_face[s+1])).
+struct Shells {
+    ControlMesh mesh;
+    std::vector<std::size_t> first_face{0};
+};
+
+Shells join(const std::vector<ControlMesh>& parts) {
+    Shells out;
+    out.mesh.name = "shells";
+    for (const ControlMesh& part : parts) {
+        const auto base = static_cast<std::uint32_t>(out.mesh.positions.size());
+        out.mesh.positions.insert(out.mesh.positions.end(), part.positions.begin(), part.positions.end());
+        for (std::size_t f = 0; f < part.face_count(); ++f) {
+            for (std::uint32_t c = part.face_offsets[f]; c < part.face_offsets[f + 1]; ++c)
+                out.mesh.face_vertices.push_back(base + part.face_vertices[c]);
+            out.mesh.face_offsets.push_back(static_cast<std::uint32_t>(out.mesh.face_vertices.size()));
+        }
+        out.first_face.push_back(out.mesh.face_count());
+    }
+    return out;
+}
+
+// Signed volume of shell s of a joined mesh (its faces alone, the same positions).
+double shell_volume(const Shells& shells, const ControlMesh& mesh, std::size_t s) {
+    ControlMesh part;
+    part.positions = mesh.positions;
+    for (std::size_t f = shells.first_face[s]; f < shells.first_face[s + 1]; ++f) {
+        for (std::uint32_t c = mesh.face_offsets[f]; c < mesh.face_offsets[f + 1]; ++c)
+            part.face_vertices.push_back(mesh.face_vertices[c]);
+        part.face_offsets.push_back(static_cast<std::uint32_t>(part.face_vertices.size()));
+    }
+    return part.signed_volume();
+}
+
+// orient_outward on the joined shells: each shell's volume must then have the sign given
+// (+1 bounds the solid from outside, -1 a cavity), the faces of the shells not reversed must be
+// as they were, and the warning must be there exactly when something was reversed.
+void expect_oriented(const std::vector<ControlMesh>& parts, const std::vector<int>& signs, const char* what) {
+    SCOPED_TRACE(what);
+    Shells shells = join(parts);
+    ControlMesh& m = shells.mesh;
+    ASSERT_TRUE(m.is_closed());
+    bool needs_reversal = false;
+    for (std::size_t s = 0; s < parts.size(); ++s) needs_reversal |= (shell_volume(shells, m, s) > 0) != (signs[s] > 0);
+    EXPECT_EQ(classify_orientation(m), needs_reversal ? SurfaceOrientation::inward : SurfaceOrientation::outward);
+    const ControlMesh before = m;
+    EXPECT_EQ(orient_outward(m), SurfaceOrientation::outward);
+    EXPECT_EQ(m.warnings.size(), needs_reversal ? 1u : 0u);
+    for (std::size_t s = 0; s < parts.size(); ++s) {
+        const double v = shell_volume(shells, m, s);
+        EXPECT_GT(v * signs[s], 0) << "shell " << s << ": volume " << v;
+        const bool flipped = (shell_volume(shells, before, s) > 0) != (signs[s] > 0);
+        for (std::size_t f = shells.first_face[s]; f < shells.first_face[s + 1]; ++f)
+            for (std::uint32_t c = m.face_offsets[f], n = m.face_size(f), i = 0; i < n; ++i)
+                EXPECT_EQ(m.face_vertices[c + i], before.face_vertices[flipped ? c + n - 1 - i : c + i]) << "face " << f;
+    }
+    EXPECT_EQ(classify_orientation(m), SurfaceOrientation::outward);  // idempotent
+}
+
+TEST(OrientationShells, TwoShellsOneReversedEndUpBothOutward) {
+    // Equal spheres, the second inside out: their total volume is 0 (the whole-mesh rule called
+    // the pair flat, or flipped one by rounding).
+    expect_oriented({sphere({-1.5f, 0, 0}, 1), sphere({1.5f, 0, 0}, 1, true)}, {+1, +1}, "equal");
+    // A large sphere inside out beside a small outward one: the total is negative, and reversing
+    // the whole mesh would turn the small one inside out.
+    expect_oriented({sphere({-3, 0, 0}, 2, true), sphere({1, 0, 0}, 0.5f)}, {+1, +1}, "large reversed");
+    ControlMesh both = join({sphere({-1.5f, 0, 0}, 1, true), sphere({1.5f, 0, 0}, 1, true)}).mesh;
+    EXPECT_EQ(orient_outward(both), SurfaceOrientation::outward);
+    ASSERT_EQ(both.warnings.size(), 1u);
+    EXPECT_NE(both.warnings[0].find("2 of 2 closed shells oriented inward"), std::string::npos) << both.warnings[0];
+    ControlMesh one = join({sphere({-1.5f, 0, 0}, 1), sphere({1.5f, 0, 0}, 1, true)}).mesh;
+    orient_outward(one);
+    ASSERT_EQ(one.warnings.size(), 1u);
+    EXPECT_NE(one.warnings[0].find("1 of 2 closed shells oriented inward"), std::string::npos) << one.warnings[0];
+}
+
+TEST(OrientationShells, HollowSolidsCavityFacesIntoTheCavity) {
+    // The cavity's wall bounds empty space inside the solid: its normals point into the cavity,
+    // away from the material, i.e. negative volume, however it was written.
+    for (bool outer_reversed : {false, true})
+        for (bool inner_reversed : {false, true})
+            expect_oriented({sphere({0, 0, 0}, 2, outer_reversed), sphere({0.3f, -0.2f, 0.1f}, 1, inner_reversed)},
+                            {+1, -1}, outer_reversed ? (inner_reversed ? "both reversed" : "outer reversed")
+                                                     : (inner_reversed ? "inner reversed" : "both written outward"));
+    // Order in the file does not matter, nor do several cavities.
+    expect_oriented({sphere({-0.8f, 0, 0}, 0.5f), sphere({0, 0, 0}, 3), sphere({1, 0.5f, 0}, 0.4f, true)},
+                    {-1, +1, -1}, "two cavities, listed around the outer shell");
+    // A hollow solid far from the origin: the nesting test works in double.
+    expect_oriented({sphere({1e5f, -1e5f, 1e5f}, 20), sphere({1e5f, -1e5f, 1e5f}, 10)}, {+1, -1}, "far away");
+    // And its total volume is the material's.
+    ControlMesh hollow = join({sphere({0, 0, 0}, 2), sphere({0, 0, 0}, 1)}).mesh;
+    orient_outward(hollow);
+    EXPECT_NEAR(hollow.signed_volume(), join({sphere({0, 0, 0}, 2)}).mesh.signed_volume() -
+                                            join({sphere({0, 0, 0}, 1)}).mesh.signed_volume(), 1e-9);
+}
+
+TEST(OrientationShells, NestedSpheresAlternateByNestingParity) {
+    // Depths 0, 1, 2, 3: solid, cavity, an island in the cavity, a cavity in the island.
+    const float radii[4] = {4, 3, 2, 1};
+    for (int written = 0; written < 16; ++written) {  // every combination of written orientations
+        std::vector<ControlMesh> parts;
+        for (int s = 0; s < 4; ++s)
+            parts.push_back(sphere({0.05f * float(s), 0, 0}, radii[s], (written >> s & 1) != 0));
+        expect_oriented(parts, {+1, -1, +1, -1}, ("written " + std::to_string(written)).c_str());
+    }
+    // Listed inner first.
+    expect_oriented({sphere({0, 0, 0}, 1), sphere({0, 0, 0}, 2), sphere({0, 0, 0}, 3)}, {+1, -1, +1}, "inner first");
+}
+
+TEST(OrientationShells, TwoToriEndUpBothOutward) {
+    // The whole-mesh rule called this pair flat (total volume 0) and drew it two-sided.
+    expect_oriented({torus({-2.5f, 0, 0}, 1.5f, 0.5f), torus({2.5f, 0, 0}, 1.5f, 0.5f, true)}, {+1, +1}, "side by side");
+    // Linked like two chain links (each through the other's hole): neither is inside the other.
+    // Swapping y and z turns the second's axis along y, through the first's hole, and mirrors it:
+    // inside out.
+    ControlMesh link = torus({0, 0, 0}, 1.5f, 0.4f);
+    for (Vec3& p : link.positions) p = {p.x + 1.5f, p.z, p.y};
+    expect_oriented({torus({0, 0, 0}, 1.5f, 0.4f), link}, {+1, +1}, "linked");
+    // A sphere in a torus's hole lies within its bounds but outside the solid.
+    expect_oriented({torus({0, 0, 0}, 2, 0.5f, true), sphere({0, 0, 0}, 0.3f, true)}, {+1, +1}, "sphere in the hole");
+    // A torus inside a sphere bounds a cavity.
+    expect_oriented({sphere({0, 0, 0}, 3), torus({0, 0, 0}, 1.5f, 0.5f)}, {+1, -1}, "toroidal cavity");
+}
+
+TEST(OrientationShells, IntersectingShellsAreEachOrientedOnTheirOwn) {
+    // A small sphere through the large one's surface, within its bounds: partly inside, partly
+    // outside, so not nested (some of its vertices are inside, so one sample alone could err).
+    expect_oriented({sphere({0, 0, 0}, 2), sphere({1.45f, 1.45f, 0}, 0.3f, true)}, {+1, +1}, "crossing the surface");
+    // Sunk into it, only a cap poking out (a character's eye or tooth), written inside out.
+    const float d = 1.7f / std::sqrt(3.0f);
+    expect_oriented({sphere({0, 0, 0}, 2), sphere({d, d, d}, 0.5f, true)}, {+1, +1}, "sunk in, a cap poking out");
+    // Two equal spheres overlapping by half.
+    expect_oriented({sphere({0, 0, 0}, 1, true), sphere({1, 0, 0}, 1)}, {+1, +1}, "overlapping");
+    // Coincident copies (duplicated shells, separate vertices): each outward.
+    expect_oriented({sphere({0, 0, 0}, 1), sphere({0, 0, 0}, 1, true)}, {+1, +1}, "coincident");
+}
+
+TEST(OrientationShells, AFlatShellMakesTheMeshTwoSided) {
+    Shells shells = join({sphere({0, 0, 0}, 1), box(2, 3, 0, {5, 0, 0})});
+    EXPECT_EQ(classify_orientation(shells.mesh), SurfaceOrientation::flat);
+    EXPECT_EQ(orient_outward(shells.mesh), SurfaceOrientation::flat);
+    ASSERT_EQ(shells.mesh.warnings.size(), 1u);
+    EXPECT_NE(shells.mesh.warnings[0].find("a closed shell encloses no volume"), std::string::npos);
+    // An open shell beside a closed one: the mesh is open.
+    ControlMesh open = box(2, 3, 4, {5, 0, 0});
+    open.face_vertices.resize(open.face_vertices.size() - 4);
+    open.face_offsets.pop_back();
+    EXPECT_EQ(classify_orientation(join({sphere({0, 0, 0}, 1), open}).mesh), SurfaceOrientation::open);
 }
 
 }  // namespace
