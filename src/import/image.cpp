@@ -16,6 +16,7 @@
 #include <iterator>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "patchcull/error.h"
@@ -32,27 +33,43 @@ namespace {
 
 // stb_image's failure reasons are terse codes ("bad sizes", "zlib corrupt"): what each says is
 // wrong with the file, in words, followed by the code itself for a bug report.
-std::string explain_stb_failure(const char* code) {
+std::string explain_stb_failure(const char* code, const char* before) {
+    // stb_image fails some inputs without a reason of its own (a deflate block of the reserved
+    // type 3): its last reason is then stale, the one set on purpose before decoding.
+    if (code == before) return "corrupt PNG: its pixel data cannot be decoded (stb_image gives no reason)";
     const std::string why = code ? code : "";
+    if (why.empty()) return "unknown reason";
     static const char* const kDeflate[] = {"bad codelengths", "bad sizes", "bad huffman code", "bad dist", "bad zlib header",
                                            "no preset dict", "bad compression", "zlib corrupt", "output buffer limit",
                                            "read past buffer", "outofdata"};
-    static const char* const kHeader[] = {"bad ctype", "1/2/4/8/16-bit only", "bad comp method", "bad filter method",
-                                          "bad interlace method", "0-pixel image", "invalid width", "first not IHDR",
-                                          "multiple IHDR", "bad IHDR len"};
-    static const char* const kPalette[] = {"no PLTE", "invalid PLTE", "tRNS after IDAT", "tRNS before PLTE",
-                                           "bad tRNS len", "tRNS with alpha"};
-    const auto in = [&](const auto& list) { return std::find(std::begin(list), std::end(list), why) != std::end(list); };
-    std::string what;
-    if (in(kDeflate)) what = "corrupt PNG: its compressed pixel data (the zlib stream in the IDAT chunks) is damaged";
-    else if (in(kHeader)) what = "corrupt or unsupported PNG header (IHDR: size, bit depth, colour type or methods)";
-    else if (in(kPalette)) what = "corrupt PNG: bad palette or transparency chunk";
-    else if (why == "not enough pixels" || why == "too large") what = "corrupt PNG: the pixel data does not match the image size in its header";
-    else if (why == "invalid filter") what = "corrupt PNG: a row of pixels has an invalid filter type";
-    else if (why == "no IDAT") what = "corrupt PNG: no pixel data (no IDAT chunk)";
-    else if (why == "outofmem") what = "out of memory while decoding";
-    else if (why.empty()) return "unknown reason";
-    else what = "PNG decoding failed";
+    static const std::pair<const char*, const char*> kWords[] = {
+        {"first not IHDR", "corrupt PNG: it does not start with an IHDR chunk"},
+        {"multiple IHDR", "corrupt PNG: more than one IHDR chunk"},
+        {"bad IHDR len", "corrupt PNG: an IHDR chunk of the wrong length"},
+        {"0-pixel image", "corrupt PNG: its header gives a width or height of 0"},
+        {"invalid width", "corrupt PNG: its header gives an invalid width"},
+        {"1/2/4/8/16-bit only", "unsupported PNG: a bit depth other than 1, 2, 4, 8 or 16"},
+        {"bad ctype", "corrupt PNG: an invalid colour type in its header"},
+        {"bad comp method", "corrupt PNG: an unknown compression method in its header"},
+        {"bad filter method", "corrupt PNG: an unknown filter method in its header"},
+        {"bad interlace method", "corrupt PNG: an unknown interlace method in its header"},
+        {"no PLTE", "corrupt PNG: a palette image without a palette (PLTE chunk)"},
+        {"invalid PLTE", "corrupt PNG: an invalid palette (PLTE chunk)"},
+        {"tRNS after IDAT", "corrupt PNG: a transparency chunk (tRNS) after the pixel data"},
+        {"tRNS before PLTE", "corrupt PNG: a transparency chunk (tRNS) before the palette"},
+        {"bad tRNS len", "corrupt PNG: a transparency chunk (tRNS) of the wrong length"},
+        {"tRNS with alpha", "corrupt PNG: a transparency chunk (tRNS) in an image with alpha"},
+        {"no IDAT", "corrupt PNG: no pixel data (no IDAT chunk)"},
+        {"not enough pixels", "corrupt PNG: its pixel data is shorter than the size in its header"},
+        {"too large", "corrupt PNG: its pixel data does not match the size in its header"},
+        {"invalid filter", "corrupt PNG: a row of pixels has an invalid filter type"},
+        {"outofmem", "out of memory while decoding"},
+    };
+    std::string what = "PNG decoding failed";
+    if (std::find(std::begin(kDeflate), std::end(kDeflate), why) != std::end(kDeflate))
+        what = "corrupt PNG: its compressed pixel data (the zlib stream in its IDAT chunks) is damaged";
+    for (const auto& [known, words] : kWords)
+        if (why == known) what = words;
     return what + " (stb_image: " + why + ")";
 }
 
@@ -122,17 +139,22 @@ DisplacementMap decode_displacement_png(const unsigned char* data, std::size_t s
     DisplacementMap map;
     map.scale = scale;
     map.midlevel = midlevel;
+    // A failure reason set on purpose (no format starts with a zero byte), to tell a stale one.
+    static constexpr unsigned char kNoImage[1] = {0};
+    int ignored = 0;
+    stbi_info_from_memory(kNoImage, 1, &ignored, &ignored, &ignored);
+    const char* const before = stbi_failure_reason();
     if (stbi_is_16_bit_from_memory(data, length)) {
         const std::unique_ptr<stbi_us, StbiFree> pixels(
             stbi_load_16_from_memory(data, length, &width, &height, &channels, 1));
-        if (!pixels) fail(name, explain_stb_failure(stbi_failure_reason()).c_str());
+        if (!pixels) fail(name, explain_stb_failure(stbi_failure_reason(), before).c_str());
         map.width = width;
         map.height = height;
         copy_flipped(pixels.get(), 65535.0f, map);
     } else {
         const std::unique_ptr<stbi_uc, StbiFree> pixels(
             stbi_load_from_memory(data, length, &width, &height, &channels, 1));
-        if (!pixels) fail(name, explain_stb_failure(stbi_failure_reason()).c_str());
+        if (!pixels) fail(name, explain_stb_failure(stbi_failure_reason(), before).c_str());
         map.width = width;
         map.height = height;
         copy_flipped(pixels.get(), 255.0f, map);

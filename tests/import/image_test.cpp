@@ -1,8 +1,10 @@
 // PNG height maps (8- and 16-bit) load with the right values, scaling and row order.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <fstream>
 #include <iterator>
+#include <string>
 #include <vector>
 
 #include "patchcull/error.h"
@@ -83,19 +85,68 @@ TEST(Image, ColourImagesUseLuminance) {
 TEST(Image, MalformedFilesGiveOneShortLine) {
     const std::pair<const char*, const char*> cases[] = {
         {"not_png.jpg", "not a PNG file"},
-        {"signature_only.png", "first not IHDR"},
+        {"signature_only.png", "corrupt PNG: it does not start with an IHDR chunk (stb_image: first not IHDR)"},
         {"truncated_in_ihdr.png", "truncated PNG chunk"},
         {"truncated_in_idat.png", "truncated PNG chunk"},
         // 2^24 x 2^24 declared in 68 bytes: refused before stb_image reserves memory for it.
         {"huge_dimensions.png", "image data too short for 16777216x16777216"},
-        {"zero_width.png", "0-pixel image"},
-        {"bad_depth.png", "1/2/4/8/16-bit only"},
+        {"zero_width.png", "corrupt PNG: its header gives a width or height of 0 (stb_image: 0-pixel image)"},
+        {"bad_depth.png", "unsupported PNG: a bit depth other than 1, 2, 4, 8 or 16 (stb_image: 1/2/4/8/16-bit only)"},
     };
     for (const auto& [file, reason] : cases) {
         const std::string message = error_of(corpus(file));
         EXPECT_EQ(message, corpus(file) + ": cannot read image: " + reason);
         EXPECT_TRUE(is_printable_line(message)) << message;
     }
+}
+
+namespace {
+// A 1x1 8-bit grey PNG whose IDAT holds `deflate` after a zlib header (CRCs zero: stb_image skips them).
+std::vector<unsigned char> png_with_deflate(const std::vector<unsigned char>& deflate) {
+    std::vector<unsigned char> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    const auto chunk = [&png](const char* type, const std::vector<unsigned char>& body) {
+        const std::uint32_t n = static_cast<std::uint32_t>(body.size());
+        for (int shift = 24; shift >= 0; shift -= 8) png.push_back(static_cast<unsigned char>(n >> shift));
+        png.insert(png.end(), type, type + 4);
+        png.insert(png.end(), body.begin(), body.end());
+        png.insert(png.end(), 4, 0);
+    };
+    chunk("IHDR", {0, 0, 0, 1, 0, 0, 0, 1, 8, 0, 0, 0, 0});
+    std::vector<unsigned char> idat = {0x78, 0x9C};
+    idat.insert(idat.end(), deflate.begin(), deflate.end());
+    idat.insert(idat.end(), 16, 0);
+    chunk("IDAT", idat);
+    chunk("IEND", {});
+    return png;
+}
+
+std::string decode_error(const std::vector<unsigned char>& png) {
+    try {
+        decode_displacement_png(png.data(), png.size(), "bad.png", 1.0f);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+}  // namespace
+
+TEST(Image, ACorruptPngSaysWhatIsWrongWithIt) {
+    // A dynamic-Huffman block whose 19 code-length codes are all 1 bit long: more codes of one
+    // length than that length allows (stb_image's terse "bad sizes").
+    std::vector<unsigned char> bits = {1, 0, 1};          // final block, type 2 (dynamic)
+    bits.insert(bits.end(), 10, 0);                        // HLIT = 0, HDIST = 0
+    bits.insert(bits.end(), {1, 1, 1, 1});                 // HCLEN = 15: 19 code-length codes
+    for (int k = 0; k < 19; ++k) bits.insert(bits.end(), {1, 0, 0});  // each 1 bit long
+    std::vector<unsigned char> deflate((bits.size() + 7) / 8, 0);
+    for (std::size_t i = 0; i < bits.size(); ++i) deflate[i / 8] |= static_cast<unsigned char>(bits[i] << (i % 8));
+    EXPECT_EQ(decode_error(png_with_deflate(deflate)),
+              "bad.png: cannot read image: corrupt PNG: its compressed pixel data (the zlib stream in its IDAT chunks) "
+              "is damaged (stb_image: bad sizes)");
+    // A block of the reserved type 3: stb_image fails without a reason; none is made up.
+    EXPECT_EQ(decode_error(png_with_deflate({0x07})),
+              "bad.png: cannot read image: corrupt PNG: its pixel data cannot be decoded (stb_image gives no reason)");
+    // The same file with a valid stored block decodes: the failures above are the damage's.
+    EXPECT_EQ(decode_error(png_with_deflate({0x01, 0x02, 0x00, 0xFD, 0xFF, 0x00, 0x80})), "(no error)");
 }
 
 TEST(Image, ChunkLengthPastTheEndIsRefusedBeforeAllocating) {
