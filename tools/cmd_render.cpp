@@ -71,6 +71,7 @@
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
 #include "render_dumps.h"
+#include "patchcull/scene_file.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -162,6 +163,7 @@ Runner add_render_command(CLI::App& app) {
             prepare_output_dir("--dump-hiz", state->dump_hiz, {"hiz.json"});
         }
         Scene scene = load_scene(state->model, state->scheme, state->split);
+        check_scene_motion(scene, state->model, state->frames, kSecondsPerFrame);  // before any GL work
         apply_displace_options(state->displace, scene);
         const std::vector<std::size_t> bounds_patches =
             state->draw_bounds.empty() ? std::vector<std::size_t>{}

@@ -55,6 +55,7 @@
 #include "patchcull/fused_cost_model.h"
 #include "patchcull/fused_cull.h"
 #include "patchcull/hiz.h"
+#include "patchcull/scene_file.h"
 #include "progress.h"
 #include "render_support.h"
 
@@ -90,6 +91,7 @@ int run_fused_eval(const FusedEvalOptions& o) {
     parse_size("--size", o.size, width, height);
     const BackPatchCone cone = o.cone == "ncone" ? BackPatchCone::ncone : BackPatchCone::tcone;
     const Scene scene = load_scene(o.scene, o.scheme, 0);
+    check_scene_motion(scene, o.scene, o.frames, kSecondsPerFrame);
     const bool one_sided = scene_is_one_sided(scene);
 
     gl::GlContext context = gl::GlContext::create_headless();

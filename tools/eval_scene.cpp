@@ -52,6 +52,7 @@
 #include "patchcull/gl_object_queries.h"
 #include "patchcull/scene_object_level.h"
 #include "patchcull/scene_occlusion.h"
+#include "patchcull/scene_file.h"
 #include "progress.h"
 #include "render_support.h"
 
@@ -139,6 +140,7 @@ int run_scene_eval(const SceneEvalOptions& o) {
     int width = 0, height = 0;
     parse_size("--size", o.size, width, height);
     Scene scene = load_scene(o.scene, o.scheme, 0);
+    check_scene_motion(scene, o.scene, o.frames, kSecondsPerFrame);
     const bool one_sided = scene_is_one_sided(scene);
     ObjectLevelSetup setup;
     setup.clusters = false;  // the object level here is the frustum (BVH); occluders keep their order

@@ -37,6 +37,18 @@ namespace patchcull {
 /// the origin), not culled wrongly.
 inline constexpr double kMaxSceneCoordinate = 8192;
 
+/// Checks what a scene's motion reaches before it is drawn: over frames 0 .. frames - 1 (frame f
+/// at scene time f * seconds_per_frame), every instance's placed rest control points moved by its
+/// velocity x (time + time_offset), and every camera's eye and target (a walk's start + f x step,
+/// an orbit's eye at distance and height around its target), must stay within
+/// kMaxSceneCoordinate of the origin. load_scene_file checks the placements at rest; this adds
+/// the time, which only the caller knows (its frame count). Throws patchcull::Error, one line,
+/// for the first frame that goes beyond: "SOURCE: PATH: ... at frame F ...", PATH the JSON path
+/// of the cause in the scene-file form of the scene (instance i is objects[i]:
+/// "objects[1].animation.velocity", "objects[0].animation.time_offset", "camera.walk.step",
+/// "camera.orbit.distance"); source names the scene (its file, or a built-in scene's name).
+void check_scene_motion(const Scene& scene, const std::string& source, int frames, double seconds_per_frame);
+
 /// Largest scene file load_scene_file reads (a regular file; devices and FIFOs are refused).
 inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;
 

@@ -366,21 +366,58 @@ Scene load_scene_file(const std::string& path) {
     std::map<std::string, std::size_t> instance_names;
     std::vector<std::size_t> copies;
     const json& objects = r.array(r.require(root, "", "objects"), "objects", true);
+    // The file a model name stands for, and the model's key (file and scheme).
+    auto model_file = [&](const std::string& spec) {
+        if (spec == "bigguy" || spec == "monsterfrog") return shipped_model_path(spec + ".obj");
+        return spec == "teapot" ? std::string("teapot") : r.resolve(spec);
+    };
+    auto model_key = [&](const std::string& spec, Scheme scheme) {
+        ModelKey key{model_file(spec), spec == "teapot" ? Scheme::acc : scheme};
+        if (spec != "teapot") {
+            std::error_code ec;
+            const fs::path canonical = fs::weakly_canonical(key.file, ec);
+            if (!ec) key.file = canonical.string();
+        }
+        return key;
+    };
+    // Default names are "STEM#k", k counting the objects of one model (file and scheme). Where
+    // models of one stem differ (one model in both schemes, or two files of one name), the stem
+    // alone would name two objects alike: their default names then say the model as the file
+    // writes it (when the files differ) and the scheme (when the schemes differ), e.g.
+    // "bigguy:osd#0", "a/bigguy.obj#0". A first pass finds them (without loading, and without
+    // failing: the main pass reports malformed objects in file order).
+    std::map<ModelKey, std::string> default_keys;
+    {
+        std::map<std::string, std::vector<std::pair<ModelKey, std::string>>> by_stem;  // stem -> (key, spec)
+        for (const json& o : objects) {
+            const auto m = o.is_object() ? o.find("model") : o.end();
+            if (m == o.end() || !m->is_string() || m->get<std::string>().empty()) continue;
+            const auto sc = o.find("scheme");
+            Scheme scheme = Scheme::acc;
+            if (sc != o.end() && !(sc->is_string() && parse_scheme(sc->get<std::string>(), scheme))) continue;
+            const std::string spec = m->get<std::string>();
+            const ModelKey key = model_key(spec, scheme);
+            auto& group = by_stem[fs::path(model_file(spec)).stem().string()];
+            if (std::none_of(group.begin(), group.end(), [&](const auto& g) { return !(g.first < key) && !(key < g.first); }))
+                group.emplace_back(key, spec);
+        }
+        for (const auto& [stem, group] : by_stem) {
+            bool files_differ = false, schemes_differ = false;
+            for (const auto& g : group) {
+                files_differ = files_differ || g.first.file != group.front().first.file;
+                schemes_differ = schemes_differ || g.first.scheme != group.front().first.scheme;
+            }
+            for (const auto& [key, spec] : group)
+                default_keys[key] = (files_differ ? spec : stem) + (schemes_differ ? std::string(":") + scheme_name(key.scheme) : "");
+        }
+    }
     for (std::size_t i = 0; i < objects.size(); ++i) {
         const std::string p = index("objects", i);
         const json& o = r.object(objects[i], p, {"name", "model", "scheme", "transform", "animation", "displaced"});
         const std::string spec = r.string(r.require(o, p, "model"), join(p, "model"));
         const Scheme scheme = read_scheme(r, o, p);
-        std::string file;
-        if (spec == "bigguy" || spec == "monsterfrog") file = shipped_model_path(spec + ".obj");
-        else if (spec == "teapot") file = "teapot";
-        else file = r.resolve(spec);
-        ModelKey key{file, spec == "teapot" ? Scheme::acc : scheme};
-        if (spec != "teapot") {
-            std::error_code ec;
-            const fs::path canonical = fs::weakly_canonical(file, ec);
-            if (!ec) key.file = canonical.string();
-        }
+        const std::string file = model_file(spec);
+        const ModelKey key = model_key(spec, scheme);
         auto found = loaded.find(key);
         if (found == loaded.end()) {
             try {
@@ -417,8 +454,7 @@ Scene load_scene_file(const std::string& path) {
             for (const Vec4& c : patch.cp) points.push_back(cartesian(instance.object_to_world * c));
         check_placed(r, join(p, "transform"), points, "model");
         const json* n = r.find(o, "name");
-        instance.name = n ? r.string(*n, join(p, "name"))
-                          : fs::path(model.name).stem().string() + "#" + std::to_string(copies[instance.model]);
+        instance.name = n ? r.string(*n, join(p, "name")) : default_keys.at(key) + "#" + std::to_string(copies[instance.model]);
         ++copies[instance.model];
         if (!instance_names.emplace(instance.name, i).second)
             r.fail(join(p, "name"), "duplicate object name " + quote_input(instance.name) + " (also objects[" +
@@ -603,6 +639,98 @@ Scene load_scene_file(const std::string& path) {
         }
     }
     return scene;
+}
+
+namespace {
+
+// The first coordinate of the points in [lo, hi] (a box) moved by d that lies beyond the limit
+// (axis in 0..2, value), or axis -1.
+struct Reach {
+    int axis = -1;
+    double value = 0;
+};
+Reach beyond_limit(const double lo[3], const double hi[3], const double d[3]) {
+    for (int a = 0; a < 3; ++a)
+        for (double c : {lo[a] + d[a], hi[a] + d[a]})
+            if (!(std::fabs(c) <= kMaxSceneCoordinate)) return {a, c};
+    return {};
+}
+
+[[noreturn]] void motion_fail(const std::string& source, const std::string& path, const std::string& what, Reach r,
+                              int frame, double seconds) {
+    static const char* const axes[3] = {"x", "y", "z"};
+    throw Error(printable_line(source + ": " + path + ": " + what + " reaches " + axes[r.axis] + " = " +
+                               number_text(r.value) + " at frame " + std::to_string(frame) + " (time " +
+                               number_text(seconds) + " s); scenes take world coordinates up to " +
+                               number_text(kMaxSceneCoordinate) + " (render fewer frames, or move it less far)"));
+}
+
+}  // namespace
+
+void check_scene_motion(const Scene& scene, const std::string& source, int frames, double seconds_per_frame) {
+    if (frames <= 0) return;
+    const int last = frames - 1;
+    auto seconds = [&](int f) { return double(f) * seconds_per_frame; };
+    // Objects: the placed rest control points' box (in double), moved by velocity x time.
+    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
+        const SceneInstance& instance = scene.instances[i];
+        const Vec3 v = instance.velocity;
+        if (v.x == 0 && v.y == 0 && v.z == 0) continue;  // placed once: the loader checked it
+        const Mat4& m = instance.object_to_world;
+        double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+        for (const BezierPatch& patch : scene.models.at(instance.model).rest.patches)
+            for (const Vec4& c : patch.cp) {
+                const double h[4] = {c.x, c.y, c.z, c.w};
+                double w = 0;
+                for (int k = 0; k < 4; ++k) w += double(m.at(3, k)) * h[k];
+                for (int a = 0; a < 3; ++a) {
+                    double x = 0;
+                    for (int k = 0; k < 4; ++k) x += double(m.at(a, k)) * h[k];
+                    x /= w;
+                    lo[a] = std::min(lo[a], x);
+                    hi[a] = std::max(hi[a], x);
+                }
+            }
+        auto moved = [&](int f) {
+            const double t = seconds(f) + double(instance.time_offset);
+            const double d[3] = {double(v.x) * t, double(v.y) * t, double(v.z) * t};
+            return beyond_limit(lo, hi, d);
+        };
+        // The motion is linear: within the limit at the first and the last frame, within it at
+        // every frame between.
+        if (moved(0).axis < 0 && moved(last).axis < 0) continue;
+        for (int f = 0; f <= last; ++f)
+            if (const Reach r = moved(f); r.axis >= 0) {
+                const std::string path = "objects[" + std::to_string(i) + "].animation." +
+                                         (f == 0 && instance.time_offset != 0 ? "time_offset" : "velocity");
+                motion_fail(source, path, "the moving model (" + quote_input(instance.name) + ")", r, f, seconds(f));
+            }
+    }
+    // The camera: its eye and target at every frame (the path is not linear for an orbit).
+    const CameraPath& c = scene.camera;
+    for (int f = 0; f <= last; ++f) {
+        double eye[3], target[3];
+        if (c.walk) {
+            for (int a = 0; a < 3; ++a) {
+                eye[a] = double((&c.walk_start.x)[a]) + double(f) * double((&c.walk_step.x)[a]);
+                target[a] = eye[a] + double((&c.walk_direction.x)[a]);
+            }
+        } else {
+            const double angle = (double(c.start_degrees) + double(f) * double(c.degrees_per_frame)) * (3.14159265358979323846 / 180.0);
+            target[0] = c.target.x, target[1] = c.target.y, target[2] = c.target.z;
+            eye[0] = target[0] + double(c.distance) * std::sin(angle);
+            eye[1] = target[1] + double(c.height);
+            eye[2] = target[2] + double(c.distance) * std::cos(angle);
+        }
+        const double zero[3] = {0, 0, 0};
+        if (const Reach r = beyond_limit(eye, eye, zero); r.axis >= 0)
+            motion_fail(source,
+                        c.walk ? "camera.walk.step" : r.axis == 1 ? "camera.orbit.height" : "camera.orbit.distance",
+                        "the camera's eye", r, f, seconds(f));
+        if (const Reach r = beyond_limit(target, target, zero); r.axis >= 0)
+            motion_fail(source, c.walk ? "camera.walk.direction" : "camera.orbit.target", "the camera's target", r, f,
+                        seconds(f));
+    }
 }
 
 }  // namespace patchcull
