@@ -10,6 +10,10 @@
 //   the end caps next to extraordinary vertices, which are OpenSubdiv's own B-spline
 //   approximation (about 0.15% of the model's radius at level 2; our patches equal OpenSubdiv's
 //   evaluation of them to float precision). Handles boundaries, creases, triangles, n-gons.
+// Both take the mesh's holes and SubdivisionOptions (mesh.h; OpenSubdiv's OBJ tags): osd hands
+// them to Far; acc leaves out the faces Far leaves out (holes, and faces at an uninterpolated
+// boundary), ignores creases and corners with a warning, and refuses boundary options it
+// cannot follow (an edges-only boundary with corners), naming the tag's line and osd.
 //   PatchInfo::extraordinary marks every patch that is not one regular patch covering a whole
 //   base quad (patches from adaptive isolation, including the end caps).
 //
