@@ -15,14 +15,19 @@ namespace patchcull::detail {
 /// "<name>:<line>: " for face f of a mesh read from a file, else "<name>: face <f+1>: ".
 inline std::string at_face(const ControlMesh& mesh, std::size_t f) {
     const std::uint32_t line = mesh.face_line(f);
-    if (line != 0) return mesh.name + ":" + std::to_string(line) + ": ";
-    return mesh.name + ": face " + std::to_string(f + 1) + ": ";
+    std::string s = mesh.name;
+    s += line != 0 ? ":" : ": face ";
+    s += std::to_string(line != 0 ? line : f + 1);
+    s += ": ";
+    return s;
 }
 
-/// "line <n>" or "face <f+1>": where face f is, for a second face named in a message.
-inline std::string face_place(const ControlMesh& mesh, std::size_t f) {
+/// "the one at line <n>" or "face <f+1>": a second face named in a message.
+inline std::string other_face(const ControlMesh& mesh, std::size_t f) {
     const std::uint32_t line = mesh.face_line(f);
-    return line != 0 ? "line " + std::to_string(line) : "face " + std::to_string(f + 1);
+    std::string s = line != 0 ? "the one at line " : "face ";  // += : GCC 12's false -Wrestrict on "x" + string
+    s += std::to_string(line != 0 ? line : f + 1);
+    return s;
 }
 
 inline std::string edge_vertices(std::uint32_t a, std::uint32_t b) {
@@ -42,8 +47,8 @@ inline std::string edge_shared_message(const ControlMesh& mesh, std::size_t thir
 /// Edge a -> b walked in the same direction by two faces (first_face before second_face).
 inline std::string edge_orientation_message(const ControlMesh& mesh, std::size_t first_face, std::size_t second_face,
                                             std::uint32_t a, std::uint32_t b) {
-    return at_face(mesh, second_face) + edge_vertices(a, b) + ": this face and the one at " +
-           face_place(mesh, first_face) + " run along it in the same direction (oriented inconsistently)";
+    return at_face(mesh, second_face) + edge_vertices(a, b) + ": this face and " + other_face(mesh, first_face) +
+           " run along it in the same direction (oriented inconsistently)";
 }
 
 /// Vertex v whose faces do not form one fan (a "bowtie"); reported at its first face.
