@@ -4,6 +4,7 @@
 // Meshes of several shells are oriented shell by shell, by nesting parity.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -174,16 +175,23 @@ Shells join(const std::vector<ControlMesh>& parts) {
     return out;
 }
 
-// Signed volume of shell s of a joined mesh (its faces alone, the same positions).
+// Signed volume of shell s of a joined mesh (its faces' fans, as ControlMesh::signed_volume).
 double shell_volume(const Shells& shells, const ControlMesh& mesh, std::size_t s) {
-    ControlMesh part;
-    part.positions = mesh.positions;
+    const Vec3 o = mesh.positions[mesh.face_vertices[mesh.face_offsets[shells.first_face[s]]]];
+    auto rel = [&](std::uint32_t c) {
+        const Vec3 p = mesh.positions[mesh.face_vertices[c]];
+        return std::array<double, 3>{double(p.x) - o.x, double(p.y) - o.y, double(p.z) - o.z};
+    };
+    double six_volume = 0;
     for (std::size_t f = shells.first_face[s]; f < shells.first_face[s + 1]; ++f) {
-        for (std::uint32_t c = mesh.face_offsets[f]; c < mesh.face_offsets[f + 1]; ++c)
-            part.face_vertices.push_back(mesh.face_vertices[c]);
-        part.face_offsets.push_back(static_cast<std::uint32_t>(part.face_vertices.size()));
+        const auto a = rel(mesh.face_offsets[f]);
+        for (std::uint32_t c = mesh.face_offsets[f] + 1; c + 1 < mesh.face_offsets[f + 1]; ++c) {
+            const auto b = rel(c), d = rel(c + 1);
+            six_volume += a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0]) +
+                          a[2] * (b[0] * d[1] - b[1] * d[0]);
+        }
     }
-    return part.signed_volume();
+    return six_volume / 6;
 }
 
 // orient_outward on the joined shells: each shell's volume must then have the sign given
@@ -287,6 +295,25 @@ TEST(OrientationShells, IntersectingShellsAreEachOrientedOnTheirOwn) {
     expect_oriented({sphere({0, 0, 0}, 1, true), sphere({1, 0, 0}, 1)}, {+1, +1}, "overlapping");
     // Coincident copies (duplicated shells, separate vertices): each outward.
     expect_oriented({sphere({0, 0, 0}, 1), sphere({0, 0, 0}, 1, true)}, {+1, +1}, "coincident");
+}
+
+TEST(OrientationShells, ManyHollowCubesEachWithItsCavity) {
+    // A voxel-like model: 12 x 12 x 12 hollow boxes (2 shells each, 3456 in all) written with
+    // every combination of orientations; each box's cavity must face into it, whatever the
+    // neighbours (whose bounds do not hold it) are.
+    std::vector<ControlMesh> parts;
+    std::vector<int> signs;
+    for (int i = 0; i < 12 * 12 * 12; ++i) {
+        const Vec3 corner{float(i % 12) * 3, float(i / 12 % 12) * 3, float(i / 144) * 3};
+        ControlMesh outer = box(2, 2, 2, corner), inner = box(1, 1, 1, corner + Vec3{0.5f, 0.5f, 0.5f});
+        if (i % 3 == 1) outer.reverse_faces();
+        if (i % 2 == 1) inner.reverse_faces();
+        parts.push_back(outer);
+        parts.push_back(inner);
+        signs.push_back(+1);
+        signs.push_back(-1);
+    }
+    expect_oriented(parts, signs, "voxels");
 }
 
 TEST(OrientationShells, AFlatShellMakesTheMeshTwoSided) {
