@@ -51,3 +51,46 @@ TEST(CliInputErrors, AMalformedPngIsOneLine) {
     expect_printable_error(run("cull teapot --displace " + path + " --methods frustum --views 1"),
                            "truncated_in_idat.png: cannot read image: truncated PNG chunk");
 }
+
+TEST(CliInputErrors, ARepeatedOptionSaysWhichAndThatItMayBeGivenOnce) {
+    // CLI11 alone said "At Most 1 required but received 2"; parsing fails before any work.
+    expect_printable_error(run("render default --frames 2 --frames 3"),
+                           "patchcull: error: --frames may be given once (given 2 times)");
+    expect_printable_error(run("cull teapot --views 1 --views 2 --views 3"),
+                           "patchcull: error: --views may be given once (given 3 times)");
+    expect_printable_error(run("info teapot --scheme acc --scheme osd"),
+                           "patchcull: error: --scheme may be given once (given 2 times)");
+}
+
+TEST(CliInputErrors, AVertexRecordSaysHowManyValuesItHas) {
+    const std::string path = write_file("five.obj", "v 0 0 0\nv 0 0 0 1 7\n");
+    expect_printable_error(run("info " + path), "five.obj:2: vertex has 5 values; expected 3 (x y z), 4 (x y z w)");
+}
+
+TEST(CliInputErrors, ABadSharpnessIsCalledASharpness) {
+    const std::string path = write_file("sharp.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt crease 2/1/0 0 1 nan\n");
+    expect_printable_error(run("info " + path), "sharp.obj:6: non-finite sharpness 'nan'");
+}
+
+TEST(CliInputErrors, NonManifoldEdgesGiveOneBasedVerticesAndTheLineWithBothSchemes) {
+    const std::string path = write_file("fin.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 1 -1 0\nv 0 -1 0\nv 1 0 1\n"
+                                                   "v 0 0 1\nf 1 2 3 4\nf 2 1 6 5\nf 1 2 7 8\n");
+    for (const char* scheme : {"acc", "osd"})
+        expect_printable_error(run("info " + path + " --scheme " + scheme),
+                               "fin.obj:11: non-manifold edge between vertices 1 and 2: 3 faces share it");
+}
+
+TEST(CliInputErrors, ACorruptPngSaysWhatIsWrongWithIt) {
+    // A PNG whose IHDR is fine and whose compressed pixel data is not.
+    std::string png("\x89PNG\r\n\x1A\n", 8);
+    const auto chunk = [&png](const std::string& type, const std::string& body) {
+        for (int shift = 24; shift >= 0; shift -= 8) png += static_cast<char>(body.size() >> shift & 0xFF);
+        png += type + body + std::string(4, '\0');
+    };
+    chunk("IHDR", std::string("\0\0\0\x04\0\0\0\x04\x08\0\0\0\0", 13));
+    chunk("IDAT", std::string("\x78\x9C\xFD\xFF\xFF\xFF\xFF\xFF\xFF\xFF\xFF\xFF", 12) + std::string(16, '\xFF'));
+    chunk("IEND", "");
+    const std::string path = write_file("damaged.png", png);
+    expect_printable_error(run("cull teapot --displace " + path + " --methods frustum --views 1"),
+                           "damaged.png: cannot read image: corrupt PNG: its compressed pixel data");
+}
