@@ -46,7 +46,8 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
         return model;
     }
     ControlMesh mesh = load_obj(spec);
-    // Orientation from geometry: an inside-out closed mesh is reversed, a flat one is two-sided.
+    // Orientation from geometry, shell by shell (mesh.h): inside-out shells are reversed, a flat or
+    // undecided mesh is two-sided.
     const SurfaceOrientation orientation = orient_outward(mesh);
     const Bounds bounds = compute_bounds(mesh.positions);
     double diagonal_squared = 0;
