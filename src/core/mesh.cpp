@@ -4,6 +4,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace patchcull {
 
@@ -133,8 +137,10 @@ std::vector<Shell> find_shells(const ControlMesh& mesh) {
         shells[s].faces.push_back(static_cast<std::uint32_t>(f));
     }
     // Volume, area, bounds and sample vertices, in double relative to each shell's first vertex.
-    std::vector<std::uint8_t> seen(mesh.positions.size(), 0);
-    for (Shell& shell : shells) {
+    // (Shells may share a vertex without sharing an edge: seen is per shell.)
+    std::vector<std::uint32_t> seen(mesh.positions.size(), UINT32_MAX);
+    for (std::size_t s = 0; s < shells.size(); ++s) {
+        Shell& shell = shells[s];
         const Vec3 o = mesh.positions[mesh.face_vertices[mesh.face_offsets[shell.faces[0]]]];
         auto rel = [&](std::uint32_t v) {
             const Vec3 p = mesh.positions[v];
@@ -146,7 +152,7 @@ std::vector<Shell> find_shells(const ControlMesh& mesh) {
             const std::uint32_t first = mesh.face_offsets[f], n = mesh.face_size(f);
             for (std::uint32_t i = 0; i < n; ++i) {
                 const std::uint32_t v = mesh.face_vertices[first + i];
-                if (!seen[v]) seen[v] = 1, vertices.push_back(v);
+                if (seen[v] != s) seen[v] = static_cast<std::uint32_t>(s), vertices.push_back(v);
             }
             const auto a = rel(mesh.face_vertices[first]);
             for (std::uint32_t i = 1; i + 1 < n; ++i) {

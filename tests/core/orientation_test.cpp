@@ -4,6 +4,7 @@
 // Meshes of several shells are oriented shell by shell, by nesting parity.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -295,6 +296,23 @@ TEST(OrientationShells, IntersectingShellsAreEachOrientedOnTheirOwn) {
     expect_oriented({sphere({0, 0, 0}, 1, true), sphere({1, 0, 0}, 1)}, {+1, +1}, "overlapping");
     // Coincident copies (duplicated shells, separate vertices): each outward.
     expect_oriented({sphere({0, 0, 0}, 1), sphere({0, 0, 0}, 1, true)}, {+1, +1}, "coincident");
+}
+
+TEST(OrientationShells, ShellsSharingOnlyAVertexAreTwo) {
+    // Two boxes touching at a corner, the vertex shared (index 7 of the first), the second inside
+    // out: shells are connected over edges, so only the second is reversed.
+    Shells shells = join({box(1, 1, 1), box(1, 1, 1, {1, 1, 1})});
+    ControlMesh& m = shells.mesh;
+    for (std::size_t c = m.face_offsets[shells.first_face[1]]; c < m.face_vertices.size(); ++c)
+        if (m.face_vertices[c] == 8) m.face_vertices[c] = 7;
+    for (std::size_t f = shells.first_face[1]; f < m.face_count(); ++f)
+        std::reverse(m.face_vertices.begin() + m.face_offsets[f], m.face_vertices.begin() + m.face_offsets[f + 1]);
+    ASSERT_TRUE(m.is_closed());
+    EXPECT_EQ(orient_outward(m), SurfaceOrientation::outward);
+    EXPECT_DOUBLE_EQ(shell_volume(shells, m, 0), 1.0);
+    EXPECT_DOUBLE_EQ(shell_volume(shells, m, 1), 1.0);
+    ASSERT_EQ(m.warnings.size(), 1u);
+    EXPECT_NE(m.warnings[0].find("1 of 2"), std::string::npos) << m.warnings[0];
 }
 
 TEST(OrientationShells, ManyHollowCubesEachWithItsCavity) {
