@@ -62,6 +62,11 @@ inline std::string check_mesh(const ControlMesh& mesh) {
             return "invalid crease";
     for (const Crease& c : mesh.corners)
         if (c.v0 >= mesh.positions.size() || !std::isfinite(c.sharpness) || c.sharpness < 0) return "invalid corner";
+    for (std::size_t k = 0; k < mesh.holes.size(); ++k)
+        if (mesh.holes[k] >= mesh.face_count() || (k > 0 && mesh.holes[k] <= mesh.holes[k - 1]))
+            return "hole out of range or not sorted";
+    for (std::size_t f = 1; f < mesh.face_count(); ++f)
+        if (mesh.face_line(f) <= mesh.face_line(f - 1)) return "face lines not increasing";
     for (const std::string& w : mesh.warnings)
         if (const std::string bad = check_message(w.c_str()); !bad.empty()) return "warning: " + bad;
     (void)classify_orientation(mesh);  // the orientation check every render runs: must not crash
