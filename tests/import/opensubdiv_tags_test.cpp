@@ -235,6 +235,27 @@ TEST(ObjTags, NoBoundaryInterpolationLeavesTheSameFacesOutWithBothSchemes) {
     // Face (i, j) of the 4x4 grid is face 4 j + i; it touches the boundary unless i and j are 1 or 2.
     EXPECT_EQ(acc, (std::set<std::uint32_t>{5, 6, 9, 10}));
 
+    // With a non-quad face acc goes through one OpenSubdiv refinement first: still the same faces.
+    // Face 5 split into two triangles (faces 5 and 6; the faces after it move up by one).
+    std::istringstream lines(grid_obj(4));
+    std::string split;
+    int face = 0;
+    for (std::string line; std::getline(lines, line);) {
+        if (line.starts_with("f ") && face++ == 5) {
+            std::istringstream corners(line.substr(2));
+            std::string a, b, c, d;
+            corners >> a >> b >> c >> d;
+            split += "f " + a + " " + b + " " + c + "\nf " + a + " " + c + " " + d + "\n";
+        } else {
+            split += line + "\n";
+        }
+    }
+    const ControlMesh mixed = parse(split + "t interpolateboundary 1/0/0 0\n");
+    ASSERT_FALSE(mixed.all_quads());
+    const std::set<std::uint32_t> acc_mixed = base_faces(build_model(mixed, Scheme::acc));
+    EXPECT_EQ(acc_mixed, base_faces(build_model(mixed, Scheme::osd)));
+    EXPECT_EQ(acc_mixed, (std::set<std::uint32_t>{5, 6, 7, 10, 11}));
+
     // Creases sharpening every boundary edge infinitely keep the boundary faces in Far (crease
     // rules acc ignores): acc refuses, naming the tag's line and the osd scheme.
     std::string sharp = grid_obj(2) + "t interpolateboundary 1/0/0 0\n";
