@@ -6,7 +6,9 @@
 //   t crease n/1/0 v0 v1 [v2 v3 ..] s   creases on the edges (v0,v1), (v2,v3), .. (vertex pairs)
 //   t corner n/1/0 v.. s, n/n/0 v.. s..  vertex sharpness
 //   t hole n/0/0 f..                     faces without surface (ControlMesh::holes)
-//   t interpolateboundary 1/0/0 m        0 none, 1 edges and corners (the default), 2 edges only
+//   t interpolateboundary 1/0/0 m        0 none, 1 edges and corners, 2 edges only (a file
+//                                        without the tag gets edges and corners, patchcull's
+//                                        default; OpenSubdiv's regression harness uses edges only)
 //   t creasemethod 0/0/1 normal|chaikin  t smoothtriangles 0/0/1 catmark|smooth
 //   t facevaryinginterpolateboundary 1/0/0 m, t facevaryingpropagatecorners 1/0/0 b: checked
 //                                        and ignored (patchcull has no face-varying data)
