@@ -533,7 +533,12 @@ std::vector<std::uint8_t> faces_left_out(const ControlMesh& mesh) {
         if (f < nf) out[f] = 1;
     if (boundary == BoundaryInterpolation::edge_and_corner) return out;
 
-    const std::string where = mesh.name + (mesh.options.boundary_line ? ":" + std::to_string(mesh.options.boundary_line) : std::string()) + ": ";
+    std::string where = mesh.name;  // built with += : GCC 12 warns falsely (-Wrestrict) on ":" + std::string
+    if (mesh.options.boundary_line) {
+        where += ":";
+        where += std::to_string(mesh.options.boundary_line);
+    }
+    where += ": ";
     const std::size_t nv = mesh.positions.size();
     if (boundary == BoundaryInterpolation::edge_only) {
         std::vector<std::uint32_t> faces_at(nv, 0);

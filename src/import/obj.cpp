@@ -139,7 +139,9 @@ struct TagState {
 void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, TagState& state, const LineContext& ctx) {
     if (tokens.size() < 3) ctx.fail("malformed tag line (expected 't NAME ints/floats/strings arguments...', e.g. 't crease 2/1/0 v0 v1 sharpness')");
     const std::string_view kind = tokens[1];
-    const std::string tag = "'" + std::string(kind) + "' tag";
+    std::string tag = "'";  // built with += : GCC 12 warns falsely (-Wrestrict) on "'" + std::string
+    tag += kind;
+    tag += "' tag";
     static constexpr std::string_view kKnown[] = {"crease", "corner", "hole", "interpolateboundary",
                                                   "facevaryinginterpolateboundary", "facevaryingpropagatecorners",
                                                   "creasemethod", "smoothtriangles"};
