@@ -128,6 +128,20 @@ CLI::Option* add_choice_option(CLI::App& command, const std::string& flag, std::
     return option;
 }
 
+CLI::Option* add_clip_depth_option(CLI::App& command, std::string& target) {
+    return add_choice_option(command, "--clip-depth", target,
+                             {"zero-to-one", "minus-one-to-one", "reversed", "reversed-infinite"},
+                             "depth convention to draw, cull and verify in: zero-to-one (near 0, far 1), "
+                             "minus-one-to-one (OpenGL's default), reversed (near 1, far 0, GL_GREATER) or "
+                             "reversed-infinite (near 1, no far plane)");
+}
+
+ClipDepth parse_clip_depth_option(const std::string& text) {
+    ClipDepth depth = ClipDepth::zero_to_one;
+    if (!parse_clip_depth(text, depth)) throw Error("--clip-depth: unknown convention " + quote_input(text));
+    return depth;
+}
+
 CLI::Option* add_size_option(CLI::App& command, const std::string& flag, std::string& target,
                              const std::string& description) {
     CLI::Option* option = command.add_option_function<std::string>(

@@ -11,6 +11,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "patchcull/clip_space.h"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -51,6 +53,12 @@ CLI::Option* add_text_option(CLI::App& command, const std::string& flag, std::st
 /// A string option whose value must be one of choices; the error lists them.
 CLI::Option* add_choice_option(CLI::App& command, const std::string& flag, std::string& target,
                                const std::vector<std::string>& choices, const std::string& description);
+
+/// --clip-depth zero-to-one|minus-one-to-one|reversed|reversed-infinite (clip_space.h): the depth
+/// convention a GPU command draws, culls and verifies in.
+CLI::Option* add_clip_depth_option(CLI::App& command, std::string& target);
+/// The ClipDepth of --clip-depth's text (checked by add_clip_depth_option).
+ClipDepth parse_clip_depth_option(const std::string& text);
 
 /// A "WIDTHxHEIGHT" option checked as it is parsed by parse_size (commands.h: each in 1..8192);
 /// the target keeps the text, which the command converts with parse_size again.

@@ -146,6 +146,7 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
         if (!queries_) queries_ = std::make_unique<gl::ObjectQueries>();  // on the current context
         gl::FrameObjects objects;
         objects.world_to_clip = camera.view_projection();
+        objects.depth = camera.depth;
         objects.eye = camera.eye;
         objects.boxes = level_->boxes().data();
         objects.count = instance_ranges_.size();
@@ -172,7 +173,7 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
     cpu_culled_.assign(pose.size(), 0);
     cpu_patch_tests_ = cull_frustum_after_objects(
         *result_, batch.view(), cpu_margins_.empty() ? nullptr : cpu_margins_.data(),
-        make_frustum_planes(camera.view_projection(), ClipDepth::zero_to_one), cpu_culled_.data());
+        make_frustum_planes(camera.view_projection(), camera.depth), cpu_culled_.data());
     cpu_frustum_culled_ = 0;
     for (std::uint8_t c : cpu_culled_) cpu_frustum_culled_ += c;
     cpu_frustum_culled_ -= result_->stats.patches_culled;

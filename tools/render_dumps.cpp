@@ -148,8 +148,8 @@ std::vector<std::size_t> parse_patch_list(const std::string& text, std::size_t p
 ScreenBound screen_bound(const BezierPatch& patch, DisplacementRange range, DisplacedBoundKind kind,
                          NormalConeKind cone, const gl::RenderParams& frame) {
     // The view the pipeline's DisplacedPass gets (cull_pipeline.cpp): world-space patches, the
-    // frame's view and zero-to-one projection.
-    const DisplacedCullView view = make_displaced_cull_view(frame.view, frame.projection, ClipDepth::zero_to_one);
+    // frame's view and projection in its depth convention.
+    const DisplacedCullView view = make_displaced_cull_view(frame.view, frame.projection, frame.depth);
     ScreenBound s;
     s.bound = compute_displaced_bound(patch, range, kind, cone, view);
     s.projected = s.bound.status == kDisplacedBoundProjected;

@@ -22,6 +22,7 @@ gl::RenderParams render_params(const Camera& camera, int width, int height, int 
     params.discard_back_facing = one_sided;
     params.view = camera.view();
     params.projection = camera.projection();
+    params.depth = camera.depth;
     params.width = width;
     params.height = height;
     params.tess_level = tess_level;

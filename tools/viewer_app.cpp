@@ -207,9 +207,9 @@ int run_viewer(ViewerConfig& config) {
             ++anim_frame;
             world.pose(anim_frame * kSecondsPerFrame, pipeline);
         }
-        const Camera view_camera = settings.camera == ViewerCameraMode::path
-                                       ? cameras[static_cast<std::size_t>(anim_frame % lap)]
-                                       : camera.camera();
+        Camera view_camera = settings.camera == ViewerCameraMode::path ? cameras[static_cast<std::size_t>(anim_frame % lap)]
+                                                                       : camera.camera();
+        view_camera.depth = config.clip_depth;
 
         gl::PipelineParams params;
         params.frame.render = render_params(view_camera, width, height, settings.tess, world.one_sided());

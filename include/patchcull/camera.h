@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "patchcull/clip_space.h"
 #include "patchcull/math.h"
 #include "patchcull/mesh.h"
 
@@ -25,10 +26,11 @@ struct Camera {
     float fovy_radians = 1.0471976f;  ///< 60 degrees
     float aspect = 1.0f;
     float z_near = 0.1f;
-    float z_far = 100.0f;
+    float z_far = 100.0f;                       ///< ignored by ClipDepth::reversed_infinite
+    ClipDepth depth = ClipDepth::zero_to_one;  ///< the convention projection() is written in
 
     Mat4 view() const { return look_at(eye, target, up); }
-    Mat4 projection() const { return perspective(fovy_radians, aspect, z_near, z_far); }
+    Mat4 projection() const { return perspective(fovy_radians, aspect, z_near, z_far, depth); }
     /// projection() * view(): object (world) space to clip space.
     Mat4 view_projection() const { return projection() * view(); }
 };

@@ -104,7 +104,8 @@ struct QueryStats {
 
 /// The objects of one frame (object order = PipelineParams::objects' order).
 struct FrameObjects {
-    Mat4 world_to_clip;  ///< projection * view, clip depth zero-to-one (the renderer's)
+    Mat4 world_to_clip;  ///< projection * view, in the renderer's clip depth convention
+    ClipDepth depth = ClipDepth::zero_to_one;  ///< world_to_clip's convention (RenderParams::depth)
     Vec3 eye;            ///< world space
     /// World box of each object, holding everything it draws this frame.
     const Bounds* boxes = nullptr;

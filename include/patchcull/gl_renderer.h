@@ -8,9 +8,10 @@
 // Conventions (as math.h, frustum.h, hiz.h and displacement.h):
 // - Patches are in object space = world space (no model matrix); render parameters give view and
 //   projection, object_to_clip = projection * view. Clip space is GL's with
-//   glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE): depth z/w in [0,1], larger = farther, cleared to 1,
-//   depth test GL_LESS. RenderParams::projection must be of that convention (a standard OpenGL
-//   projection first goes through to_zero_to_one, clip_space.h). An object far from the origin
+//   glClipControl(GL_LOWER_LEFT, ...) in the depth convention RenderParams::depth names
+//   (clip_space.h): zero_to_one (the default: depth cleared to 1, GL_LESS), minus_one_to_one (GL's
+//   own, drawn with GL_NEGATIVE_ONE_TO_ONE), reversed and reversed_infinite (cleared to 0,
+//   GL_GREATER). RenderParams::projection must be written in it. An object far from the origin
 //   stays in its local frame (ControlMesh::origin) and the camera comes into it in double
 //   (WorldCamera::local, camera.h): every GL float then holds object-sized numbers.
 // - Framebuffer: RGBA8 colour, R32UI patch id, DEPTH32F; all read-backs of it are width*height
@@ -212,7 +213,11 @@ struct PatchAttributes {
 /// Parameters of one frame.
 struct RenderParams {
     Mat4 view;        ///< world -> view (look_at); also gives the eye position for shading
-    Mat4 projection;  ///< view -> clip (perspective, depth [0,1])
+    Mat4 projection;  ///< view -> clip (perspective) in convention depth
+    /// The depth convention of projection (clip_space.h); the renderer draws in it: glClipControl
+    /// depth GL_ZERO_TO_ONE (GL_NEGATIVE_ONE_TO_ONE for minus_one_to_one), the depth test GL_LESS
+    /// with depth cleared to 1, or GL_GREATER with depth cleared to 0 for the reversed ones.
+    ClipDepth depth = ClipDepth::zero_to_one;
     int width = 256;
     int height = 256;
     int tess_level = 8;           ///< uniform tessellation level (adaptive: the maximum), clamped to [1, 64]
@@ -239,7 +244,8 @@ class PatchRenderer {
 public:
     /// Makes ctx current and compiles the embedded drawing shaders (shaders/*.glsl). Throws
     /// patchcull::Error("GL: shader NAME: <log>") when the driver rejects one, or when ctx lacks
-    /// GL 4.5 core. Control points must be finite with w > 0.
+    /// GL 4.5 core. Weights must be positive: set_patches and update_patches throw Error naming the
+    /// patch and point otherwise (patch.h).
     explicit PatchRenderer(const GlContext& ctx);
     PatchRenderer(PatchRenderer&&) noexcept;
     PatchRenderer& operator=(PatchRenderer&&) noexcept;

@@ -189,7 +189,7 @@ void make_back_mask(const NormalMaskGrid& grid, const Mat4& world_to_clip, ClipD
     const double grow = 2e-5;
     const double x0 = -1.0 + 2.0 * sector_x / sectors - grow, x1 = -1.0 + 2.0 * (sector_x + 1) / sectors + grow;
     const double y0 = -1.0 + 2.0 * sector_y / sectors - grow, y1 = -1.0 + 2.0 * (sector_y + 1) / sectors + grow;
-    const double zmid = depth == ClipDepth::zero_to_one ? 0.5 : 0.0;
+    const double zmid = depth == ClipDepth::minus_one_to_one ? 0.0 : 0.5;  // a depth inside the clip volume
     const double ndc[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
     double rays[4][3];
     for (int k = 0; k < 4; ++k) {

@@ -125,11 +125,15 @@ void OcclusionHorizon::cull(const Mat4& world_to_clip, ClipDepth depth, int widt
     if (occluder_count > 0xffffffffu || object_count > 0xffffffffu)
         throw Error("occlusion horizon: more than 2^32 - 1 boxes");
 
-    // The camera in double, depth row in zero_to_one form (z' = (z + w) / 2, clip_space.h).
+    // The camera in double, depth row in zero_to_one form (z' = (z + w) / 2, or w - z for the
+    // reversed conventions: clip_space.h), so that only forward depth is compared below.
+    check_clip_depth(world_to_clip, depth, "occlusion horizon");
     for (int r = 0; r < 4; ++r)
         for (int c = 0; c < 4; ++c) clip_[r][c] = world_to_clip.at(r, c);
     if (depth == ClipDepth::minus_one_to_one)
         for (int c = 0; c < 4; ++c) clip_[2][c] = 0.5 * (clip_[2][c] + clip_[3][c]);
+    if (is_reversed(depth))
+        for (int c = 0; c < 4; ++c) clip_[2][c] = clip_[3][c] - clip_[2][c];
     width_ = width;
     height_ = height;
     low_.assign(static_cast<std::size_t>(width), kInfF);

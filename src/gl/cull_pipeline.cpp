@@ -286,7 +286,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         } else {
             for (std::size_t i : *only) mark_culled(objects[i].first, objects[i].first + objects[i].count);
         }
-        const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
+        const FrustumPlanes planes = make_frustum_planes(object_to_clip, rp.depth);
         if (fused) {
             // One dispatch per span for all three tests; its time counts as chain A.
             const std::uint32_t fused_tests =
@@ -294,14 +294,14 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
             for (std::size_t i : *only)
                 if (objects[i].cull)
                     for (const PatchSpan& s : object_spans[i])
-                        m.fused.run(buffers_of(s), fused_tests, object_to_clip, ClipDepth::zero_to_one, params.backpatch,
+                        m.fused.run(buffers_of(s), fused_tests, object_to_clip, rp.depth, params.backpatch,
                                     eye, hiz);
         }
         for (std::size_t i : *only)
             if (!fused && objects[i].cull && (tests & sh::kCullFrustum))
                 for (const PatchSpan& s : object_spans[i]) {
                     if (aabb)
-                        m.frustum_disp.run(buffers_of(s), object_to_clip, ClipDepth::zero_to_one);
+                        m.frustum_disp.run(buffers_of(s), object_to_clip, rp.depth);
                     else
                         m.frustum.run(buffers_of(s), planes);
                 }
@@ -324,11 +324,11 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         // against the frustum: the bound is built only for the Hi-Z test.
         const bool bounds = ranges && (aabb ? occluding != nullptr : (tests & (sh::kCullFrustum | sh::kCullOcclusion)) != 0);
         const DisplacedCullView view =
-            bounds ? make_displaced_cull_view(rp.view, rp.projection, ClipDepth::zero_to_one) : DisplacedCullView{};
+            bounds ? make_displaced_cull_view(rp.view, rp.projection, rp.depth) : DisplacedCullView{};
         for (std::size_t i : *only) {
             if (!objects[i].cull) continue;
             for (const PatchSpan& s : object_spans[i]) {
-                if (occluding && !fused) m.occlusion.run(buffers_of(s), object_to_clip, ClipDepth::zero_to_one, *occluding, false);
+                if (occluding && !fused) m.occlusion.run(buffers_of(s), object_to_clip, rp.depth, *occluding, false);
                 if (bounds) m.displaced.run(buffers_of(s), ranges, params.bound, params.cone, view, occluding, true);
             }
         }
@@ -388,7 +388,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         clock.mark();
         // 2. Hi-Z from that depth.
         m.ensure_hiz();
-        m.hiz_build.run(r.depth_texture(), m.hiz);
+        m.hiz_build.run(r.depth_texture(), m.hiz, rp.depth);
         clock.mark();
         // 3. test every patch (of the objects drawn), update statuses.
         run_chain(&m.hiz);

@@ -117,6 +117,7 @@ struct ObjectQueries::Impl {
     // This frame's input.
     QueryOptions options;
     Mat4 world_to_clip;
+    ClipDepth depth = ClipDepth::zero_to_one;
     Vec3 eye;
     std::vector<Bounds> boxes;  // per object
     std::vector<std::uint32_t> patches;
@@ -256,11 +257,14 @@ struct ObjectQueries::Impl {
         outside.resize(total);
         near_distance.resize(total);
         weight.assign(total, 0);
-        const FrustumPlanes planes = make_frustum_planes(world_to_clip, ClipDepth::zero_to_one);
+        const FrustumPlanes planes = make_frustum_planes(world_to_clip, depth);
+        // The box margins and the near-plane test read depth in the zero-to-one form (the same
+        // depth slopes, up to sign, in every convention).
+        const Mat4 zero_to_one = to_zero_to_one(world_to_clip, depth);
         for (std::uint32_t t = 0; t < total; ++t) {
             const Bounds& b = box_of(t);
-            query_box[t] = widened_query_box(b, world_to_clip, eye);
-            can_query[t] = queryable(query_box[t], world_to_clip);
+            query_box[t] = widened_query_box(b, zero_to_one, eye);
+            can_query[t] = queryable(query_box[t], zero_to_one);
             PlaneCullState state;
             std::uint32_t plane_tests = 0;
             outside[t] = classify_aabb(planes, b, state, plane_tests) == Containment::outside;
@@ -277,7 +281,7 @@ struct ObjectQueries::Impl {
         };
         for (std::size_t t = 0; t < total; ++t) put(t, query_box[t]);
         // A tight box is widened as its object's box is (the same margins, scaled to its size).
-        for (std::size_t k = 0; k < tight.size(); ++k) put(total + k, widened_query_box(tight[k], world_to_clip, eye));
+        for (std::size_t k = 0; k < tight.size(); ++k) put(total + k, widened_query_box(tight[k], zero_to_one, eye));
         upload(box_buffer, gpu_boxes.size() * sizeof(float), gpu_boxes.data());
         glProgramUniformMatrix4fv(program, world_to_clip_loc, 1, GL_FALSE, world_to_clip.m);
         check_gl("ObjectQueries frame setup");
@@ -487,6 +491,7 @@ void ObjectQueries::set_frame(const FrameObjects& frame, const QueryOptions& opt
                          options.visible_interval != m.options.visible_interval;
     m.options = options;
     m.world_to_clip = frame.world_to_clip;
+    m.depth = frame.depth;
     m.eye = frame.eye;
     m.boxes.assign(frame.boxes, frame.boxes + frame.count);
     m.patches.clear();

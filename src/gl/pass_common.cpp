@@ -24,7 +24,7 @@ static_assert(sizeof(pp::DisplacedParams) == 64 + 6 * 16 + 3 * 16 + 5 * 16 + 48)
 static_assert(sizeof(pp::CullStatusParams) == 16);
 static_assert(sizeof(pp::FusedCullParams) == 4 * 16 + 3 * 16 + 16 + 32);
 static_assert(offsetof(pp::FusedCullParams, first_patch) == 4 * 16 + 3 * 16 + 16);
-static_assert(offsetof(pp::OcclusionParams, first_patch) == 4 * 16 + 2 * 16);
+static_assert(offsetof(pp::OcclusionParams, first_patch) == 4 * 16 + 3 * 16);
 static_assert(offsetof(pp::DisplacedParams, first_patch) == 64 + 6 * 16 + 3 * 16 + 5 * 16);
 
 PassContext::Impl::~Impl() {

@@ -195,7 +195,7 @@ void PatchRenderer::begin_frame_drawing(const RenderParams& params, bool honour_
 void PatchRenderer::begin_depth_test_draws() {
     Impl& m = *impl_;
     m.bind_target(m.fbo, m.width, m.height);
-    glDepthFunc(GL_LEQUAL);
+    glDepthFunc(m.depth_less(true));
     glDepthMask(GL_FALSE);
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     check_gl("begin_depth_test_draws");
@@ -204,7 +204,7 @@ void PatchRenderer::begin_depth_test_draws() {
 void PatchRenderer::end_depth_test_draws() {
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
-    glDepthFunc(GL_LESS);
+    glDepthFunc(impl_->depth_less());
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     check_gl("end_depth_test_draws");
 }
@@ -270,7 +270,7 @@ std::vector<std::uint8_t> PatchRenderer::mark_front_patches(const RenderParams& 
     m.draw_patches(level, params.use_cull_flags ? sh::kCullReasonMask : 0u, 0u, true);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
-    glDepthFunc(GL_LESS);
+    glDepthFunc(m.depth_less());
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     check_gl("mark_front_patches");

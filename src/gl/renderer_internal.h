@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <cstdio>
 #include <string>
 #include <utility>
@@ -45,6 +46,7 @@ struct PatchRenderer::Impl {
     bool has_ranges = false;
     bool has_tangents = false;  // the tangent buffer holds kTangentVec4s vec4 per patch
     int frame_level = 1;        // begin_frame's effective tessellation level
+    ClipDepth clip_depth = ClipDepth::zero_to_one;  // the last set_draw_uniforms' RenderParams::depth
     std::uint64_t flag_generation = 0;  // PatchRenderer::flag_generation
     GLuint fbo = 0, color = 0, ids = 0, depth = 0;
     int width = 0, height = 0;
@@ -128,6 +130,11 @@ struct PatchRenderer::Impl {
     }
 
     void set_patches(const float* aos_points, std::size_t n, const PatchAttributes& a, bool keep_flags = false) {
+        for (std::size_t p = 0; p < n; ++p) {  // weights <= 0 refused (patch.h)
+            BezierPatch patch;
+            std::memcpy(&patch, aos_points + p * kPatchPoints * 4, sizeof patch);
+            check_patch_weights(patch, p);
+        }
         if (!a.max_displacement.empty() && a.max_displacement.size() != n)
             throw Error("GL: set_patches: max_displacement has " + std::to_string(a.max_displacement.size()) +
                         " entries for " + std::to_string(n) + " patches");
@@ -197,8 +204,16 @@ struct PatchRenderer::Impl {
     // Sets the patch programs' uniforms for params (draw_program with color_mode; mark_program the
     // same geometry); returns the effective tessellation level. mark_drawn: the draw records the
     // patches it tessellates in drawn_marks (render, render_frame; not the status image).
+    // The depth test of the convention: GL_LESS, or GL_GREATER (reversed); or_equal: GL_LEQUAL /
+    // GL_GEQUAL.
+    GLenum depth_less(bool or_equal = false) const {
+        if (is_reversed(clip_depth)) return or_equal ? GL_GEQUAL : GL_GREATER;
+        return or_equal ? GL_LEQUAL : GL_LESS;
+    }
+
     int set_draw_uniforms(const RenderParams& params, const Mat4& object_to_clip, GLuint color_mode,
                           bool mark_drawn = false) {
+        clip_depth = params.depth;
         const int level = std::clamp(params.tess_level, 1, 64);
         Mat4 view_inverse;
         Vec3 eye{0, 0, 0};
@@ -229,25 +244,26 @@ struct PatchRenderer::Impl {
         return level;
     }
 
-    // Binds target (fbo, or vis_fbo) with the fixed-function state of every draw: zero-to-one
-    // clip depth, depth test GL_LESS with writes, no face culling, no blending.
+    // Binds target (fbo, or vis_fbo) with the fixed-function state of every draw: clip depth of
+    // the convention, its depth test (depth_less) with writes, no face culling, no blending.
     void bind_target(GLuint target, int w, int h) {
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target);
         glViewport(0, 0, w, h);
-        glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+        glClipControl(GL_LOWER_LEFT,
+                      clip_depth == ClipDepth::minus_one_to_one ? GL_NEGATIVE_ONE_TO_ONE : GL_ZERO_TO_ONE);
         glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
+        glDepthFunc(depth_less());
         glDepthMask(GL_TRUE);
         glDisable(GL_CULL_FACE);
         glDisable(GL_BLEND);
     }
 
-    // bind_target, then clears it (colour dark grey, id 0, depth 1).
+    // bind_target, then clears it (colour dark grey, id 0, depth 1, or 0 when reversed).
     void begin_target(GLuint target, int w, int h) {
         bind_target(target, w, h);
         const float background[4] = {0.12f, 0.12f, 0.14f, 1.0f};
         const GLuint no_id[4] = {sh::kIdBackground, 0, 0, 0};
-        const float far_depth = 1.0f;
+        const float far_depth = is_reversed(clip_depth) ? 0.0f : 1.0f;
         glClearNamedFramebufferfv(target, GL_COLOR, 0, background);
         if (target == fbo) glClearNamedFramebufferuiv(target, GL_COLOR, 1, no_id);
         glClearNamedFramebufferfv(target, GL_DEPTH, 0, &far_depth);

@@ -148,7 +148,7 @@ const ObjectCullResult& SceneObjectLevel::cull(const std::vector<BezierPatch>& p
             }
             if (culler_.has_clusters(i)) {
                 Mat4 inverse;
-                if (!invert(instance_to_world(scene.instances[i], time_seconds), inverse))
+                if (!invert(instance_to_frame(scene.instances[i], time_seconds, scene.frame_origin), inverse))
                     throw Error("object level: " + scene.instances[i].name + ": its transform is singular");
                 world_to_cluster_[i] = inverse;
             }
@@ -167,7 +167,7 @@ const ObjectCullResult& SceneObjectLevel::cull(const std::vector<BezierPatch>& p
     ObjectFrame frame;
     frame.clusters_usable = clusters_usable_.data();
     frame.world_to_clip = camera.view_projection();
-    frame.depth = ClipDepth::zero_to_one;
+    frame.depth = camera.depth;
     frame.eye = camera.eye;
     frame.boxes = boxes_.data();
     frame.world_to_cluster = world_to_cluster_.data();

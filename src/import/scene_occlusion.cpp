@@ -209,10 +209,10 @@ const ObjectCullResult& SceneOcclusion::cull(const ObjectCullResult& result, con
                 b.max = b.max - Vec3{m, m, m};
                 if (b.min.x <= b.max.x && b.min.y <= b.max.y && b.min.z <= b.max.z) occluder_boxes_.push_back(b);
             }
-        horizon_.cull(world_to_clip, ClipDepth::zero_to_one, width, height, occluder_boxes_.data(), occluder_boxes_.size(),
+        horizon_.cull(world_to_clip, camera.depth, width, height, occluder_boxes_.data(), occluder_boxes_.size(),
                       tested_boxes_.data(), tested_boxes_.size(), occluded_.data(), stats_.horizon);
-    } else if (!near_pyramid_touches_environment(world_to_clip, camera.eye)) {
-        const FrustumPlanes planes = make_frustum_planes(world_to_clip, ClipDepth::zero_to_one);
+    } else if (!near_pyramid_touches_environment(to_zero_to_one(world_to_clip, camera.depth), camera.eye)) {
+        const FrustumPlanes planes = make_frustum_planes(world_to_clip, camera.depth);
         stats_.eye_in_cell = portals_->traverse(camera.eye, planes, stats_.portals);
         for (std::size_t k = 0; k < tested_boxes_.size(); ++k) occluded_[k] = !portals_->box_visible(tested_boxes_[k]);
     } else {

@@ -187,7 +187,7 @@ std::vector<TestView> make_views(const Scene& s, unsigned seed) {
 /// depths (caf / full bounds), over a far background: many patches end up behind them.
 HiZPyramid make_hiz(const Scene& s, const DisplacedCullView& view, std::mt19937& rng) {
     std::vector<DisplacedBound> b(s.patches.size());
-    const PatchBatch batch = make_batch(s.patches);
+    const PatchBatch batch = test::unchecked_batch(s.patches);
     compute_displaced_bounds(batch.view(), s.ranges.data(), DisplacedBoundKind::caf, NormalConeKind::full, view, b.data());
     std::vector<float> near;
     for (const DisplacedBound& x : b)
@@ -235,7 +235,7 @@ struct Tally {
 
 TEST(DisplacedGpu, DecisionsAndBoundsEqualTheCpu) {
     const Scene s = make_scene(11, 1500);
-    const PatchBatch batch = make_batch(s.patches);
+    const PatchBatch batch = test::unchecked_batch(s.patches);
     const std::size_t n = s.patches.size();
     DisplacedCuller& gpu = culler();
     gpu.set_patches(s.patches, s.ranges);
@@ -323,7 +323,7 @@ TEST(DisplacedGpu, DifferentInputsGiveDifferentDecisions) {
     // on no ranges, or with another cone or bound disagrees with the CPU on the real input (caf /
     // acon, occlusion), in decisions and in bound values.
     const Scene s = make_scene(11, 1500);
-    const PatchBatch batch = make_batch(s.patches);
+    const PatchBatch batch = test::unchecked_batch(s.patches);
     const std::size_t n = s.patches.size();
     std::vector<DisplacementRange> halved = s.ranges;
     for (DisplacementRange& r : halved) r = {r.d_min * 0.5f, r.d_max * 0.5f};
@@ -399,7 +399,7 @@ TEST(DisplacedGpu, ReadsTheRenderersPatchBuffer) {
     DisplacedCuller& g = culler();
     g.use_patch_buffer(renderer.patch_buffer(), patches.size());
     g.set_ranges(ranges);
-    const PatchBatch batch = make_batch(patches);
+    const PatchBatch batch = test::unchecked_batch(patches);
     Camera cam;
     cam.eye = {0, 0, 1.2f};  // inside the body, looking along +x: the patches behind the eye are culled
     cam.target = {1, 0, 1.2f};
@@ -417,7 +417,7 @@ TEST(DisplacedGpu, ReadsTheRenderersPatchBuffer) {
 TEST(DisplacedGpu, BatchUploadMatchesTheCpu) {
     // set_patches from a structure-of-arrays batch (the CPU kernels' input) with its ranges pointer.
     const Scene s = make_scene(14, 200);
-    const PatchBatch batch = make_batch(s.patches);
+    const PatchBatch batch = test::unchecked_batch(s.patches);
     const std::size_t n = s.patches.size();
     const std::vector<TestView> views = make_views(s, 41);
     const DisplacedCullView& view = views[2].view;  // free: some patches outside

@@ -97,7 +97,7 @@ TEST(GpuFrustumCull, SameDecisionsAsCpuKernelOnRandomInputs) {
         test::cull_frustum(r, planes, &gpu_values);
         const std::vector<std::uint32_t> gpu = r.read_cull_flags();
 
-        const PatchBatch batch = make_batch(c.patches);
+        const PatchBatch batch = test::unchecked_batch(c.patches);
         std::vector<std::uint8_t> cpu(c.patches.size());
         cull_frustum_scalar(batch.view(), c.displacement.empty() ? nullptr : c.displacement.data(), planes, cpu.data());
         ASSERT_EQ(gpu.size(), cpu.size());
@@ -181,7 +181,7 @@ TEST(GpuFrustumCull, MultiplyAddIsRoundedOnceOnHardCases) {
         }
         const auto flags = r.read_cull_flags();
         std::vector<std::uint8_t> cpu(patches.size());
-        cull_frustum_scalar(make_batch(patches).view(), nullptr, planes, cpu.data());
+        cull_frustum_scalar(test::unchecked_batch(patches).view(), nullptr, planes, cpu.data());
         for (std::size_t p = 0; p < patches.size(); ++p) ASSERT_EQ(flags[p] != 0, cpu[p] != 0) << "patch " << p;
     }
     EXPECT_EQ(wrong, 0u) << (test::passes().fma_via_double() ? "double-precision emulation" : "native GLSL fma");
@@ -217,7 +217,7 @@ struct StrictStats {
 // must agree.
 void strict_views(PatchRenderer& r, const std::vector<BezierPatch>& patches, const PatchAttributes& attributes,
                   ViewMode mode, std::uint64_t seed, int views, StrictStats& stats) {
-    const PatchBatch batch = make_batch(patches);
+    const PatchBatch batch = test::unchecked_batch(patches);
     const float* disp = attributes.max_displacement.empty() ? nullptr : attributes.max_displacement.data();
     ViewGenerator gen(test::control_point_bounds(patches), mode, seed);
     for (int v = 0; v < views; ++v) {

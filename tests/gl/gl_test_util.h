@@ -101,6 +101,20 @@ inline PatchAttributes random_texture_windows(std::size_t count, const Displacem
 }
 
 /// Distinct non-background ids in an id buffer.
+// A batch written through component(), as an engine's own memory would be: no weight check, for
+// tests that feed the kernels patches which make_batch refuses (weights <= 0).
+inline PatchBatch unchecked_batch(const std::vector<BezierPatch>& patches) {
+    PatchBatch batch(patches.size());
+    for (std::size_t p = 0; p < patches.size(); ++p)
+        for (int k = 0; k < kPatchPoints; ++k) {
+            batch.component(k, 0)[p] = patches[p].cp[k].x;
+            batch.component(k, 1)[p] = patches[p].cp[k].y;
+            batch.component(k, 2)[p] = patches[p].cp[k].z;
+            batch.component(k, 3)[p] = patches[p].cp[k].w;
+        }
+    return batch;
+}
+
 inline std::set<std::uint32_t> ids_present(const std::vector<std::uint32_t>& ids) {
     std::set<std::uint32_t> s;
     for (std::uint32_t id : ids)
