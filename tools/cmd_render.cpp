@@ -103,6 +103,7 @@ Runner add_render_command(CLI::App& app) {
         std::string cull = "all";
         std::string backpatch = "tcone";
         std::string frustum = "hull";
+        std::string clip_depth = "zero-to-one";
         std::string pose = "cpu";
         bool fused_pass = false;
         int tess = 8;
@@ -129,6 +130,7 @@ Runner add_render_command(CLI::App& app) {
                       "back-patch test of backpatch/all");
     add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
                       "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
+    add_clip_depth_option(*command, state->clip_depth);
     command->add_flag("--fused-pass", state->fused_pass,
                       "frustum, back-patch (tcone/ncone) and Hi-Z tests in one compute pass (issue 14)");
     add_choice_option(*command, "--pose", state->pose, {"cpu", "gpu"},
@@ -191,7 +193,9 @@ Runner add_render_command(CLI::App& app) {
         const std::vector<BezierPatch>* pose = frame_poser.pose(0);  // a CPU pose (frame 0 uploads the attributes)
         pipeline.renderer().set_displacement_map(scene.displacement);
         upload_scene_occluders(pipeline.renderer(), scene);
-        const std::vector<Camera> cameras = scene.camera_path(state->frames, float(width) / float(height));
+        std::vector<Camera> cameras = scene.camera_path(state->frames, float(width) / float(height));
+        const ClipDepth clip_depth = parse_clip_depth_option(state->clip_depth);
+        for (Camera& c : cameras) c.depth = clip_depth;  // drawn, culled and verified in it
         const std::vector<SceneObject> objects = scene_objects(scene);
         std::vector<gl::ObjectRange> ranges;
         for (const SceneObject& o : objects) ranges.push_back(o.range);
@@ -321,6 +325,7 @@ Runner add_render_command(CLI::App& app) {
             out["model"] = scene.name;
             out["patches"] = scene.patch_count();
             out["size"] = {width, height};
+            out["clip_depth"] = clip_depth_name(clip_depth);
             out["tess"] = state->tess;
             out["tess_mode"] = tess_mode.adaptive ? "adaptive" : "uniform";
             out["cull"] = automatic ? "auto" : gl::cull_mode_name(cull);

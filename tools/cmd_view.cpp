@@ -48,6 +48,7 @@ Runner add_view_command(CLI::App& app) {
         TessOptions tess_options;
         DisplaceOptions displace;
         std::string size = "960x540";
+        std::string clip_depth = "zero-to-one";
         bool aggressive = false;
         std::string screenshot;
         std::string screenshot_dir = "out";
@@ -68,6 +69,7 @@ Runner add_view_command(CLI::App& app) {
                       "back-patch test of backpatch/all");
     add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
                       "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
+    add_clip_depth_option(*command, state->clip_depth);
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
     add_displace_options(*command, state->displace);
@@ -97,6 +99,7 @@ Runner add_view_command(CLI::App& app) {
         apply_displace_options(state->displace, scene);
         config.tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         config.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
+        config.clip_depth = parse_clip_depth_option(state->clip_depth);
 
         ViewerSettings& s = config.settings;
         set_cull_toggles(s, applicable_cull_mode(scene, cull, "view"));
