@@ -178,22 +178,47 @@ Runner add_render_command(CLI::App& app) {
         const gl::CullMode applied = applicable_cull_mode(scene, cull, "render");
         const bool backpatch_applied = (static_cast<std::uint32_t>(applied) & gl::kFlagBackPatch) != 0;
         const bool one_sided = scene_is_one_sided(scene);
-        ObjectLevelRun object_level(state->objects, scene, one_sided);  // before the occluders go up
-        if (automatic && object_level.sets_objects())
+        // Camera-relative frames (default_scene.h's rebase_scene): each frame is drawn and culled
+        // in the float frame of the grid point nearest its eye, everything in it composed in
+        // double and rounded once. A scene whose eyes stay within 1024 of the origin never leaves
+        // the world frame (its cameras are camera_path's, as always).
+        const float aspect = float(width) / float(height);
+        const std::vector<WorldCamera> world_cameras = scene.world_camera_path(state->frames, aspect);
+        auto same = [](DVec3 a, DVec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+        std::vector<DVec3> frame_origins;
+        bool rebases = false;
+        for (const WorldCamera& c : world_cameras) {
+            frame_origins.push_back(scene_frame_near(c.eye));
+            rebases = rebases || !same(frame_origins.back(), scene.frame_origin);
+        }
+        Scene world;  // the placements in world coordinates (without the models), when frames move
+        if (rebases) {
+            std::vector<LoadedModel> models = std::move(scene.models);
+            world = scene;
+            scene.models = std::move(models);
+            rebase_scene(world, frame_origins[0], scene);
+        }
+        auto object_level = std::make_unique<ObjectLevelRun>(state->objects, scene, one_sided);  // before the occluders go up
+        if (automatic && object_level->sets_objects())
             throw Error("--object-occlusion: a query method decides per object itself; not with --cull auto");
 
         gl::GlContext context = gl::GlContext::create_headless();
         gl::CullPipeline pipeline(context);
-        GlReleaseGuard release_object_level(object_level);
+        struct ReleaseGuard {  // GlReleaseGuard for the object level of the frame
+            std::unique_ptr<ObjectLevelRun>& run;
+            ~ReleaseGuard() { run->release_gl(); }
+        } release_object_level{object_level};
         ScenePoser poser(scene);
         // The CPU readers of posed patches (object level, --cull auto, --draw-bounds) keep a CPU
         // pose under --pose gpu: their bounds stay the CPU's, exactly.
-        const bool cpu_patches = object_level.enabled() || automatic || !bounds_patches.empty();
+        const bool cpu_patches = object_level->enabled() || automatic || !bounds_patches.empty();
         FramePoser frame_poser(context, poser, pipeline.renderer(), parse_pose_where("--pose", state->pose), cpu_patches);
         const std::vector<BezierPatch>* pose = frame_poser.pose(0);  // a CPU pose (frame 0 uploads the attributes)
         pipeline.renderer().set_displacement_map(scene.displacement);
         upload_scene_occluders(pipeline.renderer(), scene);
-        std::vector<Camera> cameras = scene.camera_path(state->frames, float(width) / float(height));
+        std::vector<Camera> cameras = scene.camera_path(state->frames, aspect);
+        if (rebases)
+            for (std::size_t f = 0; f < cameras.size(); ++f) cameras[f] = world_cameras[f].local(frame_origins[f]);
         const ClipDepth clip_depth = parse_clip_depth_option(state->clip_depth);
         for (Camera& c : cameras) c.depth = clip_depth;  // drawn, culled and verified in it
         const std::vector<SceneObject> objects = scene_objects(scene);
@@ -207,6 +232,14 @@ Runner add_render_command(CLI::App& app) {
         std::size_t total_false = 0;
         nlohmann::json hiz_dump, drawn_bounds;
         for (int f = 0; f < state->frames; ++f) {
+            if (!same(frame_origins[static_cast<std::size_t>(f)], scene.frame_origin)) {
+                // A new frame: the scene's floats rounded into it, the object level (built on the
+                // occluders' order) and the occluders made again.
+                rebase_scene(world, frame_origins[static_cast<std::size_t>(f)], scene);
+                object_level->release_gl();
+                object_level = std::make_unique<ObjectLevelRun>(state->objects, scene, one_sided);
+                upload_scene_occluders(pipeline.renderer(), scene);
+            }
             // gpu without a CPU reader: no CPU pose; `pose` keeps frame 0's, which nothing reads.
             if (f > 0)
                 if (const std::vector<BezierPatch>* posed = frame_poser.pose(f * kSecondsPerFrame)) pose = posed;
@@ -222,7 +255,7 @@ Runner add_render_command(CLI::App& app) {
             params.cone = displace_cone(state->displace);
             params.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
             params.fused_pass = state->fused_pass;
-            object_level.apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height, params, width);
+            object_level->apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height, params, width);
             if (automatic) {
                 policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
                 params.objects = policy.objects();
@@ -251,9 +284,9 @@ Runner add_render_command(CLI::App& app) {
             }
             nlohmann::json ms = {{"pass1", stats.pass1_ms}, {"hiz", stats.hiz_ms}, {"cull", stats.cull_ms},
                                  {"pass2", stats.pass2_ms}, {"total", stats.total_ms}};
-            if (object_level.enabled()) {
-                ms["object_level"] = object_level.object_level_ms();  // CPU, before the GPU frame
-                ms["cpu_frustum_after_objects"] = object_level.cpu_frustum_ms();
+            if (object_level->enabled()) {
+                ms["object_level"] = object_level->object_level_ms();  // CPU, before the GPU frame
+                ms["cpu_frustum_after_objects"] = object_level->cpu_frustum_ms();
             }
             std::size_t false_culls = 0, depth_ties = 0;
             std::vector<std::uint32_t> false_culled;  // patch indices, ascending
@@ -264,7 +297,7 @@ Runner add_render_command(CLI::App& app) {
                 const gl::FrameComparison cmp = gl::compare_frames(reference.capture, culled);
                 // Patches culled by detail culling are not false culls (it is not conservative):
                 // they are reported as pixels changed.
-                object_check = object_level.verify(reference.capture.ids, cmp.false_culled);
+                object_check = object_level->verify(reference.capture.ids, cmp.false_culled);
                 false_culled = object_check.patch_false_culls;
                 false_culls = false_culled.size() + object_check.false_culled_triangles;
                 depth_ties = cmp.depth_ties;
@@ -293,7 +326,7 @@ Runner add_render_command(CLI::App& app) {
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
             if (automatic) frames.back()["auto_objects"] = auto_objects_json(objects, policy.decisions());
             {
-                nlohmann::json& o = frames.back()["objects"] = object_level.frame_json();
+                nlohmann::json& o = frames.back()["objects"] = object_level->frame_json();
                 if (state->verify) {
                     o["false_culled_objects"] = object_check.false_culled_objects;
                     o["false_culled_triangles"] = object_check.false_culled_triangles;
@@ -309,11 +342,11 @@ Runner add_render_command(CLI::App& app) {
                             stats.pass1_ms, stats.hiz_ms, stats.cull_ms, stats.pass2_ms);
                 if (state->verify) std::printf("; false culls %zu", false_culls);
                 std::printf("\n");
-                if (object_level.enabled()) {
-                    const ObjectCullStats& o = object_level.result().stats;
+                if (object_level->enabled()) {
+                    const ObjectCullStats& o = object_level->result().stats;
                     std::printf("  objects (%s): %zu of %zu culled (frustum %zu, back-face %zu, detail %zu); %zu patches "
                                 "and %zu triangles skipped; %u plane tests, %u BVH nodes, %u cluster tests\n",
-                                object_level.method_name(), o.frustum_culled + o.backface_culled + o.detail_culled,
+                                object_level->method_name(), o.frustum_culled + o.backface_culled + o.detail_culled,
                                 o.total, o.frustum_culled, o.backface_culled, o.detail_culled, o.patches_culled,
                                 o.triangles_culled, o.plane_tests, o.bvh_nodes_visited, o.cluster_tests);
                 }
@@ -340,8 +373,8 @@ Runner add_render_command(CLI::App& app) {
             out["frustum"] = state->frustum;
             out["pose"] = state->pose;
             out["fused_pass"] = state->fused_pass;
-            out["objects_method"] = object_level.method_name();
-            out["object_occlusion"] = object_level.occlusion_name();
+            out["objects_method"] = object_level->method_name();
+            out["object_occlusion"] = object_level->occlusion_name();
             out["detail_cull"] = state->objects.detail_pixels;
             out["environment_objects"] = scene.environment.size();
             out["renderer"] = context.renderer();

@@ -6,6 +6,7 @@
 // --frames N without a script plays render's camera path for N frames with no panel (the window
 // shows `render --out`'s images; --screenshot writes the last one), a line per frame.
 // --tess-mode / --tess-distance, --displace, --cull auto and the object-level flags as `render`.
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -14,6 +15,7 @@
 #include "object_level_options.h"
 #include "patchcull/default_scene.h"
 #include "patchcull/error.h"
+#include "patchcull/scene_file.h"
 #include "render_support.h"
 #include "viewer_app.h"
 #include "viewer_script.h"
@@ -96,6 +98,9 @@ Runner add_view_command(CLI::App& app) {
         if (!state->screenshot.empty() && state->frames == 0)
             throw Error("--screenshot: needs --frames N (the last frame is the one saved)");
         Scene scene = load_scene(state->model, state->scheme, state->split);
+        // The viewer draws in float world coordinates: the scene and the frames of its path must
+        // stay within kMaxFloatWorldCoordinate (interactive: where it starts).
+        check_scene_motion(scene, state->model, std::max(state->frames, 1), kSecondsPerFrame, kMaxFloatWorldCoordinate);
         apply_displace_options(state->displace, scene);
         config.tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         config.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;

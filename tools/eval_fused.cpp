@@ -91,7 +91,7 @@ int run_fused_eval(const FusedEvalOptions& o) {
     parse_size("--size", o.size, width, height);
     const BackPatchCone cone = o.cone == "ncone" ? BackPatchCone::ncone : BackPatchCone::tcone;
     const Scene scene = load_scene(o.scene, o.scheme, 0);
-    check_scene_motion(scene, o.scene, o.frames, kSecondsPerFrame);
+    check_scene_motion(scene, o.scene, o.frames, kSecondsPerFrame, kMaxFloatWorldCoordinate);
     const bool one_sided = scene_is_one_sided(scene);
 
     gl::GlContext context = gl::GlContext::create_headless();

@@ -13,11 +13,17 @@
 // cells and portals in buildings). Scene files (patchcull/scene_file.h) describe the same Scene.
 //
 // Conventions: world space is y-up, the ground is y = 0, lengths are in character heights
-// (every character is scaled to height 1 before it is placed). Patches are world-space (the
-// renderer has no model matrix): each instance's control points are transformed by its affine
-// instance_to_world (object_to_world moved by the instance's velocity), which maps homogeneous
-// points exactly (w is kept). OBJ models are taken as y-up, the built-in teapot as z-up.
-// Rounding: everything is float. ScenePoser's output is exactly instance_to_world times the
+// (every character is scaled to height 1 before it is placed). Patches are posed into the
+// scene's frame (Scene::frame_origin; the world when it is 0; the renderer has no model
+// matrix): each instance's control points are transformed by its affine instance_to_frame
+// (object_to_world moved by the instance's origin and velocity, composed in double and rounded
+// once), which maps homogeneous points exactly (w is kept). OBJ models are taken as y-up, the
+// built-in teapot as z-up. Worlds of game size: world positions are doubles
+// (SceneInstance::origin, CameraPath::origin, Scene::occluder_world) and `render` draws each
+// frame in the frame of the grid point nearest its camera (scene_frame_near, rebase_scene), so
+// the float data the kernels and the GPU see are small numbers near the eye wherever the scene
+// is (scene_file.h's kMaxSceneCoordinate gives the limit and its derivation).
+// Rounding: everything else is float. ScenePoser's output is exactly instance_to_frame times the
 // (animated) control points, in float (tested bit for bit; for a mirroring transform the same
 // products in transposed order, see ScenePoser); the built-in scenes keep characters
 // at least 0.1 (plus their reach, measured on the float control points) from walls and buildings,
@@ -54,6 +60,12 @@ struct SceneInstance {
     bool deforms = true;
     /// Rigid motion in world units per second (see instance_to_world); zero: it stays in place.
     Vec3 velocity{0, 0, 0};
+    /// World position (double) of the instance's own frame: the instance is placed by
+    /// translation(origin) * object_to_world, and object_to_world's translation stays small (the
+    /// scene file reader keeps it within half a kSceneFrameGrid of 0: scene_frame_near).
+    /// Composed in double with the motion and the scene's frame (instance_to_frame). 0 for the
+    /// built-in scenes.
+    DVec3 origin;
     // A mirroring object_to_world (instance_mirrors: det of the linear part < 0) is allowed:
     // ScenePoser poses such an instance with its patches' parameterisation reversed (u and v
     // swapped), so that du x dv of the world patches points out of the mirrored solid.
@@ -65,10 +77,15 @@ struct SceneInstance {
 /// object_to_world's).
 bool instance_mirrors(const SceneInstance& instance);
 
-/// The instance's transform at scene time t:
-/// translation(velocity * (t + time_offset)) * object_to_world. Affine (the w row is kept, so
-/// homogeneous control points map exactly as by object_to_world); the linear part is
-/// object_to_world's. Computed in float, the translation added to column 3.
+/// The instance's transform at scene time t into the frame whose 0 is the world point
+/// frame_origin: translation(origin - frame_origin + velocity * (t + time_offset)) *
+/// object_to_world. Affine (the w row is kept, so homogeneous control points map exactly as by
+/// object_to_world); the linear part is object_to_world's. The translation is composed in
+/// double (object_to_world's column 3, origin - frame_origin, velocity x time) and rounded once
+/// to float into column 3: an instance 1e6 units out, seen from a camera beside it, gets a
+/// small, exact translation.
+Mat4 instance_to_frame(const SceneInstance& instance, float time_seconds, DVec3 frame_origin);
+/// instance_to_frame into the world frame (frame_origin 0).
 Mat4 instance_to_world(const SceneInstance& instance, float time_seconds);
 
 /// A triangle-mesh object of the environment: triangles [first_triangle, first_triangle +
@@ -91,6 +108,9 @@ struct EnvironmentObject {
 /// distance and height are not used by a walk's cameras; the walk scenes set them to a typical
 /// viewing distance (hypot(distance, height) is the CLI's default adaptive-tessellation distance).
 struct CameraPath {
+    /// World position (double) that target and walk_start are relative to (0 for the built-in
+    /// scenes; the scene file reader keeps them within half a kSceneFrameGrid of it: scene_frame_near).
+    DVec3 origin;
     Vec3 target{0, 0, 0};
     float distance = 5;
     float height = 1;
@@ -130,8 +150,17 @@ struct Scene {
     std::string name;
     std::vector<LoadedModel> models;
     std::vector<SceneInstance> instances;
-    /// Triangle occluders (world space), for PatchRenderer::set_occluders.
+    /// The world position (double) of the scene's float frame: occluder_vertices, cells, portals,
+    /// the patches ScenePoser poses and the cameras camera_path gives are relative to it (they
+    /// hold small numbers near the camera when it is near the camera: rebase_scene). 0 as built
+    /// and as read from a file (the world frame).
+    DVec3 frame_origin;
+    /// Triangle occluders (in the scene's frame), for PatchRenderer::set_occluders.
     std::vector<Vec3> occluder_vertices;
+    /// The occluder vertices in world coordinates (double), as the scene file reader places them:
+    /// empty (then occluder_vertices + frame_origin are the world vertices), or one per
+    /// occluder vertex. rebase_scene rounds them into a new frame once.
+    std::vector<DVec3> occluder_world;
     std::vector<std::uint32_t> occluder_indices;
     /// The occluder triangles grouped into objects: their ranges tile occluder_indices exactly,
     /// in order (object k starts where object k-1 ends; the first starts at triangle 0).
@@ -150,9 +179,41 @@ struct Scene {
 
     /// Total patch count over the instances (the size of pose()'s output).
     std::size_t patch_count() const;
-    /// Cameras of frames 0 .. frames-1 along `camera` (aspect = width / height), orbit or walk.
+    /// Cameras of frames 0 .. frames-1 along `camera` (aspect = width / height), orbit or walk,
+    /// in the scene's frame. Where the path's origin is the frame's (the built-in scenes, files
+    /// near the origin), computed in float as always; else eye and target are composed in
+    /// double (world_camera_path) and moved into the frame (WorldCamera::local).
     std::vector<Camera> camera_path(int frames, float aspect) const;
+    /// The same cameras in world coordinates (double): eye = origin + walk_start + f x walk_step,
+    /// or the orbit's eye around origin + target.
+    std::vector<WorldCamera> world_camera_path(int frames, float aspect) const;
 };
+
+/// The frames scenes are drawn in (rebase_scene) and the scene file reader's world origins
+/// (SceneInstance::origin, CameraPath::origin): a point within kSceneWorldFrame of the world's
+/// origin on every axis stays in the world frame (0: scenes near the origin are drawn as they
+/// always were); a point farther out gets the nearest multiple of kSceneFrameGrid on each axis,
+/// so that it lies within 8 units of its frame's 0, where the float kernels work at the
+/// precision of the built-in scenes (their cameras are 2-15 units from the origin). A coarser
+/// grid costs culling: with frames 1024 apart the eye sat up to 512 units from its frame's 0
+/// and ptp's rounding margin (which grows with the coordinates) let no back-patch cull through.
+inline constexpr double kSceneFrameGrid = 16;
+inline constexpr double kSceneWorldFrame = 1024;
+
+/// The frame origin for a camera at world point eye, or for a position the scene file reader
+/// places (see kSceneFrameGrid): 0 within kSceneWorldFrame of the origin, else the nearest
+/// multiple of kSceneFrameGrid on each axis.
+DVec3 scene_frame_near(DVec3 eye);
+
+/// Moves a scene's float frame to the world point origin: `frame` gets world's instances,
+/// environment, camera path, cells and portals, with every float that is relative to the frame
+/// (occluder vertices, cells, portals) rounded once from world coordinates composed in double;
+/// instances and the camera path keep their world origins (ScenePoser and camera_path subtract
+/// frame_origin in double). frame.models are left as they are (the caller's: usually the same
+/// models as world's, moved or shared). world is not changed; its own frame may be any. Object
+/// levels and uploads built on `frame` must be made again after a rebase (occluder indices come
+/// back in world's order).
+void rebase_scene(const Scene& world, DVec3 origin, Scene& frame);
 
 /// The built-in default scene: three BigGuys and three MonsterFrogs (`scheme`; ACC: 1450 and 1292 patches
 /// each, 8226 in all) on a 12 x 12 ground quad with a long low wall in front of them and two
@@ -283,7 +344,7 @@ struct PoseModelTables {
 struct PoseMeshes {
     std::vector<Vec3> vertices;
     std::vector<std::size_t> first_vertex;  ///< per instance: its group's first vertex
-    std::vector<Mat4> to_world;             ///< per instance: instance_to_world at the pose's time
+    std::vector<Mat4> to_world;             ///< per instance: instance_to_frame at the pose's time (the scene's frame)
     std::vector<std::uint8_t> mirrored;     ///< per instance: instance_mirrors
 };
 
@@ -292,8 +353,9 @@ public:
     explicit ScenePoser(const Scene& scene);
     /// The scene posed (the constructor's; it must outlive the poser).
     const Scene& scene() const { return *scene_; }
-    /// World-space patches of every instance at time_seconds, instance by instance (each
-    /// instance's patches in its model's order): instance_to_world times the (animated) model
+    /// The patches of every instance at time_seconds in the scene's frame (world space when
+    /// Scene::frame_origin is 0), instance by instance (each instance's patches in its model's
+    /// order): instance_to_frame(instance, time_seconds, frame_origin) times the (animated) model
     /// patch, transposed for mirrored instances (see above). The reference stays valid until the
     /// next call.
     const std::vector<BezierPatch>& pose(float time_seconds);

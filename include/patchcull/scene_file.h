@@ -15,11 +15,15 @@
 // Input text in messages is quoted through quote_input (patchcull/error.h).
 //
 // Float rounding: numbers are read as double and must fit a float (|x| <= FLT_MAX, else an
-// error); transforms are composed in float exactly as the built-in scenes compose them (so
-// default.json reproduces make_default_scene bit for bit). Placed models and environment
-// vertices must lie within kMaxMeshExtent of the origin and be at least kMinMeshDiagonal across
-// (scene.h's load_model limits, applied in world space): beyond them the float kernels lose
-// their guarantees, so the file is refused rather than culled wrongly.
+// error). World positions (objects' positions and translations, environment corners, camera
+// targets and walk starts) stay in double: each is split into a frame origin (scene_frame_near:
+// SceneInstance::origin, CameraPath::origin) and a float rest within 8 of it; environment
+// vertices are kept in double too (Scene::occluder_world). Within kSceneWorldFrame (1024) of the
+// world's origin the origin is 0 and transforms are composed in float exactly as the built-in scenes compose them
+// (so default.json reproduces make_default_scene bit for bit). Placed models and environment
+// vertices must lie within kMaxSceneCoordinate of the origin and be at least kMinMeshDiagonal
+// across (scene.h's load_model limit, applied in world space); cells and portals, kept in float
+// world coordinates, within kMaxFloatWorldCoordinate.
 #pragma once
 
 #include <cstdint>
@@ -29,25 +33,39 @@
 
 namespace patchcull {
 
-/// The largest world coordinate a scene file may place anything at (objects' control points,
-/// environment vertices, positions, cameras). A scene is drawn and culled in float world space
-/// (no per-object local frame yet): at 2e4 from the origin a rigid BigGuy had visible patches
-/// culled by the Hi-Z test (2 in 6 frames, tests/data/scenes/far_rigid_1e5.json moved there), at
-/// 1e4 none; 8192 keeps a margin. Farther scenes are refused with one line (move them nearer
-/// the origin), not culled wrongly.
-inline constexpr double kMaxSceneCoordinate = 8192;
+/// The largest world coordinate a scene may place anything at or move anything to (objects'
+/// control points, environment vertices, positions, cameras), 2^29. Scenes keep world positions
+/// in double (SceneInstance::origin, CameraPath::origin, Scene::occluder_world) and `render`
+/// draws and culls each frame in a float frame near its camera (rebase_scene): what stays in
+/// float is an object's own extent, the frame-relative offsets (the eye within 8 units of 0),
+/// and each object's offset from the frame, composed in double and rounded once into its
+/// matrix. The limit is where the doubles stop being finer than those floats: a double's
+/// spacing at 2^29 is 2^29 x 2^-52 = 2^-23, the spacing of floats in [1, 2), the float data of a
+/// character (1 unit high) next to the camera. Beyond it the world position itself would be
+/// coarser than the floats it is rounded into, so a scene reaching farther is refused with one
+/// line (docs/ENGINE.md, "Worlds of game size").
+inline constexpr double kMaxSceneCoordinate = 536870912;
+/// The largest world coordinate of commands that draw a scene in float world coordinates (demo,
+/// eval, view: one float frame at the world's origin) and of cells and portals (kept in float
+/// world coordinates): a rigid BigGuy at 2e4 had visible patches culled by the Hi-Z test (2 in
+/// 6 frames), at 1e4 none; 8192 keeps a margin.
+inline constexpr double kMaxFloatWorldCoordinate = 8192;
 
-/// Checks what a scene's motion reaches before it is drawn: over frames 0 .. frames - 1 (frame f
-/// at scene time f * seconds_per_frame), every instance's placed rest control points moved by its
-/// velocity x (time + time_offset), and every camera's eye and target (a walk's start + f x step,
-/// an orbit's eye at distance and height around its target), must stay within
-/// kMaxSceneCoordinate of the origin. load_scene_file checks the placements at rest; this adds
-/// the time, which only the caller knows (its frame count). Throws patchcull::Error, one line,
-/// for the first frame that goes beyond: "SOURCE: PATH: ... at frame F ...", PATH the JSON path
-/// of the cause in the scene-file form of the scene (instance i is objects[i]:
-/// "objects[1].animation.velocity", "objects[0].animation.time_offset", "camera.walk.step",
-/// "camera.orbit.distance"); source names the scene (its file, or a built-in scene's name).
-void check_scene_motion(const Scene& scene, const std::string& source, int frames, double seconds_per_frame);
+/// Checks what a scene reaches before it is drawn: over frames 0 .. frames - 1 (frame f at scene
+/// time f * seconds_per_frame), every instance's placed rest control points moved by its
+/// velocity x (time + time_offset), every camera's eye and target (a walk's start + f x step,
+/// an orbit's eye at distance and height around its target), the environment and the cells
+/// must stay within `limit` of the origin (kMaxSceneCoordinate for `render`, which draws in
+/// frames near the camera; kMaxFloatWorldCoordinate for commands that draw in float world
+/// coordinates). load_scene_file checks the placements at rest against kMaxSceneCoordinate; this
+/// adds the time, which only the caller knows (its frame count), and the caller's limit. Throws
+/// patchcull::Error, one line, for the first frame that goes beyond: "SOURCE: PATH: ... at frame
+/// F ...", PATH the JSON path of the cause in the scene-file form of the scene (instance i is
+/// objects[i]: "objects[1].animation.velocity", "objects[0].animation.time_offset",
+/// "objects[2].transform", "environment[0]", "camera.walk.step", "camera.orbit.distance");
+/// source names the scene (its file, or a built-in scene's name).
+void check_scene_motion(const Scene& scene, const std::string& source, int frames, double seconds_per_frame,
+                        double limit = kMaxSceneCoordinate);
 
 /// Largest scene file load_scene_file reads (a regular file; devices and FIFOs are refused).
 inline constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{64} << 20;

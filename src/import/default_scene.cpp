@@ -154,19 +154,57 @@ bool instance_mirrors(const SceneInstance& instance) {
     return det < 0;
 }
 
-Mat4 instance_to_world(const SceneInstance& instance, float time_seconds) {
-    const float t = time_seconds + instance.time_offset;
+Mat4 instance_to_frame(const SceneInstance& instance, float time_seconds, DVec3 frame_origin) {
+    // translation(d) * M adds d * M's w row to each column's xyz: for an affine M the w row is
+    // (0, 0, 0, 1), so only column 3 moves. d = origin - frame_origin + v * (t + time_offset),
+    // summed in double with column 3 and rounded once.
     Mat4 m = instance.object_to_world;
-    // translation(v * t) * M adds (v * t) * M's w row to each column's xyz: for an affine M the
-    // w row is (0, 0, 0, 1), so only column 3 moves.
-    const Vec3 d = instance.velocity * t;
+    const double t = double(time_seconds) + double(instance.time_offset);
+    const double d[3] = {instance.origin.x - frame_origin.x + double(instance.velocity.x) * t,
+                         instance.origin.y - frame_origin.y + double(instance.velocity.y) * t,
+                         instance.origin.z - frame_origin.z + double(instance.velocity.z) * t};
     for (int c = 0; c < 4; ++c) {
-        const float w = m.at(3, c);
-        m.at(0, c) += d.x * w;
-        m.at(1, c) += d.y * w;
-        m.at(2, c) += d.z * w;
+        const double w = m.at(3, c);
+        if (w == 0) continue;
+        for (int r = 0; r < 3; ++r) m.at(r, c) = static_cast<float>(double(m.at(r, c)) + d[r] * w);
     }
     return m;
+}
+
+Mat4 instance_to_world(const SceneInstance& instance, float time_seconds) {
+    return instance_to_frame(instance, time_seconds, {});
+}
+
+DVec3 scene_frame_near(DVec3 eye) {
+    if (std::fabs(eye.x) <= kSceneWorldFrame && std::fabs(eye.y) <= kSceneWorldFrame && std::fabs(eye.z) <= kSceneWorldFrame)
+        return {};
+    auto snap = [](double x) { return std::nearbyint(x / kSceneFrameGrid) * kSceneFrameGrid; };
+    return {snap(eye.x), snap(eye.y), snap(eye.z)};
+}
+
+void rebase_scene(const Scene& world, DVec3 origin, Scene& frame) {
+    // Frame-relative floats: world coordinates (double) minus origin, rounded once.
+    const DVec3 shift = world.frame_origin - origin;
+    auto moved = [&](Vec3 v) { return to_float(to_double(v) + shift); };
+    frame.name = world.name;
+    frame.instances = world.instances;
+    frame.environment = world.environment;
+    frame.occluder_indices = world.occluder_indices;
+    frame.occluder_world = world.occluder_world;
+    frame.occluder_vertices.resize(world.occluder_vertices.size());
+    for (std::size_t i = 0; i < world.occluder_vertices.size(); ++i)
+        frame.occluder_vertices[i] = world.occluder_world.empty() ? moved(world.occluder_vertices[i])
+                                                                  : to_float(world.occluder_world[i] - origin);
+    frame.animation = world.animation;
+    frame.displacement = world.displacement;
+    frame.displacement_name = world.displacement_name;
+    frame.camera = world.camera;
+    frame.cells = world.cells;
+    for (SceneCell& cell : frame.cells) cell.box = {moved(cell.box.min), moved(cell.box.max)};
+    frame.portals = world.portals;
+    for (ScenePortal& portal : frame.portals)
+        for (Vec3& c : portal.corners) c = moved(c);
+    frame.frame_origin = origin;
 }
 
 std::size_t Scene::patch_count() const {
@@ -175,7 +213,38 @@ std::size_t Scene::patch_count() const {
     return n;
 }
 
+std::vector<WorldCamera> Scene::world_camera_path(int frames, float aspect) const {
+    std::vector<WorldCamera> cameras;
+    const DVec3 o = camera.origin;
+    for (int f = 0; f < frames; ++f) {
+        WorldCamera cam;
+        if (camera.walk) {
+            cam.eye = o + to_double(camera.walk_start) + DVec3{double(camera.walk_step.x) * f, double(camera.walk_step.y) * f,
+                                                               double(camera.walk_step.z) * f};
+            cam.target = cam.eye + to_double(camera.walk_direction);
+        } else {
+            const double a = (double(camera.start_degrees) + double(f) * double(camera.degrees_per_frame)) *
+                             (3.14159265358979323846 / 180.0);
+            cam.target = o + to_double(camera.target);
+            cam.eye = cam.target + DVec3{double(camera.distance) * std::sin(a), double(camera.height),
+                                         double(camera.distance) * std::cos(a)};
+        }
+        cam.up = {0, 1, 0};
+        cam.fovy_radians = camera.fovy_radians;
+        cam.aspect = aspect;
+        cam.z_near = camera.z_near;
+        cam.z_far = camera.z_far;
+        cameras.push_back(cam);
+    }
+    return cameras;
+}
+
 std::vector<Camera> Scene::camera_path(int frames, float aspect) const {
+    if (camera.origin.x != frame_origin.x || camera.origin.y != frame_origin.y || camera.origin.z != frame_origin.z) {
+        std::vector<Camera> cameras;
+        for (const WorldCamera& w : world_camera_path(frames, aspect)) cameras.push_back(w.local(frame_origin));
+        return cameras;
+    }
     std::vector<Camera> cameras;
     for (int f = 0; f < frames; ++f) {
         Camera cam;
@@ -388,7 +457,7 @@ const PoseMeshes& ScenePoser::gpu_meshes(float time_seconds) {
             group_time = times_[i];
         }
         meshes_.first_vertex[i] = group_first;
-        meshes_.to_world[i] = instance_to_world(instance, time_seconds);
+        meshes_.to_world[i] = instance_to_frame(instance, time_seconds, scene.frame_origin);
         meshes_.mirrored[i] = instance_mirrors(instance) ? 1 : 0;
     }
     return meshes_;
@@ -437,7 +506,7 @@ const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
             frame_model = instance.model;
             frame_time = times_[i];
         }
-        const Mat4 to_world = instance_to_world(instance, time_seconds);
+        const Mat4 to_world = instance_to_frame(instance, time_seconds, scene.frame_origin);
         // Tangent vectors map by the linear part of the affine transform (w = 0).
         auto linear = [&](Vec3 d) {
             const Vec4 m = to_world * Vec4{d.x, d.y, d.z, 0.0f};

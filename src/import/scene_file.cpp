@@ -40,6 +40,14 @@ std::string number_text(double v) {
     return text;
 }
 
+// A range bound: as number_text, the scene coordinate limit in full (536870912, not 5.36871e+08).
+std::string bound_text(double v) {
+    if (std::fabs(v) != kMaxSceneCoordinate) return number_text(v);
+    char text[32];
+    std::snprintf(text, sizeof text, "%.0f", v);
+    return text;
+}
+
 std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 std::string index(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
 
@@ -88,8 +96,8 @@ struct Reader {
         if (!std::isfinite(v)) fail(path, "expected a finite number");
         if (std::fabs(v) > double(FLT_MAX)) fail(path, "number " + number_text(v) + " does not fit a float");
         if (!(lo_open ? v > lo : v >= lo) || !(v <= hi))
-            fail(path, "expected a number " + std::string(lo_open ? "> " : ">= ") + number_text(lo) +
-                           (hi < DBL_MAX ? " and <= " + number_text(hi) : "") + ", got " + number_text(v));
+            fail(path, "expected a number " + std::string(lo_open ? "> " : ">= ") + bound_text(lo) +
+                           (hi < DBL_MAX ? " and <= " + bound_text(hi) : "") + ", got " + number_text(v));
         return static_cast<float>(v);
     }
 
@@ -127,14 +135,28 @@ struct Reader {
         return s;
     }
 
-    // A finite coordinate: any float within kMaxSceneCoordinate of 0.
-    Vec3 vec3(const json& j, const std::string& path) const {
+    // A finite number in [lo, hi] kept in double (a world position).
+    double real(const json& j, const std::string& path, double lo, double hi) const {
+        number(j, path, lo, hi);  // the same checks and messages
+        return j.get<double>();
+    }
+
+    // 3 finite floats within `limit` of 0 (offsets, directions, and what is kept in float world
+    // coordinates: cells and portals).
+    Vec3 vec3(const json& j, const std::string& path, double limit = kMaxSceneCoordinate) const {
         if (!j.is_array() || j.size() != 3) fail(path, "expected 3 numbers");
         Vec3 v;
         float* out = &v.x;
-        for (std::size_t k = 0; k < 3; ++k)
-            out[k] = number(j[k], index(path, k), -kMaxSceneCoordinate, kMaxSceneCoordinate);
+        for (std::size_t k = 0; k < 3; ++k) out[k] = number(j[k], index(path, k), -limit, limit);
         return v;
+    }
+
+    // A world position: 3 finite numbers within kMaxSceneCoordinate of 0, in double.
+    DVec3 position(const json& j, const std::string& path) const {
+        if (!j.is_array() || j.size() != 3) fail(path, "expected 3 numbers");
+        double v[3];
+        for (std::size_t k = 0; k < 3; ++k) v[k] = real(j[k], index(path, k), -kMaxSceneCoordinate, kMaxSceneCoordinate);
+        return {v[0], v[1], v[2]};
     }
 
     const json& array(const json& j, const std::string& path, bool non_empty) const {
@@ -158,37 +180,62 @@ double linear_determinant(const Mat4& m) {
            a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
 }
 
+// A transform split into a world origin (double, scene_frame_near: SceneInstance::origin) and a
+// float matrix whose translation is within half a kSceneFrameGrid of 0.
+struct Placement {
+    Mat4 m;
+    DVec3 origin;
+};
+
+// The placement of a world translation t (double) and a float linear part: t's nearest grid
+// point becomes the origin, the rest (|x| <= 8) the float translation, rounded once. Near the
+// world's origin (within 1024) the origin is 0 and the translation float(t), as in float world
+// coordinates (default.json reproduces the built-in scene bit for bit).
+Placement split_translation(Mat4 m, DVec3 t) {
+    Placement out;
+    out.origin = scene_frame_near(t);
+    const DVec3 rest = t - out.origin;
+    m.at(0, 3) = to_float(rest.x);
+    m.at(1, 3) = to_float(rest.y);
+    m.at(2, 3) = to_float(rest.z);
+    out.m = m;
+    return out;
+}
+
 // A transform: an object {position, yaw_degrees, scale | height} or 16 numbers row-major.
 // `standing` (objects only) gives the height form's standing transform. The result maps the
-// object's own coordinates (relative to `origin`, the loader's local frame) to world space.
-Mat4 read_transform(const Reader& r, const json& j, const std::string& path, const LoadedModel* model, DVec3 origin) {
+// object's own coordinates (relative to `origin`, the loader's local frame) to world space:
+// translation(result.origin) * result.m, composed in double.
+Placement read_transform(const Reader& r, const json& j, const std::string& path, const LoadedModel* model,
+                         DVec3 origin) {
     if (j.is_array()) {
         if (j.size() != 16) r.fail(path, "expected 16 numbers (a row-major 4x4 matrix) or an object");
         Mat4 m;
+        double t[3];
         for (int row = 0; row < 4; ++row)
-            for (int col = 0; col < 4; ++col)
-                m.at(row, col) = r.number(j[static_cast<std::size_t>(4 * row + col)], index(path, static_cast<std::size_t>(4 * row + col)),
-                                          -FLT_MAX, FLT_MAX);
+            for (int col = 0; col < 4; ++col) {
+                const std::size_t k = static_cast<std::size_t>(4 * row + col);
+                m.at(row, col) = r.number(j[k], index(path, k), -FLT_MAX, FLT_MAX);
+                if (col == 3 && row < 3) t[row] = j[k].get<double>();
+            }
         if (m.at(3, 0) != 0 || m.at(3, 1) != 0 || m.at(3, 2) != 0 || m.at(3, 3) != 1)
             r.fail(path, "the last row must be 0 0 0 1 (an affine matrix)");
         const double det = linear_determinant(m);
         if (!(std::fabs(det) > 0) || !std::isfinite(det)) r.fail(path, "the matrix is singular (a zero scale)");
-        if (origin.x != 0 || origin.y != 0 || origin.z != 0) {
-            // M * translation(origin), the new translation summed in double.
-            for (int row = 0; row < 3; ++row)
-                m.at(row, 3) = to_float(double(m.at(row, 0)) * origin.x + double(m.at(row, 1)) * origin.y +
-                                        double(m.at(row, 2)) * origin.z + double(m.at(row, 3)));
-        }
-        return m;
+        // M * translation(origin): the translation summed in double.
+        for (int row = 0; row < 3; ++row)
+            t[row] += double(m.at(row, 0)) * origin.x + double(m.at(row, 1)) * origin.y + double(m.at(row, 2)) * origin.z;
+        return split_translation(m, {t[0], t[1], t[2]});
     }
     if (model) r.object(j, path, {"position", "yaw_degrees", "scale", "height"});
     else r.object(j, path, {"position", "yaw_degrees", "scale"});
     const json* p = r.find(j, "position");
-    const Vec3 position = p ? r.vec3(*p, join(path, "position")) : Vec3{};
+    const DVec3 position = p ? r.position(*p, join(path, "position")) : DVec3{};
     const float yaw = r.number_or(j, path, "yaw_degrees", 0, -1e6, 1e6);
     const json* height = model ? r.find(j, "height") : nullptr;
     if (height && r.find(j, "scale")) r.fail(path, "give 'height' or 'scale', not both");
     Mat4 local;
+    DVec3 shift{};  // R * s * origin (the model's local frame, scale form), in double
     if (height) {
         const float h = r.number(*height, join(path, "height"), 0, 1e9, true);
         try {
@@ -198,24 +245,35 @@ Mat4 read_transform(const Reader& r, const json& j, const std::string& path, con
         }
     } else {
         const float s = r.number_or(j, path, "scale", 1, 0, 1e9, true);
-        local = scaling(s) * translation({to_float(origin.x), to_float(origin.y), to_float(origin.z)});
+        local = scaling(s);
+        const Mat4 turn = rotation_y(yaw);
+        const double so[3] = {double(s) * origin.x, double(s) * origin.y, double(s) * origin.z};
+        double* out = &shift.x;
+        for (int row = 0; row < 3; ++row)
+            out[row] = double(turn.at(row, 0)) * so[0] + double(turn.at(row, 1)) * so[1] + double(turn.at(row, 2)) * so[2];
     }
-    return translation(position) * rotation_y(yaw) * local;
+    // translation(rest) * rotation_y(yaw) * local in float, the rest of the position after its
+    // grid origin (all of it near the world's origin) added in float as the built-in scenes do.
+    Placement out;
+    out.origin = scene_frame_near(position + shift);
+    const DVec3 rest = position + shift - out.origin;
+    out.m = translation(patchcull::to_float(rest)) * rotation_y(yaw) * local;
+    return out;
 }
 
 // World-space points must be finite, within kMaxSceneCoordinate of 0 and (together) at least
 // kMinMeshDiagonal across.
-void check_placed(const Reader& r, const std::string& path, const std::vector<Vec3>& points, const char* what) {
+void check_placed(const Reader& r, const std::string& path, const std::vector<DVec3>& points, const char* what) {
     double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-    for (const Vec3& p : points) {
-        const float* c = &p.x;
+    for (const DVec3& p : points) {
+        const double* c = &p.x;
         for (int a = 0; a < 3; ++a) {
-            if (!std::isfinite(c[a]) || std::fabs(double(c[a])) > kMaxSceneCoordinate)
+            if (!std::isfinite(c[a]) || std::fabs(c[a]) > kMaxSceneCoordinate)
                 r.fail(path, std::string("the placed ") + what + " reaches " + number_text(c[a]) +
-                                 "; scene files take world coordinates up to 8192 (scenes are drawn and culled in "
-                                 "float world space; move the scene nearer the origin)");
-            lo[a] = std::min(lo[a], double(c[a]));
-            hi[a] = std::max(hi[a], double(c[a]));
+                                 "; scene files take world coordinates up to 536870912 (2^29: beyond it a double world "
+                                 "position is coarser than the float data it places)");
+            lo[a] = std::min(lo[a], c[a]);
+            hi[a] = std::max(hi[a], c[a]);
         }
     }
     double diagonal = 0;
@@ -432,8 +490,10 @@ Scene load_scene_file(const std::string& path) {
         SceneInstance instance;
         instance.model = found->second;
         const json* t = r.find(o, "transform");
-        instance.object_to_world = t ? read_transform(r, *t, join(p, "transform"), &model, model.origin)
-                                     : read_transform(r, json::object(), join(p, "transform"), &model, model.origin);
+        const Placement placed = t ? read_transform(r, *t, join(p, "transform"), &model, model.origin)
+                                   : read_transform(r, json::object(), join(p, "transform"), &model, model.origin);
+        instance.object_to_world = placed.m;
+        instance.origin = placed.origin;
         if (const json* a = r.find(o, "animation")) {
             const std::string ap = join(p, "animation");
             r.object(*a, ap, {"deform", "time_offset", "velocity"});
@@ -448,10 +508,10 @@ Scene load_scene_file(const std::string& path) {
         if (instance.displaced && scene.displacement.empty())
             r.fail(join(p, "displaced"), "true, but the scene has no displacement map (\"displacement\")");
         // The placed model's control points at rest (which bound the surface) must fit the limits.
-        std::vector<Vec3> points;
+        std::vector<DVec3> points;
         points.reserve(model.rest.patches.size() * kPatchPoints);
         for (const BezierPatch& patch : model.rest.patches)
-            for (const Vec4& c : patch.cp) points.push_back(cartesian(instance.object_to_world * c));
+            for (const Vec4& c : patch.cp) points.push_back(to_double(cartesian(instance.object_to_world * c)) + instance.origin);
         check_placed(r, join(p, "transform"), points, "model");
         const json* n = r.find(o, "name");
         instance.name = n ? r.string(*n, join(p, "name")) : default_keys.at(key) + "#" + std::to_string(copies[instance.model]);
@@ -478,23 +538,27 @@ Scene load_scene_file(const std::string& path) {
             if (const json* box = r.find(e, "box")) {
                 const std::string bp = join(p, "box");
                 r.object(*box, bp, {"min", "max"});
-                const Vec3 lo = r.vec3(r.require(*box, bp, "min"), join(bp, "min"));
-                const Vec3 hi = r.vec3(r.require(*box, bp, "max"), join(bp, "max"));
+                const DVec3 lo = r.position(r.require(*box, bp, "min"), join(bp, "min"));
+                const DVec3 hi = r.position(r.require(*box, bp, "max"), join(bp, "max"));
                 if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
                     r.fail(bp, "max must be greater than min on every axis (a flat or empty box)");
+                // add_box's triangles over its corners (bit 0 = x, bit 1 = y, bit 2 = z), in double.
                 Scene tmp;
-                add_box(tmp, "", lo, hi);
-                for (const Vec3& v : tmp.occluder_vertices) local.push_back({v.x, v.y, v.z});
+                add_box(tmp, "", {0, 0, 0}, {1, 1, 1});
+                for (const Vec3& v : tmp.occluder_vertices)
+                    local.push_back({v.x > 0 ? hi.x : lo.x, v.y > 0 ? hi.y : lo.y, v.z > 0 ? hi.z : lo.z});
                 indices = tmp.occluder_indices;
                 one_sided = true;
             } else if (const json* quad = r.find(e, "quad")) {
                 const std::string qp = join(p, "quad");
                 if (!quad->is_array() || quad->size() != 4) r.fail(qp, "expected 4 corners");
-                Vec3 c[4];
-                for (std::size_t k = 0; k < 4; ++k) c[k] = r.vec3((*quad)[k], index(qp, k));
-                const float area = length(cross(c[1] - c[0], c[2] - c[0])) + length(cross(c[2] - c[0], c[3] - c[0]));
+                DVec3 c[4];
+                for (std::size_t k = 0; k < 4; ++k) c[k] = r.position((*quad)[k], index(qp, k));
+                // The area from offsets to the first corner (small numbers, whatever the position).
+                const Vec3 e1 = to_float(c[1] - c[0]), e2 = to_float(c[2] - c[0]), e3 = to_float(c[3] - c[0]);
+                const float area = length(cross(e1, e2)) + length(cross(e2, e3));
                 if (!(area > 0)) r.fail(qp, "the corners span no area");
-                for (const Vec3& v : c) local.push_back({v.x, v.y, v.z});
+                for (const DVec3& v : c) local.push_back(v);
                 indices = {0, 1, 2, 0, 2, 3};
             } else {
                 const std::string file = r.resolve(r.string(*r.find(e, "obj"), join(p, "obj")));
@@ -517,19 +581,26 @@ Scene load_scene_file(const std::string& path) {
             // The transform maps the object's coordinates (an OBJ's own, with its local frame's
             // origin added back) to world space, in double.
             const json* t = r.find(e, "transform");
-            const Mat4 m = t ? read_transform(r, *t, join(p, "transform"), nullptr, {}) : Mat4{};
+            const Placement placed = t ? read_transform(r, *t, join(p, "transform"), nullptr, {}) : Placement{};
+            const Mat4& m = placed.m;
             const double det = linear_determinant(m);
             if (!(std::fabs(det) > 0)) r.fail(join(p, "transform"), "the transform is singular (a zero scale)");
-            std::vector<Vec3> world;
+            std::vector<DVec3> world;
             world.reserve(local.size());
             for (const DVec3& v : local) {
                 const double x = v.x + origin.x, y = v.y + origin.y, z = v.z + origin.z;
                 double w[3];
                 for (int row = 0; row < 3; ++row)
                     w[row] = double(m.at(row, 0)) * x + double(m.at(row, 1)) * y + double(m.at(row, 2)) * z + double(m.at(row, 3));
-                world.push_back({to_float(w[0]), to_float(w[1]), to_float(w[2])});
+                world.push_back(DVec3{w[0], w[1], w[2]} + placed.origin);
             }
             check_placed(r, t ? join(p, "transform") : p, world, "environment object");
+            // The scene's frame is the world's (origin 0): float world vertices, and the exact
+            // ones in double for rebase_scene.
+            std::vector<Vec3> world_float;
+            world_float.reserve(world.size());
+            for (const DVec3& v : world) world_float.push_back({to_float(v.x), to_float(v.y), to_float(v.z)});
+            scene.occluder_world.insert(scene.occluder_world.end(), world.begin(), world.end());
             // A mirroring transform turns counter-clockwise into clockwise: flip the triangles back.
             if (det < 0)
                 for (std::size_t k = 0; k + 2 < indices.size(); k += 3) std::swap(indices[k + 1], indices[k + 2]);
@@ -538,7 +609,7 @@ Scene load_scene_file(const std::string& path) {
             if (!environment_names.emplace(object_name, i).second)
                 r.fail(join(p, "name"), "duplicate environment name " + quote_input(object_name) + " (also environment[" +
                                             std::to_string(environment_names[object_name]) + "])");
-            add_triangles(scene, object_name, world, indices, one_sided);
+            add_triangles(scene, object_name, world_float, indices, one_sided);
         }
     }
 
@@ -552,7 +623,9 @@ Scene load_scene_file(const std::string& path) {
         if (orbit) {
             r.object(*orbit, "camera.orbit", {"target", "distance", "height", "start_degrees", "degrees_per_frame"});
             const json* target = r.find(*orbit, "target");
-            cam.target = target ? r.vec3(*target, "camera.orbit.target") : Vec3{};
+            const DVec3 t = target ? r.position(*target, "camera.orbit.target") : DVec3{};
+            cam.origin = scene_frame_near(t);
+            cam.target = to_float(t - cam.origin);
             cam.distance = r.number(r.require(*orbit, "camera.orbit", "distance"), "camera.orbit.distance", 0, kMaxMeshExtent, true);
             cam.height = r.number_or(*orbit, "camera.orbit", "height", 0, -kMaxMeshExtent, kMaxMeshExtent);
             cam.start_degrees = r.number_or(*orbit, "camera.orbit", "start_degrees", 0, -1e6, 1e6);
@@ -560,7 +633,9 @@ Scene load_scene_file(const std::string& path) {
         } else {
             r.object(*walk, "camera.walk", {"start", "step", "direction", "view_distance"});
             cam.walk = true;
-            cam.walk_start = r.vec3(r.require(*walk, "camera.walk", "start"), "camera.walk.start");
+            const DVec3 start = r.position(r.require(*walk, "camera.walk", "start"), "camera.walk.start");
+            cam.origin = scene_frame_near(start);
+            cam.walk_start = to_float(start - cam.origin);
             cam.walk_step = r.vec3(r.require(*walk, "camera.walk", "step"), "camera.walk.step");
             cam.walk_direction = r.vec3(r.require(*walk, "camera.walk", "direction"), "camera.walk.direction");
             const Vec3 d = cam.walk_direction;
@@ -588,8 +663,8 @@ Scene load_scene_file(const std::string& path) {
             cell.name = r.string(r.require(c, p, "name"), join(p, "name"));
             if (!cell_names.emplace(cell.name, i).second)
                 r.fail(join(p, "name"), "duplicate cell name " + quote_input(cell.name));
-            cell.box.min = r.vec3(r.require(c, p, "min"), join(p, "min"));
-            cell.box.max = r.vec3(r.require(c, p, "max"), join(p, "max"));
+            cell.box.min = r.vec3(r.require(c, p, "min"), join(p, "min"), kMaxFloatWorldCoordinate);
+            cell.box.max = r.vec3(r.require(c, p, "max"), join(p, "max"), kMaxFloatWorldCoordinate);
             if (!(cell.box.max.x > cell.box.min.x && cell.box.max.y > cell.box.min.y && cell.box.max.z > cell.box.min.z))
                 r.fail(p, "max must be greater than min on every axis");
             auto names = [&](const char* key, const std::map<std::string, std::size_t>& known, const char* what,
@@ -631,7 +706,8 @@ Scene load_scene_file(const std::string& path) {
             if (portal.cell_a == portal.cell_b) r.fail(join(p, "cells"), "a portal joins two different cells");
             const json& corners = r.require(o, p, "corners");
             if (!corners.is_array() || corners.size() != 4) r.fail(join(p, "corners"), "expected 4 corners");
-            for (std::size_t k = 0; k < 4; ++k) portal.corners[k] = r.vec3(corners[k], index(join(p, "corners"), k));
+            for (std::size_t k = 0; k < 4; ++k)
+                portal.corners[k] = r.vec3(corners[k], index(join(p, "corners"), k), kMaxFloatWorldCoordinate);
             const Vec3* c = portal.corners;
             if (!(length(cross(c[1] - c[0], c[2] - c[0])) + length(cross(c[2] - c[0], c[3] - c[0])) > 0))
                 r.fail(join(p, "corners"), "the corners span no area");
@@ -649,35 +725,48 @@ struct Reach {
     int axis = -1;
     double value = 0;
 };
-Reach beyond_limit(const double lo[3], const double hi[3], const double d[3]) {
+Reach beyond_limit(const double lo[3], const double hi[3], const double d[3], double limit) {
     for (int a = 0; a < 3; ++a)
         for (double c : {lo[a] + d[a], hi[a] + d[a]})
-            if (!(std::fabs(c) <= kMaxSceneCoordinate)) return {a, c};
+            if (!(std::fabs(c) <= limit)) return {a, c};
     return {};
 }
 
+static_assert(kMaxSceneCoordinate == 536870912.0, "the messages name the limit as 536870912 (2^29)");
+
+// A limit as written in the docs: 536870912 (2^29), 8192.
+std::string limit_text(double limit) {
+    char text[48];
+    std::snprintf(text, sizeof text, "%.0f", limit);
+    return text + std::string(limit == kMaxSceneCoordinate ? " (2^29)" : "");
+}
+
 [[noreturn]] void motion_fail(const std::string& source, const std::string& path, const std::string& what, Reach r,
-                              int frame, double seconds) {
+                              int frame, double seconds, double limit, const char* advice) {
     static const char* const axes[3] = {"x", "y", "z"};
     throw Error(printable_line(source + ": " + path + ": " + what + " reaches " + axes[r.axis] + " = " +
                                number_text(r.value) + " at frame " + std::to_string(frame) + " (time " +
-                               number_text(seconds) + " s); scenes take world coordinates up to " +
-                               number_text(kMaxSceneCoordinate) + " (render fewer frames, or move it less far)"));
+                               number_text(seconds) + " s); " + advice + limit_text(limit)));
 }
 
 }  // namespace
 
-void check_scene_motion(const Scene& scene, const std::string& source, int frames, double seconds_per_frame) {
+void check_scene_motion(const Scene& scene, const std::string& source, int frames, double seconds_per_frame,
+                        double limit) {
     if (frames <= 0) return;
     const int last = frames - 1;
+    const char* advice = limit >= kMaxSceneCoordinate ? "scenes take world coordinates up to "
+                                                      : "this command draws scenes in float world coordinates, up to ";
     auto seconds = [&](int f) { return double(f) * seconds_per_frame; };
+    const DVec3 world = scene.frame_origin;
     // Objects: the placed rest control points' box (in double), moved by velocity x time.
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
         const SceneInstance& instance = scene.instances[i];
         const Vec3 v = instance.velocity;
-        if (v.x == 0 && v.y == 0 && v.z == 0) continue;  // placed once: the loader checked it
+        const bool moves = v.x != 0 || v.y != 0 || v.z != 0;
         const Mat4& m = instance.object_to_world;
         double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+        const double o[3] = {instance.origin.x, instance.origin.y, instance.origin.z};
         for (const BezierPatch& patch : scene.models.at(instance.model).rest.patches)
             for (const Vec4& c : patch.cp) {
                 const double h[4] = {c.x, c.y, c.z, c.w};
@@ -686,50 +775,68 @@ void check_scene_motion(const Scene& scene, const std::string& source, int frame
                 for (int a = 0; a < 3; ++a) {
                     double x = 0;
                     for (int k = 0; k < 4; ++k) x += double(m.at(a, k)) * h[k];
-                    x /= w;
+                    x = x / w + o[a];
                     lo[a] = std::min(lo[a], x);
                     hi[a] = std::max(hi[a], x);
                 }
             }
         auto moved = [&](int f) {
-            const double t = seconds(f) + double(instance.time_offset);
+            const double t = moves ? seconds(f) + double(instance.time_offset) : 0.0;
             const double d[3] = {double(v.x) * t, double(v.y) * t, double(v.z) * t};
-            return beyond_limit(lo, hi, d);
+            return beyond_limit(lo, hi, d, limit);
         };
         // The motion is linear: within the limit at the first and the last frame, within it at
         // every frame between.
         if (moved(0).axis < 0 && moved(last).axis < 0) continue;
         for (int f = 0; f <= last; ++f)
             if (const Reach r = moved(f); r.axis >= 0) {
-                const std::string path = "objects[" + std::to_string(i) + "].animation." +
-                                         (f == 0 && instance.time_offset != 0 ? "time_offset" : "velocity");
-                motion_fail(source, path, "the moving model (" + quote_input(instance.name) + ")", r, f, seconds(f));
+                const std::string path = "objects[" + std::to_string(i) + "]" +
+                                         (!moves                                  ? ".transform"
+                                          : f == 0 && instance.time_offset != 0 ? ".animation.time_offset"
+                                                                                 : ".animation.velocity");
+                motion_fail(source, path, std::string(moves ? "the moving" : "the placed") + " model (" +
+                                              quote_input(instance.name) + ")",
+                            r, f, seconds(f), limit, advice);
             }
+    }
+    // The environment, the cells and the portals do not move.
+    const double zero[3] = {0, 0, 0};
+    for (std::size_t e = 0; e < scene.environment.size(); ++e) {
+        const EnvironmentObject& object = scene.environment[e];
+        for (std::size_t k = 3 * std::size_t{object.first_triangle};
+             k < 3 * (std::size_t{object.first_triangle} + object.triangle_count); ++k) {
+            const std::uint32_t index = scene.occluder_indices[k];
+            const DVec3 p = scene.occluder_world.empty() ? to_double(scene.occluder_vertices[index]) + world
+                                                         : scene.occluder_world[index];
+            const double c[3] = {p.x, p.y, p.z};
+            if (const Reach r = beyond_limit(c, c, zero, limit); r.axis >= 0)
+                motion_fail(source, "environment[" + std::to_string(e) + "]",
+                            "the environment object (" + quote_input(object.name) + ")", r, 0, 0, limit, advice);
+        }
+    }
+    for (std::size_t i = 0; i < scene.cells.size(); ++i) {
+        const Bounds& b = scene.cells[i].box;
+        const double lo[3] = {b.min.x + world.x, b.min.y + world.y, b.min.z + world.z};
+        const double hi[3] = {b.max.x + world.x, b.max.y + world.y, b.max.z + world.z};
+        if (const Reach r = beyond_limit(lo, hi, zero, limit); r.axis >= 0)
+            motion_fail(source, "cells[" + std::to_string(i) + "]", "the cell", r, 0, 0, limit, advice);
     }
     // The camera: its eye and target at every frame (the path is not linear for an orbit).
     const CameraPath& c = scene.camera;
+    const std::vector<WorldCamera> cameras = scene.world_camera_path(frames, 1.0f);
     for (int f = 0; f <= last; ++f) {
-        double eye[3], target[3];
-        if (c.walk) {
-            for (int a = 0; a < 3; ++a) {
-                eye[a] = double((&c.walk_start.x)[a]) + double(f) * double((&c.walk_step.x)[a]);
-                target[a] = eye[a] + double((&c.walk_direction.x)[a]);
-            }
-        } else {
-            const double angle = (double(c.start_degrees) + double(f) * double(c.degrees_per_frame)) * (3.14159265358979323846 / 180.0);
-            target[0] = c.target.x, target[1] = c.target.y, target[2] = c.target.z;
-            eye[0] = target[0] + double(c.distance) * std::sin(angle);
-            eye[1] = target[1] + double(c.height);
-            eye[2] = target[2] + double(c.distance) * std::cos(angle);
-        }
-        const double zero[3] = {0, 0, 0};
-        if (const Reach r = beyond_limit(eye, eye, zero); r.axis >= 0)
+        const WorldCamera& cam = cameras[static_cast<std::size_t>(f)];
+        const double eye[3] = {cam.eye.x, cam.eye.y, cam.eye.z};
+        const double target[3] = {cam.target.x, cam.target.y, cam.target.z};
+        if (const Reach r = beyond_limit(eye, eye, zero, limit); r.axis >= 0)
             motion_fail(source,
-                        c.walk ? "camera.walk.step" : r.axis == 1 ? "camera.orbit.height" : "camera.orbit.distance",
-                        "the camera's eye", r, f, seconds(f));
-        if (const Reach r = beyond_limit(target, target, zero); r.axis >= 0)
+                        c.walk ? (f == 0 ? "camera.walk.start" : "camera.walk.step")
+                        : r.axis == 1 ? "camera.orbit.height"
+                                      : "camera.orbit.distance",
+                        "the camera's eye", r, f, seconds(f), limit, advice);
+        if (const Reach r = beyond_limit(target, target, zero, limit); r.axis >= 0)
             motion_fail(source, c.walk ? "camera.walk.direction" : "camera.orbit.target", "the camera's target", r, f,
-                        seconds(f));
+                        seconds(f), limit, advice);
     }
 }
 

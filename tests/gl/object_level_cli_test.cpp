@@ -218,14 +218,20 @@ TEST(ObjectLevelCli, MirroredRigidInstanceHasNoFalseCulls) {
     (void)s;
 }
 
-// A rigid BigGuy at 1e5 from the origin. Its world-space float control points are rounded by
-// ~0.008: the object-space patch clusters culled drawn patches at the silhouette (26 false culls
-// in 6 frames; fixed by kClusterRoundingRatio, scene_object_level.h), and with --cull occlusion
-// the Hi-Z test culled visible patches from 2e4 on. Scene files now refuse world coordinates
-// beyond kMaxSceneCoordinate (8192) with one line naming the file and the JSON path.
-TEST(ObjectLevelCli, FarSceneFilesAreRefused) {
-    expect_one_line_error(run("render " + test_scene("far_rigid_1e5.json") + " --objects bvh+backface --frames 1 --json"),
-                          "far_rigid_1e5.json: objects[0].transform.position[0]: expected a number >= -8192 and <= 8192");
+// A rigid BigGuy at 1e5 from the origin. Drawn in float world coordinates, its control points
+// were rounded by ~0.008: the object-space patch clusters culled drawn patches at the silhouette
+// (26 false culls in 6 frames; kClusterRoundingRatio, scene_object_level.h, then left them out),
+// and with --cull occlusion the Hi-Z test culled visible patches from 2e4 on. Drawn in a frame
+// near the camera (rebase_scene), the clusters are used again (cluster tests every frame) and
+// nothing is culled falsely.
+TEST(ObjectLevelCli, FarSceneFilesVerify) {
+    const std::string far = "render " + test_scene("far_rigid_1e5.json") + " --size 160x90 --tess 2 --frames 6";
+    verified_render(far + " --objects bvh+backface", 1, 6);
+    const CliRun r = run(far + " --objects bvh+backface --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    for (const auto& frame : nlohmann::json::parse(r.out)["frames"])
+        EXPECT_GT(frame["objects"]["cluster_tests"].get<std::size_t>(), 0u) << frame.dump();
+    verified_render(far + " --cull occlusion --objects frustum", 1, 6);
 }
 
 namespace patchcull::gl {

@@ -395,7 +395,7 @@ TEST(SceneFile, PathsAreRelativeToTheFile) {
 TEST(SceneFile, FarFromTheOriginAndMirrored) {
     const TempDir dir("far");
     // An OBJ environment mesh at 5000 (the OBJ reader recentres it; the file adds the origin back
-    // in double), a character and a box at 2000-8000 (kMaxSceneCoordinate is 8192).
+    // in double), a character and a box at 2000-8000.
     write(dir / "far.obj", cube_obj(5000, 2));
     write(dir / "cube.obj", cube_obj());
     std::string text = with(valid_scene(), R"("obj": "cube.obj", "transform": {"position": [-3, 0, 3], "scale": 2})",
@@ -412,15 +412,34 @@ TEST(SceneFile, FarFromTheOriginAndMirrored) {
     EXPECT_EQ(b.min.x, 5000.0f);
     EXPECT_EQ(b.max.x, 5002.0f);
     EXPECT_EQ(b.max.z, 5002.0f);
-    EXPECT_EQ(s.instances[1].object_to_world.at(2, 3), 8000.0f);
-    // An OBJ environment mesh beyond it is refused with one line.
-    write(dir / "far2.obj", cube_obj(1e5, 2));
+    // The character's position beyond kSceneWorldFrame: its frame origin (a multiple of
+    // kSceneFrameGrid, in double) and a float rest within 8 of it (0 here); placed in the world
+    // frame, 8000 again.
+    EXPECT_EQ(s.instances[1].origin.z, 8000.0);
+    EXPECT_EQ(s.instances[1].origin.x, 2000.0);
+    EXPECT_EQ(s.instances[1].object_to_world.at(2, 3), 0.0f);
+    EXPECT_EQ(instance_to_world(s.instances[1], 0).at(2, 3), 8000.0f);
+    EXPECT_EQ(s.instances[0].origin.x, 0.0);  // near the origin: no grid origin, as before
+    // An OBJ environment mesh at 1e5 keeps its exact vertices in double (Scene::occluder_world),
+    // one per occluder vertex; one beyond kMaxSceneCoordinate is refused with one line.
+    write(dir / "far1.obj", cube_obj(1e5 + 0.25, 2));
+    write(dir / "c.json", with(text, R"("obj": "far.obj")", R"("obj": "far1.obj")"));
+    const Scene c = load_scene_file((dir / "c.json").string());
+    ASSERT_EQ(c.occluder_world.size(), c.occluder_vertices.size());
+    double lo = 1e30;
+    for (std::uint32_t t = c.environment[2].first_triangle; t < c.environment[2].first_triangle + c.environment[2].triangle_count; ++t)
+        for (int k = 0; k < 3; ++k) lo = std::min(lo, c.occluder_world[c.occluder_indices[3 * t + k]].x);
+    EXPECT_EQ(lo, 1e5 + 0.25);
+    write(dir / "far2.obj", cube_obj(1e9, 2));
     write(dir / "b.json", with(text, R"("obj": "far.obj")", R"("obj": "far2.obj")"));
     try {
         load_scene_file((dir / "b.json").string());
-        ADD_FAILURE() << "a mesh at 1e5 loaded";
+        ADD_FAILURE() << "a mesh at 1e9 loaded";
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("scene files take world coordinates up to 8192"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("environment[2]: the placed environment object reaches 1e+09; scene files "
+                                             "take world coordinates up to 536870912 (2^29"),
+                  std::string::npos)
+            << e.what();
     }
     // A mirroring matrix keeps boxes outward: the triangles are flipped back.
     text = with(valid_scene(), R"("box": {"min": [3, 0, 3], "max": [4, 1, 4]})",
@@ -518,15 +537,19 @@ TEST_F(SceneFileErrors, TransformsAndDegenerateInputs) {
                   .find("e-09 units across; patchcull takes meshes of at least 1e-06 units across (the kernels work in float)"),
               std::string::npos);
     expect(with(valid_scene(), "\"position\": [2, 0, 0]", "\"position\": [2, 0, 3e11]"),
-           "objects[1].transform.position[2]: expected a number >= -8192 and <= 8192, got 3e+11");
-    // kMaxSceneCoordinate: scenes are culled in float world space; 2e4 showed false culls.
-    expect(with(valid_scene(), "\"position\": [2, 0, 0]", "\"position\": [2, 0, 20000]"),
-           "objects[1].transform.position[2]: expected a number >= -8192 and <= 8192, got 20000");
+           "objects[1].transform.position[2]: expected a number >= -536870912 and <= 536870912, got 3e+11");
+    // kMaxSceneCoordinate (2^29): beyond it a double world position is coarser than the floats
+    // it places.
+    expect(with(valid_scene(), "\"position\": [2, 0, 0]", "\"position\": [2, 0, 6e8]"),
+           "objects[1].transform.position[2]: expected a number >= -536870912 and <= 536870912, got 6e+08");
+    // Cells and portals stay in float world coordinates: kMaxFloatWorldCoordinate.
+    expect(with(valid_scene(), "\"min\": [0, 0, -5], \"max\": [5, 3, 5]", "\"min\": [0, 0, -5], \"max\": [9000, 3, 5]"),
+           "cells[1].max[0]: expected a number >= -8192 and <= 8192, got 9000");
     const std::string huge = with(valid_scene(), "[1, 0, 0, -2, 0, 1, 0, 0, 0, 0, 1, 0", "[5e11, 0, 0, -2, 0, 5e11, 0, 0, 0, 0, 5e11, 0");
     expect_prefix(huge, "objects[2].transform: the placed model reaches ");
     EXPECT_NE(load_error(dir_, huge)
-                  .find("e+11; scene files take world coordinates up to 8192 (scenes are drawn and culled in float "
-                        "world space; move the scene nearer the origin)"),
+                  .find("e+11; scene files take world coordinates up to 536870912 (2^29: beyond it a double world "
+                        "position is coarser than the float data it places)"),
               std::string::npos);
     expect(with(valid_scene(), "\"max\": [4, 1, 4]", "\"max\": [4, 0, 4]"),
            "environment[1].box: max must be greater than min on every axis (a flat or empty box)");

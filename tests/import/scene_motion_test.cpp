@@ -47,10 +47,11 @@ Scene load_text(const TempDir& dir, const std::string& text, const std::string& 
     return load_scene_file(path.string());
 }
 
-// The error check_scene_motion gives ("" when the motion stays within the limit).
-std::string motion_error(const Scene& scene, int frames) {
+// The error check_scene_motion gives ("" when the motion stays within the limit). The float world
+// limit (8192) keeps the numbers small; the scene limit is tested at the end.
+std::string motion_error(const Scene& scene, int frames, double limit = kMaxFloatWorldCoordinate) {
     try {
-        check_scene_motion(scene, "a.json", frames, kSecondsPerFrame);
+        check_scene_motion(scene, "a.json", frames, kSecondsPerFrame, limit);
     } catch (const Error& e) {
         const std::string what = e.what();
         EXPECT_EQ(what.find('\n'), std::string::npos) << what;
@@ -70,9 +71,9 @@ const std::string kOrbit = R"({"orbit": {"distance": 4, "height": 1}})";
 
 // The first frame f at which an object whose placed box ends at hi_x reaches beyond the limit
 // moving at speed (t = f / 12 + offset).
-int first_frame_beyond(double hi_x, double speed, double offset) {
+int first_frame_beyond(double hi_x, double speed, double offset, double limit = kMaxFloatWorldCoordinate) {
     for (int f = 0;; ++f)
-        if (hi_x + speed * (f * kSecondsPerFrame + offset) > kMaxSceneCoordinate) return f;
+        if (hi_x + speed * (f * kSecondsPerFrame + offset) > limit) return f;
 }
 
 }  // namespace
@@ -211,4 +212,126 @@ TEST(SceneFileNames, DefaultNamesAreUniqueAcrossSchemesAndPaths) {
                   std::string::npos)
             << e.what();
     }
+}
+
+// The scene limit (2^29) of `render`, which draws each frame near its camera: 1e6 units out is
+// accepted, a scene that moves beyond 2^29 refused; the float world limit of the other commands
+// refuses the same 1e6 scene and says why.
+TEST(SceneMotion, TheSceneLimitAndTheFloatWorldLimit) {
+    TempDir dir(test_name());
+    const Scene far = load_text(dir, scene_text(R"({"time_offset": 1e6, "velocity": [1, 0, 0]})", kOrbit));
+    EXPECT_EQ(motion_error(far, 200, kMaxSceneCoordinate), "");
+    std::string e = motion_error(far, 1);
+    EXPECT_NE(e.find("objects[1].animation.time_offset: the moving model ('monsterfrog#0') reaches x = 999999 at frame "
+                     "0 (time 0 s); this command draws scenes in float world coordinates, up to 8192"),
+              std::string::npos)
+        << e;
+    // 1e6 units per second from 5e8 (time offset 500 s): beyond 2^29 after 36.87 s.
+    const Scene fast = load_text(dir, scene_text(R"({"time_offset": 500, "velocity": [1e6, 0, 0]})", kOrbit), "b.json");
+    double hi_x = -1e30;
+    for (const BezierPatch& p : fast.models.at(fast.instances[1].model).rest.patches)
+        for (const Vec4& c : p.cp) hi_x = std::max(hi_x, double(cartesian(fast.instances[1].object_to_world * c).x));
+    const int f = first_frame_beyond(hi_x, 1e6, 500, kMaxSceneCoordinate);
+    EXPECT_EQ(f, 443);  // (2^29 - 5e8) / 1e6 s = 36.87 s: frame 443 (36.92 s)
+    EXPECT_EQ(motion_error(fast, f, kMaxSceneCoordinate), "");
+    e = motion_error(fast, f + 1, kMaxSceneCoordinate);
+    EXPECT_NE(e.find("objects[1].animation.velocity: the moving model ('monsterfrog#0') reaches x = 5.36"), std::string::npos) << e;
+    EXPECT_NE(e.find(" at frame 443 (time 36.9167 s); scenes take world coordinates up to 536870912 (2^29)"),
+              std::string::npos)
+        << e;
+    // Static placements beyond the float world limit are named by their JSON path.
+    const Scene placed = load_text(
+        dir, R"({"objects": [{"model": "bigguy", "transform": {"position": [3e5, 0, 0]}}], "camera": {"orbit": {"distance": 4}}})",
+        "c.json");
+    EXPECT_EQ(motion_error(placed, 1, kMaxSceneCoordinate), "");
+    EXPECT_NE(motion_error(placed, 1).find("a.json: objects[0].transform: the placed model ('bigguy#0') reaches x = 299"),
+              std::string::npos)
+        << motion_error(placed, 1);
+}
+
+// Frames near the camera (default_scene.h): scene_frame_near's grid, instance_to_frame composed
+// in double, rebase_scene rounding world coordinates into a frame once, camera paths in double.
+TEST(SceneFrames, FrameOriginsAreTheWorldNearTheOriginAndAGridFarOut) {
+    const DVec3 near = scene_frame_near({1000, -1024, 3});
+    EXPECT_EQ(near.x, 0.0);
+    EXPECT_EQ(near.y, 0.0);
+    EXPECT_EQ(near.z, 0.0);
+    const DVec3 far = scene_frame_near({1e6 + 7.9, 3, -1e5 - 8.2});
+    EXPECT_EQ(far.x, 1e6);  // multiples of 16, on every axis
+    EXPECT_EQ(far.y, 0.0);
+    EXPECT_EQ(far.z, -1e5 - 16);
+    const DVec3 eye{-4.2e8 + 0.3, 1025, 12345.678};
+    const DVec3 o = scene_frame_near(eye);
+    for (double d : {eye.x - o.x, eye.y - o.y, eye.z - o.z}) EXPECT_LE(std::fabs(d), kSceneFrameGrid / 2);
+}
+
+TEST(SceneFrames, InstancesAreComposedInDoubleAndRoundedOnce) {
+    SceneInstance instance;
+    instance.object_to_world.at(0, 3) = 0.25f;
+    instance.origin = {1e6, 0, -3e5};
+    instance.velocity = {8000, 0, 0.5f};
+    instance.time_offset = 1000;
+    // At t = 1 / 12: x = 0.25 + 1e6 + 8000 * 1000.0833..., in the frame at (9e6, 0, -3e5).
+    const DVec3 frame{9e6, 0, -3e5};
+    const Mat4 m = instance_to_frame(instance, 1.0f / 12.0f, frame);
+    const double t = double(1.0f / 12.0f) + 1000.0;
+    EXPECT_EQ(m.at(0, 3), static_cast<float>(0.25 + 1e6 + 8000.0 * t - 9e6));
+    EXPECT_EQ(m.at(2, 3), static_cast<float>(0.5 * t));
+    EXPECT_EQ(m.at(0, 0), 1.0f);
+    // Into the world frame it is instance_to_world; a still instance at the origin keeps its matrix.
+    const Mat4 w = instance_to_world(instance, 0);
+    EXPECT_EQ(w.at(0, 3), static_cast<float>(0.25 + 1e6 + 8000.0 * 1000.0));
+    SceneInstance still;
+    still.object_to_world.at(1, 3) = 0.1f;
+    EXPECT_EQ(instance_to_world(still, 5).at(1, 3), 0.1f);
+}
+
+TEST(SceneFrames, RebasedScenesPoseNearTheirFrame) {
+    TempDir dir(test_name());
+    // A BigGuy and a quad 1e6 out, an orbit camera around them.
+    const Scene world = load_text(dir, R"({"objects": [{"model": "bigguy", "transform": {"position": [1000000.3, 0, 0], "height": 1},
+                                                        "animation": {"deform": false, "velocity": [1, 0, 0]}}],
+        "environment": [{"quad": [[999990.1, 0, -5], [999990.1, 0, 5], [1000010.1, 0, 5], [1000010.1, 0, -5]]}],
+        "camera": {"orbit": {"target": [1000000.3, 0.5, 0], "distance": 3, "height": 0.5}}})");
+    EXPECT_EQ(world.instances[0].origin.x, 1000000.0);
+    EXPECT_EQ(world.camera.origin.x, 1000000.0);
+    ASSERT_EQ(world.occluder_world.size(), world.occluder_vertices.size());
+    const std::vector<WorldCamera> cameras = world.world_camera_path(3, 1.5f);
+    const DVec3 origin = scene_frame_near(cameras[1].eye);
+    Scene frame;
+    frame.models = world.models;
+    rebase_scene(world, origin, frame);
+    EXPECT_EQ(frame.frame_origin.x, origin.x);
+    // Occluders: world coordinates minus the origin, rounded once (near 0).
+    for (std::size_t i = 0; i < frame.occluder_vertices.size(); ++i) {
+        EXPECT_EQ(frame.occluder_vertices[i].x, static_cast<float>(world.occluder_world[i].x - origin.x));
+        EXPECT_LE(std::fabs(frame.occluder_vertices[i].x), 20.0f);
+    }
+    // Cameras: the world camera moved into the frame; its eye within 8 of 0.
+    const std::vector<Camera> local = frame.camera_path(3, 1.5f);
+    const Camera expected = cameras[1].local(origin);
+    EXPECT_NEAR(local[1].eye.x, expected.eye.x, 1e-5);
+    EXPECT_NEAR(local[1].eye.z, expected.eye.z, 1e-5);
+    EXPECT_LE(std::fabs(local[1].eye.x), 8.0f);
+    // A frame the path's origin is not: composed in double (world_camera_path, then local).
+    Scene moved;
+    rebase_scene(world, {origin.x + 32, origin.y, origin.z}, moved);
+    const Camera there = moved.camera_path(3, 1.5f)[2];
+    const Camera expected_there = cameras[2].local({origin.x + 32, origin.y, origin.z});
+    EXPECT_EQ(there.eye.x, expected_there.eye.x);
+    EXPECT_EQ(there.target.z, expected_there.target.z);
+    // Patches: posed near 0, where the world's patches are, to float precision at their size.
+    ScenePoser world_poser(world), frame_poser(frame);
+    const std::vector<BezierPatch> far = world_poser.pose(1.0f / 12.0f);
+    const std::vector<BezierPatch>& near = frame_poser.pose(1.0f / 12.0f);
+    ASSERT_EQ(far.size(), near.size());
+    const double x = 1000000.3 + 1.0 / 12.0 - origin.x;
+    float lo = 1e30f, hi = -1e30f;
+    for (const BezierPatch& p : near)
+        for (const Vec4& c : p.cp) lo = std::min(lo, c.x), hi = std::max(hi, c.x);
+    EXPECT_LT(lo, float(x));
+    EXPECT_GT(hi, float(x));
+    EXPECT_LT(hi - lo, 2.0f);
+    for (std::size_t p = 0; p < near.size(); p += 97)
+        for (int k = 0; k < 16; ++k) EXPECT_NEAR(double(near[p].cp[k].x) + origin.x, double(far[p].cp[k].x), 0.07);
 }
