@@ -177,8 +177,11 @@ std::vector<SceneObject> scene_objects(const Scene& scene) {
     for (const SceneInstance& instance : scene.instances) {
         const LoadedModel& model = scene.models.at(instance.model);
         SceneObject o;
-        // LoadedModel::name is the OBJ path (or "teapot"): its file name without the extension.
-        o.name = std::filesystem::path(model.name).stem().string() + "#" + std::to_string(copies[instance.model]++);
+        // The instance's own name (unique: every scene builder and the scene file reader set
+        // it); else LoadedModel::name (the OBJ path or "teapot") without the extension.
+        const std::size_t copy = copies[instance.model]++;
+        o.name = !instance.name.empty() ? instance.name
+                                        : std::filesystem::path(model.name).stem().string() + "#" + std::to_string(copy);
         o.range.first = first;
         o.range.count = model.rest.patches.size();
         o.range.cull = true;

@@ -121,8 +121,9 @@ void upload_scene_occluders(gl::PatchRenderer& renderer, const Scene& scene);
 /// One object of a scene for PipelineParams::objects: an instance's patches in the pose
 /// (ScenePoser's order: instance by instance, each in its model's order).
 struct SceneObject {
-    /// The model's file name without extension, '#', the instance's number among that model's
-    /// instances from 0 ("bigguy#0", "monsterfrog#2", "teapot#0").
+    /// The instance's name (SceneInstance::name, unique: "bigguy#0", "monsterfrog#2",
+    /// "teapot#0", a scene file's names); for an unnamed instance the model's file name without
+    /// extension, '#', its number among that model's instances from 0.
     std::string name;
     gl::ObjectRange range;  ///< first patch, patch count; cull = true
 };
