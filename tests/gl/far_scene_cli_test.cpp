@@ -1,9 +1,10 @@
 // Scenes far from the origin, drawn camera-relative (default_scene.h's rebase_scene): `render
 // SCENE --verify` reports 0 false culls for a chase at 8000 units per second (a BigGuy and a
 // displaced MonsterFrog, both deforming, a walk camera following them to 1.3e5 units in 200
-// frames) and for characters, a ground and a wall placed 1e5 and 1e6 units out by their time
-// offset, under every cull mode and back-patch method, the fused pass, GPU posing, displaced
-// bounds, every --objects method and the --object-occlusion methods a scene without cells has.
+// frames) and for characters, a ground and a wall placed 1e6 units out by their time offset,
+// under every cull mode and back-patch method, the fused pass, GPU posing, displaced bounds,
+// every --objects method and the --object-occlusion methods a scene without cells has (and at
+// 1e5 under a few of them: the added runs must stay within about a minute on two cores).
 // Drawn in float world coordinates instead (before the frames), the chase had its first false
 // cull at frame 35 and the 1e5 and 1e6 scenes 1-20 in 3 frames (all, occlusion, ncone). Tiny
 // sizes and tessellation 2: llvmpipe renders every frame twice.
@@ -78,24 +79,20 @@ Counts verified(const std::string& file, const std::string& args, std::size_t fr
 }  // namespace
 
 // The chase: 8000 units per second for 200 frames (16.7 s, x to 1.33e5), the camera keeping
-// them in view; the occlusion test culls the frog behind the BigGuy every frame.
+// them in view, every test of `all` and the object level (made again in every frame's frame);
+// the occlusion test culls the frog behind the BigGuy every frame.
 TEST(FarSceneCli, ChaseAt8000UnitsPerSecondVerifies) {
-    const std::string chase = test_scene("chase_8000.json");
-    const Counts all = verified(chase, "", 200);
+    const Counts all = verified(test_scene("chase_8000.json"), "--objects bvh+backface", 200);
     EXPECT_GT(all.occlusion, 200u);
     EXPECT_GT(all.backpatch, 200u);
-    // The first 40 frames (the float world render's first false cull was at 35) with the fused
-    // pass and the object level.
-    const Counts fused = verified(chase, "--cull occlusion --fused-pass --objects bvh+backface --object-occlusion chc++", 40);
-    EXPECT_GT(fused.occlusion, 40u);
 }
 
-// Characters, ground and wall at 1e5 and 1e6: every cull mode and back-patch method, the fused
-// pass, GPU posing, displaced bounds, every object-level method and the query and horizon
-// occlusion methods (portals need cells, which stay within 8192: kMaxFloatWorldCoordinate).
+// Characters, ground and wall at 1e6 and 1e5: every cull mode and back-patch method, the fused pass, GPU
+// posing, displaced bounds, every object-level method and the query and horizon occlusion
+// methods (portals need cells, which stay within 8192: kMaxFloatWorldCoordinate).
 TEST(FarSceneCli, ObjectsPlacedFarByTheirTimeOffsetVerify) {
-    for (double d : {1e5, 1e6}) {
-        const std::string file = write_file("far_" + std::to_string(static_cast<long long>(d)) + ".json", far_scene(d));
+    {
+        const std::string file = write_file("far_1000000.json", far_scene(1e6));
         EXPECT_GT(verified(file, "--cull frustum", 3).frustum, 0u);
         EXPECT_GT(verified(file, "--cull backpatch --backpatch ncone --objects bvh", 3).backpatch, 0u);
         EXPECT_GT(verified(file, "--cull backpatch --backpatch ptp --pose gpu", 3).backpatch, 0u);
@@ -109,4 +106,12 @@ TEST(FarSceneCli, ObjectsPlacedFarByTheirTimeOffsetVerify) {
         verified(file, "--cull auto --objects bvh", 3);
         EXPECT_GT(verified(file, "--frustum aabb --objects bvh+backface --object-occlusion chc++", 3).occlusion, 0u);
     }
+    // At 1e5 (where float world coordinates gave their first false culls in this scene): the
+    // tests of `all` with an object level, occlusion alone, and the fused pass.
+    const std::string file = write_file("far_100000.json", far_scene(1e5));
+    const Counts all = verified(file, "--objects bvh+backface --object-occlusion horizon", 3);
+    EXPECT_GT(all.occlusion, 0u);
+    EXPECT_GT(all.backpatch, 0u);
+    EXPECT_GT(verified(file, "--cull occlusion", 3).occlusion, 0u);
+    EXPECT_GT(verified(file, "--fused-pass --backpatch ncone --objects frustum --object-occlusion chc++", 3).occlusion, 0u);
 }
