@@ -151,6 +151,12 @@ TEST(GpuFrustumCull, MultiplyAddIsRoundedOnceOnHardCases) {
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(-2.0f, 2.0f);
     for (int i = 0; i < 2000; ++i) bc.push_back({u(rng), u(rng)});
+    // The multiplicand is the patch's weight, which must be positive (patch.h): fma(a, -b, -c) is
+    // -fma(a, b, c), rounded alike, so a pair with b <= 0 is negated (b = 0 becomes 2^-20).
+    for (auto& [b, c] : bc) {
+        if (b < 0) b = -b, c = -c;
+        if (b == 0) b = 0x1p-20f;
+    }
     std::vector<BezierPatch> patches(bc.size());
     for (std::size_t p = 0; p < bc.size(); ++p)
         for (Vec4& cp : patches[p].cp) cp = {bc[p].second, 0, 0, bc[p].first};
@@ -181,7 +187,7 @@ TEST(GpuFrustumCull, MultiplyAddIsRoundedOnceOnHardCases) {
         }
         const auto flags = r.read_cull_flags();
         std::vector<std::uint8_t> cpu(patches.size());
-        cull_frustum_scalar(test::unchecked_batch(patches).view(), nullptr, planes, cpu.data());
+        cull_frustum_scalar(make_batch(patches).view(), nullptr, planes, cpu.data());
         for (std::size_t p = 0; p < patches.size(); ++p) ASSERT_EQ(flags[p] != 0, cpu[p] != 0) << "patch " << p;
     }
     EXPECT_EQ(wrong, 0u) << (test::passes().fma_via_double() ? "double-precision emulation" : "native GLSL fma");

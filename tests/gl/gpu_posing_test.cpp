@@ -98,9 +98,11 @@ void expect_identical_poses(const Scene& scene, const std::vector<float>& times,
     a.tangent_index = cpu.tangent_index();
     a.tangents = cpu.tangents();
     PatchRenderer r(test::context());
-    // Zeros in the patch buffer (the tangent buffer gets the layout's size): everything compared
+    // Zero points in the patch buffer (the tangent buffer gets the layout's size): everything compared
     // below was written by the pass.
-    r.set_patches(std::vector<BezierPatch>(first.size(), BezierPatch{}), a);
+    BezierPatch placeholder;  // zero points, weight 1 (weights must be positive: patch.h)
+    for (Vec4& c : placeholder.cp) c = {0, 0, 0, 1};
+    r.set_patches(std::vector<BezierPatch>(first.size(), placeholder), a);
     StencilPoser gpu = make_poser(gpu_side);
     ASSERT_EQ(gpu.patch_count(), first.size());
     for (float t : times) {
