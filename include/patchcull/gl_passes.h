@@ -65,10 +65,11 @@
 // The PassContext constructor, on a GPU (not on software rasterizers), runs the fma probe once:
 // it binds shader storage bindings 13 and 14 (backpatch_shared.h's kBindingProbeIn/Out) and a
 // program, reads one small buffer back (a wait), and leaves glUseProgram(0).
-// Depth conventions: the depth texture and the pyramid hold window depths in [0, 1] (glDepthRange
-// 0..1, GL_LOWER_LEFT, cleared to 1, depth test GL_LESS; no reversed Z: the pyramid keeps the
-// maximum). Matrices are zero-to-one clip space unless a pass takes a ClipDepth (clip_space.h:
-// FrustumPlanes and DisplacedCullView are built with one; OcclusionPass takes one).
+// Depth conventions: any of clip_space.h's four (zero-to-one, -1..1, reversed, reversed with an
+// infinite far plane), named wherever a decision depends on depth: FrustumPlanes and
+// DisplacedCullView are built with one; HiZBuildPass, OcclusionPass, FrustumDispPass and
+// FusedCullPass take one. The depth texture holds window depths in [0, 1] (glDepthRange(0, 1),
+// GL_LOWER_LEFT) written in that convention; the pyramid holds depth keys (hiz.h).
 //
 // Threads and lifetime: a PassContext and its passes belong to the GL context current when the
 // PassContext was made; use and destroy them on that thread with that context current.
@@ -247,10 +248,10 @@ public:
     OcclusionPass(OcclusionPass&&) noexcept;
     OcclusionPass& operator=(OcclusionPass&&) noexcept;
     ~OcclusionPass();
-    /// depth: the convention of object_to_clip (clip_space.h; the matrix is converted with
-    /// to_zero_to_one, as the CPU kernel does). The pyramid must come from a depth buffer of
-    /// window depths in [0, 1] (glDepthRange(0, 1)), larger = farther, GL_LOWER_LEFT origin: what
-    /// GL writes for either convention's matrix under the matching glClipControl depth mode.
+    /// depth: the convention of object_to_clip (clip_space.h; planes and depth keys as the CPU
+    /// kernel makes them). The pyramid must have been built by HiZBuildPass::run in a convention
+    /// of the same direction (forward or reversed; else Error), from a depth buffer with the
+    /// GL_LOWER_LEFT origin. A matrix contradicting depth: Error (check_clip_depth).
     void run(const PatchBuffers& patches, const Mat4& object_to_clip, ClipDepth depth, const HiZTexture& hiz,
              bool with_frustum = true);
 
