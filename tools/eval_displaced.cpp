@@ -85,7 +85,6 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
     for (DisplacedBoundKind bound : {DisplacedBoundKind::oobb, DisplacedBoundKind::caf})
         for (NormalConeKind cone : {NormalConeKind::full, NormalConeKind::acon, NormalConeKind::con})
             rows.push_back({bound, cone});
-    std::vector<float> depth_bottom_up(static_cast<std::size_t>(width) * height);
     std::vector<std::uint8_t> decision(patches);
     std::vector<bool> visible(patches);
     HiZPyramid hiz;
@@ -98,11 +97,7 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
         params.use_cull_flags = false;
         renderer.render(params);
         const std::vector<std::uint32_t> ids = renderer.read_ids();
-        const std::vector<float> depth = renderer.read_depth();  // top row first
-        for (int y = 0; y < height; ++y)
-            std::copy_n(depth.begin() + static_cast<std::ptrdiff_t>(y) * width, width,
-                        depth_bottom_up.begin() + static_cast<std::ptrdiff_t>(height - 1 - y) * width);
-        hiz.build(depth_bottom_up.data(), width, height);
+        hiz.build(renderer.read_depth_bottom_up().data(), width, height, camera.depth);
         std::fill(visible.begin(), visible.end(), false);
         for (std::uint32_t id : ids)
             if (id != 0 && (id & gl::kIdOccluderBit) == 0 && id <= patches) visible[id - 1] = true;

@@ -123,7 +123,6 @@ int run_fused_eval(const FusedEvalOptions& o) {
     std::size_t culled[4] = {};
     std::map<std::string, std::size_t> choices;
 
-    std::vector<float> depth_bottom_up(static_cast<std::size_t>(width) * height);
     std::vector<std::uint8_t> decision, scratch, scratch2;
     std::vector<bool> shown;
     const std::vector<std::uint8_t> all_culled(scene.patch_count(), 1);
@@ -140,15 +139,12 @@ int run_fused_eval(const FusedEvalOptions& o) {
         renderer.set_cull_flags(all_culled.data());
         params.use_cull_flags = true;
         renderer.render(params);
-        const std::vector<float> depth = renderer.read_depth();  // top row first
+        const std::vector<float> depth = renderer.read_depth_bottom_up();  // hiz.h's row order
         // The truth: the unculled frame's id buffer.
         params.use_cull_flags = false;
         renderer.render(params);
         const std::vector<std::uint32_t> ids = renderer.read_ids();
-        for (int y = 0; y < height; ++y)
-            std::copy_n(depth.begin() + static_cast<std::ptrdiff_t>(y) * width, width,
-                        depth_bottom_up.begin() + static_cast<std::ptrdiff_t>(height - 1 - y) * width);
-        hiz.build(depth_bottom_up.data(), width, height);
+        hiz.build(depth.data(), width, height, camera.depth);
         shown.assign(pose.size(), false);
         for (std::uint32_t id : ids)
             if (id != 0 && (id & gl::kIdOccluderBit) == 0 && id <= pose.size()) shown[id - 1] = true;

@@ -398,7 +398,9 @@ public:
     int width() const;
     int height() const;
     std::vector<std::uint32_t> read_ids() const;     ///< patch index + 1, 0 = background
-    std::vector<float> read_depth() const;           ///< window depth in [0,1], 1 = background
+    std::vector<float> read_depth() const;           ///< window depth in [0,1], background 1 (0 reversed)
+    /// The depth buffer with row 0 = bottom, hiz.h's order: what HiZPyramid::build takes as it is.
+    std::vector<float> read_depth_bottom_up() const;
     std::vector<std::uint8_t> read_color() const;    ///< RGBA8, 4 bytes per pixel
     /// Writes the colour image of the last render as a PNG. Throws patchcull::Error("PATH: cannot
     /// write PNG") on failure.

@@ -341,13 +341,17 @@ std::vector<std::uint32_t> PatchRenderer::read_ids() const {
     return flip_rows(ids, m.width, m.height, 1);
 }
 
-std::vector<float> PatchRenderer::read_depth() const {
+std::vector<float> PatchRenderer::read_depth_bottom_up() const {
     const Impl& m = *impl_;
     std::vector<float> depth(static_cast<std::size_t>(m.width) * m.height);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glGetTextureImage(m.depth, 0, GL_DEPTH_COMPONENT, GL_FLOAT, static_cast<GLsizei>(depth.size() * 4), depth.data());
     check_gl("read_depth");
-    return flip_rows(depth, m.width, m.height, 1);
+    return depth;  // a texture's row 0 is the bottom row
+}
+
+std::vector<float> PatchRenderer::read_depth() const {
+    return flip_rows(read_depth_bottom_up(), impl_->width, impl_->height, 1);
 }
 
 std::vector<std::uint8_t> PatchRenderer::read_color() const {

@@ -131,8 +131,9 @@ struct PatchRenderer::Impl {
 
     void set_patches(const float* aos_points, std::size_t n, const PatchAttributes& a, bool keep_flags = false) {
         for (std::size_t p = 0; p < n; ++p) {  // weights <= 0 refused (patch.h)
+            const float* q = aos_points + p * kPatchPoints * 4;
             BezierPatch patch;
-            std::memcpy(&patch, aos_points + p * kPatchPoints * 4, sizeof patch);
+            for (int k = 0; k < kPatchPoints; ++k) patch.cp[k] = {q[4 * k], q[4 * k + 1], q[4 * k + 2], q[4 * k + 3]};
             check_patch_weights(patch, p);
         }
         if (!a.max_displacement.empty() && a.max_displacement.size() != n)

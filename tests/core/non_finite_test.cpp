@@ -55,7 +55,8 @@ PatchBatch poisoned_copies(const BezierPatch& base) {
         for (int c = 0; c < 4; ++c)
             for (float v : bad) {
                 BezierPatch p = base;
-                (&p.cp[k].x)[c] = v;
+                float* component[4] = {&p.cp[k].x, &p.cp[k].y, &p.cp[k].z, &p.cp[k].w};
+                *component[c] = v;
                 put(p);
             }
     return batch;

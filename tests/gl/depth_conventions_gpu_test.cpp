@@ -121,7 +121,8 @@ std::vector<BezierPatch> poisoned_copies(const BezierPatch& base) {
         for (int c = 0; c < 4; ++c)
             for (float v : bad) {
                 BezierPatch p = base;
-                (&p.cp[k].x)[c] = v;
+                float* component[4] = {&p.cp[k].x, &p.cp[k].y, &p.cp[k].z, &p.cp[k].w};
+                *component[c] = v;
                 out.push_back(p);
             }
     return out;

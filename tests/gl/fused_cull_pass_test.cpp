@@ -238,7 +238,7 @@ TEST(FusedCullPass, ReasonsEqualTheCpuKernels) {
         params.height = h;
         params.tess_level = 5;
         r.render(params);
-        const std::vector<float> depth = test::depth_bottom_up(r);
+        const std::vector<float> depth = r.read_depth_bottom_up();
         HiZPyramid cpu_hiz;
         cpu_hiz.build(depth.data(), w, h);
         CullView s;

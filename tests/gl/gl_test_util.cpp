@@ -23,16 +23,6 @@ std::vector<float> ScratchBuffer::read_floats(std::size_t count) const {
     return out;
 }
 
-std::vector<float> depth_bottom_up(const PatchRenderer& r) {
-    const std::vector<float> top_down = r.read_depth();
-    std::vector<float> out(top_down.size());
-    const int w = r.width(), h = r.height();
-    for (int y = 0; y < h; ++y)
-        std::copy_n(top_down.begin() + static_cast<std::ptrdiff_t>(h - 1 - y) * w, w,
-                    out.begin() + static_cast<std::ptrdiff_t>(y) * w);
-    return out;
-}
-
 void cull_frustum(PatchRenderer& r, const FrustumPlanes& planes, std::vector<float>* plane_values) {
     static CullStatusPass status(passes());
     static FrustumPass frustum(passes());

@@ -55,9 +55,6 @@ private:
 /// patch.
 void cull_frustum(PatchRenderer& r, const FrustumPlanes& planes, std::vector<float>* plane_values = nullptr);
 
-/// The renderer's depth buffer as hiz.h wants it (row 0 = bottom; read_depth gives row 0 = top).
-std::vector<float> depth_bottom_up(const PatchRenderer& r);
-
 /// Attributes with only the cull margins set.
 inline PatchAttributes margins_only(std::vector<float> max_displacement) {
     PatchAttributes a;

@@ -87,7 +87,7 @@ GpuPyramid& gpu_pyramid() {
 
 // Compares the GPU pyramid with the CPU one built from the read-back depth; returns the CPU one.
 HiZPyramid check_pyramid(PatchRenderer& r, const char* what) {
-    const std::vector<float> depth = test::depth_bottom_up(r);
+    const std::vector<float> depth = r.read_depth_bottom_up();
     HiZPyramid cpu;
     cpu.build(depth.data(), r.width(), r.height());
     const std::vector<float> gpu = read_hiz_texture(gpu_pyramid().build(r));
