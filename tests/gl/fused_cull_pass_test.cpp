@@ -194,7 +194,9 @@ TEST(FusedCullPass, FlagWordsEqualTheChainForEveryTestSubset) {
         const std::vector<std::uint32_t> fused = run_fused(r, part, words, 7, BackpatchMethod::tcone, s);
         EXPECT_EQ(count_differences(chain, fused, "sub-range"), 0u);
         for (std::size_t p = 0; p < words.size(); ++p)
-            if (p < 100 || p >= 800) EXPECT_EQ(fused[p], words[p]) << "patch " << p << " outside the range";
+            if (p < 100 || p >= 800) {
+                EXPECT_EQ(fused[p], words[p]) << "patch " << p << " outside the range";
+            }
         glDeleteTextures(1, &s.hiz.texture);
     }
     // Every test decides something (counted over both conventions and both cones).

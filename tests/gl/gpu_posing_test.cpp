@@ -121,8 +121,9 @@ void expect_identical_poses(const Scene& scene, const std::vector<float>& times,
         }
     }
     EXPECT_GT(gpu.last_upload_bytes(), 0u);
-    if (small_upload)
+    if (small_upload) {
         EXPECT_LT(gpu.last_upload_bytes(), first.size() * sizeof(BezierPatch) / 10) << "the pose upload is not small";
+    }
 }
 
 const std::vector<float> kTimes = {0.0f, 1.0f / 12, 5.0f / 12, 1.3f};
