@@ -4,7 +4,7 @@
 // Control point (i, j) of a patch, i along u and j along v, is cp[4*j + i]; B(u,v) =
 // sum_ij B_i(u) B_j(v) cp[4*j+i] with cubic Bernstein polynomials B_i. Control points are
 // homogeneous (w*x, w*y, w*z, w): a polynomial patch has w = 1 everywhere, a rational patch has
-// positive weights w (seed 001 §3 allows rational patches). Weights must be positive: the cull
+// positive weights w (Loop, Niessner and Eisenacher allow rational patches). Weights must be positive: the cull
 // tests rest on the convex hull of the homogeneous control points, which holds only when every
 // weight has the same sign, and test it for positive ones. PatchBatch, PatchBlocks and the GL
 // renderer's uploads refuse a weight <= 0 (check_patch_weights: Error naming the patch and point);
