@@ -101,7 +101,7 @@ void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_di
     }
     for (std::size_t p = 0; p < patches.count; ++p) {
         const float d = max_displacement ? max_displacement[p] : 0.0f;
-        float lo[3], hi[3];
+        float lo[3] = {}, hi[3] = {};  // set by point 0
         float probe = 0;
         for (int k = 0; k < kPatchPoints; ++k) {
             const float W = patches.at(p, k, 3);
