@@ -61,7 +61,7 @@ int run_demo(const DemoOptions& options) {
     // after the whole job (seconds to minutes) has run.
     prepare_output_dir("--out-dir", options.out_dir, {"frame.png", "cull.png"});
     Scene scene = load_scene(options.scene, "acc", 0);
-    check_scene_motion(scene, options.scene, options.frames, kSecondsPerFrame, kMaxFloatWorldCoordinate);
+    place_scene_at_first_camera(scene, options.scene, options.frames, kSecondsPerFrame);
     gl::GlContext context = gl::GlContext::create_headless();
     gl::CullPipeline pipeline(context);
     gl::PatchRenderer& renderer = pipeline.renderer();

@@ -98,9 +98,9 @@ Runner add_view_command(CLI::App& app) {
         if (!state->screenshot.empty() && state->frames == 0)
             throw Error("--screenshot: needs --frames N (the last frame is the one saved)");
         Scene scene = load_scene(state->model, state->scheme, state->split);
-        // The viewer draws in float world coordinates: the scene and the frames of its path must
-        // stay within kMaxFloatWorldCoordinate (interactive: where it starts).
-        check_scene_motion(scene, state->model, std::max(state->frames, 1), kSecondsPerFrame, kMaxFloatWorldCoordinate);
+        // The viewer draws in one float frame, at its first camera's grid point: the frames of
+        // its path must stay within kMaxSingleFrameReach of it (interactive: where it starts).
+        place_scene_at_first_camera(scene, state->model, std::max(state->frames, 1), kSecondsPerFrame);
         apply_displace_options(state->displace, scene);
         config.tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         config.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;

@@ -140,7 +140,7 @@ int run_scene_eval(const SceneEvalOptions& o) {
     int width = 0, height = 0;
     parse_size("--size", o.size, width, height);
     Scene scene = load_scene(o.scene, o.scheme, 0);
-    check_scene_motion(scene, o.scene, o.frames, kSecondsPerFrame, kMaxFloatWorldCoordinate);
+    place_scene_at_first_camera(scene, o.scene, o.frames, kSecondsPerFrame);
     const bool one_sided = scene_is_one_sided(scene);
     ObjectLevelSetup setup;
     setup.clusters = false;  // the object level here is the frustum (BVH); occluders keep their order

@@ -176,6 +176,11 @@ struct Scene {
     /// Cells and portals (the `building` scene, scene files with "cells"); both empty elsewhere.
     std::vector<SceneCell> cells;
     std::vector<ScenePortal> portals;
+    /// The cells' boxes (min, max) and the portals' corners in world coordinates (double), as the
+    /// scene file reader places them: empty (then the floats + frame_origin are the world's), or
+    /// one per cell and one per portal. rebase_scene rounds them into a new frame once.
+    std::vector<std::array<DVec3, 2>> cell_world;
+    std::vector<std::array<DVec3, 4>> portal_world;
 
     /// Total patch count over the instances (the size of pose()'s output).
     std::size_t patch_count() const;

@@ -200,10 +200,19 @@ void rebase_scene(const Scene& world, DVec3 origin, Scene& frame) {
     frame.displacement_name = world.displacement_name;
     frame.camera = world.camera;
     frame.cells = world.cells;
-    for (SceneCell& cell : frame.cells) cell.box = {moved(cell.box.min), moved(cell.box.max)};
+    frame.cell_world = world.cell_world;
+    for (std::size_t i = 0; i < frame.cells.size(); ++i) {
+        Bounds& box = frame.cells[i].box;
+        box = world.cell_world.empty() ? Bounds{moved(box.min), moved(box.max)}
+                                       : Bounds{to_float(world.cell_world[i][0] - origin), to_float(world.cell_world[i][1] - origin)};
+    }
     frame.portals = world.portals;
-    for (ScenePortal& portal : frame.portals)
-        for (Vec3& c : portal.corners) c = moved(c);
+    frame.portal_world = world.portal_world;
+    for (std::size_t i = 0; i < frame.portals.size(); ++i)
+        for (int k = 0; k < 4; ++k) {
+            Vec3& c = frame.portals[i].corners[k];
+            c = world.portal_world.empty() ? moved(c) : to_float(world.portal_world[i][std::size_t(k)] - origin);
+        }
     frame.frame_origin = origin;
 }
 

@@ -663,10 +663,13 @@ Scene load_scene_file(const std::string& path) {
             cell.name = r.string(r.require(c, p, "name"), join(p, "name"));
             if (!cell_names.emplace(cell.name, i).second)
                 r.fail(join(p, "name"), "duplicate cell name " + quote_input(cell.name));
-            cell.box.min = r.vec3(r.require(c, p, "min"), join(p, "min"), kMaxFloatWorldCoordinate);
-            cell.box.max = r.vec3(r.require(c, p, "max"), join(p, "max"), kMaxFloatWorldCoordinate);
-            if (!(cell.box.max.x > cell.box.min.x && cell.box.max.y > cell.box.min.y && cell.box.max.z > cell.box.min.z))
-                r.fail(p, "max must be greater than min on every axis");
+            // World positions in double (rebase_scene rounds them into each frame); the scene's
+            // frame is the world's, so the floats are the world coordinates rounded.
+            const DVec3 lo = r.position(r.require(c, p, "min"), join(p, "min"));
+            const DVec3 hi = r.position(r.require(c, p, "max"), join(p, "max"));
+            if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) r.fail(p, "max must be greater than min on every axis");
+            cell.box = {patchcull::to_float(lo), patchcull::to_float(hi)};
+            scene.cell_world.push_back({lo, hi});
             auto names = [&](const char* key, const std::map<std::string, std::size_t>& known, const char* what,
                              std::vector<std::size_t>& out) {
                 const json* list = r.find(c, key);
@@ -706,12 +709,17 @@ Scene load_scene_file(const std::string& path) {
             if (portal.cell_a == portal.cell_b) r.fail(join(p, "cells"), "a portal joins two different cells");
             const json& corners = r.require(o, p, "corners");
             if (!corners.is_array() || corners.size() != 4) r.fail(join(p, "corners"), "expected 4 corners");
-            for (std::size_t k = 0; k < 4; ++k)
-                portal.corners[k] = r.vec3(corners[k], index(join(p, "corners"), k), kMaxFloatWorldCoordinate);
-            const Vec3* c = portal.corners;
-            if (!(length(cross(c[1] - c[0], c[2] - c[0])) + length(cross(c[2] - c[0], c[3] - c[0])) > 0))
-                r.fail(join(p, "corners"), "the corners span no area");
+            std::array<DVec3, 4> world;
+            for (std::size_t k = 0; k < 4; ++k) {
+                world[k] = r.position(corners[k], index(join(p, "corners"), k));
+                portal.corners[k] = patchcull::to_float(world[k]);
+            }
+            // The area in double, relative to the first corner (floats far out would round it).
+            const Vec3 e1 = patchcull::to_float(world[1] - world[0]), e2 = patchcull::to_float(world[2] - world[0]),
+                       e3 = patchcull::to_float(world[3] - world[0]);
+            if (!(length(cross(e1, e2)) + length(cross(e2, e3)) > 0)) r.fail(join(p, "corners"), "the corners span no area");
             scene.portals.push_back(portal);
+            scene.portal_world.push_back(world);
         }
     }
     return scene;
@@ -725,10 +733,11 @@ struct Reach {
     int axis = -1;
     double value = 0;
 };
-Reach beyond_limit(const double lo[3], const double hi[3], const double d[3], double limit) {
+Reach beyond_limit(const double lo[3], const double hi[3], const double d[3], double limit, DVec3 centre) {
+    const double o[3] = {centre.x, centre.y, centre.z};
     for (int a = 0; a < 3; ++a)
         for (double c : {lo[a] + d[a], hi[a] + d[a]})
-            if (!(std::fabs(c) <= limit)) return {a, c};
+            if (!(std::fabs(c - o[a]) <= limit)) return {a, c};
     return {};
 }
 
@@ -742,21 +751,29 @@ std::string limit_text(double limit) {
 }
 
 [[noreturn]] void motion_fail(const std::string& source, const std::string& path, const std::string& what, Reach r,
-                              int frame, double seconds, double limit, const char* advice) {
+                              int frame, double seconds, const std::string& advice) {
     static const char* const axes[3] = {"x", "y", "z"};
     throw Error(printable_line(source + ": " + path + ": " + what + " reaches " + axes[r.axis] + " = " +
                                number_text(r.value) + " at frame " + std::to_string(frame) + " (time " +
-                               number_text(seconds) + " s); " + advice + limit_text(limit)));
+                               number_text(seconds) + " s); " + advice));
 }
 
 }  // namespace
 
 void check_scene_motion(const Scene& scene, const std::string& source, int frames, double seconds_per_frame,
-                        double limit) {
+                        double limit, DVec3 centre) {
     if (frames <= 0) return;
     const int last = frames - 1;
-    const char* advice = limit >= kMaxSceneCoordinate ? "scenes take world coordinates up to "
-                                                      : "this command draws scenes in float world coordinates, up to ";
+    const bool at_origin = centre.x == 0 && centre.y == 0 && centre.z == 0;
+    const std::string advice =
+        limit >= kMaxSceneCoordinate && at_origin
+            ? "scenes take world coordinates up to " + limit_text(limit)
+            : "this command draws a scene in one float frame, at its first camera's grid point (" +
+                  number_text(centre.x) + ", " + number_text(centre.y) + ", " + number_text(centre.z) +
+                  "), and takes what lies within " + limit_text(limit) + " of it";
+    auto beyond = [&](const double lo[3], const double hi[3], const double d[3]) {
+        return beyond_limit(lo, hi, d, limit, centre);
+    };
     auto seconds = [&](int f) { return double(f) * seconds_per_frame; };
     const DVec3 world = scene.frame_origin;
     // Objects: the placed rest control points' box (in double), moved by velocity x time.
@@ -783,7 +800,7 @@ void check_scene_motion(const Scene& scene, const std::string& source, int frame
         auto moved = [&](int f) {
             const double t = moves ? seconds(f) + double(instance.time_offset) : 0.0;
             const double d[3] = {double(v.x) * t, double(v.y) * t, double(v.z) * t};
-            return beyond_limit(lo, hi, d, limit);
+            return beyond(lo, hi, d);
         };
         // The motion is linear: within the limit at the first and the last frame, within it at
         // every frame between.
@@ -796,7 +813,7 @@ void check_scene_motion(const Scene& scene, const std::string& source, int frame
                                                                                  : ".animation.velocity");
                 motion_fail(source, path, std::string(moves ? "the moving" : "the placed") + " model (" +
                                               quote_input(instance.name) + ")",
-                            r, f, seconds(f), limit, advice);
+                            r, f, seconds(f), advice);
             }
     }
     // The environment, the cells and the portals do not move.
@@ -809,18 +826,28 @@ void check_scene_motion(const Scene& scene, const std::string& source, int frame
             const DVec3 p = scene.occluder_world.empty() ? to_double(scene.occluder_vertices[index]) + world
                                                          : scene.occluder_world[index];
             const double c[3] = {p.x, p.y, p.z};
-            if (const Reach r = beyond_limit(c, c, zero, limit); r.axis >= 0)
+            if (const Reach r = beyond(c, c, zero); r.axis >= 0)
                 motion_fail(source, "environment[" + std::to_string(e) + "]",
-                            "the environment object (" + quote_input(object.name) + ")", r, 0, 0, limit, advice);
+                            "the environment object (" + quote_input(object.name) + ")", r, 0, 0, advice);
         }
     }
     for (std::size_t i = 0; i < scene.cells.size(); ++i) {
         const Bounds& b = scene.cells[i].box;
-        const double lo[3] = {b.min.x + world.x, b.min.y + world.y, b.min.z + world.z};
-        const double hi[3] = {b.max.x + world.x, b.max.y + world.y, b.max.z + world.z};
-        if (const Reach r = beyond_limit(lo, hi, zero, limit); r.axis >= 0)
-            motion_fail(source, "cells[" + std::to_string(i) + "]", "the cell", r, 0, 0, limit, advice);
+        const DVec3 l = scene.cell_world.empty() ? to_double(b.min) + world : scene.cell_world[i][0];
+        const DVec3 h = scene.cell_world.empty() ? to_double(b.max) + world : scene.cell_world[i][1];
+        const double lo[3] = {l.x, l.y, l.z}, hi[3] = {h.x, h.y, h.z};
+        if (const Reach r = beyond(lo, hi, zero); r.axis >= 0)
+            motion_fail(source, "cells[" + std::to_string(i) + "]", "the cell", r, 0, 0, advice);
     }
+    for (std::size_t i = 0; i < scene.portals.size(); ++i)
+        for (std::size_t k = 0; k < 4; ++k) {
+            const DVec3 p = scene.portal_world.empty() ? to_double(scene.portals[i].corners[k]) + world
+                                                       : scene.portal_world[i][k];
+            const double c[3] = {p.x, p.y, p.z};
+            if (const Reach r = beyond(c, c, zero); r.axis >= 0)
+                motion_fail(source, "portals[" + std::to_string(i) + "].corners[" + std::to_string(k) + "]", "the portal",
+                            r, 0, 0, advice);
+        }
     // The camera: its eye and target at every frame (the path is not linear for an orbit).
     const CameraPath& c = scene.camera;
     const std::vector<WorldCamera> cameras = scene.world_camera_path(frames, 1.0f);
@@ -828,16 +855,29 @@ void check_scene_motion(const Scene& scene, const std::string& source, int frame
         const WorldCamera& cam = cameras[static_cast<std::size_t>(f)];
         const double eye[3] = {cam.eye.x, cam.eye.y, cam.eye.z};
         const double target[3] = {cam.target.x, cam.target.y, cam.target.z};
-        if (const Reach r = beyond_limit(eye, eye, zero, limit); r.axis >= 0)
+        if (const Reach r = beyond(eye, eye, zero); r.axis >= 0)
             motion_fail(source,
                         c.walk ? (f == 0 ? "camera.walk.start" : "camera.walk.step")
                         : r.axis == 1 ? "camera.orbit.height"
                                       : "camera.orbit.distance",
-                        "the camera's eye", r, f, seconds(f), limit, advice);
-        if (const Reach r = beyond_limit(target, target, zero, limit); r.axis >= 0)
+                        "the camera's eye", r, f, seconds(f), advice);
+        if (const Reach r = beyond(target, target, zero); r.axis >= 0)
             motion_fail(source, c.walk ? "camera.walk.direction" : "camera.orbit.target", "the camera's target", r, f,
-                        seconds(f), limit, advice);
+                        seconds(f), advice);
     }
+}
+
+void place_scene_at_first_camera(Scene& scene, const std::string& source, int frames, double seconds_per_frame) {
+    check_scene_motion(scene, source, frames, seconds_per_frame);
+    const DVec3 origin = scene_frame_near(scene.world_camera_path(1, 1.0f).front().eye);
+    const DVec3 now = scene.frame_origin;
+    if (origin.x != now.x || origin.y != now.y || origin.z != now.z) {
+        std::vector<LoadedModel> models = std::move(scene.models);
+        const Scene world = scene;  // the placements, without the models
+        scene.models = std::move(models);
+        rebase_scene(world, origin, scene);
+    }
+    check_scene_motion(scene, source, frames, seconds_per_frame, kMaxSingleFrameReach, origin);
 }
 
 }  // namespace patchcull

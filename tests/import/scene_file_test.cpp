@@ -542,9 +542,9 @@ TEST_F(SceneFileErrors, TransformsAndDegenerateInputs) {
     // it places.
     expect(with(valid_scene(), "\"position\": [2, 0, 0]", "\"position\": [2, 0, 6e8]"),
            "objects[1].transform.position[2]: expected a number >= -536870912 and <= 536870912, got 6e+08");
-    // Cells and portals stay in float world coordinates: kMaxFloatWorldCoordinate.
-    expect(with(valid_scene(), "\"min\": [0, 0, -5], \"max\": [5, 3, 5]", "\"min\": [0, 0, -5], \"max\": [9000, 3, 5]"),
-           "cells[1].max[0]: expected a number >= -8192 and <= 8192, got 9000");
+    // Cells and portals are world positions (double) within kMaxSceneCoordinate.
+    expect(with(valid_scene(), "\"min\": [0, 0, -5], \"max\": [5, 3, 5]", "\"min\": [0, 0, -5], \"max\": [6e8, 3, 5]"),
+           "cells[1].max[0]: expected a number >= -536870912 and <= 536870912, got 6e+08");
     const std::string huge = with(valid_scene(), "[1, 0, 0, -2, 0, 1, 0, 0, 0, 0, 1, 0", "[5e11, 0, 0, -2, 0, 5e11, 0, 0, 0, 0, 5e11, 0");
     expect_prefix(huge, "objects[2].transform: the placed model reaches ");
     EXPECT_NE(load_error(dir_, huge)

@@ -47,9 +47,10 @@ Scene load_text(const TempDir& dir, const std::string& text, const std::string& 
     return load_scene_file(path.string());
 }
 
-// The error check_scene_motion gives ("" when the motion stays within the limit). The float world
-// limit (8192) keeps the numbers small; the scene limit is tested at the end.
-std::string motion_error(const Scene& scene, int frames, double limit = kMaxFloatWorldCoordinate) {
+// The error check_scene_motion gives ("" when the motion stays within the limit). The one-frame
+// reach (8192, measured from the origin here) keeps the numbers small; the scene limit is tested
+// at the end.
+std::string motion_error(const Scene& scene, int frames, double limit = kMaxSingleFrameReach) {
     try {
         check_scene_motion(scene, "a.json", frames, kSecondsPerFrame, limit);
     } catch (const Error& e) {
@@ -71,7 +72,7 @@ const std::string kOrbit = R"({"orbit": {"distance": 4, "height": 1}})";
 
 // The first frame f at which an object whose placed box ends at hi_x reaches beyond the limit
 // moving at speed (t = f / 12 + offset).
-int first_frame_beyond(double hi_x, double speed, double offset, double limit = kMaxFloatWorldCoordinate) {
+int first_frame_beyond(double hi_x, double speed, double offset, double limit = kMaxSingleFrameReach) {
     for (int f = 0;; ++f)
         if (hi_x + speed * (f * kSecondsPerFrame + offset) > limit) return f;
 }
@@ -215,15 +216,16 @@ TEST(SceneFileNames, DefaultNamesAreUniqueAcrossSchemesAndPaths) {
 }
 
 // The scene limit (2^29) of `render`, which draws each frame near its camera: 1e6 units out is
-// accepted, a scene that moves beyond 2^29 refused; the float world limit of the other commands
-// refuses the same 1e6 scene and says why.
-TEST(SceneMotion, TheSceneLimitAndTheFloatWorldLimit) {
+// accepted, a scene that moves beyond 2^29 refused; the one-frame reach of the other commands,
+// measured from the world's origin, refuses the same 1e6 scene and says why.
+TEST(SceneMotion, TheSceneLimitAndTheOneFrameReach) {
     TempDir dir(test_name());
     const Scene far = load_text(dir, scene_text(R"({"time_offset": 1e6, "velocity": [1, 0, 0]})", kOrbit));
     EXPECT_EQ(motion_error(far, 200, kMaxSceneCoordinate), "");
     std::string e = motion_error(far, 1);
     EXPECT_NE(e.find("objects[1].animation.time_offset: the moving model ('monsterfrog#0') reaches x = 999999 at frame "
-                     "0 (time 0 s); this command draws scenes in float world coordinates, up to 8192"),
+                     "0 (time 0 s); this command draws a scene in one float frame, at its first camera's grid point (0, 0, 0), "
+                     "and takes what lies within 8192 of it"),
               std::string::npos)
         << e;
     // 1e6 units per second from 5e8 (time offset 500 s): beyond 2^29 after 36.87 s.
@@ -239,7 +241,7 @@ TEST(SceneMotion, TheSceneLimitAndTheFloatWorldLimit) {
     EXPECT_NE(e.find(" at frame 443 (time 36.9167 s); scenes take world coordinates up to 536870912 (2^29)"),
               std::string::npos)
         << e;
-    // Static placements beyond the float world limit are named by their JSON path.
+    // Static placements beyond the reach are named by their JSON path.
     const Scene placed = load_text(
         dir, R"({"objects": [{"model": "bigguy", "transform": {"position": [3e5, 0, 0]}}], "camera": {"orbit": {"distance": 4}}})",
         "c.json");
@@ -247,6 +249,45 @@ TEST(SceneMotion, TheSceneLimitAndTheFloatWorldLimit) {
     EXPECT_NE(motion_error(placed, 1).find("a.json: objects[0].transform: the placed model ('bigguy#0') reaches x = 299"),
               std::string::npos)
         << motion_error(placed, 1);
+}
+
+// Commands that draw a run in one frame (demo, eval, view) move the scene's frame to their first
+// camera's grid point: a scene 1e6 units out whose run stays near it is taken, in a frame at the
+// camera (the cameras, cells and environment near 0), and a run that travels 9000 units from it
+// is refused with the frame named.
+TEST(SceneMotion, OneFrameCommandsDrawAtTheirFirstCamera) {
+    TempDir dir(test_name());
+    const std::string near = R"({"time_offset": 1e6, "velocity": [1, 0, 0]})";
+    const std::string camera = R"({"orbit": {"target": [1e6, 0.5, -1], "distance": 4, "height": 1}})";
+    Scene scene = load_text(dir, R"({"objects": [{"model": "bigguy", "transform": {"position": [1e6, 0, 0], "height": 1}},
+                           {"model": "monsterfrog", "transform": {"position": [0, 0, -2], "height": 1},
+                            "animation": )" + near + R"(}],
+        "environment": [{"name": "wall", "box": {"min": [1e6, 0, -3], "max": [1000001, 1, -2.5]}}],
+        "cells": [{"name": "c", "min": [999990, -1, -10], "max": [1000010, 5, 10]}],
+        "camera": )" + camera + "}");
+    place_scene_at_first_camera(scene, "a.json", 24, kSecondsPerFrame);
+    EXPECT_EQ(scene.frame_origin.x, 1e6);
+    EXPECT_EQ(scene.frame_origin.y, 0.0);
+    const Camera first = scene.camera_path(1, 1.0f).front();
+    EXPECT_LT(std::fabs(first.eye.x), 8.0f);
+    EXPECT_EQ(first.target.x, 0.0f);
+    EXPECT_EQ(scene.cells.at(0).box.min.x, -10.0f);  // rounded from the world's double, once
+    EXPECT_EQ(scene.cells.at(0).box.max.x, 10.0f);
+    ASSERT_FALSE(scene.occluder_vertices.empty());
+    for (const Vec3& v : scene.occluder_vertices) EXPECT_LE(std::fabs(v.x), 1.0f);
+    // A run that travels 9000 units from its frame.
+    Scene fast = load_text(dir, scene_text(R"({"time_offset": 0, "velocity": [9000, 0, 0]})", kOrbit), "c.json");
+    try {
+        place_scene_at_first_camera(fast, "c.json", 24, kSecondsPerFrame);
+        ADD_FAILURE() << "a run 9000 units from its frame was taken";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("c.json: objects[1].animation.velocity: the moving model ('monsterfrog#0') reaches x = "),
+                  std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("at frame 11 (time 0.916667 s); this command draws a scene in one float frame"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 // Frames near the camera (default_scene.h): scene_frame_near's grid, instance_to_frame composed
