@@ -167,6 +167,7 @@ Runner add_eval_command(CLI::App& app) {
                      "displacement of height 1 in object units (default 2% of the model's diagonal)");
     add_size_option(*displaced_command, "--size", displaced->size, "framebuffer size");
     add_int_option(*displaced_command, "--tess", displaced->tess, 1, 64, "uniform tessellation level");
+    add_clip_depth_option(*displaced_command, displaced->clip_depth);
     displaced_command->add_flag("--json", displaced->json, "print one JSON object");
 
     auto temporal = std::make_shared<TemporalEvalOptions>();
@@ -222,6 +223,7 @@ Runner add_eval_command(CLI::App& app) {
     add_int_option(*fused_command, "--profile-interval", fused->profile_interval, 1, 10000,
                    "frames between an object's profiling runs (cost model)");
     add_choice_option(*fused_command, "--cone", fused->cone, {"tcone", "ncone"}, "the back-patch cone test");
+    add_clip_depth_option(*fused_command, fused->clip_depth);
     fused_command->add_flag("--json", fused->json, "print one JSON object");
     return [command, occlusion, displaced_command, displaced, temporal_command, temporal, scene_command, scene,
             fused_command, fused]() {

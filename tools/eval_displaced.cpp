@@ -15,7 +15,7 @@
 // frame found visible) from a first frame until its visible set is stable (at most 8 frames), its
 // last frame compared with the unculled render (render_reference: a false cull is judged per
 // patch). Output (--json):
-//   {"model","patches","views","displace","displace_scale","size","tess","seed",
+//   {"model","clip_depth","patches","views","displace","displace_scale","size","tess","seed",
 //    "rows":[{"bound":"oobb"|"caf","cone":"full"|"acon"|"con","cull_rate":0..1,"false_culls":n,
 //             "pipeline_cull_rate":0..1,"pipeline_frames":mean,"pipeline_false_culls":n}, ...]}
 // with one row per combination (cull_rate, pipeline_cull_rate: the mean over views of the culled
@@ -28,6 +28,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_options.h"
 #include "commands.h"
 #include "patchcull/displaced_bounds.h"
 #include "patchcull/error.h"
@@ -72,6 +73,7 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
     pipeline.set_patches(model.rest.patches, pipeline_attributes);
     pipeline.renderer().set_displacement_map(map);
     ViewGenerator views(patch_bounds(model.rest), ViewMode::contain, o.seed, float(width) / float(height));
+    const ClipDepth clip_depth = parse_clip_depth_option(o.clip_depth);
 
     struct Row {
         DisplacedBoundKind bound;
@@ -92,7 +94,8 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
     Progress progress("eval displaced", "view-bounds", std::uint64_t(o.views) * rows.size(), progress_wanted(o.json));
     std::uint64_t done = 0;
     for (int v = 0; v < o.views; ++v) {
-        const Camera camera = views.next();
+        Camera camera = views.next();
+        camera.depth = clip_depth;  // drawn and culled in it
         gl::RenderParams params = render_params(camera, width, height, o.tess, false);  // displaced: two-sided
         params.use_cull_flags = false;
         renderer.render(params);
@@ -101,7 +104,7 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
         std::fill(visible.begin(), visible.end(), false);
         for (std::uint32_t id : ids)
             if (id != 0 && (id & gl::kIdOccluderBit) == 0 && id <= patches) visible[id - 1] = true;
-        const DisplacedCullView cull_view = make_displaced_cull_view(camera.view(), camera.projection(), ClipDepth::zero_to_one);
+        const DisplacedCullView cull_view = make_displaced_cull_view(camera.view(), camera.projection(), camera.depth);
         for (Row& row : rows) {
             cull_displaced_occlusion(batch.view(), ranges.data(), row.bound, row.cone, cull_view, hiz, decision.data());
             std::size_t culled = 0;
@@ -130,6 +133,7 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
     }
     nlohmann::json out;
     out["model"] = model.name;
+    out["clip_depth"] = clip_depth_name(clip_depth);
     out["patches"] = patches;
     out["views"] = o.views;
     out["displace"] = o.displace;

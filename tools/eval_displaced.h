@@ -17,6 +17,7 @@ struct DisplacedEvalOptions {
     float displace_scale = -1;  ///< < 0: 2% of the model's bounding-box diagonal
     std::string size = "512x512";
     int tess = 8;
+    std::string clip_depth = "zero-to-one";  ///< --clip-depth: drawn and culled in it
     bool json = false;
 };
 

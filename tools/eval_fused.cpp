@@ -26,7 +26,7 @@
 // but was culled is a false cull (one line on stderr each, up to 10, with what the Hi-Z test saw);
 // any makes the exit status 1.
 // Output (--json), one object, times in seconds per frame (sums over the objects, mean over frames):
-//   {"scene","scheme","target","objects","fused_objects","patches","fused_patches","frames",
+//   {"scene","clip_depth","scheme","target","objects","fused_objects","patches","fused_patches","frames",
 //    "size":[w,h],"tess","repeats","profile_interval","cone",
 //    "culled":{"frustum","backpatch","occlusion","visible"} (fractions of fused_patches, plan FBH),
 //    "plans":[{"plan","seconds","ratio_to_best"}], "best_plan",
@@ -90,8 +90,8 @@ int run_fused_eval(const FusedEvalOptions& o) {
     int width = 0, height = 0;
     parse_size("--size", o.size, width, height);
     const BackPatchCone cone = o.cone == "ncone" ? BackPatchCone::ncone : BackPatchCone::tcone;
-    const Scene scene = load_scene(o.scene, o.scheme, 0);
-    check_scene_motion(scene, o.scene, o.frames, kSecondsPerFrame, kMaxFloatWorldCoordinate);
+    Scene scene = load_scene(o.scene, o.scheme, 0);
+    place_scene_at_first_camera(scene, o.scene, o.frames, kSecondsPerFrame);
     const bool one_sided = scene_is_one_sided(scene);
 
     gl::GlContext context = gl::GlContext::create_headless();
@@ -100,7 +100,9 @@ int run_fused_eval(const FusedEvalOptions& o) {
     renderer.set_patches(poser.pose(0), pose_attributes(poser));
     renderer.set_displacement_map(scene.displacement);
     upload_scene_occluders(renderer, scene);
-    const std::vector<Camera> cameras = scene.camera_path(o.frames, float(width) / float(height));
+    std::vector<Camera> cameras = scene.camera_path(o.frames, float(width) / float(height));
+    const ClipDepth clip_depth = parse_clip_depth_option(o.clip_depth);
+    for (Camera& c : cameras) c.depth = clip_depth;  // drawn and culled in it
 
     std::vector<gl::ObjectRange> fused;  // the objects the fused kernel may cull
     const std::vector<SceneObject> objects = scene_objects(scene);
@@ -150,7 +152,7 @@ int run_fused_eval(const FusedEvalOptions& o) {
             if (id != 0 && (id & gl::kIdOccluderBit) == 0 && id <= pose.size()) shown[id - 1] = true;
 
         const PatchBatch batch = make_batch(pose);
-        const FusedCullSetup setup = make_fused_setup(params.projection * params.view, ClipDepth::zero_to_one,
+        const FusedCullSetup setup = make_fused_setup(params.projection * params.view, camera.depth,
                                                       camera.eye, cone, &hiz);
         for (std::size_t i = 0; i < fused.size(); ++i) {
             const PatchBatchView view = batch.view().subrange(fused[i].first, fused[i].count);
@@ -175,7 +177,7 @@ int run_fused_eval(const FusedEvalOptions& o) {
                         // What the Hi-Z test saw, and the patch's own depth where the frame shows it.
                         PatchScreenBounds b;
                         const bool projectable = patch_screen_bounds(view, p, params.projection * params.view,
-                                                                     ClipDepth::zero_to_one, width, height, b);
+                                                                     camera.depth, width, height, b);
                         const std::vector<float> frame_depth = renderer.read_depth();
                         float own = 2;
                         for (std::size_t px = 0; px < ids.size(); ++px)
@@ -219,7 +221,7 @@ int run_fused_eval(const FusedEvalOptions& o) {
             // The separate kernels.
             separate_seconds += min_seconds(o.repeats, [&] {
                 (cone == BackPatchCone::tcone ? cull_tcone_simd : cull_ncone_simd)(view, camera.eye, scratch.data());
-                cull_occlusion_simd(view, params.projection * params.view, ClipDepth::zero_to_one, hiz, scratch2.data());
+                cull_occlusion_simd(view, params.projection * params.view, camera.depth, hiz, scratch2.data());
             });
         }
         model.next_frame();
@@ -239,6 +241,7 @@ int run_fused_eval(const FusedEvalOptions& o) {
 
     nlohmann::json out;
     out["scene"] = scene.name;
+    out["clip_depth"] = clip_depth_name(clip_depth);
     out["scheme"] = o.scheme;
     out["target"] = simd_target_name();
     out["objects"] = objects.size();

@@ -16,6 +16,7 @@ struct FusedEvalOptions {
     int repeats = 5;            ///< timed runs per object, plan and frame (the minimum is kept)
     int profile_interval = 16;  ///< FusedCostModel::Config::profile_interval
     std::string cone = "tcone";
+    std::string clip_depth = "zero-to-one";  ///< --clip-depth: drawn and culled in it
     bool json = false;
 };
 
