@@ -19,31 +19,11 @@
 #include "patchcull/hiz.h"
 #include "patchcull/teapot.h"
 
+#include "core/test_patches.h"
+
 using namespace patchcull;
 
 namespace {
-
-// The teapot split twice (512 patches), and its bounds.
-std::vector<BezierPatch> split_teapot() {
-    std::vector<BezierPatch> patches = teapot_patches();
-    for (int level = 0; level < 2; ++level) {
-        std::vector<BezierPatch> next;
-        for (const BezierPatch& p : patches) {
-            BezierPatch four[4];
-            split_patch(p, four);
-            next.insert(next.end(), four, four + 4);
-        }
-        patches = next;
-    }
-    return patches;
-}
-
-Bounds bounds_of(const std::vector<BezierPatch>& patches) {
-    std::vector<Vec3> points;
-    for (const BezierPatch& p : patches)
-        for (const Vec4& c : p.cp) points.push_back(cartesian(c));
-    return compute_bounds(points);
-}
 
 struct Pair {
     Mat4 zo, no;  // the same camera: zero_to_one and minus_one_to_one object_to_clip
@@ -97,7 +77,7 @@ TEST(ClipDepth, PerspectiveMapsNearAndFarToEachConventionsDepth) {
 // matrices' z rows differ by a rounding), and none of them culls a patch with a sample inside
 // the view volume.
 TEST(ClipDepth, EveryDepthSensitiveEntryDecidesAlikeInBothConventions) {
-    const std::vector<BezierPatch> patches = split_teapot();
+    const std::vector<BezierPatch> patches = test_patches::split_teapot(2);
     const PatchBatch batch = make_batch(patches);
     const std::size_t n = patches.size();
     constexpr int kGrid = 9;
@@ -112,7 +92,7 @@ TEST(ClipDepth, EveryDepthSensitiveEntryDecidesAlikeInBothConventions) {
     HiZPyramid hiz;
     hiz.build(depth.data(), W, H);
 
-    ViewGenerator views(bounds_of(patches), ViewMode::free, 11);
+    ViewGenerator views(test_patches::control_point_bounds(patches), ViewMode::free, 11);
     std::size_t decisions = 0, differences = 0, frustum_culled = 0, occluded = 0, ptp_culled = 0;
     for (int v = 0; v < 60; ++v) {
         const Pair c = both_conventions(views.next());
@@ -158,10 +138,10 @@ TEST(ClipDepth, EveryDepthSensitiveEntryDecidesAlikeInBothConventions) {
 // What naming the convention prevents: an OpenGL matrix read as zero-to-one (all the old API
 // could do) has its near plane at 2fn/(f+n) and culls patches that are in view.
 TEST(ClipDepth, MisreadingAnOpenGlMatrixCullsVisiblePatches) {
-    const std::vector<BezierPatch> patches = split_teapot();
+    const std::vector<BezierPatch> patches = test_patches::split_teapot(2);
     const PatchBatch batch = make_batch(patches);
     const std::size_t n = patches.size();
-    ViewGenerator views(bounds_of(patches), ViewMode::contain, 5);
+    ViewGenerator views(test_patches::control_point_bounds(patches), ViewMode::contain, 5);
     std::size_t right = 0, misread = 0;
     for (int v = 0; v < 20; ++v) {
         const Pair c = both_conventions(views.next());

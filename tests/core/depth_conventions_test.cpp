@@ -22,33 +22,14 @@
 #include "patchcull/hiz.h"
 #include "patchcull/teapot.h"
 
+#include "core/test_patches.h"
+
 using namespace patchcull;
 
 namespace {
 
 constexpr ClipDepth kConventions[] = {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed,
                                       ClipDepth::reversed_infinite};
-
-std::vector<BezierPatch> split_teapot() {
-    std::vector<BezierPatch> patches = teapot_patches();
-    for (int level = 0; level < 2; ++level) {
-        std::vector<BezierPatch> next;
-        for (const BezierPatch& p : patches) {
-            BezierPatch four[4];
-            split_patch(p, four);
-            next.insert(next.end(), four, four + 4);
-        }
-        patches = next;
-    }
-    return patches;
-}
-
-Bounds bounds_of(const std::vector<BezierPatch>& patches) {
-    std::vector<Vec3> points;
-    for (const BezierPatch& p : patches)
-        for (const Vec4& c : p.cp) points.push_back(cartesian(c));
-    return compute_bounds(points);
-}
 
 // Window depth (glDepthRange(0, 1)) of view distance t under projection p of convention depth.
 double window_depth(const Mat4& p, ClipDepth depth, double t) {
@@ -108,7 +89,7 @@ TEST(DepthConventions, PerspectiveMapsNearAndFarInEachConvention) {
 // Every CPU entry with a depth convention, on one camera written in each convention, with a wall
 // at view distance between the teapot's near and far ends covering the left half of the screen.
 TEST(DepthConventions, EveryEntryDecidesAsZeroToOneAndCullsNothingVisible) {
-    const std::vector<BezierPatch> patches = split_teapot();
+    const std::vector<BezierPatch> patches = test_patches::split_teapot(2);
     const PatchBatch batch = make_batch(patches);
     const std::size_t n = patches.size();
     constexpr int kGrid = 9;
@@ -117,7 +98,7 @@ TEST(DepthConventions, EveryEntryDecidesAsZeroToOneAndCullsNothingVisible) {
     for (std::size_t i = 0; i < n; ++i)
         sample_displaced_patch(patches[i], nullptr, uv, nullptr, kGrid, &samples[i * kGrid * kGrid]);
     constexpr int W = 64, H = 48;
-    ViewGenerator views(bounds_of(patches), ViewMode::free, 23, float(W) / H);
+    ViewGenerator views(test_patches::control_point_bounds(patches), ViewMode::free, 23, float(W) / H);
     std::size_t differences = 0, decisions = 0;
     std::size_t culled[4] = {}, occluded[4] = {};
     for (int v = 0; v < 40; ++v) {

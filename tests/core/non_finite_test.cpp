@@ -19,46 +19,26 @@
 #include "patchcull/fused_cull.h"
 #include "patchcull/hiz.h"
 
+#include "core/test_patches.h"
+
 using namespace patchcull;
 
 namespace {
 
-// A flat 1 x 1 patch at depth z (object = world space), its normal du x dv along +z, or -z when
-// flipped.
-BezierPatch flat_patch(float x0, float y0, float z, bool flipped) {
-    BezierPatch p;
-    for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i)
-            p.cp[4 * j + i] = {x0 + i / 3.0f, flipped ? y0 - j / 3.0f : y0 + j / 3.0f, z, 1.0f};
-    return p;
-}
+using test_patches::flat_patch;
 
-// The base patch followed by one copy per (point, component, value) with that coordinate replaced
-// by NaN, +Inf or -Inf: 1 + 16 * 4 * 3 patches. The batch is filled through component(): weights
-// of NaN and -Inf must reach the kernels too.
+// The base patch and its 192 poisoned copies (test_patches::poisoned_copies) in a batch filled
+// through component(): weights of NaN and -Inf must reach the kernels too.
 PatchBatch poisoned_copies(const BezierPatch& base) {
-    const float bad[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
-                          -std::numeric_limits<float>::infinity()};
-    PatchBatch batch(1 + kPatchPoints * 4 * 3);
-    std::size_t n = 0;
-    auto put = [&](const BezierPatch& p) {
+    const std::vector<BezierPatch> patches = test_patches::poisoned_copies(base);
+    PatchBatch batch(patches.size());
+    for (std::size_t n = 0; n < patches.size(); ++n)
         for (int k = 0; k < kPatchPoints; ++k) {
-            batch.component(k, 0)[n] = p.cp[k].x;
-            batch.component(k, 1)[n] = p.cp[k].y;
-            batch.component(k, 2)[n] = p.cp[k].z;
-            batch.component(k, 3)[n] = p.cp[k].w;
+            batch.component(k, 0)[n] = patches[n].cp[k].x;
+            batch.component(k, 1)[n] = patches[n].cp[k].y;
+            batch.component(k, 2)[n] = patches[n].cp[k].z;
+            batch.component(k, 3)[n] = patches[n].cp[k].w;
         }
-        ++n;
-    };
-    put(base);
-    for (int k = 0; k < kPatchPoints; ++k)
-        for (int c = 0; c < 4; ++c)
-            for (float v : bad) {
-                BezierPatch p = base;
-                float* component[4] = {&p.cp[k].x, &p.cp[k].y, &p.cp[k].z, &p.cp[k].w};
-                *component[c] = v;
-                put(p);
-            }
     return batch;
 }
 

@@ -4,8 +4,8 @@
 //   bit for bit, 24-bit ones keys at or beyond the far end of each stored integer (never nearer);
 // - no pass culls a patch with a NaN or infinite coordinate (any component of any point);
 // - `render --clip-depth C --verify` reports no false culls in every convention and every cull
-//   mode, with the decisions of zero-to-one (the strict id-buffer test: the culled frame's ids equal
-//   the unculled frame's); a repeated or unknown --clip-depth is a one-line error.
+//   mode and method, with the decisions of zero-to-one (the strict id-buffer test: the culled
+//   frame's ids equal the unculled frame's); a repeated or unknown --clip-depth is a one-line error.
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
@@ -16,6 +16,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -33,6 +34,8 @@ using namespace patchcull::gl;
 using namespace patchcull::cli_test;
 
 namespace {
+
+using test_patches::flat_patch;
 
 // A width x height depth texture of internal format `format`, filled with `depth` (row 0 = bottom)
 // quantized as the format stores it.
@@ -104,33 +107,9 @@ struct RawPatches {
     }
 };
 
-BezierPatch flat_patch(float x0, float y0, float z, bool flipped) {
-    BezierPatch p;
-    for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i)
-            p.cp[4 * j + i] = {x0 + i / 3.0f, flipped ? y0 - j / 3.0f : y0 + j / 3.0f, z, 1.0f};
-    return p;
-}
-
-// The base patch and its 192 poisoned copies (each coordinate in turn NaN, +Inf, -Inf).
-std::vector<BezierPatch> poisoned_copies(const BezierPatch& base) {
-    const float bad[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
-                          -std::numeric_limits<float>::infinity()};
-    std::vector<BezierPatch> out{base};
-    for (int k = 0; k < kPatchPoints; ++k)
-        for (int c = 0; c < 4; ++c)
-            for (float v : bad) {
-                BezierPatch p = base;
-                float* component[4] = {&p.cp[k].x, &p.cp[k].y, &p.cp[k].z, &p.cp[k].w};
-                *component[c] = v;
-                out.push_back(p);
-            }
-    return out;
-}
-
 void expect_only_base_culled(const std::string& name, const BezierPatch& base, float margin,
                              const std::function<void(const PatchBuffers&)>& pass, bool with_margins = false) {
-    const RawPatches raw(poisoned_copies(base), margin);
+    const RawPatches raw(test_patches::poisoned_copies(base), margin);
     pass(raw.buffers(with_margins));
     const std::vector<std::uint32_t> w = raw.words();
     EXPECT_NE(w[0] & shared::kCullReasonMask, 0u) << name << ": the finite base patch must be culled";
@@ -254,34 +233,57 @@ TEST(DepthConventionsGpu, NoPassCullsAPatchWithANonFiniteCoordinate) {
 }
 
 // The strict id-buffer test in every convention: the same scene and camera path drawn, culled and
-// verified in each, every cull mode; the decisions equal zero-to-one's up to patches whose
-// occlusion depends on the last bits of depth (the conventions round depth differently).
+// verified in each, for every cull mode, back-patch method, frustum test, the fused pass, GPU
+// posing, the displaced bounds, `auto`, and every object-level occlusion method (city_small for
+// the query methods and the horizon, two rooms for portals). In every convention the test named
+// by the case culls something, nothing is culled falsely, and the frustum counts equal
+// zero-to-one's and the occlusion counts are within 1% of them (the conventions round depth
+// differently, so a patch at the edge of occlusion may go either way).
 TEST(DepthConventionsGpu, RenderVerifiesEveryModeInEveryConvention) {
-    struct Case {
-        const char* args;
+    enum class Culls { frustum, backpatch, occlusion, objects };
+    const std::string rooms = std::string(PATCHCULL_SOURCE_DIR) + "/tests/data/scenes/two_rooms.json";
+    const std::string city = std::string(PATCHCULL_SOURCE_DIR) + "/data/scenes/city_small.json";
+    // Each case and the counter that must be positive in every convention.
+    const std::vector<std::pair<std::string, Culls>> cases = {
+        {"default --frames 2 --cull frustum", Culls::frustum},
+        {"default --frames 2 --cull frustum --frustum aabb", Culls::frustum},
+        {"default --frames 2 --cull backpatch --backpatch tcone", Culls::backpatch},
+        {"default --frames 2 --cull backpatch --backpatch ncone", Culls::backpatch},
+        {"default --frames 2 --cull backpatch --backpatch ptp", Culls::backpatch},
+        {"default --frames 2 --cull occlusion", Culls::occlusion},
+        {"default --frames 2 --cull all", Culls::occlusion},
+        {"default --frames 2 --cull all --fused-pass", Culls::occlusion},
+        {"default --frames 2 --cull all --pose gpu --bound caf --cone acon", Culls::occlusion},
+        {"default --frames 2 --cull auto", Culls::occlusion},
+        {city + " --frames 1 --objects frustum --object-occlusion stop-and-wait", Culls::objects},
+        {city + " --frames 1 --objects bvh --object-occlusion batched", Culls::objects},
+        {city + " --frames 1 --objects bvh --object-occlusion chc", Culls::objects},
+        {city + " --frames 1 --objects bvh+backface --object-occlusion chc++", Culls::objects},
+        {city + " --frames 1 --objects bvh+backface --object-occlusion horizon", Culls::objects},
+        {rooms + " --frames 2 --objects frustum --object-occlusion portals", Culls::objects},
     };
-    // Kept small for the suite's time (the manual matrix in docs/ENGINE.md covers every mode).
-    const Case cases[] = {
-        {"default --frames 2 --cull all"},
-        {"default --frames 2 --cull all --fused-pass"},
-        {"city --frames 1 --cull all --backpatch ptp --objects bvh --object-occlusion chc++"},
-    };
-    for (const Case& c : cases) {
+    for (const auto& [case_args, culls] : cases) {
         long reference_occluded = -1, reference_frustum = -1;
         for (const char* convention : {"zero-to-one", "minus-one-to-one", "reversed", "reversed-infinite"}) {
-            const std::string args = std::string("render ") + c.args + " --size 64x48 --tess 2 --clip-depth " +
-                                     convention + " --verify --json";
+            const std::string args = "render " + case_args + " --size 64x48 --tess 2 --clip-depth " + convention + " --verify --json";
             const CliRun r = run(args);
             ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
             const auto j = nlohmann::json::parse(r.out);
             EXPECT_EQ(j["clip_depth"], convention);
             EXPECT_EQ(j["false_culls"], 0) << args;
             EXPECT_EQ(j["verified"], true) << args;
-            long occluded = 0, frustum = 0;
+            long occluded = 0, frustum = 0, backpatch = 0, objects = 0;
             for (const auto& f : j["frames"]) {
                 occluded += f["occlusion_culled"].get<long>();
                 frustum += f["frustum_culled"].get<long>();
+                backpatch += f["backpatch_culled"].get<long>();
+                if (f.contains("objects")) {
+                    const auto& o = f["objects"]["occlusion"];
+                    objects += o.value("occlusion_culled", 0L) + o.value("objects_culled", 0L);
+                }
             }
+            const long named[] = {frustum, backpatch, occluded, objects};
+            EXPECT_GT(named[static_cast<int>(culls)], 0) << args;
             if (reference_occluded < 0) {
                 reference_occluded = occluded;
                 reference_frustum = frustum;

@@ -19,7 +19,12 @@
 #include "patchcull/patch.h"
 #include "patchcull/teapot.h"
 
+#include "core/test_patches.h"
+
 namespace patchcull::gl::test {
+
+using test_patches::control_point_bounds;
+using test_patches::split_teapot;
 
 /// The process's context (created on first use, on the calling thread). Creation failing is a
 /// test failure, not a skip: the supported platform (Debian 12) always has Mesa's llvmpipe.
@@ -62,23 +67,7 @@ inline PatchAttributes margins_only(std::vector<float> max_displacement) {
     return a;
 }
 
-/// The teapot's 32 patches after `levels` 1-to-4 splits (32 * 4^levels patches).
-inline std::vector<BezierPatch> split_teapot(int levels) {
-    std::vector<BezierPatch> patches = teapot_patches();
-    for (int l = 0; l < levels; ++l) {
-        std::vector<BezierPatch> next(patches.size() * 4);
-        for (std::size_t i = 0; i < patches.size(); ++i) split_patch(patches[i], &next[4 * i]);
-        patches.swap(next);
-    }
-    return patches;
-}
 
-inline Bounds control_point_bounds(const std::vector<BezierPatch>& patches) {
-    std::vector<Vec3> points;
-    for (const BezierPatch& p : patches)
-        for (const Vec4& c : p.cp) points.push_back(cartesian(c));
-    return compute_bounds(points);
-}
 
 /// Attributes for `count` displaced patches, each sampling its own random square window of MAP
 /// (origin in [-0.5, 1.5)^2, side 0.05..0.35, drawn from SEED), with max_displacement = the
