@@ -17,41 +17,22 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
 
 #include "patchcull/error.h"
 #include "patchcull/scene_file.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace patchcull;
 
 namespace {
 
-const fs::path kScenes = fs::path(PATCHCULL_SOURCE_DIR) / "data" / "scenes";
-
-// A fresh directory per test under the system's temp directory, named by the test and the
-// process (test runs of other build directories may run at the same time), removed at the end.
-struct TempDir {
-    fs::path path;
-    explicit TempDir(const std::string& name)
-        : path(fs::temp_directory_path() / ("patchcull_scene_file_" + name + "_" + std::to_string(::getpid()))) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    fs::path operator/(const std::string& p) const { return path / p; }
-    std::string string() const { return path.string(); }
+struct TempDir : test_files::TempDir {
+    explicit TempDir(const std::string& name) : test_files::TempDir("patchcull_scene_file", name) {}
 };
+using test_files::write_file;
 
-void write(const fs::path& path, const std::string& text) {
-    fs::create_directories(path.parent_path());
-    std::ofstream(path, std::ios::binary) << text;
-}
+const fs::path kScenes = fs::path(PATCHCULL_SOURCE_DIR) / "data" / "scenes";
 
 // A unit cube as a closed, outward quad mesh, offset by `at`.
 std::string cube_obj(double at = 0, double size = 1) {
@@ -97,7 +78,7 @@ std::string valid_scene() {
 // Loads text as dir/a.json and returns the error message ("" when it loads).
 std::string load_error(const fs::path& dir, const std::string& text, const std::string& file = "a.json") {
     const fs::path path = dir / file;
-    write(path, text);
+    write_file(path, text);
     try {
         load_scene_file(path.string());
     } catch (const Error& e) {
@@ -119,7 +100,7 @@ protected:
     void SetUp() override {
         temp_ = std::make_unique<TempDir>(::testing::UnitTest::GetInstance()->current_test_info()->name());
         dir_ = temp_->path;
-        write(dir_ / "cube.obj", cube_obj());
+        write_file(dir_ / "cube.obj", cube_obj());
         ASSERT_EQ(load_error(dir_, valid_scene()), "");
     }
     // The message of the mutated valid scene: exactly "dir/a.json: " + expected.
@@ -300,9 +281,9 @@ TEST(SceneFile, DocumentedExampleLoads) {
     ASSERT_NE(start, std::string::npos);
     ASSERT_NE(end, std::string::npos);
     const TempDir dir("example");
-    write(dir / "models" / "crate.obj", cube_obj());
-    write(dir / "meshes" / "statue.obj", cube_obj());
-    write(dir / "yard.json", doc.substr(start + 8, end - start - 8));
+    write_file(dir / "models" / "crate.obj", cube_obj());
+    write_file(dir / "meshes" / "statue.obj", cube_obj());
+    write_file(dir / "yard.json", doc.substr(start + 8, end - start - 8));
     const Scene s = load_scene_file((dir / "yard.json").string());
     EXPECT_EQ(s.name, "yard");
     EXPECT_EQ(s.instances.size(), 4u);
@@ -316,8 +297,8 @@ TEST(SceneFile, DocumentedExampleLoads) {
 
 TEST(SceneFile, ValidSceneSectionsAndModelsLoadedOnce) {
     const TempDir dir("valid");
-    write(dir / "cube.obj", cube_obj());
-    write(dir / "a.json", valid_scene());
+    write_file(dir / "cube.obj", cube_obj());
+    write_file(dir / "a.json", valid_scene());
     const Scene s = load_scene_file((dir / "a.json").string());
     EXPECT_EQ(s.name, "small");
     ASSERT_EQ(s.models.size(), 2u);  // cube.obj (acc) once for "a" and "b", and the teapot
@@ -362,19 +343,19 @@ TEST(SceneFile, ValidSceneSectionsAndModelsLoadedOnce) {
     EXPECT_EQ(s.portals[0].cell_b, 1u);
     // A second scheme of the same file is a second model.
     const std::string osd = with(valid_scene(), R"("scheme": "acc")", R"("scheme": "osd")");
-    write(dir / "b.json", osd);
+    write_file(dir / "b.json", osd);
     EXPECT_EQ(load_scene_file((dir / "b.json").string()).models.size(), 3u);
 }
 
 TEST(SceneFile, PathsAreRelativeToTheFile) {
     const TempDir dir("relative");
-    write(dir / "models" / "cube.obj", cube_obj());
+    write_file(dir / "models" / "cube.obj", cube_obj());
     // The file in scenes/, the model named two ways from there: one model.
     std::string text = with(valid_scene(), R"("model": "cube.obj", "transform": {"position": [0)",
                             R"("model": "../models/cube.obj", "transform": {"position": [0)");
     text = with(text, R"("model": "cube.obj", "scheme")", R"("model": "../scenes/../models/cube.obj", "scheme")");
     text = with(text, R"("obj": "cube.obj")", R"("obj": "../models/cube.obj")");
-    write(dir / "scenes" / "a.json", text);
+    write_file(dir / "scenes" / "a.json", text);
     const fs::path cwd = fs::current_path();
     fs::current_path(fs::temp_directory_path());  // not the file's directory
     Scene s;
@@ -382,7 +363,7 @@ TEST(SceneFile, PathsAreRelativeToTheFile) {
     fs::current_path(cwd);
     EXPECT_EQ(s.models.size(), 2u);
     // Named as the file gives it, the model's error names the resolved path.
-    write(dir / "scenes" / "b.json", with(text, "../models/cube.obj\", \"transform\"", "missing.obj\", \"transform\""));
+    write_file(dir / "scenes" / "b.json", with(text, "../models/cube.obj\", \"transform\"", "missing.obj\", \"transform\""));
     try {
         load_scene_file((dir / "scenes" / "b.json").string());
         ADD_FAILURE() << "no error";
@@ -396,13 +377,13 @@ TEST(SceneFile, FarFromTheOriginAndMirrored) {
     const TempDir dir("far");
     // An OBJ environment mesh at 5000 (the OBJ reader recentres it; the file adds the origin back
     // in double), a character and a box at 2000-8000.
-    write(dir / "far.obj", cube_obj(5000, 2));
-    write(dir / "cube.obj", cube_obj());
+    write_file(dir / "far.obj", cube_obj(5000, 2));
+    write_file(dir / "cube.obj", cube_obj());
     std::string text = with(valid_scene(), R"("obj": "cube.obj", "transform": {"position": [-3, 0, 3], "scale": 2})",
                             R"("obj": "far.obj", "one_sided": true)");
     text = with(text, R"("position": [2, 0, 0], "yaw_degrees": 30)", R"("position": [2000, 0, 8000], "yaw_degrees": 30)");
     text = with(text, R"("min": [3, 0, 3], "max": [4, 1, 4])", R"("min": [3000, 0, 3000], "max": [3001, 1, 3001])");
-    write(dir / "a.json", text);
+    write_file(dir / "a.json", text);
     const Scene s = load_scene_file((dir / "a.json").string());
     std::vector<Vec3> mesh;
     const EnvironmentObject& far = s.environment[2];
@@ -422,16 +403,16 @@ TEST(SceneFile, FarFromTheOriginAndMirrored) {
     EXPECT_EQ(s.instances[0].origin.x, 0.0);  // near the origin: no grid origin, as before
     // An OBJ environment mesh at 1e5 keeps its exact vertices in double (Scene::occluder_world),
     // one per occluder vertex; one beyond kMaxSceneCoordinate is refused with one line.
-    write(dir / "far1.obj", cube_obj(1e5 + 0.25, 2));
-    write(dir / "c.json", with(text, R"("obj": "far.obj")", R"("obj": "far1.obj")"));
+    write_file(dir / "far1.obj", cube_obj(1e5 + 0.25, 2));
+    write_file(dir / "c.json", with(text, R"("obj": "far.obj")", R"("obj": "far1.obj")"));
     const Scene c = load_scene_file((dir / "c.json").string());
     ASSERT_EQ(c.occluder_world.size(), c.occluder_vertices.size());
     double lo = 1e30;
     for (std::uint32_t t = c.environment[2].first_triangle; t < c.environment[2].first_triangle + c.environment[2].triangle_count; ++t)
         for (int k = 0; k < 3; ++k) lo = std::min(lo, c.occluder_world[c.occluder_indices[3 * t + k]].x);
     EXPECT_EQ(lo, 1e5 + 0.25);
-    write(dir / "far2.obj", cube_obj(1e9, 2));
-    write(dir / "b.json", with(text, R"("obj": "far.obj")", R"("obj": "far2.obj")"));
+    write_file(dir / "far2.obj", cube_obj(1e9, 2));
+    write_file(dir / "b.json", with(text, R"("obj": "far.obj")", R"("obj": "far2.obj")"));
     try {
         load_scene_file((dir / "b.json").string());
         ADD_FAILURE() << "a mesh at 1e9 loaded";
@@ -444,7 +425,7 @@ TEST(SceneFile, FarFromTheOriginAndMirrored) {
     // A mirroring matrix keeps boxes outward: the triangles are flipped back.
     text = with(valid_scene(), R"("box": {"min": [3, 0, 3], "max": [4, 1, 4]})",
                 R"("box": {"min": [3, 0, 3], "max": [4, 1, 4]}, "transform": [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])");
-    write(dir / "m.json", text);
+    write_file(dir / "m.json", text);
     const Scene m = load_scene_file((dir / "m.json").string());
     double volume = 0;
     const EnvironmentObject& box = m.environment[1];
@@ -575,7 +556,7 @@ TEST_F(SceneFileErrors, NamesAndReferences) {
 TEST_F(SceneFileErrors, WalkCamera) {
     const std::string orbit = "\"orbit\": {\"target\": [0, 0.5, 0], \"distance\": 6, \"height\": 1}";
     const std::string walk = "\"walk\": {\"start\": [0, 1, 4], \"step\": [0, 0, -0.1], \"direction\": [0, 0, -1]}";
-    write(dir_ / "w.json", with(valid_scene(), orbit, walk));
+    write_file(dir_ / "w.json", with(valid_scene(), orbit, walk));
     const Scene s = load_scene_file((dir_ / "w.json").string());
     ASSERT_TRUE(s.camera.walk);
     const std::vector<Camera> cams = s.camera_path(3, 1.0f);
@@ -601,11 +582,11 @@ TEST_F(SceneFileErrors, UnreadableFilesAndModels) {
         EXPECT_EQ(std::string(e.what()), dir_.string() + ": not a regular file (patchcull reads scene files only)");
     }
     // A model beyond load_model's limits: its message, after the file and JSON path.
-    write(dir_ / "huge.obj", cube_obj(0, 1e12));
+    write_file(dir_ / "huge.obj", cube_obj(0, 1e12));
     expect(with(valid_scene(), "\"model\": \"teapot\"", "\"model\": \"huge.obj\""),
            "objects[2].model: " + (dir_ / "huge.obj").string() +
                ": the mesh is 1e+12 units across; patchcull takes meshes up to 2e+11 units across (the kernels work in float)");
-    write(dir_ / "bad.obj", "v 0 0 0\nv 1 0 nan\n");
+    write_file(dir_ / "bad.obj", "v 0 0 0\nv 1 0 nan\n");
     expect(with(valid_scene(), "\"obj\": \"cube.obj\"", "\"obj\": \"bad.obj\""),
            "environment[2].obj: " + (dir_ / "bad.obj").string() + ":2: non-finite coordinate 'nan'");
     expect(with(valid_scene(), "\"map\": \"procedural\", \"scale\": 0.02, \"size\": 64", "\"map\": \"h.png\", \"scale\": 0.02"),
@@ -617,7 +598,7 @@ TEST_F(SceneFileErrors, UnreadableFilesAndModels) {
 // everywhere.
 TEST(SceneFile, MutantsLoadOrFailWithOneLine) {
     const TempDir dir("mutants");
-    write(dir / "cube.obj", cube_obj());
+    write_file(dir / "cube.obj", cube_obj());
     const std::string base = valid_scene();
     const char* const tokens[] = {"1e39", "-1e39", "1e-50", "nan", "-0", "0", "-1", "1e308", "99999999999999999999",
                                   "\"\"", "[]", "{}", "null", "true", "\"teapot\"", "\"../cube.obj\"", "\"/dev/zero\"",
@@ -680,7 +661,7 @@ TEST(SceneFile, MutantsLoadOrFailWithOneLine) {
             }
         }
         const fs::path path = dir / "m.json";
-        write(path, text);
+        write_file(path, text);
         try {
             load_scene_file(path.string());
             ++loaded;

@@ -11,39 +11,27 @@
 #include <fstream>
 #include <string>
 
-#include <unistd.h>
 
 #include "patchcull/error.h"
 #include "patchcull/scene_file.h"
+#include "temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace patchcull;
 
 namespace {
 
-constexpr double kSecondsPerFrame = 1.0 / 12.0;  // the CLI's (tools/render_support.h)
-
-struct TempDir {
-    fs::path path;
-    explicit TempDir(const std::string& name)
-        : path(fs::temp_directory_path() / ("patchcull_scene_motion_" + name + "_" + std::to_string(::getpid()))) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
+struct TempDir : test_files::TempDir {
+    explicit TempDir(const std::string& name) : test_files::TempDir("patchcull_scene_motion", name) {}
 };
+
+constexpr double kSecondsPerFrame = 1.0 / 12.0;  // the CLI's (tools/render_support.h)
 
 std::string test_name() { return ::testing::UnitTest::GetInstance()->current_test_info()->name(); }
 
 Scene load_text(const TempDir& dir, const std::string& text, const std::string& file = "a.json") {
     const fs::path path = dir.path / file;
-    fs::create_directories(path.parent_path());
-    std::ofstream(path, std::ios::binary) << text;
+    test_files::write_file(path, text);
     return load_scene_file(path.string());
 }
 

@@ -24,7 +24,6 @@
 //   exactly their complement.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -41,6 +40,7 @@
 #include "patchcull/ground_truth.h"
 #include "patchcull/scene_file.h"
 #include "patchcull/scene_object_level.h"
+#include "temp_dir.h"
 
 using namespace patchcull;
 
@@ -640,21 +640,6 @@ Bounds environment_bounds(const Scene& scene, const EnvironmentObject& o) {
     return compute_bounds(points);
 }
 
-// A fresh directory under the system's temp directory, removed at the end.
-struct TempDir {
-    std::filesystem::path path;
-    explicit TempDir(const std::string& name)
-        : path(std::filesystem::temp_directory_path() /
-               ("patchcull_object_level_" + name + "_" + std::to_string(::getpid()))) {
-        std::filesystem::remove_all(path);
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-};
-
 }  // namespace
 
 // The 2 x 2 city with 8 characters over its walk, and adversarial cameras: inside a building
@@ -792,7 +777,7 @@ TEST(SceneObjectLevelTruth, SceneFile) {
 // box building, a one-sided ground quad, a camera walking past them. Float spacing there is
 // ~1e-3: the volumes' relative growth and the clusters' margins must keep every cull honest.
 Totals far_scene_truth(bool world_float_truth) {
-    const TempDir dir("far");
+    const test_files::TempDir dir("patchcull_object_level", "far");
     const std::string text = R"({
       "name": "far",
       "displacement": {"map": "procedural", "scale": 0.03},
