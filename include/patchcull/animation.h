@@ -1,4 +1,4 @@
-// patchcull/animation.h: procedural control-mesh animation (seed 000 §1: patches change every
+// patchcull/animation.h: procedural control-mesh animation (Niessner & Loop §1: patches change every
 // frame, so nothing per patch can be precomputed from positions).
 #pragma once
 

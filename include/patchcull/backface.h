@@ -1,5 +1,5 @@
 // patchcull/backface.h: back-face culling of triangles: the per-triangle test and normal masks
-// (G. Zachmann's lecture "Advanced Visibility Computations" (seed 004), "Back-Face Culling" and
+// (G. Zachmann's lecture "Advanced Visibility Computations", "Back-Face Culling" and
 // "Normal Masks"; normal masks are Zhang & Hoff, "Fast backface culling using normal masks",
 // 1997). Clustered back-face culling (Johannsen & Carter 1998) is in backface_clusters.h.
 //

@@ -1,8 +1,8 @@
 // patchcull/backface_clusters.h: clustered back-face culling (Johannsen & Carter, "Clustered
 // Backface Culling", 1998) and its hierarchy, as G. Zachmann's lecture "Advanced Visibility
-// Computations" (seed 004) presents them, for clusters of triangles and, beyond the lecture, for
+// Computations" presents them, for clusters of triangles and, beyond the lecture, for
 // clusters of bicubic patches bounded by their object-space tangent control planes (Loop,
-// Niessner & Eisenacher, "Effective Back-Patch Culling for Hardware Tessellation", seed 001).
+// Niessner & Eisenacher, "Effective Back-Patch Culling for Hardware Tessellation").
 //
 // A cluster is a set of planes (n_i, p_i): triangles (face normal n = (p1 - p0) x (p2 - p0),
 // a vertex p, backface.h's conventions) or patch control planes (n_k, w_k) with w_k = -n_k . p.
@@ -206,7 +206,7 @@ std::vector<BackfaceCluster> merge_into_leaves(const std::vector<BackfaceCluster
 ClusterHierarchy build_cluster_hierarchy(const std::vector<BackfaceCluster>& leaves, const ClusterBuildOptions& options,
                                          const Bounds& default_viewpoints);
 
-// ---- clusters of patches (beyond the lecture, issue 11) --------------------------------------
+// ---- clusters of patches (beyond the lecture) ------------------------------------------------
 
 /// The 64 Bezier control planes t_k (k = 8 jv + iu, bidegree 7) of the parametric tangent plane
 /// T(u, v) = cross4(B, B_u, B_v) = sum B7_iu(u) B7_jv(v) t_k of the patch, in object space
@@ -214,7 +214,7 @@ ClusterHierarchy build_cluster_hierarchy(const std::vector<BackfaceCluster>& lea
 /// origin = 0 the object-space planes; ground_truth.h's sample_tangent_planes are their Bernstein
 /// combinations). Since the Bernstein weights are >= 0, e . T(u, v) <= max_k e . t_k: every
 /// tangent plane has the eye on its back side when every control plane does. Computed in double
-/// from seed 001's table (src/core/ptp_table.inc); terms with two equal control points (a
+/// from Loop, Niessner & Eisenacher's table (src/core/ptp_table.inc); terms with two equal control points (a
 /// collapsed edge) are exact zeros and skipped, so such planes come out exactly 0 with bound 0.
 /// error[k] (if not null) bounds |computed - exact| of plane k, component by component.
 /// Never throws.

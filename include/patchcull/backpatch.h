@@ -1,13 +1,13 @@
-// patchcull/backpatch.h: back-patch cull kernels (seed 001): a patch is culled (culled[i] = 1)
+// patchcull/backpatch.h: back-patch cull kernels (Loop, Niessner & Eisenacher): a patch is culled (culled[i] = 1)
 // only when no point of it faces the eye, i.e. e . T(u,v) <= 0 for all (u,v) in [0,1]^2, where
-// T(u,v) = cross4(B, B_u, B_v) is the parametric tangent plane (seed 001 §3) and e the
+// T(u,v) = cross4(B, B_u, B_v) is the parametric tangent plane (Loop, Niessner & Eisenacher §3) and e the
 // homogeneous eye point. For a polynomial patch, e . T = n . (e - p) with n = B_u x B_v, so a
 // patch faces the eye where its outward normal (du x dv, patch.h) points towards the eye.
 //
 // Methods (each a `patchcull cull` method name):
-// - tcone (seed 001 §2, Sederberg & Meyers 1988 as Munkberg et al. 2010 use it): a cone of
+// - tcone (Loop, Niessner & Eisenacher §2, Sederberg & Meyers 1988 as Munkberg et al. 2010 use it): a cone of
 //   normals built from the cones of the tangent patch B_u and the bitangent patch B_v.
-// - ncone (seed 001 §2, Shirman & Abi-Ezzi 1993): a cone bounding the normal patch
+// - ncone (Loop, Niessner & Eisenacher §2, Shirman & Abi-Ezzi 1993): a cone bounding the normal patch
 //   N = B_u x B_v in Bezier form (bidegree 5).
 //   Both cone tests are made conservative for a perspective eye and a patch of finite extent:
 //   with the patch inside a sphere (c, r) and d = e - c, the directions e - p (p on the patch)
@@ -16,7 +16,7 @@
 //   a . d/|d| <= -sin(alpha + beta). (Without the alpha + beta <= 90deg condition the last
 //   inequality also holds for facing patches: alpha = beta = 80deg, angle(a, d) = 175deg.)
 //   Cones apply to polynomial patches (all w = 1); a rational patch is never culled by them.
-// - ptp (seed 001 §3-6): the 8x8 Bezier control planes of T, from the 516 weighted cross4
+// - ptp (Loop, Niessner & Eisenacher §3-6): the 8x8 Bezier control planes of T, from the 516 weighted cross4
 //   products of the clip-space control points, evaluated as z components only (cross4Z). With
 //   the eye at (0, 0, alpha, 0) in clip space, e . t_i = s * alpha * t_i.z, where s = sign(det M)
 //   because cross4 of transformed points is det(M) times the transformed plane (det < 0 for
@@ -33,7 +33,7 @@
 //
 // Contracts: culled must hold patches.count bytes. Kernels never allocate or throw; each has a
 // scalar reference and a SIMD version that give identical decisions. Displacement is not
-// handled by back-patch culling (seed 001 §8): callers must not use these on displaced patches.
+// handled by back-patch culling (Loop, Niessner & Eisenacher §8): callers must not use these on displaced patches.
 #pragma once
 
 #include <cstdint>

@@ -1,9 +1,9 @@
 // patchcull/bounding_volumes.h: object-level bounding volumes (sphere, AABB, OBB) and their
 // view-frustum tests, meta-BVs, plane masking and plane coherence, and detail culling, after
-// G. Zachmann's lecture "Advanced Visibility Computations" (seed 004: "Bounding Volumes", "Test
+// G. Zachmann's lecture "Advanced Visibility Computations" ("Bounding Volumes", "Test
 // Kugel/Box - Frustum", "N-/P-Vertex", "Meta-BVs", "zeitliche Kohärenz", "Plane Masking",
 // "Detail Culling"). The object pre-test that Niessner & Loop ("Patch-Based Occlusion Culling for
-// Hardware Tessellation", seed 000 §3) ask for before patch culling. The hierarchy over these
+// Hardware Tessellation", §3) ask for before patch culling. The hierarchy over these
 // volumes is in object_bvh.h.
 //
 // Frustum planes are patchcull::FrustumPlanes (frustum.h): six rows over homogeneous points, a
@@ -102,7 +102,7 @@ Bounds grow_bounds(const Bounds& box, float margin);
 
 // ---- frustum tests ----------------------------------------------------------------------------
 
-/// Plane masking and plane coherence (seed 004): state carried per volume (or BVH node).
+/// Plane masking and plane coherence (Zachmann's lecture): state carried per volume (or BVH node).
 struct PlaneCullState {
     std::uint8_t plane_mask = 0x3f;  ///< in: planes still to test (bit k = FrustumPlanes row k);
                                      ///< out: planes the volume straddles (children test only
@@ -150,7 +150,7 @@ void classify_obbs_simd(const FrustumPlanes& planes, const Obb* boxes, std::size
 
 // ---- meta-BVs ------------------------------------------------------------------------------------
 
-/// The frustum's bounding sphere and AABB (seed 004 "Meta-BVs"): a quick reject before the planes.
+/// The frustum's bounding sphere and AABB (Zachmann's lecture "Meta-BVs"): a quick reject before the planes.
 struct FrustumMetaBounds {
     Sphere sphere;
     Bounds box;
@@ -176,7 +176,7 @@ float projection_pixel_scale(float fovy_radians, float viewport_height);
 /// Projected radius in pixels, r * pixel_scale / d (d = |centre - eye|), the lecture's
 /// approximation of the sphere's screen size; +inf when the eye is inside the sphere.
 float projected_radius_pixels(const Sphere& sphere, Vec3 eye, float pixel_scale);
-/// Detail culling (seed 004, end): true when pi * projected_radius^2 < min_pixel_area. NOT
+/// Detail culling (Zachmann's lecture, end): true when pi * projected_radius^2 < min_pixel_area. NOT
 /// conservative (the object may still cover pixels; callers report what it changes). Never true
 /// when the eye is inside the sphere or min_pixel_area <= 0; true for the empty sphere when
 /// min_pixel_area > 0.

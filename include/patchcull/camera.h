@@ -1,6 +1,6 @@
 // patchcull/camera.h: perspective cameras and seeded random view generators.
 //
-// View modes (seed 000 §6.2, seed 001 §7):
+// View modes (Niessner & Loop §6.2, Loop, Niessner & Eisenacher §7):
 // - ViewMode::contain: every view contains the whole object: the camera looks at a point near
 //   the object's centre from a random direction, far enough that the object's bounding sphere
 //   lies inside the view volume, near and far planes included.

@@ -1,6 +1,6 @@
 // patchcull/cones.h: cones bounding the normals of a bicubic patch, computed per frame from the
-// control points alone (patches are animated). Shared by back-patch culling (tcone, ncone; seed
-// 001 §2) and by the displaced-patch bounds of seed 000 §4.2 (ACoN, CoN).
+// control points alone (patches are animated). Shared by back-patch culling (tcone, ncone;
+// Loop, Niessner & Eisenacher §2) and by the displaced-patch bounds of Niessner & Loop §4.2 (ACoN, CoN).
 //
 // A cone (axis a, unit; half-angle alpha) bounds a vector field when every non-zero vector of
 // the field makes an angle <= alpha with a. valid is false when no cone under 90 degrees exists

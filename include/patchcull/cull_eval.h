@@ -17,13 +17,13 @@ namespace patchcull {
 
 /// Names of the cull methods the CPU runs, in a stable order: "frustum", "frustum-disp" (view
 /// frustum; judged by surface samples inside the view volume), "tcone", "ncone", "ptp",
-/// "ptp-pcnt" (back-patch, seed 001; judged by sampled tangent planes facing the eye; they
-/// refuse displaced patches).
+/// "ptp-pcnt" (back-patch, Loop, Niessner & Eisenacher; judged by sampled tangent planes facing
+/// the eye; they refuse displaced patches).
 std::vector<std::string> cull_method_names();
 bool is_cull_method(const std::string& name);
 
-/// The "distance" view distribution (`cull --view-mode distance`), closer to seed 001's Table 1
-/// whole-object views than ViewMode::contain: every view looks at the centre of the object's
+/// The "distance" view distribution (`cull --view-mode distance`), closer to Loop, Niessner &
+/// Eisenacher's Table 1 whole-object views than ViewMode::contain: every view looks at the centre of the object's
 /// bounding sphere with a fixed 45-degree field of view (narrower side), from a uniformly random
 /// direction, at distance m * fit, where fit is the distance at which that sphere just touches the
 /// sides of the view and m is uniform in [min, max]. m >= 1 keeps the whole object in view.

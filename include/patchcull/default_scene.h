@@ -1,15 +1,15 @@
 // patchcull/default_scene.h: scenes for the renderer (the `render` command and the main job):
 // placed, animated copies of subdivision models among triangle-mesh occluders, and a camera path.
 //
-// The built-in default scene follows seed 000 Fig. 1 (c): animated characters (BigGuy and
+// The built-in default scene follows Niessner & Loop, Fig. 1 (c): animated characters (BigGuy and
 // MonsterFrog, ACC patches) standing on a ground plane among walls that act as triangle occluders,
 // seen from a camera that moves along a path over a few frames, so that frustum, back-patch and
-// occlusion culling (and the temporal statuses of seed 000 §3) all have work to do.
+// occlusion culling (and the temporal statuses of Niessner & Loop §3) all have work to do.
 //
 // The `city` (a street grid of box buildings with 200+ characters, the camera walking a street)
 // and `building` (rooms joined by doors and windows, with cells and portals) scenes are the
-// object-level scenes of issue 11 and 12, after G. Zachmann's lecture "Advanced Visibility
-// Computations" (seed 004: bounding-volume hierarchies for many objects, occlusion in cities,
+// object-level scenes, after G. Zachmann's lecture "Advanced Visibility
+// Computations" (bounding-volume hierarchies for many objects, occlusion in cities,
 // cells and portals in buildings). Scene files (patchcull/scene_file.h) describe the same Scene.
 //
 // Conventions: world space is y-up, the ground is y = 0, lengths are in character heights
@@ -125,7 +125,7 @@ struct CameraPath {
     Vec3 walk_direction{0, 0, -1}; ///< look direction, any non-zero length (walk)
 };
 
-/// A cell of a cell-and-portal scene (a room of the `building` scene; read by issue 12's portal
+/// A cell of a cell-and-portal scene (a room of the `building` scene; read by the portal
 /// traversal). The cells' boxes tile the interior: neighbouring rooms' boxes meet at the
 /// mid-plane of the wall between them, so every eye inside the building (doorways included) is
 /// in at least one box.
@@ -224,7 +224,7 @@ void rebase_scene(const Scene& world, DVec3 origin, Scene& frame);
 /// each, 8226 in all) on a 12 x 12 ground quad with a long low wall in front of them and two
 /// pillars between them (20 occluder triangles); the camera circles the group at 2.3 units, 5
 /// degrees per frame from -20. The MonsterFrogs are displaced, as the characters of Niessner &
-/// Loop's scenes are (seed 000 §6): by make_procedural_displacement(512, kDefaultSceneDisplaceScale),
+/// Loop's scenes are (Niessner & Loop §6): by make_procedural_displacement(512, kDefaultSceneDisplaceScale),
 /// a smooth bump field of +-1.5% of a BigGuy's height along the normal, at the frogs' own
 /// texcoords; the BigGuys are not. Throws patchcull::Error when a shipped model cannot be read
 /// (PATCHCULL_DATA_DIR as in shipped_model_path).
@@ -267,7 +267,7 @@ struct CityParams {
     int camera_street = -1;          ///< index of the z street the camera walks; -1: the middle one
 };
 
-/// The built-in `city` scene (issue 11): a blocks_x x blocks_z grid of box buildings (heights
+/// The built-in `city` scene: a blocks_x x blocks_z grid of box buildings (heights
 /// uniform in [min_height, max_height], each one EnvironmentObject "building#i", one-sided,
 /// counter-clockwise outward) separated by streets, on one ground quad ("ground", one-sided,
 /// front +y) that covers the grid and its outer streets. `characters` BigGuys and MonsterFrogs
@@ -297,7 +297,7 @@ struct BuildingParams {
     unsigned seed = 5;
 };
 
-/// The built-in `building` scene (issue 11, read by issue 12's cells and portals): a
+/// The built-in `building` scene (read by the cell-and-portal culling): a
 /// rooms_x x rooms_z grid of rooms under one ceiling. Every wall is built from closed boxes
 /// around its openings (one EnvironmentObject per box: "wall#k", one-sided, counter-clockwise
 /// outward); each room has a floor slab and a ceiling slab ("floor#i", "ceiling#i", boxes).
@@ -380,7 +380,7 @@ public:
     const std::vector<std::array<Vec2, 4>>& texcoords() const { return texcoords_; }
     const std::vector<DisplacementRange>& displacement_ranges() const { return ranges_; }
 
-    // ---- posing on the GPU (gl_posing.h's StencilPoser; issue 14) --------------------------
+    // ---- posing on the GPU (gl_posing.h's StencilPoser) ------------------------------------
     /// The stencil tables whose rows, applied to gpu_meshes()'s vertices and mapped by each
     /// instance's transform (transposed for mirrored instances), give exactly pose()'s patches and
     /// tangents(), per model (Scene::models order). A subdivision model's own tables

@@ -1,5 +1,5 @@
 // patchcull/displaced_bounds.h: bounds of displaced bicubic patches and their frustum and Hi-Z
-// occlusion tests (seed 000 §4.2; the OOBB of Munkberg et al. 2010 as the comparison), CPU side.
+// occlusion tests (Niessner & Loop §4.2; the OOBB of Munkberg et al. 2010 as the comparison), CPU side.
 //
 // The GLSL twin is to be written from this header: every step below is defined exactly.
 // Conventions are those of math.h, frustum.h and hiz.h: column-major matrices, right-handed view
@@ -18,11 +18,12 @@
 // displacement vector d = D n lies in a set E that does not depend on (u,v), S lies in
 // hull(P_k) + E = hull(P_k + E): every bound below is a convex set holding the 16 sets P_k + E.
 //
-// ---- Cones and per-axis extensions (seed 000 §4.2) ----------------------------------------------
+// ---- Cones and per-axis extensions (Niessner & Loop §4.2) ---------------------------------------
 // Cone kinds (NormalConeKind) bound the direction of n:
 //   full: no cone; E = ball of radius R = max(|d_min|, |d_max|);
-//   acon: tangent_normal_cone() of cones.h (Sederberg & Meyers; seed 001 TCONE);
-//   con:  normal_patch_cone() of cones.h (the normal patch, Shirman & Abi-Ezzi; seed 001 NCONE).
+//   acon: tangent_normal_cone() of cones.h (Sederberg & Meyers; Loop, Niessner & Eisenacher's TCONE);
+//   con:  normal_patch_cone() of cones.h (the normal patch, Shirman & Abi-Ezzi; Loop, Niessner &
+//         Eisenacher's NCONE).
 // An invalid cone (aperture >= 90deg, rational patch, degenerate vectors) falls back to full.
 // For a unit direction r and a cone (unit axis a, half-angle alpha), with c = r.a = cos(theta)
 // and s = |r x a| = sin(theta), the extreme values of r.n over unit n in the cone are
@@ -32,7 +33,7 @@
 // This is the seed's max(cos(acos(a_x) + alpha), cos(acos(a_x) - alpha)) without acos: for
 // theta in [0, pi] and alpha in [0, pi/2] the max is always the theta - alpha term. The range of
 // r.d = D (r.n) over D in [d_min, d_max] and r.n in [-delta-, delta+] is the product of the two
-// intervals, whose ends are (seed 000 §4.2; both >= 0 because D = 0 is allowed)
+// intervals, whose ends are (Niessner & Loop §4.2; both >= 0 because D = 0 is allowed)
 //   ext+(r) = max(d_max delta+, -d_min delta-),   ext-(r) = max(d_max delta-, -d_min delta+):
 //   r.d lies in [-ext-(r), ext+(r)]. For full: ext+ = ext- = R.
 // Float: delta+- get + kDisplacedDeltaSlack (capped at 1) and ext+- the factor kDisplacedExtScale,
@@ -41,7 +42,7 @@
 // For a direction r of any length (a row of a non-rigid view matrix) the extension is |r| times
 // that of r/|r|.
 //
-// ---- caf: the camera-aligned frustum (seed 000 §4.2) ---------------------------------------------
+// ---- caf: the camera-aligned frustum (Niessner & Loop §4.2) -------------------------------------
 // In view space (t = -z, the distance along the viewing direction; the seed's camera looks down
 // +z, ours down -z) with V = object_to_view = [L | T]:
 // 1. Q_k = V P_k (Cartesian: divided by the weight w_k > 0).
@@ -189,7 +190,7 @@ struct DisplacedBound {
 NormalCone displaced_normal_cone(const BezierPatch& patch, NormalConeKind cone);
 
 /// The bound of one patch with an explicit cone (invalid cone = full). For static patches whose
-/// cone is precomputed (seed 000: CoN for static objects), and for tests.
+/// cone is precomputed (Niessner & Loop: CoN for static objects), and for tests.
 DisplacedBound compute_displaced_bound_with_cone(const BezierPatch& patch, DisplacementRange range,
                                                  const NormalCone& cone, DisplacedBoundKind kind,
                                                  const DisplacedCullView& view);

@@ -1,12 +1,12 @@
 // patchcull/displacement.h: scalar displacement maps and per-patch displacement bounds.
 //
 // A displaced surface point is S(u,v) = B(u,v) + D(s,t) * n(u,v), n the unit normal and (s,t) the
-// texture coordinate interpolated bilinearly from the patch's corner texcoords (seed 002).
+// texture coordinate interpolated bilinearly from the patch's corner texcoords (Sathe).
 // D(s,t) = scale * (h(s,t) - midlevel), h the bilinearly filtered map value in [0,1], with
 // wrap-around addressing (GL_REPEAT) and texel centres at ((i + 0.5)/width, (j + 0.5)/height).
 // Row 0 of texels is t = 0 (OBJ's vt origin is bottom-left; image loaders flip rows).
 //
-// Seed 002's pre-processing step bounds D over every texel a patch can sample. The texels a patch
+// Sathe's pre-processing step bounds D over every texel a patch can sample. The texels a patch
 // can read form its window: the texel rows and columns touched by bilinear samples inside the
 // texture-space bounding box of its corner texcoords, widened by one texel on every side (float
 // rounding of the interpolated texcoords, and a GPU's limited sub-texel precision, may move a

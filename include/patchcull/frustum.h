@@ -1,4 +1,4 @@
-// patchcull/frustum.h: view-frustum cull kernels over patch batches (seed 000 §4.1.1, seed 002).
+// patchcull/frustum.h: view-frustum cull kernels over patch batches (Niessner & Loop §4.1.1, Sathe).
 //
 // Clip space as in math.h: inside means -w <= x <= w, -w <= y <= w, 0 <= z <= w. Entries that
 // take a clip matrix also take its ClipDepth (clip_space.h), with no default: a standard OpenGL
@@ -9,7 +9,7 @@
 // when control points straddle w <= 0 (behind the eye): no division by w ever happens.
 // A patch with a NaN or infinite coordinate is never culled (see "Non-finite input" below).
 //
-// - frustum (seed 000 §4.1.1): the clip-space bounds of the control points. For a polynomial or
+// - frustum (Niessner & Loop §4.1.1): the clip-space bounds of the control points. For a polynomial or
 //   rational patch with positive weights, the patch lies in the convex hull of its homogeneous
 //   control points, so if every control point is outside one clip plane the patch is too. With
 //   w > 0 this equals "the NDC bounding box of the control points misses the clip cube".
@@ -27,7 +27,7 @@
 //   Displacement up to max_displacement[i] along a unit normal moves a plane value by at most
 //   |D| * |plane row xyz| (per unit weight), which the kernel adds as a margin
 //   fma(fl(D * |row xyz|), W, value) when margins are given.
-// - frustum-disp (seed 002): the object-space AABB of the control points grown by max |D| on
+// - frustum-disp (Sathe): the object-space AABB of the control points grown by max |D| on
 //   every side; its 8 corners are transformed to clip space and tested against the clip planes
 //   (the NDC in-out test, done as homogeneous comparisons).
 //
@@ -51,7 +51,7 @@
 // "Relative" means relative to the terms' magnitude, |control point| and the eye's distance from
 // the frame's 0: patches must be in a local frame near them (ControlMesh::origin, mesh.h; a
 // world camera comes in through WorldCamera::local, camera.h). World coordinates of 1e5 in float
-// made visible BigGuy patches cull (issue 9); in the local frame any translation culls alike.
+// made visible BigGuy patches cull; in the local frame any translation culls alike.
 #pragma once
 
 #include <cmath>
@@ -119,7 +119,7 @@ void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displac
 void cull_frustum_simd(const PatchBatchView& patches, const float* max_displacement,
                        const FrustumPlanes& planes, std::uint8_t* culled);
 
-/// frustum-disp kernel (seed 002), scalar reference.
+/// frustum-disp kernel (Sathe), scalar reference.
 void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement,
                               const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled);
 /// frustum-disp kernel, SIMD.

@@ -5,8 +5,8 @@
 //
 // Shaders: shaders/backpatch_cones.comp.glsl (tcone, and ncone with PATCHCULL_NCONE; one
 // invocation per patch, the cone code in shaders/backpatch_cones.h mirrors
-// src/core/cones_internal.h operation by operation) and shaders/backpatch_ptp.comp.glsl (seed 001
-// §6: 16 invocations per patch, 8 patches per
+// src/core/cones_internal.h operation by operation) and shaders/backpatch_ptp.comp.glsl
+// (Loop, Niessner & Eisenacher §6: 16 invocations per patch, 8 patches per
 // work group; lane tau owns the 4 destinations of its 4x4 block, summed in the CPU schedule's
 // order from shaders/ptp_schedule.h, generated from src/core/ptp_schedule.h; the signs are
 // counted by a parallel reduction in shared memory).

@@ -1,5 +1,5 @@
 // patchcull/gl_displaced.h: GPU culling of displaced patches (library patchcull_gl): the bounds of
-// displaced_bounds.h (seed 000 §4.2's camera-aligned frustum `caf`, Munkberg et al.'s `oobb`, each
+// displaced_bounds.h (Niessner & Loop §4.2's camera-aligned frustum `caf`, Munkberg et al.'s `oobb`, each
 // with the cone `full`, `acon` or `con`) and their frustum and Hi-Z occlusion decisions, in a
 // compute shader that mirrors src/core/displaced_bounds.cpp operation by operation: gl_passes.h's
 // DisplacedPass over buffers and a Hi-Z texture that DisplacedCuller owns, with read-backs (tests,

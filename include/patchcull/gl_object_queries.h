@@ -1,6 +1,6 @@
 // patchcull/gl_object_queries.h: object-level occlusion culling with hardware occlusion queries
 // (library patchcull_gl), following G. Zachmann's lecture "Advanced Visibility Computations"
-// (seed 004: occlusion queries, the naive stop-and-wait loop, CHC and CHC++), Bittner, Wimmer,
+// (occlusion queries, the naive stop-and-wait loop, CHC and CHC++), Bittner, Wimmer,
 // Piringer & Purgathofer, "Coherent Hierarchical Culling: Hardware Occlusion Queries Made
 // Useful" (Eurographics 2004), and Mattausch, Bittner & Wimmer, "CHC++: Coherent Hierarchical
 // Culling Revisited" (Eurographics 2008).

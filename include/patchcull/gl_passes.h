@@ -93,7 +93,7 @@
 
 namespace patchcull::gl {
 
-/// Back-patch test of Loop, Niessner & Eisenacher (seed 001): the tangent cone, the normal cone,
+/// Back-patch test of Loop, Niessner & Eisenacher: the tangent cone, the normal cone,
 /// or the parametric tangent plane.
 enum class BackpatchMethod { tcone, ncone, ptp };
 /// "tcone", "ncone", "ptp" (the `patchcull cull` method names).
@@ -169,7 +169,7 @@ HiZTexture create_hiz_texture(int width, int height);
 /// level(l).offset, W_l x H_l row-major, row 0 = bottom). Waits for the GPU.
 std::vector<float> read_hiz_texture(const HiZTexture& hiz);
 
-/// Seed 000 §4.1's pyramid: level 0 = max over 2x2 pixels of the depth texture, level l = max
+/// Niessner & Loop §4.1's pyramid: level 0 = max over 2x2 pixels of the depth texture, level l = max
 /// over 2x2 texels of level l-1 (bit-identical to HiZPyramid::build on the same depth buffer).
 class HiZBuildPass {
 public:
@@ -277,7 +277,7 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
-/// cull_ptp_scalar on the GPU (seed 001 §6: 16 invocations per patch): reason kCullBackPatch.
+/// cull_ptp_scalar on the GPU (Loop, Niessner & Eisenacher §6: 16 invocations per patch): reason kCullBackPatch.
 /// object_to_clip = projection * view (* model), alpha = clip_space_eye_alpha(projection). When
 /// alpha or det(object_to_clip) is zero or not finite nothing may be culled and nothing runs.
 class BackpatchPtpPass {
@@ -297,7 +297,7 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
-/// cull_displaced_frustum / cull_displaced_occlusion on the GPU (seed 000 §4.2): the bound (caf or
+/// cull_displaced_frustum / cull_displaced_occlusion on the GPU (Niessner & Loop §4.2): the bound (caf or
 /// oobb) of each displaced patch from its range and cone, tested against the frustum and, when
 /// hiz is given, the pyramid: reasons kCullFrustum, kCullOcclusion. only_displaced: patches whose
 /// range is (0, 0) are left to the other passes (in a frame); false: every patch of the range is
@@ -320,7 +320,7 @@ private:
 };
 
 /// FrustumPass, BackpatchConePass and OcclusionPass (with_frustum = false) in one dispatch, one
-/// invocation per patch (issue 14's fused pass): the control points are read once, and the tests
+/// invocation per patch (the fused pass): the control points are read once, and the tests
 /// of `tests` run in the chain's order (frustum, back-patch cone, Hi-Z), stopping at the first that
 /// culls. Each patch gets exactly the reason (and the flag word) that the chain begin ->
 /// FrustumPass(make_frustum_planes(M, zero_to_one)) -> BackpatchConePass(method, eye) ->

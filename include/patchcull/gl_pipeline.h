@@ -1,6 +1,6 @@
 // patchcull/gl_pipeline.h: the whole per-frame cull pipeline of one patch set on the GPU (library
 // patchcull_gl): Niessner & Loop's two-pass temporal-coherence frame ("Patch-Based Occlusion
-// Culling for Hardware Tessellation", seed 000 §3, Fig. 2), built from the passes of gl_passes.h
+// Culling for Hardware Tessellation", Niessner & Loop §3, Fig. 2), built from the passes of gl_passes.h
 // chained through the renderer's flag buffer, with PatchRenderer (gl_renderer.h) drawing. No
 // decision is read back to the CPU; only the counters are (FrameStats).
 //
@@ -12,13 +12,13 @@
 //      the back-patch pass of PipelineParams::backpatch (BackpatchConePass or BackpatchPtpPass;
 //      displaced patches skipped); OcclusionPass (control-point boxes; displaced patches
 //      skipped) - or those three as one FusedCullPass (PipelineParams::fused_pass);
-//      DisplacedPass (seed 000 §4.2's bound of each displaced patch, against the frustum
+//      DisplacedPass (Niessner & Loop §4.2's bound of each displaced patch, against the frustum
 //      and the same pyramid); CullStatusPass::end (statuses, counters);
 //   4. the newly visible patches (draw pass 2; skipped when aggressive).
 // Without occlusion: the chain (without the Hi-Z passes; the displaced pass then tests the
 // frustum only), then clear, occluders and the patches that passed (one draw).
 // The first frame after set_patches or reset_visibility tags the even-indexed patches visible
-// (seed 000 §3: half of them). Conservative (except aggressive): the final id buffer equals the
+// (Niessner & Loop §3: half of them). Conservative (except aggressive): the final id buffer equals the
 // unculled render's, up to exact depth ties between patches (the draw order differs).
 //
 // Timing: on llvmpipe GL timer queries measure only part of the work (the vertex/tessellation
@@ -53,7 +53,7 @@ const char* timing_method_name(TimingMethod method);  ///< "automatic", "wall-cl
 struct FrameParams {
     RenderParams render;         ///< camera, size, tessellation (use_cull_flags is ignored)
     CullMode cull = CullMode::all;
-    /// Seed 000 §3.1: skip the second pass (newly visible patches appear one frame late). NOT
+    /// Niessner & Loop §3.1: skip the second pass (newly visible patches appear one frame late). NOT
     /// conservative for the current frame: its image can miss patches that became visible; the
     /// status update still fixes the next frame (identical again after one static frame).
     bool aggressive = false;
@@ -62,7 +62,7 @@ struct FrameParams {
 
 /// One object of the patch set: the patches [first, first + count), culled or not this frame.
 /// An object with cull = false is drawn whole (its flag words get kStatusVisible), its tests are
-/// not run: the per-object switch of seed 000 §6.3 (culling an object costs more than it saves
+/// not run: the per-object switch of Niessner & Loop §6.3 (culling an object costs more than it saves
 /// when it is small on screen or almost all visible).
 struct ObjectRange {
     std::size_t first = 0;
@@ -121,15 +121,15 @@ public:
 /// Parameters of one pipeline frame: the frame and the choice of each test.
 struct PipelineParams {
     FrameParams frame;
-    BackpatchMethod backpatch = BackpatchMethod::tcone;  ///< the back-patch test (seed 001)
+    BackpatchMethod backpatch = BackpatchMethod::tcone;  ///< the back-patch test (Loop, Niessner & Eisenacher)
     PtpRule ptp_rule = PtpRule::ncnt;                    ///< rule of ptp (ignored by the cones)
-    /// Bound and cone of displaced patches (seed 000 §4.2; used when the set has
+    /// Bound and cone of displaced patches (Niessner & Loop §4.2; used when the set has
     /// displacement_ranges and a displacement map is set).
     DisplacedBoundKind bound = DisplacedBoundKind::caf;
     NormalConeKind cone = NormalConeKind::acon;
     /// The frustum test of the chain (FrustumTest; hull is the pipeline's original behaviour).
     FrustumTest frustum = FrustumTest::hull;
-    /// Issue 14's fused pass: FusedCullPass (gl_passes.h) runs the frame's frustum, back-patch and
+    /// The fused pass: FusedCullPass (gl_passes.h) runs the frame's frustum, back-patch and
     /// Hi-Z tests in one dispatch per object in place of FrustumPass, BackpatchConePass and
     /// OcclusionPass, with the same decisions, so the frame (flag words, statuses, counts, image)
     /// is the same. Used where the choices allow it: frustum hull and back-patch tcone or ncone (or
@@ -166,8 +166,8 @@ struct FrameStats {
     std::size_t patches = 0;
     std::size_t object_culled = 0;   ///< in PipelineParams::object_culled, or of objects the ObjectPass left out
     std::size_t objects_left_out = 0;  ///< objects the ObjectPass did not draw (0 without one)
-    bool two_pass = false;           ///< the mode includes occlusion (seed 000 §3's pipeline)
-    // Every pass issues all patches to the TCS (seed 000 §6.3's RT_0 cost per pass); "drawn" =
+    bool two_pass = false;           ///< the mode includes occlusion (Niessner & Loop §3's pipeline)
+    // Every pass issues all patches to the TCS (Niessner & Loop §6.3's RT_0 cost per pass); "drawn" =
     // tessellated (levels > 0), the others get levels 0 there.
     std::size_t pass1_drawn = 0;     ///< patches drawn (tessellated) in the first pass
     std::size_t pass2_drawn = 0;     ///< ... in the second pass (newly visible; 0 when aggressive)

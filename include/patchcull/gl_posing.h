@@ -1,4 +1,4 @@
-// patchcull/gl_posing.h: posing animated objects on the GPU (library patchcull_gl, issue 14).
+// patchcull/gl_posing.h: posing animated objects on the GPU (library patchcull_gl).
 //
 // Both subdivision schemes make every Bezier control point (and every ACC tangent vector) a fixed
 // linear combination of control-mesh vertices: a stencil row (subdivision.h's PointStencils).

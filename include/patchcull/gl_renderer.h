@@ -2,7 +2,7 @@
 // windowed context, and bicubic patches drawn through hardware tessellation (TCS/TES) into an
 // off-screen framebuffer, with per-patch cull flags read by the TCS and triangle-mesh occluders.
 // The renderer only draws: the cull passes are gl_passes.h's (they run on any context and any
-// buffers), and gl_pipeline.h's CullPipeline chains them with this renderer into seed 000 §3's
+// buffers), and gl_pipeline.h's CullPipeline chains them with this renderer into Niessner & Loop §3's
 // two-pass temporal-coherence frame.
 //
 // Conventions (as math.h, frustum.h, hiz.h and displacement.h):
@@ -24,11 +24,11 @@
 //   (2), kFlagOcclusion (4) (shaders/shared.h). Bits 8-9 = temporal status of the pipeline:
 //   kStatusVisible (passed the latest tests) and kStatusNewlyVisible (passed them, and was not
 //   tagged visible before); gl_passes.h's flag chain writes both. A culled patch gets tessellation
-//   levels 0 in the TCS and is discarded by the tessellator (seed 000 §3, seed 002: cull in the
+//   levels 0 in the TCS and is discarded by the tessellator (Niessner & Loop §3, Sathe: cull in the
 //   patch-constant phase).
 // - Tessellation: uniform integer level L (equal_spacing) on every edge and the interior, L in
 //   [1, 64], scaled by 2^(D - depth) per patch for sets of mixed refinement depth
-//   (PatchAttributes::depth), or adaptive by distance (RenderParams::adaptive_tess, seed 000
+//   (PatchAttributes::depth), or adaptive by distance (RenderParams::adaptive_tess, Niessner & Loop
 //   §6.3); the surface is evaluated exactly (rational Bezier) at the tessellator points.
 // - Shading normal: du x dv of the patch's ACC tangent patches where it has them
 //   (PatchAttributes::tangents; continuous across extraordinary vertices), else of the patch's own
@@ -40,7 +40,7 @@
 //   separately, so tests can check that it bounds the surface. With margins, a patch whose margin
 //   is 0 is drawn undisplaced (D = 0 there anyway; shaders/patch_displaced.h), so one map can
 //   serve a scene of displaced and plain objects. Displaced patches are drawn two-sided and culled
-//   by the frustum pass (with their margin) and the displaced pass (seed 000 §4.2's bounds, from
+//   by the frustum pass (with their margin) and the displaced pass (Niessner & Loop §4.2's bounds, from
 //   PatchAttributes::displacement_ranges); never by the back-patch or control-point Hi-Z tests.
 //
 // Workarounds for Mesa llvmpipe (22.3.6 and still in 25.0.7), applied ALWAYS (they cost nothing
@@ -192,7 +192,7 @@ struct PatchAttributes {
     /// ACC tangent patches (Loop & Schaefer 2008; PatchFrame::tangents and PatchInfo::tangent_index):
     /// patch p uses tangents[tangent_index[p]] when tangent_index[p] >= 0. The TES then shades
     /// with their normal du x dv, continuous across extraordinary vertices, instead of the
-    /// patch's own derivatives. Displacement keeps the patch's own normal: seed 000 §4.2's cone
+    /// patch's own derivatives. Displacement keeps the patch's own normal: Niessner & Loop §4.2's cone
     /// bounds (displaced_bounds.h), computed from the control points, bound that normal only.
     /// tangent_index: empty (no tangents) or one per patch.
     std::vector<std::int32_t> tangent_index;
@@ -205,7 +205,7 @@ struct PatchAttributes {
     /// adaptive_tess, whose levels follow the eye distance.
     std::vector<std::uint8_t> depth;
     /// DisplacementRange of each patch (min and max of D over it, displacement.h), or empty: the
-    /// input of the displaced pass (gl_passes.h's DisplacedPass, seed 000 §4.2's bounds), uploaded
+    /// input of the displaced pass (gl_passes.h's DisplacedPass, Niessner & Loop §4.2's bounds), uploaded
     /// as vec2 per patch (range_buffer()). A patch with range (0, 0) is not displaced.
     std::vector<DisplacementRange> displacement_ranges;
 };
@@ -223,7 +223,7 @@ struct RenderParams {
     int tess_level = 8;           ///< uniform tessellation level (adaptive: the maximum), clamped to [1, 64]
     bool use_cull_flags = true;   ///< false: ignore the flags and draw every patch (the reference)
     bool displace = true;         ///< displace the surface when a displacement map is set
-    /// Adaptive tessellation by distance (seed 000 §6.3): each edge gets
+    /// Adaptive tessellation by distance (Niessner & Loop §6.3): each edge gets
     /// clamp(tess_level * tess_reference_distance / d, 1, tess_level), d = distance from the eye to
     /// the midpoint of the edge's two corner points; interior levels the max of opposite edges.
     /// Shared edges get equal levels (no T-junction cracks). false: tess_level everywhere.
@@ -261,7 +261,7 @@ public:
     void set_patches(const PatchBatchView& patches, const PatchAttributes& attributes = {});
     /// Animation: replaces the control points (and attributes) of the uploaded set by those of
     /// the same patches in a new pose, KEEPING the flag words, so the pipeline's temporal status
-    /// carries over to the next frame (seed 000 §3 with animated patches). Throws
+    /// carries over to the next frame (Niessner & Loop §3 with animated patches). Throws
     /// patchcull::Error when patches.size() != patch_count() or an attribute vector has the
     /// wrong size.
     void update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes = {});
@@ -312,7 +312,7 @@ public:
     std::uint64_t flag_generation() const;
 
     // ---- occluders ---------------------------------------------------------------------------
-    /// Sets the triangle-mesh occluders (seed 000 §3), replacing the previous ones: triangle t has
+    /// Sets the triangle-mesh occluders (Niessner & Loop §3), replacing the previous ones: triangle t has
     /// corners vertices[indices[3t + i]] (object space). They are drawn by render() and
     /// begin_frame() before any patch, with ids kIdOccluderBit | t, so they occlude
     /// patches through the depth buffer and the Hi-Z pyramid. Empty vectors remove them. Throws
@@ -353,14 +353,14 @@ public:
     /// frame's camera and tessellation (and clears the drawn marks, read_drawn_patches);
     /// draw_selected then draws, over what is there, the patches whose flag word w has
     /// (w & mask) == value (shaders/patchcull_tcs.h's selections, e.g. kStatusVisible twice for
-    /// the first pass of seed 000 §3), as many times as needed. params.use_cull_flags is ignored.
+    /// the first pass of Niessner & Loop §3), as many times as needed. params.use_cull_flags is ignored.
     void begin_frame(const RenderParams& params);
     void draw_selected(std::uint32_t mask, std::uint32_t value);
     /// draw_selected restricted to the patches of spans (disjoint, any order, within the set, else
     /// throws): the patches of objects culled whole are never issued, so they cost no TCS work.
     void draw_selected(std::uint32_t mask, std::uint32_t value, const std::vector<PatchSpan>& spans);
 
-    /// Visualisation (seed 000 Fig. 2's statuses): renders every patch, ignoring the flags, with a
+    /// Visualisation (Niessner & Loop, Fig. 2's statuses): renders every patch, ignoring the flags, with a
     /// colour from its flag word, and the occluders in grey, seen through `view` (its camera, size
     /// and tessellation; use_cull_flags ignored), into a separate image (the framebuffer keeps the
     /// last frame). Legend:

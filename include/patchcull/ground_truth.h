@@ -7,7 +7,7 @@
 // undisplaced). A sample inside the clip volume means the patch is visible to the frustum test:
 // culling it is a false cull. Clip tests run in double precision, independently of the kernels.
 //
-// Memory (issue 14): the samples are large (grid^2 * 12 bytes of surface points and grid^2 * 32
+// Memory: the samples are large (grid^2 * 12 bytes of surface points and grid^2 * 32
 // bytes of tangent planes per patch: 12.7 KB at grid 17), so a judge of many patches keeps them
 // for a small window of patches at a time (PatchTruthWindow below) and computes them again when
 // the window comes back to a patch; the answers are those of the functions above, whatever the
@@ -24,7 +24,7 @@
 
 namespace patchcull {
 
-inline constexpr int kGroundTruthGrid = 17;  ///< samples per side (issue 2: "for example 17x17")
+inline constexpr int kGroundTruthGrid = 17;  ///< samples per side (17x17)
 
 /// Writes grid*grid samples of the displaced patch to out (row v, column u). tangents and
 /// displacement may be null; uv are the patch's corner texture coordinates (PatchInfo::uv).
@@ -35,14 +35,14 @@ void sample_displaced_patch(const BezierPatch& patch, const TangentPatches* tang
 /// 0<=z<=w, w>0), evaluated in double precision.
 bool any_point_in_clip_volume(const Mat4& object_to_clip, const Vec3* points, std::size_t count);
 
-// ---- back-facing ground truth (seed 001) --------------------------------------------------
+// ---- back-facing ground truth (Loop, Niessner & Eisenacher) -------------------------------
 
 /// A homogeneous plane in double precision.
 struct PlaneD {
     double x = 0, y = 0, z = 0, w = 0;
 };
 
-/// Parametric tangent planes T(u,v) = cross4(B, B_u, B_v) (object space; seed 001 eq. 1) of the
+/// Parametric tangent planes T(u,v) = cross4(B, B_u, B_v) (object space; Loop, Niessner & Eisenacher eq. 1) of the
 /// patch at a grid x grid lattice (row v, column u), computed directly in double precision.
 /// For a polynomial patch T = (n, -n.p) with n = B_u x B_v, so e . T = n . (e - p).
 void sample_tangent_planes(const BezierPatch& patch, int grid, PlaneD* out);
@@ -79,7 +79,7 @@ SampleSphere bounding_sphere(const Vec3* points, std::size_t count);
 /// any_point_in_clip_volume (double precision, with a relative safety margin).
 bool sphere_outside_clip_volume(const Mat4& object_to_clip, const SampleSphere& sphere);
 
-// ---- streamed ground truth (issue 14) --------------------------------------------------------
+// ---- streamed ground truth ----------------------------------------------------------------
 
 /// One patch's inputs to the dense samples: what sample_displaced_patch and sample_tangent_planes
 /// take. tangents may be null; uv (4 corner texcoords, patch.h order) is read only when the

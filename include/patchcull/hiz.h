@@ -1,4 +1,4 @@
-// patchcull/hiz.h: the Hi-Z pyramid and the patch occlusion test (seed 000 §4.1, §4.1.1), CPU side.
+// patchcull/hiz.h: the Hi-Z pyramid and the patch occlusion test (Niessner & Loop §4.1, §4.1.1), CPU side.
 //
 // Everything below is defined exactly, so that the GLSL compute-shader mirror can reproduce the
 // pyramid bit for bit and the decisions operation by operation. Conventions are those of math.h:
@@ -19,7 +19,7 @@
 // (2^24 - 1) reversed, rounded one ulp outward (farther): a fragment that ties with u under
 // GL_LEQUAL or GL_GEQUAL is then never hidden.
 //
-// ---- Pyramid (seed 000 §4.1) -----------------------------------------------------------------
+// ---- Pyramid (Niessner & Loop §4.1) ----------------------------------------------------------
 // The full-resolution level is skipped (seed): level 0 has half resolution. With s(l) = 2^(l+1),
 //   size:      W_l = ceil(W / s(l)),  H_l = ceil(H / s(l))     (equivalently W_{l+1} = ceil(W_l / 2))
 //   footprint: texel (tx, ty) of level l covers exactly the depth pixels (x, y) with
@@ -43,7 +43,7 @@
 // standard 2x2 reduction: the used texels equal T_l above exactly (for depths in [0,1]; tested).
 // Storage: level l is a row-major W_l x H_l block (row 0 = bottom) at level(l).offset in data().
 //
-// ---- Occlusion test (seed 000 §4.1.1), per patch, in this order --------------------------------
+// ---- Occlusion test (Niessner & Loop §4.1.1), per patch, in this order -----------------------
 // 1. Frustum: exactly cull_frustum_scalar without displacement (frustum.h; the kernels call it,
 //    or cull_frustum_simd, whose decisions are identical). Culled -> kHiZFrustumCulled.
 // 2. Clip-space control points: for each control point P_k (object space, homogeneous) and row r of
@@ -103,7 +103,7 @@
 // whose zmin lies within a few ulps of h. Use an exactly rounded division in the shader (e.g. a
 // quotient corrected by its fma residual), or have the equality test tolerate only such ties.
 //
-// Extension point (issue 5, displaced patches, seed 000 §4.2): a displaced patch gets its window
+// Extension point (displaced patches, Niessner & Loop §4.2): a displaced patch gets its window
 // box and front plane from the camera-aligned frustum instead of steps 2-5; steps 6-9 are
 // hiz_rect_from_window_box + hiz_rect_max + `h < zmin`, shared by both. The kernels below take no
 // displacement yet.

@@ -109,7 +109,7 @@ struct ControlMesh {
     /// consistently oriented surface, and at least one face). Only on such a surface are
     /// back-facing patches always hidden by front-facing ones when both sides are drawn: through
     /// the boundary of an open one (the teapot's lid gap) the inside of a patch facing away can
-    /// show, so back-patch culling (seed 001) is not conservative there.
+    /// show, so back-patch culling (Loop, Niessner & Eisenacher) is not conservative there.
     bool is_closed() const;
     /// Signed volume enclosed by the faces (divergence theorem over each face's triangle fan,
     /// summed in double relative to the first position, so it does not depend on where the mesh

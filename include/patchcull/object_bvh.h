@@ -1,6 +1,6 @@
 // patchcull/object_bvh.h: a bounding-volume hierarchy over a scene's objects' AABBs, traversed
 // with hierarchical view-frustum culling, plane masking and plane coherence (G. Zachmann,
-// "Advanced Visibility Computations", seed 004: "Hierarchical View Frustum Culling", "Plane
+// "Advanced Visibility Computations": "Hierarchical View Frustum Culling", "Plane
 // Masking", "zeitliche Kohärenz"), and the flat list with the same tests for comparison.
 //
 // Built once (binned SAH over the boxes' centres, leaves of <= 4 objects) and refitted per frame

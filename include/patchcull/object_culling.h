@@ -1,8 +1,8 @@
-// patchcull/object_culling.h: the object level that runs before any patch is tested (issue 11):
+// patchcull/object_culling.h: the object level that runs before any patch is tested:
 // whole objects culled by their bounding volumes against the view frustum (flat, or through a
 // BVH with plane masking and plane coherence), and back-facing clusters of their triangles or
 // patches culled by Johannsen & Carter's clustered back-face test, following G. Zachmann's
-// lecture "Advanced Visibility Computations" (seed 004) and the object bounding-box test that
+// lecture "Advanced Visibility Computations" and the object bounding-box test that
 // Sathe ("View Frustum Culling of Catmull-Clark Patches in DirectX 11") and Niessner & Loop
 // ("Patch-Based Occlusion Culling for Hardware Tessellation", §3) ask for before patch culling.
 //

@@ -45,7 +45,7 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
 /// frame is rest). out keeps its storage between frames.
 void evaluate_frame(const LoadedModel& model, const std::vector<Vec3>& positions, PatchFrame& out);
 
-/// Per-patch displacement ranges [D_min, D_max] (seed 002's pre-processing), or all zero when
+/// Per-patch displacement ranges [D_min, D_max] (Sathe's pre-processing), or all zero when
 /// map is null or empty.
 std::vector<DisplacementRange> displacement_ranges(const PatchFrame& frame, const DisplacementMap* map);
 

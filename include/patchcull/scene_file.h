@@ -1,8 +1,8 @@
 // patchcull/scene_file.h: scene files, the JSON form of a Scene (patchcull/default_scene.h): placed,
 // animated subdivision characters and triangle-mesh environment objects that are drawn and
-// occlude, a displacement map, a camera path, and optional cells and portals (issue 11; the
-// object-level scenes of G. Zachmann's lecture "Advanced Visibility Computations", seed 004, and
-// of Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation", seed 000).
+// occlude, a displacement map, a camera path, and optional cells and portals (the
+// object-level scenes of G. Zachmann's lecture "Advanced Visibility Computations", and of
+// Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation").
 // The format is documented, with a complete example, in docs/SCENE_FORMAT.md; data/scenes/ holds
 // default.json (the built-in default scene), city_small.json and building.json.
 //

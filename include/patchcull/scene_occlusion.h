@@ -1,4 +1,4 @@
-// patchcull/scene_occlusion.h: the CPU object-level occlusion methods (issue 12) set up for a
+// patchcull/scene_occlusion.h: the CPU object-level occlusion methods set up for a
 // Scene (default_scene.h), after the object level of scene_object_level.h:
 //   horizon  the occlusion horizon (occlusion_horizon.h; Downs, Möller & Séquin, "Occlusion
 //            Horizons for Driving through Urban Scenery"): the occluders are the environment

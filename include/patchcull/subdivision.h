@@ -1,7 +1,7 @@
 // patchcull/subdivision.h: Catmull-Clark control meshes to bicubic Bezier patches.
 //
-// Two schemes (seeds 000, 001, 002):
-// - Scheme::acc: Loop & Schaefer's approximate Catmull-Clark patches (ACC, seed 002): one
+// Two schemes (the papers' setups: Niessner & Loop; Loop, Niessner & Eisenacher; Sathe):
+// - Scheme::acc: Loop & Schaefer's approximate Catmull-Clark patches (ACC, Sathe): one
 //   bicubic patch per quad, exact on regular quads; extraordinary patches also get ACC tangent
 //   patches for a continuous normal field. A mesh with non-quad faces first gets one uniform
 //   Catmull-Clark refinement (OpenSubdiv Far), so every face becomes a quad.
@@ -54,7 +54,7 @@ struct PointStencils {
 /// Per-patch data that is not geometry.
 struct PatchInfo {
     /// Texture coordinates at the patch corners (u,v) = (0,0), (1,0), (0,1), (1,1). The texture
-    /// parameterization is bilinear over the patch domain (seed 002's pre-processing step).
+    /// parameterization is bilinear over the patch domain (Sathe's pre-processing step).
     Vec2 uv[4] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
     std::uint32_t base_face = 0;     ///< control-mesh face the patch comes from
     bool extraordinary = false;      ///< acc: touches an extraordinary vertex; osd: end-cap patch
@@ -110,7 +110,7 @@ struct PatchFrame {
 };
 
 /// Evaluates the model's patches for control-mesh positions (model.mesh.positions or an animated
-/// copy of the same size), then applies split_levels uniform 1-to-4 splits (seed 001's
+/// copy of the same size), then applies split_levels uniform 1-to-4 splits (Loop, Niessner & Eisenacher's
 /// MonsterFrog with 5168 patches is 1292 quads after one split). Child texture coordinates are
 /// the bilinear interpolation of the parent's.
 void evaluate_patches(const SubdivisionModel& model, const std::vector<Vec3>& positions,

@@ -1,7 +1,7 @@
 // patchcull/teapot.h: the built-in Utah teapot (Newell), 32 bicubic Bezier patches.
 //
 // The teapot keeps its degenerate patches: the lid's top and the bottom collapse a patch edge to
-// a point, where du x dv vanishes. Seed 001's Pcnt rule exists for exactly these patches.
+// a point, where du x dv vanishes. Loop, Niessner & Eisenacher's Pcnt rule exists for exactly these patches.
 #pragma once
 
 #include <vector>
