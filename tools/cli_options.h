@@ -1,4 +1,4 @@
-// Strict option values for every CLI command (issue 9), in one place so that each command rejects
+// Strict option values for every CLI command, in one place so that each command rejects
 // bad values the same way: one printable line naming the flag, exit status 2 (tools/main.cpp).
 //
 // CLI11's own conversions are too lenient for that promise: integers go through strtoll/strtoull

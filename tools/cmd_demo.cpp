@@ -1,8 +1,9 @@
 // The main job (`patchcull` with no arguments, or `patchcull demo`): renders the built-in default
-// scene (patchcull/default_scene.h; seed 000 Fig. 1 (c): animated characters among triangle
-// occluders) headless with the GPU pipeline (seed 000 §3, seed 001's back-patch tests), along the
-// scene's camera path, once without culling (the reference) and once per cull method. Every culled
-// frame is compared with the unculled one (compare_frames; a false cull fails the job, exit 1).
+// scene (patchcull/default_scene.h; Niessner & Loop, Fig. 1 (c): animated characters among triangle
+// occluders) headless with the GPU pipeline (Niessner & Loop §3; Loop, Niessner & Eisenacher's
+// back-patch tests), along the scene's camera path, once without culling (the reference) and
+// once per cull method. Every culled frame is compared with the unculled one (compare_frames; a
+// false cull fails the job, exit 1).
 // Writes OUT/frame.png (colour, last frame, cull mode all) and OUT/cull.png (the patch statuses of
 // that frame seen from another camera, turned 90 degrees and above, so that culled patches show) and
 // prints, per method, cull rates and pass times. The `auto` row is --cull auto (cull_auto.h: Niessner
@@ -83,7 +84,7 @@ int run_demo(const DemoOptions& options) {
 
     pipeline.set_patches(poses[0], attributes[0]);
     upload_scene_occluders(renderer, scene);
-    renderer.set_displacement_map(scene.displacement);  // the frogs are displaced (seed 000 §6)
+    renderer.set_displacement_map(scene.displacement);  // the frogs are displaced (Niessner & Loop §6)
     if (options.scene == "default")
         std::printf("patchcull default scene: 3 BigGuy + 3 displaced MonsterFrog (ACC, animated), %zu patches, %zu "
                     "occluder triangles;\n",
@@ -136,8 +137,8 @@ int run_demo(const DemoOptions& options) {
     for (const SceneObject& o : scene_objects(scene)) ranges.push_back(o.range);
     progress.clear();
     std::printf("\nPer method, averaged over frames 1..%d (frame 0 starts with half the patches tagged visible, "
-                "seed 000 §3);\ncull rates are fractions of the %zu patches; times in ms; 'x ref' = total / unculled "
-                "render.\n\n",
+                "Niessner & Loop §3);\ncull rates are fractions of the %zu patches; times in ms; 'x ref' = total / "
+                "unculled render.\n\n",
                 options.frames - 1, patches);
     std::printf("%-17s %7s %7s %7s %7s %7s %7s %7s %7s %7s %8s %6s %6s\n", "method", "culled", "frustum", "back",
                 "occl", "drawn", "pass1", "hiz", "cull", "pass2", "total", "x ref", "false");
@@ -212,7 +213,7 @@ int run_demo(const DemoOptions& options) {
         }
     }
     progress.finish();
-    // The object level (issue 11): the city's objects culled before the patch passes.
+    // The object level: the city's objects culled before the patch passes.
     if (options.city_frames > 0) {
         DemoCityOptions city;
         city.width = width;

@@ -1,12 +1,12 @@
 // `patchcull eval ...`: the papers' evaluations, a subcommand group: `eval occlusion` (here),
 // `eval displaced` (tools/eval_displaced.cpp) and `eval temporal` (tools/eval_temporal.cpp).
 //
-// `eval occlusion MODEL [--split N] [--views N] --json` reproduces seed 000 §6.2 for non-displaced
+// `eval occlusion MODEL [--split N] [--views N] --json` reproduces Niessner & Loop §6.2 for non-displaced
 // models (culling within one object): views that contain the whole object (camera.h, contain
-// mode); on each view the pipeline (seed 000 §3, cull mode occlusion) runs on the static model from
+// mode); on each view the pipeline (Niessner & Loop §3, cull mode occlusion) runs on the static model from
 // a first frame until its visible set is stable (converge_frame, eval_temporal.h: two consecutive
 // frames tag the same patches visible; at most --max-frames frames), and the occluded fraction of that frame is recorded. Every
-// final frame is compared with the unculled render (false culls). For comparison with seed 000's
+// final frame is compared with the unculled render (false culls). For comparison with Niessner & Loop's
 // back-patch figures it also reports the GPU tcone/ncone back-patch cull fractions of each view.
 // Output (--json): {"model","scheme","split","patches","views","size","tess","seed",
 //   "occluded_fraction" (mean over views),"occluded_fraction_min","occluded_fraction_max",
@@ -123,8 +123,8 @@ int run_occlusion(const OcclusionOptions& o) {
     } else {
         std::printf("%s: %zu patches, %d whole-object views at %dx%d, level %d\n", model.name.c_str(), patches, o.views,
                     width, height, o.tess);
-        std::printf("  occluded (seed 000 §6.2): %.2f%% (min %.2f%%, max %.2f%%), %.1f frames to a stable visible set, "
-                    "%zu views unstable\n",
+        std::printf("  occluded (Niessner & Loop §6.2): %.2f%% (min %.2f%%, max %.2f%%), %.1f frames to a stable "
+                    "visible set, %zu views unstable\n",
                     100 * occluded_sum / n, 100 * (o.views ? occluded_min : 0.0), 100 * occluded_max, frames_sum / n,
                     unstable);
         std::printf("  back-patch (GPU, same views): tcone %.2f%%, ncone %.2f%%; false culls %zu\n", 100 * tcone_sum / n,
@@ -142,7 +142,7 @@ Runner add_eval_command(CLI::App& app) {
     eval->require_subcommand(0, 1);
     auto occlusion = std::make_shared<OcclusionOptions>();
     CLI::App* command = eval->add_subcommand(
-        "occlusion", "Seed 000 §6.2: occluded fraction of a non-displaced model over whole-object views");
+        "occlusion", "Niessner & Loop §6.2: occluded fraction of a non-displaced model over whole-object views");
     add_text_option(*command, "MODEL", occlusion->model, "OBJ control mesh, or 'teapot'")->required();
     add_choice_option(*command, "--scheme", occlusion->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*command, "--split", occlusion->split, 0, 4, "uniform 1-to-4 patch splits");
@@ -155,7 +155,7 @@ Runner add_eval_command(CLI::App& app) {
 
     auto displaced = std::make_shared<DisplacedEvalOptions>();
     CLI::App* displaced_command = eval->add_subcommand(
-        "displaced", "Seed 000 Table 1: cull rates of the six displaced-patch bounds over whole-object views");
+        "displaced", "Niessner & Loop, Table 1: cull rates of the six displaced-patch bounds over whole-object views");
     add_text_option(*displaced_command, "MODEL", displaced->model, "OBJ control mesh, or 'teapot'")->required();
     add_choice_option(*displaced_command, "--scheme", displaced->scheme, {"acc", "osd"},
                       "Catmull-Clark to Bezier scheme");
@@ -172,7 +172,8 @@ Runner add_eval_command(CLI::App& app) {
 
     auto temporal = std::make_shared<TemporalEvalOptions>();
     CLI::App* temporal_command = eval->add_subcommand(
-        "temporal", "Seed 000 Fig. 9 right: occluded fraction of the running pipeline against the camera's rotation speed");
+        "temporal",
+        "Niessner & Loop, Fig. 9 right: occluded fraction of the running pipeline against the camera's rotation speed");
     add_text_option(*temporal_command, "MODEL", temporal->model, "OBJ control mesh, or 'teapot'")->required();
     add_choice_option(*temporal_command, "--scheme", temporal->scheme, {"acc", "osd"},
                       "Catmull-Clark to Bezier scheme");
@@ -195,7 +196,7 @@ Runner add_eval_command(CLI::App& app) {
 
     auto scene = std::make_shared<SceneEvalOptions>();
     CLI::App* scene_command = eval->add_subcommand(
-        "scene", "Issue 12: object-level occlusion (queries, CHC, CHC++, horizon, portals) beside per-patch Hi-Z on a scene's path");
+        "scene", "Object-level occlusion (queries, CHC, CHC++, horizon, portals) beside per-patch Hi-Z on a scene's path");
     add_text_option(*scene_command, "SCENE", scene->scene, "a built-in scene (city, building, default), a scene file (.json), or a model (OBJ or teapot) as render takes it")->required();
     add_choice_option(*scene_command, "--scheme", scene->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*scene_command, "--frames", scene->frames, 1, 10000, "frames of the scene's camera path");
@@ -213,7 +214,7 @@ Runner add_eval_command(CLI::App& app) {
 
     auto fused = std::make_shared<FusedEvalOptions>();
     CLI::App* fused_command = eval->add_subcommand(
-        "fused", "Issue 14: the fused CPU cull kernel's fixed plans against its cost model on a scene's path");
+        "fused", "The fused CPU cull kernel's fixed plans against its cost model on a scene's path");
     add_text_option(*fused_command, "SCENE", fused->scene, "a built-in scene (city, building, default), a scene file (.json), or a model (OBJ or teapot) as render takes it")->required();
     add_choice_option(*fused_command, "--scheme", fused->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*fused_command, "--frames", fused->frames, 1, 10000, "frames of the scene's camera path");

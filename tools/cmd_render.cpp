@@ -1,7 +1,7 @@
-// `patchcull render [MODEL|default] ... --json`: seed 000 §3's GPU pipeline (with seed 001's GPU
-// back-patch pass) over an animated scene and a moving camera, optionally verified frame by frame
-// against the unculled render (compare_frames: a patch visible unculled but culled is a false
-// cull). Output (--json), one object:
+// `patchcull render [MODEL|default] ... --json`: Niessner & Loop §3's GPU pipeline (with Loop,
+// Niessner & Eisenacher's GPU back-patch pass) over an animated scene and a moving camera,
+// optionally verified frame by frame against the unculled render (compare_frames: a patch
+// visible unculled but culled is a false cull). Output (--json), one object:
 //   {"model","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
 //    "displace","displace_scale","displaced_patches","bound","cone","frustum",
 //    "frames":[{"frame","pass1_drawn","pass2_drawn","frustum_culled","backpatch_culled",
@@ -10,17 +10,17 @@
 //               "total"[,"reference"]},"false_culls"[,"false_culled_patches":[indices]]}],
 //    "false_culls"}
 // --dump-hiz DIR adds "hiz_dump" (hiz.json's object) and --draw-bounds P[,P...] adds
-// "draw_bounds" (one object per patch): tools/render_dumps.h (seed 000 Figs. 3 and 6).
+// "draw_bounds" (one object per patch): tools/render_dumps.h (Niessner & Loop, Figs. 3 and 6).
 // Without --verify nothing is compared: every false_culls is 0 and "verified" is false. Patch
 // indices are positions in the scene's pose (instances in order, each in its model's order).
 // "backpatch" is "off" when no back-patch test ran (--cull none/frustum/occlusion, or `all` on a
 // scene with an open surface, see applicable_cull_mode). "tess_mode" is "uniform" (--tess on every
-// patch) or "adaptive" (--tess-mode adaptive: tessellation by distance, seed 000 §6.3, "tess" is
+// patch) or "adaptive" (--tess-mode adaptive: tessellation by distance, Niessner & Loop §6.3, "tess" is
 // the maximum; render_support.h's resolve_tess_mode gives the reference distance). "displace" is
 // the scene's map ("none", "procedural" or the PNG path; the default scene displaces its
 // MonsterFrogs), "displaced_patches" the patches with a nonzero displacement range; displaced
 // patches are culled by the frustum and the running pipeline's Hi-Z with the bound ("caf" or
-// "oobb") and cone ("full", "acon", "con") of seed 000 §4.2, and never by back-patch tests;
+// "oobb") and cone ("full", "acon", "con") of Niessner & Loop §4.2, and never by back-patch tests;
 // "displaced_occlusion_culled" counts those of "occlusion_culled" that are displaced.
 // --frustum hull|aabb (gl_pipeline.h's FrustumTest; "frustum" in the JSON): the frustum test of the
 // chain, hull (Niessner & Loop: the control points, the default) or aabb (Sathe: the control
@@ -34,7 +34,7 @@
 // measured or when there is no tessellation cost to save; cull_rate: the object's average rate the
 // decision used, null until measured). Without --json a line per frame says how many objects are
 // culled, and why each is on or off.
-// --objects frustum|bvh|bvh+backface (object_level_options.h, issue 11): the object level runs
+// --objects frustum|bvh|bvh+backface (object_level_options.h): the object level runs
 // before the patch passes (instances and environment objects; culled ones cost no patch work);
 // every frame (also with the default --objects none: zeros) gains
 //   "objects":{"total","frustum_culled","backface_culled","detail_culled","plane_tests",
@@ -44,11 +44,11 @@
 // "object_level" and "cpu_frustum_after_objects", CPU wall-clock times outside "total"), and
 // "false_culls" counts object-level false culls too (culled patches and environment triangles
 // in the unculled id buffer); --detail-cull's changes are reported as detail_pixels, not false culls.
-// --fused-pass (issue 14): the frustum, back-patch and Hi-Z tests in one FusedCullPass dispatch per
+// --fused-pass: the frustum, back-patch and Hi-Z tests in one FusedCullPass dispatch per
 // object (gl_pipeline.h's PipelineParams::fused_pass; same decisions); "fused_pass" in the JSON is
 // the flag, each frame's "fused_pass" whether the fused pass ran (not with --backpatch ptp or
 // --frustum aabb, which keep the separate passes).
-// --pose cpu|gpu (issue 14; render_support.h's PoseWhere): where each frame's animated patches
+// --pose cpu|gpu (render_support.h's PoseWhere): where each frame's animated patches
 // are evaluated: cpu (the default: ScenePoser on the CPU, every patch and attribute re-uploaded)
 // or gpu (only the control meshes go up, gl_posing.h's StencilPoser evaluates the stencils into
 // the renderer's buffers, bit-identical). "pose" in the JSON is the flag; every frame gains
@@ -125,14 +125,14 @@ Runner add_render_command(CLI::App& app) {
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 1, 1000, "number of frames");
     add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all", "auto"},
-                      "cull tests of the pipeline (auto: all, per object where it pays, seed 000 §6.3)");
+                      "cull tests of the pipeline (auto: all, per object where it pays, Niessner & Loop §6.3)");
     add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
                       "back-patch test of backpatch/all");
     add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
                       "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
     add_clip_depth_option(*command, state->clip_depth);
     command->add_flag("--fused-pass", state->fused_pass,
-                      "frustum, back-patch (tcone/ncone) and Hi-Z tests in one compute pass (issue 14)");
+                      "frustum, back-patch (tcone/ncone) and Hi-Z tests in one compute pass");
     add_choice_option(*command, "--pose", state->pose, {"cpu", "gpu"},
                       "where animated patches are evaluated: cpu, or gpu (stencils in a compute pass, bit-identical)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
@@ -140,7 +140,8 @@ Runner add_render_command(CLI::App& app) {
     add_displace_options(*command, state->displace);
     add_object_level_options(*command, state->objects);
     add_size_option(*command, "--size", state->size, "framebuffer size");
-    command->add_flag("--aggressive", state->aggressive, "skip the second pass (seed 000 §3.1; not conservative)");
+    command->add_flag("--aggressive", state->aggressive,
+                      "skip the second pass (Niessner & Loop §3.1; not conservative)");
     command->add_flag("--verify", state->verify,
                       "render the unculled reference of every frame and count false culls (exit status 1 if any)");
     add_output_file_option(*command, "--out", state->out, "write the colour image of the last frame as a PNG");
@@ -149,7 +150,7 @@ Runner add_render_command(CLI::App& app) {
                     "else black..grey 254 = the level's min..max depth below 1), raw .f32 levels, depth, ids, hiz.json");
     add_text_option(*command, "--draw-bounds", state->draw_bounds,
                     "P[,P...]: draw these patches' CAF (green) and OOBB (red) screen rectangles, as the occlusion "
-                    "test uses them, over the last frame into --out (seed 000 Fig. 6)");
+                    "test uses them, over the last frame into --out (Niessner & Loop, Fig. 6)");
     command->add_flag("--json", state->json, "print one JSON object");
     return [state]() {
         int width = 0, height = 0;

@@ -83,7 +83,7 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
             const long since = frame_ - o.last_culled;
             const long wait = o.wait > 0 ? o.wait : config_.probe_interval;
             if (!(d.break_even < 1)) {
-                // No rate can pay (seed 000 §6.3: low tess factor, no culling). Probed only rarely:
+                // No rate can pay (Niessner & Loop §6.3: low tess factor, no culling). Probed only rarely:
                 // the issue and cull costs are measured in two-pass frames alone.
                 d.reason = std::isinf(d.break_even)
                                ? format("tess factor %.1f: no measured tessellation cost to save", d.tess_factor)

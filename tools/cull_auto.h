@@ -1,5 +1,5 @@
 // `--cull auto` (render, view, the main job's `auto` row): the per-object switch of Niessner &
-// Loop, "Patch-Based Occlusion Culling for Hardware Tessellation" (seed 000), §6.3 ("Payoff",
+// Loop, "Patch-Based Occlusion Culling for Hardware Tessellation", §6.3 ("Payoff",
 // "Adaptive tessellation"): culling an object pays when its cull rate exceeds the break-even rate
 //   x = (RT0 + CT) / (RT - RT0)
 // RT: render time of the object unculled; RT0: its render time with every patch culled (patches
@@ -47,7 +47,7 @@
 //      triangles; c0 = Config::tess_cost_offset: the per-patch part that does not grow with t),
 //      tess_unit measured from the frames' drawn patches weighted by their objects' (c0 + t^2).
 //      With uniform tessellation every object has the frame's t, so c0 cancels out. When x >= 1
-//      at the object's t, no cull rate can pay (seed 000: a model small on screen, or at a low
+//      at the object's t, no cull rate can pay (Niessner & Loop: a model small on screen, or at a low
 //      tess factor, is not culled): off, probed only every 4 * Config::probe_interval frames, which
 //      refreshes the issue and cull costs (measured in two-pass frames only; tess is also measured
 //      in the one-pass frames).

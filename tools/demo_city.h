@@ -1,4 +1,4 @@
-// The main job's object-level part (issue 11): the built-in city rendered for a few frames with
+// The main job's object-level part: the built-in city rendered for a few frames with
 // each --objects method (none, frustum, bvh, bvh+backface) in front of the patch passes (cull
 // mode all), every frame verified against the unculled render.
 #pragma once

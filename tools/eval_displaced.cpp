@@ -1,15 +1,15 @@
 // `patchcull eval displaced MODEL [--split N] [--views N] [--displace FILE.png|procedural]
-// [--displace-scale X] --json`: seed 000's Table 1 (§4.2, §6.2): cull rates of the six bounds of a
+// [--displace-scale X] --json`: Niessner & Loop's Table 1 (§4.2, §6.2): cull rates of the six bounds of a
 // displaced patch, {oobb, caf} x {full, acon, con} (patchcull/displaced_bounds.h), by the frustum
 // and by occlusion inside the object, over views that contain the whole object.
 //
 // Per view (camera.h, contain mode): the displaced model is rendered unculled (GPU, the renderer's
 // TES displaces along the unit normal of the patch's own derivatives, as the bounds assume); its
-// depth buffer gives the CPU Hi-Z pyramid (hiz.h), which is what seed 000 §3's pipeline converges
+// depth buffer gives the CPU Hi-Z pyramid (hiz.h), which is what Niessner & Loop §3's pipeline converges
 // to on a static view (its visible set stable); each bound is then tested against the frustum and
 // that pyramid (cull_displaced_occlusion). A patch culled although its id is in the unculled id
 // buffer is a false cull.
-// Next to these converged-depth rates, the running pipeline's (temporal coherence, seed 000 §3):
+// Next to these converged-depth rates, the running pipeline's (temporal coherence, Niessner & Loop §3):
 // per view and combination, CullPipeline::render_frame (frustum + occlusion; the displaced patches
 // tested by DisplacedPass against the pipeline's own Hi-Z, built from the patches the previous
 // frame found visible) from a first frame until its visible set is stable (at most 8 frames), its

@@ -1,4 +1,4 @@
-// `patchcull eval displaced` (tools/eval_displaced.cpp): seed 000's Table 1, registered by
+// `patchcull eval displaced` (tools/eval_displaced.cpp): Niessner & Loop's Table 1, registered by
 // tools/cmd_eval.cpp.
 #pragma once
 

@@ -1,5 +1,5 @@
 // `patchcull eval fused SCENE [--scheme acc|osd] [--frames N] [--size WxH] [--tess L] [--repeats R]
-// [--profile-interval K] [--cone tcone|ncone] [--json]`: issue 14's measurement of the fused CPU
+// [--profile-interval K] [--cone tcone|ncone] [--json]`: a measurement of the fused CPU
 // cull kernel (fused_cull.h) and of the cost model that picks its plan per object and frame
 // (fused_cost_model.h), on a scene's camera path.
 //

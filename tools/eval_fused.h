@@ -1,4 +1,4 @@
-// `patchcull eval fused` (tools/eval_fused.cpp): issue 14's comparison of the fused CPU cull
+// `patchcull eval fused` (tools/eval_fused.cpp): a comparison of the fused CPU cull
 // kernel's plans (fused_cull.h) and of its cost model (fused_cost_model.h) on a scene's camera
 // path, registered by tools/cmd_eval.cpp.
 #pragma once

@@ -1,6 +1,6 @@
 // `patchcull eval scene SCENE [--scheme acc|osd] [--frames N] [--size WxH] [--tess L]
 // [--methods LIST] [--batch B] [--sigma S] [--max-tight-boxes K] [--c1 C] [--visible-interval N]
-// [--json]`: issue 12's comparison of object-level occlusion culling (G. Zachmann's lecture
+// [--json]`: a comparison of object-level occlusion culling (G. Zachmann's lecture
 // "Advanced Visibility Computations"; Bittner et al.'s CHC, Mattausch et al.'s CHC++; Downs et
 // al.'s occlusion horizons; Luebke & Georges' portals) with patchcull's per-patch Hi-Z culling
 // (Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation").

@@ -1,4 +1,4 @@
-// `patchcull eval scene` (tools/eval_scene.cpp): the object-level occlusion methods of issue 12
+// `patchcull eval scene` (tools/eval_scene.cpp): the object-level occlusion methods
 // (hardware occlusion queries stop-and-wait and batched, CHC, CHC++, the occlusion horizon, cells
 // and portals) side by side with patchcull's per-patch Hi-Z culling on one scene's camera path,
 // registered by tools/cmd_eval.cpp.

@@ -1,20 +1,20 @@
 // `patchcull eval temporal MODEL [--scheme acc|osd] [--speeds 0,2,5,10] [--frames N] [--size WxH]
 // [--tess L] [--json]`: Fig. 9 right of Niessner & Loop, "Patch-Based Occlusion Culling for
-// Hardware Tessellation" (seed 000 §6.3, "Temporal Coherence"): the fraction of patches culled by
+// Hardware Tessellation" (Niessner & Loop §6.3, "Temporal Coherence"): the fraction of patches culled by
 // occlusion against the camera's rotation speed, with the two-pass temporal-coherence pipeline
 // (gl::CullPipeline, cull mode occlusion) running frame after frame.
 //
-// Static model, moving view: seed 000 rotates the (non-displaced, not animated) BigGuy about its
+// Static model, moving view: Niessner & Loop rotate the (non-displaced, not animated) BigGuy about its
 // axis at each speed, "worst-case in terms of violating temporal visibility coherence"; a rigid
 // rotation of the model before a fixed camera is the camera orbiting the still model, which is
 // what runs here. The model is placed as make_model_scene places it (height 1, standing at the
 // origin) and the camera follows that scene's orbit (the whole model in view, 30 degrees above
 // the horizon, start angle 0) at `degrees_per_frame` = each speed, for --frames frames. No
 // occluders: the ground quad of make_model_scene is left out, so every cull is the model hiding
-// itself (culling within one object, as seed 000 §6.2 and Fig. 9).
+// itself (culling within one object, as Niessner & Loop §6.2 and Fig. 9).
 //
 // Per speed the pipeline starts from a first frame (reset_visibility: half the patches tagged
-// visible, seed 000 §3); frame 0 primes the statuses, and occluded_fraction is the mean over
+// visible, Niessner & Loop §3); frame 0 primes the statuses, and occluded_fraction is the mean over
 // frames 1..N-1 of occlusion_culled / patches. converged_occluded_fraction is the mean over the
 // same views of the converged pipeline's fraction: a second CullPipeline runs each view from a
 // first frame until its visible set is stable (converge_frame, as `eval occlusion`; at most 8

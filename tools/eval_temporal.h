@@ -1,5 +1,5 @@
 // `patchcull eval temporal` (tools/eval_temporal.cpp): Fig. 9 right of Niessner & Loop,
-// "Patch-Based Occlusion Culling for Hardware Tessellation" (seed 000), registered by
+// "Patch-Based Occlusion Culling for Hardware Tessellation", registered by
 // tools/cmd_eval.cpp; and the convergence loop it shares with `eval occlusion`.
 #pragma once
 
@@ -37,7 +37,7 @@ struct ConvergedFrame {
     bool stable = false;   ///< the last two frames tagged the same patches visible
 };
 
-/// Seed 000 §3's pipeline on a static view as `eval occlusion` runs it: reset_visibility (the
+/// Niessner & Loop §3's pipeline on a static view as `eval occlusion` runs it: reset_visibility (the
 /// next frame is a first frame, half the patches tagged visible), then params' frame again and
 /// again until two consecutive frames tag the same patches visible (kStatusVisible), at most
 /// max_frames frames. The renderer's framebuffer then holds the last frame.

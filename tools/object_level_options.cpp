@@ -16,7 +16,7 @@ namespace patchcull::cli {
 void add_object_level_options(CLI::App& command, ObjectLevelOptions& options) {
     add_choice_option(command, "--objects", options.method, {"none", "frustum", "bvh", "bvh+backface"},
                       "object level before the patch passes: AABB frustum test (flat), through a BVH, and "
-                      "clustered back-face culling (seed 004)");
+                      "clustered back-face culling (Zachmann's lecture)");
     add_float_option(command, "--detail-cull", options.detail_pixels, 0, 1e6,
                      "detail culling: cull objects whose bounding sphere covers fewer pixels (not conservative; "
                      "0 = off; needs --objects)");

@@ -1,4 +1,4 @@
-// The object level in the CLI (`render`, `view`, `demo`; issue 11): --objects and --detail-cull,
+// The object level in the CLI (`render`, `view`, `demo`): --objects and --detail-cull,
 // the per-frame run of SceneObjectLevel feeding CullPipeline, the object-level part of --verify,
 // and the per-frame "objects" JSON.
 #pragma once

@@ -207,7 +207,7 @@ gl::CullMode applicable_cull_mode(const Scene& scene, gl::CullMode requested, co
 
 void add_tess_options(CLI::App& command, TessOptions& options) {
     add_choice_option(command, "--tess-mode", options.mode, {"uniform", "adaptive"},
-                      "uniform: --tess everywhere; adaptive: by distance (seed 000 §6.3), --tess the maximum");
+                      "uniform: --tess everywhere; adaptive: by distance (Niessner & Loop §6.3), --tess the maximum");
     CLI::Option* distance = command.add_option_function<std::string>(
         "--tess-distance",
         [&options](const std::string& text) {
@@ -230,7 +230,8 @@ void add_displace_options(CLI::App& command, DisplaceOptions& options) {
                      "displacement of a full height step, in character heights (default 0.02)")
         ->needs(displace);
     add_choice_option(command, "--bound", options.bound, {"caf", "oobb"},
-                      "bound of displaced patches (seed 000 §4.2: camera-aligned frustum, or object-oriented box)");
+                      "bound of displaced patches (Niessner & Loop §4.2: camera-aligned frustum, or "
+                      "object-oriented box)");
     add_choice_option(command, "--cone", options.cone, {"full", "acon", "con"},
                       "normal cone of displaced patches' bounds (full, ACoN, CoN)");
 }

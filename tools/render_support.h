@@ -50,7 +50,7 @@ gl::FrameComparison compare_with_reference(const gl::PatchRenderer& renderer, co
 /// refinement depths, and for a displaced scene the texcoords and displacement ranges.
 gl::PatchAttributes pose_attributes(const ScenePoser& poser);
 
-/// --pose cpu|gpu of `render` (issue 14): how each frame's animated patches reach the renderer.
+/// --pose cpu|gpu of `render`: how each frame's animated patches reach the renderer.
 /// - cpu: ScenePoser::pose evaluates every patch on the CPU and PatchRenderer::update_patches
 ///   uploads them with all their attributes (256 bytes of control points per patch, plus
 ///   texcoords, tangents, margins, ranges, scales).
@@ -145,7 +145,7 @@ struct TessOptions {
 /// 1e9; parse errors name the flag) on command.
 void add_tess_options(CLI::App& command, TessOptions& options);
 
-/// The tessellation of a run (seed 000 §6.3's adaptive case): uniform (--tess everywhere), or
+/// The tessellation of a run (Niessner & Loop §6.3's adaptive case): uniform (--tess everywhere), or
 /// adaptive by distance (gl::RenderParams::adaptive_tess: level --tess at reference_distance from
 /// the eye and nearer, proportionally less farther away, at least 1).
 struct TessMode {
@@ -162,7 +162,7 @@ void apply_tess_mode(const TessMode& mode, gl::RenderParams& params);
 /// Distance from every eye of path to its target: sqrt(distance^2 + height^2).
 float camera_path_eye_distance(const CameraPath& path);
 
-/// --displace, --displace-scale, --bound and --cone of `render` and `view` (seed 000 §4.2, §6):
+/// --displace, --displace-scale, --bound and --cone of `render` and `view` (Niessner & Loop §4.2, §6):
 /// displaced patches tested against the frustum and the running pipeline's Hi-Z with the chosen
 /// bound (gl_passes.h's DisplacedPass inside CullPipeline::render_frame).
 struct DisplaceOptions {

@@ -1,4 +1,4 @@
-// `patchcull view`'s window loop (issue 13): each frame takes the input (mouse, keys, the panel, a
+// `patchcull view`'s window loop: each frame takes the input (mouse, keys, the panel, a
 // --script's events of that frame: all through the same code), poses the scene, runs the cull
 // pipeline from the camera, shows the colour image or the status colouring, draws the panel and
 // writes the screenshots asked for.
@@ -20,7 +20,7 @@ struct ViewerConfig {
     int width = 960, height = 540;
     /// Frames to run (0: until the window closes, Escape, or a script's quit).
     int frames = 0;
-    /// false: `view --frames N` as before issue 13: render's camera path (one lap of N frames), no
+    /// false: `view --frames N` non-interactively: render's camera path (one lap of N frames), no
     /// panel, a line per frame; the window then shows exactly `render --out`'s images.
     bool interactive = true;
     ViewerSettings settings;      ///< the starting settings (from the flags)

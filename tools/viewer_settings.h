@@ -1,5 +1,5 @@
 // The interactive viewer's state that the panel, the keys and a --script's `set` lines all edit
-// (`patchcull view`, issue 13): which cull tests run and how, the tessellation, the displacement,
+// (`patchcull view`): which cull tests run and how, the tessellation, the displacement,
 // what the window shows and how the camera moves. No GL here: the script parser validates `set`
 // lines against it before any window opens, and the unit tests use it without a context.
 #pragma once
