@@ -27,8 +27,8 @@ PATCHCULL_BP_CONST uint kConeValues = 12u;
 PATCHCULL_BP_CONST uint kBindingProbeIn = 13u;   // vec4 in[n]: (a, b, c, unused)
 PATCHCULL_BP_CONST uint kBindingProbeOut = 14u;  // float out[n]
 
-// Work groups: cones, one invocation per patch; ptp, kPtpLanes invocations per patch (seed 001
-// §6: 16 threads per patch, each owning one 4x4 block's 4 destinations) and kPtpPatchesPerGroup
+// Work groups: cones, one invocation per patch; ptp, kPtpLanes invocations per patch (Loop, Niessner &
+// Eisenacher §6: 16 threads per patch, each owning one 4x4 block's 4 destinations) and kPtpPatchesPerGroup
 // patches per work group (local size kPtpLanes x kPtpPatchesPerGroup).
 PATCHCULL_BP_CONST uint kConeGroupSize = 64u;
 PATCHCULL_BP_CONST uint kPtpLanes = 16u;

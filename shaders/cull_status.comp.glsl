@@ -4,7 +4,7 @@
 //   its status bits, so the frame's test passes start from "nothing culled" while the first
 //   drawing pass still sees last frame's statuses.
 // - kStatusEnd: turns the reasons the tests left into the temporal status of Niessner & Loop's
-//   two-pass pipeline (seed 000 §3): a patch no test culled gets kStatusVisible, plus
+//   two-pass pipeline (Niessner & Loop §3): a patch no test culled gets kStatusVisible, plus
 //   kStatusNewlyVisible when its word lacked kStatusVisible (it was not drawn in the first pass);
 //   a culled patch keeps its reason alone. It adds the counts to the caller's counter buffer
 //   (kBindingCullCounters, kCounterCount uints, cleared by the caller): one atomic add per work

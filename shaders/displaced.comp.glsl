@@ -1,4 +1,4 @@
-// Displaced-patch cull pass (DisplacedPass, src/gl/displaced_pass.cpp; seed 000 §4.2), one
+// Displaced-patch cull pass (DisplacedPass, src/gl/displaced_pass.cpp; Niessner & Loop §4.2), one
 // invocation per patch: the GPU twin of
 // cull_displaced_frustum and cull_displaced_occlusion (include/patchcull/displaced_bounds.h,
 // src/core/displaced_bounds.cpp). The bound (caf or oobb, u_bound_kind) and its decisions are

@@ -1,4 +1,4 @@
-// Hi-Z test of a screen box: hiz.h steps 5-9 (seed 000 §4.1.1), the GPU twin of
+// Hi-Z test of a screen box: hiz.h steps 5-9 (Niessner & Loop §4.1.1), the GPU twin of
 // hiz_rect_from_window_box, hiz_select_level and hiz_rect_max (src/core/hiz.cpp), operation by
 // operation (pc_fma = std::fma, `a < b ? a : b` min/max, floor, integer shifts), so the decisions
 // equal the CPU's; and steps 3-4 per control point (hiz_add_point). Shared by occlusion.comp.glsl

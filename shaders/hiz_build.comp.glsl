@@ -1,4 +1,4 @@
-// Hi-Z build pass (HiZBuildPass, src/gl/hiz_build_pass.cpp; seed 000 §4.1): one dispatch per pyramid level, one invocation per texel of the
+// Hi-Z build pass (HiZBuildPass, src/gl/hiz_build_pass.cpp; Niessner & Loop §4.1): one dispatch per pyramid level, one invocation per texel of the
 // level written. Level 0 (half resolution) reduces the depth buffer (u_depth), level l > 0 reduces
 // level l-1 of the pyramid itself (u_hiz, another level of the same texture than the one written).
 // Texel (tx, ty) = max of its (up to) 2x2 children (2tx+i, 2ty+j); a child past the last

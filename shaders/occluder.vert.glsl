@@ -1,4 +1,4 @@
-// Triangle-mesh occluder vertex shader (seed 000 §3: triangle meshes are drawn before the Hi-Z is
+// Triangle-mesh occluder vertex shader (Niessner & Loop §3: triangle meshes are drawn before the Hi-Z is
 // built, so they occlude patches). Non-indexed triangle list fetched from an SSBO (the renderer
 // expands the index buffer); the triangle index gl_VertexID / 3 becomes the id.
 #version 450 core

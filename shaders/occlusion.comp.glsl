@@ -1,4 +1,4 @@
-// Hi-Z occlusion cull pass (OcclusionPass, src/gl/occlusion_pass.cpp; seed 000 §4.1.1), one
+// Hi-Z occlusion cull pass (OcclusionPass, src/gl/occlusion_pass.cpp; Niessner & Loop §4.1.1), one
 // invocation per patch: the GPU twin of cull_occlusion_scalar (include/patchcull/hiz.h,
 // src/core/hiz.cpp), steps numbered as in hiz.h. Operation by operation the same arithmetic, so the
 // decisions are identical: products and std::fma <-> `precise` products and pc_fma (exact_fma.h),

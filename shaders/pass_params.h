@@ -119,7 +119,7 @@ PC_PARAMS(BackpatchPtpParams, kUniformPassParams) {
     PC_UINT(pad1);
 } PC_END(ptp);
 
-// displaced.comp.glsl (DisplacedPass): seed 000 §4.2's bounds, DisplacedCullView's constants.
+// displaced.comp.glsl (DisplacedPass): Niessner & Loop §4.2's bounds, DisplacedCullView's constants.
 PC_PARAMS(DisplacedParams, kUniformPassParams) {
     PC_MAT4(object_to_view);           // column-major
     PC_VEC4(view_planes[6]);           // make_frustum_planes(projection).rows

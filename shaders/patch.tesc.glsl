@@ -1,12 +1,12 @@
 // Patch tessellation control shader: passes the 16 control points through and sets the
 // tessellation factors. A patch that is not to be drawn gets outer and inner levels 0, so the
-// tessellator discards it (seed 000 §3: the decision lands where the tessellator reads it).
+// tessellator discards it (Niessner & Loop §3: the decision lands where the tessellator reads it).
 // Drawn iff (flag word & u_draw_mask) == u_draw_value: the selections of shaders/patchcull_tcs.h
 // (the include an engine's TCS uses; this shader is its first user).
 //
 // Levels: uniform u_tess_level times the patch's depth scale (kBindingPatchTessScale: patches of
 // different refinement depth get equal vertex density, so shared edges match) on every edge and
-// the interior, or adaptive by distance (seed 000
+// the interior, or adaptive by distance (Niessner & Loop
 // §6.3, like DirectX's DetailTessellation11): edge level = clamp(u_tess_level * u_tess_reference /
 // distance(eye, midpoint of the edge's two corner points), 1, u_tess_level), inner levels the max
 // of the two opposite edges. An edge's level depends only on its two corner points (symmetric in

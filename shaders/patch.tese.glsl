@@ -4,7 +4,7 @@
 // (s,t) interpolated bilinearly from the patch's corner texcoords (displacement.h). The shading
 // normal is du x dv of the patch's ACC tangent patches when it has them (Loop & Schaefer 2008:
 // continuous across extraordinary vertices), else of its own derivatives; displacement always
-// follows the latter, which the cone bounds of seed 000 §4.2 bound (gl_renderer.h).
+// follows the latter, which the cone bounds of Niessner & Loop §4.2 bound (gl_renderer.h).
 #version 450 core
 #include "shared.h"
 #include "patch_eval.h"

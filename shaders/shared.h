@@ -63,7 +63,7 @@ PATCHCULL_CONST uint kCullOcclusion = 4u;   // behind the Hi-Z pyramid
 // frustum, or a back-facing cluster of it): written by CullPipeline with a buffer clear, no pass.
 PATCHCULL_CONST uint kCullObject = 8u;
 PATCHCULL_CONST uint kCullReasonMask = 0xFFu;
-// Bits 8-9: temporal status of the two-pass pipeline (seed 000 §3), written by cull_status (end):
+// Bits 8-9: temporal status of the two-pass pipeline (Niessner & Loop §3), written by cull_status (end):
 // kStatusVisible = passed the latest test (drawn in the next frame's first pass); with
 // kStatusNewlyVisible also set it was not tagged visible before that test (drawn in the second
 // pass). Neither bit = occluded (or culled by another test).

@@ -1,6 +1,6 @@
 // Bounding volumes and their frustum tests (patchcull/bounding_volumes.h): enclosing volumes,
 // single-volume tests with plane masking and coherence, the scalar batch references, meta-BVs
-// and detail culling, after G. Zachmann, "Advanced Visibility Computations" (seed 004).
+// and detail culling, after G. Zachmann, "Advanced Visibility Computations".
 // The SIMD batch kernels live in bounding_volumes_simd.cpp.
 //
 // Bit-exact agreement with the SIMD kernels rests on the rules of frustum.cpp: every multiply-add

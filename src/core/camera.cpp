@@ -1,5 +1,6 @@
 // Perspective cameras and seeded random views (patchcull/camera.h).
-// contain mode follows seed 000 §6.2 / seed 001 §7: views that contain the whole object.
+// contain mode follows Niessner & Loop §6.2 / Loop, Niessner & Eisenacher §7:
+// views that contain the whole object.
 #include "patchcull/camera.h"
 
 #include <algorithm>

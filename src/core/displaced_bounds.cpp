@@ -2,15 +2,15 @@
 // (patchcull/displaced_bounds.h, where the conventions and every formula are written out).
 //
 // Sources:
-// - Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation" (seed 000) §4.2:
+// - Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation" §4.2:
 //   the camera-aligned frustum (CAF), the per-axis cone extensions delta+- and P_max / P_min, the
 //   Full / ACoN / CoN variants (§6.2 Table 1, Fig. 7);
 // - Munkberg, Hasselgren, Toth & Akenine-Moeller, "Efficient bounding of displaced Bezier
 //   patches", HPG 2010: the object-oriented bounding box (OOBB) with cone-of-normals extensions,
-//   the comparison of seed 000 Table 1 (our reading of it is in the header);
+//   the comparison of Niessner & Loop, Table 1 (our reading of it is in the header);
 // - the cones themselves are cones.h's (Sederberg & Meyers 1988; Shirman & Abi-Ezzi 1993).
 //
-// Derivation of delta+- without acos (seed 000 writes max(cos(acos(a_x) + alpha),
+// Derivation of delta+- without acos (Niessner & Loop write max(cos(acos(a_x) + alpha),
 // cos(acos(a_x) - alpha))): for a unit direction r at angle theta in [0, pi] from the cone axis, the
 // unit vectors of the cone make angles with r in [max(0, theta - alpha), min(pi, theta + alpha)];
 // cos is decreasing there, so max r.n = 1 when theta <= alpha, else cos(theta - alpha) =

@@ -1,4 +1,4 @@
-// Displacement sampling and seed 002's per-patch maximum-displacement pre-processing step
+// Displacement sampling and Sathe's per-patch maximum-displacement pre-processing step
 // (patchcull/displacement.h; Sathe, "View Frustum Culling of Catmull-Clark Patches in
 // DirectX 11", pre-processing step; the [D_min, D_max] of Niessner & Loop, "Patch-Based Occlusion
 // Culling for Hardware Tessellation", §4.2).

@@ -52,7 +52,7 @@ double det3(double a0, double a1, double a2, double b0, double b1, double b2, do
     return a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0);
 }
 
-// cross4 of seed 001 Appendix A: the plane through homogeneous points a, b, c (rows are the
+// cross4 of Loop, Niessner & Eisenacher, Appendix A: the plane through homogeneous points a, b, c (rows are the
 // components, columns the points).
 PlaneD cross4(const V4& a, const V4& b, const V4& c) {
     return {det3(a.y, b.y, c.y, a.z, b.z, c.z, a.w, b.w, c.w), -det3(a.x, b.x, c.x, a.z, b.z, c.z, a.w, b.w, c.w),

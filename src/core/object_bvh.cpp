@@ -1,6 +1,6 @@
 // Object BVH (patchcull/object_bvh.h): binned-SAH build, bottom-up refit and hierarchical
 // view-frustum culling with plane masking and coherence (G. Zachmann, "Advanced Visibility
-// Computations", seed 004), plus the flat list.
+// Computations"), plus the flat list.
 //
 // Layout: nodes_[0] is the root; an inner node's children are nodes_[first] and nodes_[first + 1],
 // always allocated after it, so a reverse sweep over nodes_ is a bottom-up order (refit). Leaves

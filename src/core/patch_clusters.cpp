@@ -1,5 +1,5 @@
 // Clusters of bicubic patches for clustered back-face culling (patchcull/backface_clusters.h;
-// beyond G. Zachmann's lecture "Advanced Visibility Computations", issue 11): each patch
+// beyond G. Zachmann's lecture "Advanced Visibility Computations"): each patch
 // contributes the 64 object-space Bezier control planes of its parametric tangent plane (Loop,
 // Niessner & Eisenacher, "Effective Back-Patch Culling for Hardware Tessellation", §3-6), which
 // bound every tangent plane of the patch: T(u, v) = sum B7_iu(u) B7_jv(v) t_k with weights >= 0,
@@ -35,7 +35,7 @@ struct TableRow {
 constexpr TableRow kTable[] = {
 #include "core/ptp_table.inc"
 };
-static_assert(sizeof(kTable) / sizeof(kTable[0]) == 516, "seed 001: 516 weighted cross4 products");
+static_assert(sizeof(kTable) / sizeof(kTable[0]) == 516, "Loop, Niessner & Eisenacher: 516 weighted cross4 products");
 
 double det3(double a0, double a1, double a2, double b0, double b1, double b2, double c0, double c1, double c2) {
     return a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0);
@@ -79,7 +79,7 @@ void patch_control_planes(const BezierPatch& patch, Vec3 origin, PlaneD planes[6
         const double* b = L[row.k];
         const double* c = L[row.l];
         const double w = double(row.num) / double(row.den);
-        // cross4 as in ground_truth.cpp (seed 001 Appendix A).
+        // cross4 as in ground_truth.cpp (Loop, Niessner & Eisenacher, Appendix A).
         const double t[4] = {det3(a[1], b[1], c[1], a[2], b[2], c[2], a[3], b[3], c[3]),
                              -det3(a[0], b[0], c[0], a[2], b[2], c[2], a[3], b[3], c[3]),
                              det3(a[0], b[0], c[0], a[1], b[1], c[1], a[3], b[3], c[3]),

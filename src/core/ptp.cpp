@@ -1,6 +1,7 @@
 // Parametric tangent plane (ptp) back-patch cull kernel, scalar reference (patchcull/backpatch.h,
-// seed 001 §3-6). The SIMD kernel (ptp_simd.cpp) does the same operations in the same order; the
-// schedule both follow, and the FLOP count before/after sharing minors, is in ptp_schedule.h.
+// Loop, Niessner & Eisenacher §3-6). The SIMD kernel (ptp_simd.cpp) does the same operations in
+// the same order; the schedule both follow, and the FLOP count before/after sharing minors, is in
+// ptp_schedule.h.
 //
 // Per patch:
 // 1. The 16 control points go to clip space, x, y and w only (cross4Z never needs z):

@@ -22,7 +22,7 @@
 // weighted fma: 16 FLOPs [10 instructions] each, 8256 [5160], + transform 336 [192] = 8592 [5352]):
 // 44% fewer FLOPs, 46% fewer instructions.
 //
-// Exact zeros on collapsed edges (seed 001 §7's Pcnt rule for e.g. the teapot's lid): when a
+// Exact zeros on collapsed edges (Loop, Niessner & Eisenacher §7's Pcnt rule for e.g. the teapot's lid): when a
 // patch edge collapses to one point, T vanishes along it and its 8 boundary control planes are
 // zero; they must come out as exactly 0 in floating point too, or a +tiny value blocks the Pcnt
 // cull. Every term of a boundary destination has two points on that edge (T(u,0) depends only on
@@ -50,7 +50,7 @@ inline constexpr TableRow kTable[] = {
 #include "core/ptp_table.inc"
 };
 inline constexpr int kTermCount = static_cast<int>(sizeof(kTable) / sizeof(kTable[0]));
-static_assert(kTermCount == 516, "seed 001: 516 weighted cross4 products");
+static_assert(kTermCount == 516, "Loop, Niessner & Eisenacher: 516 weighted cross4 products");
 
 struct Pair {
     std::uint8_t a, b;  // a < b

@@ -1,4 +1,4 @@
-// Seed 001's parametric tangent plane table from its definition, in exact rational arithmetic
+// Loop, Niessner & Eisenacher's parametric tangent plane table from its definition, in exact rational arithmetic
 // (ptp_table_gen.h).
 //
 // Derivation. With B(u,v) = sum_a R0_a(u,v) b_a, B_u = sum_a R1_a b_a, B_v = sum_a R2_a b_a over
@@ -280,7 +280,8 @@ bool rounds_are_hazard_free(const std::vector<Term>& ordered) {
 std::string table_inc_text(const std::vector<Term>& ordered) {
     std::ostringstream s;
     const std::vector<int> m = terms_per_destination(ordered);
-    s << "// src/core/ptp_table.inc: seed 001's parametric tangent plane table (§5-6), GENERATED: do not edit.\n"
+    s << "// src/core/ptp_table.inc: Loop, Niessner & Eisenacher's parametric tangent plane table (§5-6), "
+         "GENERATED: do not edit.\n"
          "// Regenerate (after changing src/core/ptp_table_gen.cpp):\n"
          "//   cmake --build <build> --target patchcull_gen_ptp_table\n"
          "//   <build>/gen/patchcull_gen_ptp_table > src/core/ptp_table.inc\n"
@@ -292,7 +293,7 @@ std::string table_inc_text(const std::vector<Term>& ordered) {
          "// in exact rational arithmetic; every bidegree-8 coefficient polynomial degree-reduces\n"
          "// exactly to bidegree 7.\n"
          "//\n"
-         "// Order (seed 001 §6, 16 lanes per patch): row p runs in round p / 16 on lane p % 16. Lane\n"
+         "// Order (Loop, Niessner & Eisenacher §6, 16 lanes per patch): row p runs in round p / 16 on lane p % 16. Lane\n"
          "// tau = 4*(jv%4) + (iu%4) owns destinations {iu, iu+4} x {jv, jv+4} (31..33 terms each);\n"
          "// rounds 0-30 hold one term of each lane's own block, round 31 the 32nd terms and, in the\n"
          "// lanes whose blocks have only 31, four 33rd terms; round 32 (lanes 0-3) the other four\n"

@@ -1,4 +1,4 @@
-// Generator of seed 001's parametric tangent plane table (private to patchcull; used by
+// Generator of Loop, Niessner & Eisenacher's parametric tangent plane table (private to patchcull; used by
 // gen/gen_ptp_table.cpp to write src/core/ptp_table.inc and by tests/core/ptp_test.cpp to check
 // that the checked-in table is what the definition gives).
 //
@@ -46,13 +46,13 @@ struct Expansion {
 };
 
 /// Expands cross4(B, B_u, B_v) as described above. Throws std::logic_error when a coefficient
-/// polynomial does not degree-reduce exactly (it must: seed 001 §3).
+/// polynomial does not degree-reduce exactly (it must: Loop, Niessner & Eisenacher §3).
 Expansion expand_ptp();
 
-/// Number of terms per destination as an 8x8 matrix, row jv, column iu (seed 001 §6's matrix).
+/// Number of terms per destination as an 8x8 matrix, row jv, column iu (Loop, Niessner & Eisenacher §6's matrix).
 std::vector<int> terms_per_destination(const std::vector<Term>& terms);
 
-/// Orders terms for seed 001 §6's 16 threads per patch: thread tau = 4*(jv % 4) + (iu % 4) owns
+/// Orders terms for Loop, Niessner & Eisenacher §6's 16 threads per patch: thread tau = 4*(jv % 4) + (iu % 4) owns
 /// the 4 destinations {iu, iu+4} x {jv, jv+4} (the four 4x4 quadrants summed: 31..33 terms per
 /// thread). Position p of the result is executed in round p / 16 by lane p % 16 (the seed's loop
 /// `for (k = tid; k < 516; k += 16)`): rounds 0..30 hold one term of each lane's own block; round

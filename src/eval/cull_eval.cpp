@@ -1,6 +1,6 @@
 // Cull-method evaluation over random views with dense-sample ground truth (patchcull/cull_eval.h).
 // The methods run as an engine would run them: SIMD kernels over all cores, per view. The truth
-// is streamed (issue 14): views go in blocks, and each block is judged chunk by chunk of patches
+// is streamed: views go in blocks, and each block is judged chunk by chunk of patches
 // with the chunk's samples made in per-thread scratch and dropped, so memory does not grow with
 // the patch count beyond the batch and a byte per patch.
 #include "patchcull/cull_eval.h"
@@ -93,7 +93,7 @@ void check_distance_views(const DistanceViews& d) {
 }
 
 /// Which ground truth judges a method's decisions: a sample inside the view volume (frustum
-/// methods), or a sampled tangent plane facing the eye (back-patch methods, seed 001).
+/// methods), or a sampled tangent plane facing the eye (back-patch methods; Loop, Niessner & Eisenacher).
 enum class Truth { frustum, backface };
 
 struct Method {
@@ -219,7 +219,8 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
         (m->truth == Truth::frustum ? needs_frustum_truth : needs_backface_truth) = true;
     }
     if (needs_backface_truth && displacement && !displacement->empty())
-        throw Error("--displace: back-patch methods (tcone, ncone, ptp) do not bound displaced patches (seed 001 §8)");
+        throw Error("--displace: back-patch methods (tcone, ncone, ptp) do not bound displaced patches "
+                    "(Loop, Niessner & Eisenacher §8)");
     if (options.distance) check_distance_views(*options.distance);
     const int grid = options.ground_truth_grid;
     if (grid < 1 || grid > 1024) throw Error("ground truth grid " + std::to_string(grid) + " is not in 1..1024");

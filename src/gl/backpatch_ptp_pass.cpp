@@ -1,4 +1,4 @@
-// BackpatchPtpPass (patchcull/gl_passes.h): cull_ptp_scalar on the GPU with seed 001 §6's 16
+// BackpatchPtpPass (patchcull/gl_passes.h): cull_ptp_scalar on the GPU with Loop, Niessner & Eisenacher §6's 16
 // invocations per patch, shaders/backpatch_ptp.comp.glsl.
 #include "backpatch_shared.h"
 #include "pass_common.h"

@@ -1,4 +1,4 @@
-// CullPipeline (patchcull/gl_pipeline.h): seed 000 §3's two-pass frame, the passes of
+// CullPipeline (patchcull/gl_pipeline.h): Niessner & Loop §3's two-pass frame, the passes of
 // gl_passes.h chained through the renderer's flag buffer.
 #include <epoxy/gl.h>
 
@@ -97,7 +97,7 @@ struct CullPipeline::Impl {
     // replaced, or reset_visibility) makes the next frame a first frame.
     std::uint64_t primed_generation = ~std::uint64_t{0};
 
-    // Tags the even-indexed patches visible, the others not (seed 000 §3's first frame).
+    // Tags the even-indexed patches visible, the others not (Niessner & Loop §3's first frame).
     void prime_statuses() {
         std::vector<std::uint32_t> words(renderer.patch_count());
         for (std::size_t p = 0; p < words.size(); p += 2) words[p] = sh::kStatusVisible;
@@ -392,7 +392,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         clock.mark();
         // 3. test every patch (of the objects drawn), update statuses.
         run_chain(&m.hiz);
-        // 4. newly visible patches (seed 000 §3.1: skipped when aggressive).
+        // 4. newly visible patches (Niessner & Loop §3.1: skipped when aggressive).
         if (!frame.aggressive) r.draw_selected(sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass, drawn);
         clock.mark();
     } else if (params.object_pass) {

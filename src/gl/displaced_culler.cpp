@@ -1,5 +1,5 @@
 // DisplacedCuller (patchcull/gl_displaced.h): GPU frustum and Hi-Z occlusion culling of displaced
-// patches with the bounds of seed 000 §4.2 (Niessner & Loop, "Patch-Based Occlusion Culling for
+// patches with the bounds of Niessner & Loop §4.2 ("Patch-Based Occlusion Culling for
 // Hardware Tessellation": the camera-aligned frustum, CAF, with the Full / ACoN / CoN displacement
 // extensions) and Munkberg et al.'s object-oriented box (OOBB), the GPU twin of
 // src/core/displaced_bounds.cpp (include/patchcull/displaced_bounds.h defines every step).

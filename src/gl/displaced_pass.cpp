@@ -1,4 +1,4 @@
-// DisplacedPass (patchcull/gl_passes.h): the bounds of displaced patches (seed 000 §4.2: caf,
+// DisplacedPass (patchcull/gl_passes.h): the bounds of displaced patches (Niessner & Loop §4.2: caf,
 // Munkberg et al.'s oobb; cones full, acon, con) and their frustum and Hi-Z decisions on the GPU,
 // shaders/displaced.comp.glsl (one program per cone kind).
 #include "displaced_shared.h"

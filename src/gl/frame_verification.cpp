@@ -1,4 +1,4 @@
-// PatchRenderer's status image (seed 000 Fig. 2's statuses), the comparison of a culled frame
+// PatchRenderer's status image (Niessner & Loop, Fig. 2's statuses), the comparison of a culled frame
 // with its unculled reference (compare_frames) and the cull-mode and timing names
 // (patchcull/gl_renderer.h).
 #include <epoxy/gl.h>

@@ -178,7 +178,7 @@ HiZTexture create_hiz_texture(int width, int height) {
     glTextureStorage2D(hiz.texture, levels, GL_R32F, pot_w, pot_h);
     glTextureParameteri(hiz.texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
     glTextureParameteri(hiz.texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    // Zero everywhere (seed 000: unused texels 0), so that nothing undefined is ever stored.
+    // Zero everywhere (Niessner & Loop: unused texels 0), so that nothing undefined is ever stored.
     const float zero = 0.0f;
     for (int l = 0; l < levels; ++l) glClearTexImage(hiz.texture, l, GL_RED, GL_FLOAT, &zero);
     check_gl("create_hiz_texture");

@@ -2,7 +2,7 @@
 // (patchcull/subdivision.h, Scheme::acc).
 //
 // Source: C. Loop and S. Schaefer, "Approximating Catmull-Clark Subdivision Surfaces with Bicubic
-// Patches", ACM TOG 27(1), 2008, the scheme seed 002 (Sathe, "View Frustum Culling of
+// Patches", ACM TOG 27(1), 2008, the scheme Sathe ("View Frustum Culling of
 // Catmull-Clark Patches in DirectX 11") renders and culls. tests/import/acc_test.cpp checks the
 // formulas against OpenSubdiv wherever ACC is exact (regular and regular-boundary patches, corner
 // positions, corner normals) and checks watertightness and normal continuity everywhere else.
@@ -87,7 +87,7 @@ Terms scaled(double w, const Terms& src) {
 
 // Sorts t by vertex and merges duplicates into out, so rows stay short and deterministic. The
 // duplicates' sum order is std::sort's on t's sequence: every row is built as the same sequence
-// of terms as before issue 14's rework, so every weight keeps its bits (tested).
+// of terms in the same fixed order, so every weight keeps its bits (tested).
 void compact_into(Terms& t, Terms& out) {
     std::sort(t.begin(), t.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     out.clear();
@@ -101,8 +101,8 @@ void compact_into(Terms& t, Terms& out) {
 constexpr double kPi = std::numbers::pi;
 
 // ---- Point rows of one vertex (see the file comment for the masks) ------------------------------
-// Each appends the row's terms to out in a fixed order (the order the rows had before issue 14's
-// rework, so their sums keep their bits). Called per patch corner with reused buffers: computing
+// Each appends the row's terms to out in a fixed order (so that their sums keep
+// their bits). Called per patch corner with reused buffers: computing
 // them again for each of a vertex's faces costs less than storing them per vertex (~400 bytes).
 
 // Valence used by the interior and edge masks: n for an interior vertex, 2k for a boundary vertex
@@ -455,7 +455,7 @@ constexpr std::size_t kFacesPerRun = 4096;
 // Builds the patches of an all-quad mesh into model (patch_points, tangent_points, patches),
 // each row composed through `through` when the mesh is a refinement of model.mesh.
 //
-// Speed and memory (issue 14): nothing is stored per vertex except the rules of the vertices of
+// Speed and memory: nothing is stored per vertex except the rules of the vertices of
 // extraordinary patches; each patch's rows are built in reused buffers. Runs of consecutive faces
 // are built in parallel, a few at a time, and appended in face order, so the tables are exactly
 // the sequential ones. The point table is reserved for an upper bound of its terms: on Linux the

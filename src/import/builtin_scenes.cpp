@@ -1,4 +1,4 @@
-// The built-in `city` and `building` scenes (patchcull/default_scene.h, issue 11) and the lookup
+// The built-in `city` and `building` scenes (patchcull/default_scene.h) and the lookup
 // of built-in scenes by name.
 //
 // Both place BigGuys and MonsterFrogs by rejection sampling with std::mt19937 (whose output the

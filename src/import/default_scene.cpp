@@ -1,5 +1,5 @@
 // Scenes for the renderer (patchcull/default_scene.h): the built-in default scene in the spirit
-// of seed 000 Fig. 1 (c) (animated characters among triangle occluders), and one-model scenes.
+// of Niessner & Loop, Fig. 1 (c) (animated characters among triangle occluders), and one-model scenes.
 #include "patchcull/default_scene.h"
 
 #include <algorithm>

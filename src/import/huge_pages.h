@@ -2,7 +2,7 @@
 //
 // Why: preprocessing a 1M-quad mesh writes ~1 GB of fresh stencils and patches once. With 4 KB
 // pages that is ~250,000 page faults, which cost more than the arithmetic (measured: over a third
-// of `patchcull info` on a virtual machine, issue 14); with transparent huge pages in "madvise"
+// of `patchcull info` on a virtual machine); with transparent huge pages in "madvise"
 // mode (Debian's default) a 2 MB page takes one fault. Only advice: where the kernel has no
 // huge pages, or on other systems, nothing changes, and no result ever depends on it.
 #pragma once

@@ -368,7 +368,7 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
     std::vector<DVec3> world_positions;  // as in the file, for recentre()
     // The whole stream at once (one copy of the file in memory while it is parsed), split at '\n'
     // as std::getline splits it: a 1M-face file has 2M lines, and a getline and a token vector
-    // per line were a third of the reader's instructions (callgrind, issue 14).
+    // per line were a third of the reader's instructions (callgrind).
     const std::string text = read_all(in, name);
     // Reserved from a count of the lines that start with "v " and "f " (four corners a face): the
     // arrays then grow without copies, and a copy's fresh pages cost more than the parsing.

@@ -1,8 +1,8 @@
 // Internal: ControlMesh -> Far::TopologyRefiner with validation (see osd_topology.h).
 //
 // Source: OpenSubdiv 3.5 Far, TopologyDescriptor/TopologyRefinerFactory, with the subdivision
-// options of seeds 000/001 (Catmull-Clark, EDGE_AND_CORNER vertex boundaries) unless the mesh
-// carries others (ControlMesh::options and holes, from OpenSubdiv's OBJ tags).
+// options of Niessner & Loop and Loop, Niessner & Eisenacher (Catmull-Clark, EDGE_AND_CORNER
+// vertex boundaries) unless the mesh carries others (ControlMesh::options and holes, from OpenSubdiv's OBJ tags).
 #include "import/osd_topology.h"
 
 #include <algorithm>

@@ -8,7 +8,7 @@
 // must be one-line patchcull::Error messages naming mesh.name anyway.
 //
 // Why flat arrays: a 1M-quad mesh has 1M rings; one std::vector per ring and per list (and hash
-// maps over 4M half-edges) cost gigabytes and most of the build time in malloc (issue 14). The
+// maps over 4M half-edges) cost gigabytes and most of the build time in malloc. The
 // rings live in three arrays indexed by per-vertex offsets; a ring is a view into them.
 #pragma once
 

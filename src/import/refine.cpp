@@ -2,7 +2,7 @@
 //
 // Source: OpenSubdiv 3.5 Far: TopologyRefiner::RefineUniform(level 1), StencilTableFactory for
 // the level-1 vertex stencils over the control vertices, PrimvarRefiner::InterpolateFaceVarying
-// for texture coordinates (FVAR_LINEAR_ALL, i.e. linear). Seed 002 (ACC) pre-refines non-quad
+// for texture coordinates (FVAR_LINEAR_ALL, i.e. linear). Sathe's ACC setup pre-refines non-quad
 // meshes once so every face becomes a quad; the ACC scheme (src/import/acc.cpp) is the user.
 //
 // Why stencils: animation moves the control vertices, so the refined positions must stay a
