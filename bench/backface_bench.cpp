@@ -16,11 +16,12 @@
 //   (= members). Meshes: sphere (UV sphere, 131k triangles), box (tessellated box, 98k
 //   triangles, flat faces like buildings), bigguy_tess (BigGuy's ACC patches tessellated 8 x 8,
 //   186k triangles), and the patch meshes bigguy_acc_s<levels> (BigGuy's ACC patches after 0, 1
-//   or 2 splits: 1450, 5800, 23200 patches), whose per-primitive test is ptp-pcnt (seed 001).
+//   or 2 splits: 1450, 5800, 23200 patches), whose per-primitive test is ptp-pcnt (Loop, Niessner &
+//   Eisenacher).
 // - backface/ptp_frame/bigguy_acc_s<levels>: one frame of the per-patch ptp-pcnt kernel (SIMD) on
 //   those patches, for the time the cluster tests stand against (items: frames).
 //
-// Run (numbers in the report of issue 11 / docs/PERFORMANCE.md):
+// Run (numbers in docs/PERFORMANCE.md):
 //   build-bf/bench/patchcull_bench --benchmark_filter='^backface/'
 //       --benchmark_repetitions=3 --benchmark_min_time=0.2 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>

@@ -1,8 +1,9 @@
 // Benchmarks of the cone back-patch kernels (patchcull/backpatch.h): tcone and ncone, scalar
 // reference vs SIMD (dispatched target), one thread vs all threads (parallel_for_ranges, grain
-// 1024), on 11532 (the killeroo's patch count in seed 001) and 65536 random patches: gently curved
-// sheets of random size and orientation around the eye, ~1/3 of them back-facing enough to be
-// culled. items_per_second is patches per second; the `culled` counter is the cull rate.
+// 1024), on 11532 (the killeroo's patch count in Loop, Niessner & Eisenacher) and 65536 random
+// patches: gently curved sheets of random size and orientation around the eye, ~1/3 of them
+// back-facing enough to be culled. items_per_second is patches per second; the `culled` counter
+// is the cull rate.
 //
 // Run (see docs/PERFORMANCE.md, "CPU back-patch kernels: tcone, ncone"):
 //   build-cones/bench/patchcull_bench --benchmark_filter='^(tcone|ncone)|cpu_clock'

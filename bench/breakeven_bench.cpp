@@ -1,4 +1,4 @@
-// Break-even cull rate of displaced-patch culling on our GPU pipeline (seed 000 §6.3):
+// Break-even cull rate of displaced-patch culling on our GPU pipeline (Niessner & Loop §6.3):
 //   x = (RT0 + CT) / (RT - RT0)
 // RT: the frame with every patch drawn; RT0: the same frame with every patch culled (issued to the
 // TCS, tessellation level 0: the pipeline's fixed cost); CT: the cull pass of a displaced bound

@@ -1,8 +1,8 @@
 // Benchmarks of the displaced-patch bounds (patchcull/displaced_bounds.h): the six combinations
 // {oobb, caf} x {full, acon, con}, scalar, one thread, as the frustum kernel (cull_displaced_frustum)
 // and as the frustum + Hi-Z occlusion kernel (cull_displaced_occlusion, 1920x1080 pyramid).
-// items_per_second is patches per second. Seed 000 Fig. 7 expects NoDisp, Full and ACoN at about
-// the same cost and CoN about ten times slower; two NoDisp references are included:
+// items_per_second is patches per second. Niessner & Loop, Fig. 7 expects NoDisp, Full and ACoN
+// at about the same cost and CoN about ten times slower; two NoDisp references are included:
 //   displaced_occlusion/nodisp_caf: the CAF kernel with null ranges (no cone is computed);
 //   displaced_occlusion/nodisp_hiz: hiz.h's cull_occlusion_scalar (control-point NDC box, no
 //   view-space bound), the kernel for undisplaced patches.

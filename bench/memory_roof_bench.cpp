@@ -1,4 +1,4 @@
-// Batches at the memory roof (issue 14): the stream-read roof and the SIMD cull kernels on the
+// Batches at the memory roof: the stream-read roof and the SIMD cull kernels on the
 // plain, plain + software prefetch and blocked layouts (patchcull/patch.h), at the working sets of
 // 1450, 5168, 65536 and 1M patches (256 bytes each: 0.37 MB, 1.3 MB, 16.8 MB, 268 MB), on one
 // thread and on all threads (parallel_for_ranges, grain 1024 patches, as cull_bench_loop.h).

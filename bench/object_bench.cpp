@@ -1,5 +1,5 @@
 // Benchmarks of the object level (patchcull/bounding_volumes.h, patchcull/object_bvh.h; G.
-// Zachmann, "Advanced Visibility Computations", seed 004): object tests per second for the sphere,
+// Zachmann, "Advanced Visibility Computations"): object tests per second for the sphere,
 // AABB n/p-vertex, AABB 8-corner and OBB tests (single-volume calls, and the scalar and SIMD batch
 // kernels), BVH build and refit time for 200-5000 objects, and BVH culling against the flat list
 // with and without plane masking and coherence on a walk through a city-like grid of objects.

@@ -1,6 +1,6 @@
 // Benchmarks of the object level on the real `city` scene (make_city_scene's defaults: 6 x 6 box
-// buildings + ground, 220 animated BigGuys and MonsterFrogs, ~300k ACC patches; issue 11, G.
-// Zachmann's lecture "Advanced Visibility Computations", seed 004): the CPU time that
+// buildings + ground, 220 animated BigGuys and MonsterFrogs, ~300k ACC patches; G.
+// Zachmann's lecture "Advanced Visibility Computations"): the CPU time that
 // `render city --objects ...` spends before the patch passes, which render's JSON does not time.
 //
 // - object_level/city/setup: SceneObjectLevel's construction (objects, the triangle clusters of the
@@ -19,7 +19,7 @@
 // plane_tests, bvh_nodes_visited, plane_tests_per_object, objects culled (frustum, back-face),
 // cluster_tests, triangle_tests, patches_culled, triangles_culled. One thread.
 //
-// Run (docs/PERFORMANCE.md, "Object level (issue 11)"):
+// Run (docs/PERFORMANCE.md, "Object level"):
 //   build-perf/bench/patchcull_bench --benchmark_filter='^object_level/' --benchmark_min_time=0.2
 //       --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>

@@ -1,7 +1,7 @@
-// Benchmarks of the parametric tangent plane back-patch kernel (patchcull/backpatch.h, seed 001
-// §3-6): scalar reference vs SIMD (dispatched target, and forced to 8-lane AVX2), one thread vs
-// all threads (parallel_for_ranges, grain 1024), for 11532 patches (the killeroo's count in seed
-// 001) and 65536. items_per_second is patches per second.
+// Benchmarks of the parametric tangent plane back-patch kernel (patchcull/backpatch.h,
+// Loop, Niessner & Eisenacher §3-6): scalar reference vs SIMD (dispatched target, and forced to
+// 8-lane AVX2), one thread vs all threads (parallel_for_ranges, grain 1024), for 11532 patches
+// (the killeroo's count in Loop, Niessner & Eisenacher) and 65536. items_per_second is patches per second.
 //
 // Workload: random curved bicubic sheets (0.2..1.0 across) with centres uniform in a box around a
 // perspective view (the frustum benchmark's generator), each patch facing a random direction, so

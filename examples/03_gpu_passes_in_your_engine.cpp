@@ -17,7 +17,7 @@
 //            Loop, "Patch-Based Occlusion Culling for Hardware Tessellation", §4.2: caf or oobb,
 //            cone full, acon or con) instead of its control points.
 //
-// Per frame it runs seed 000's two-pass occlusion-culling frame (§3, the order of gl_pipeline.h):
+// Per frame it runs Niessner & Loop's two-pass occlusion-culling frame (§3, the order of gl_pipeline.h):
 //   1. draw the patches tagged visible by the previous frame     (kDrawMaskFirstPass)
 //   2. build the Hi-Z pyramid from that depth buffer             (HiZBuildPass)
 //   3. the flag chain on one flag buffer: CullStatusPass::begin; FrustumPass (all, with the
@@ -41,7 +41,7 @@
 //            [--backpatch tcone|ncone|ptp] [--bound caf|oobb] [--cone full|acon|con] [--backpatch-open]
 //   --frames N    frames per camera position (3 positions, the camera moving), N in 1..1000, default 4
 //   --size WxH    framebuffer (and window) size, each in 1..8192, default 320x240
-//   --aggressive  skip pass 2 (seed 000 §3.1's aggressive variant: newly visible patches appear a
+//   --aggressive  skip pass 2 (Niessner & Loop §3.1's aggressive variant: newly visible patches appear a
 //                 frame late). NOT conservative: shows that the check catches missing patches.
 //   --backpatch   the back-patch test of bigguy (default tcone; ptp with the ncnt rule)
 //   --bound, --cone  the displaced bound of the frog and its cone of normals (default caf, acon)
@@ -169,7 +169,7 @@ Options parse_options(int argc, char** argv) {
 
 // Our own header, shared by the TES and the fragment shader: the bicubic rational Bezier patch at
 // (u, v), control point (i, j) (i along u) at cp[4 j + i], its point p and derivatives pu, pv.
-// du x dv of THIS evaluation is the normal that both the displacement (seed 000 §4.2's bounds
+// du x dv of THIS evaluation is the normal that both the displacement (Niessner & Loop §4.2's bounds
 // assume it) and the one-sided test (the back-patch tests decide on it) use.
 const char* const kPatchEvalGlsl = R"(
 void bernstein(float t, out vec4 b, out vec4 db) {
@@ -443,7 +443,7 @@ Scene make_scene() {
         const pc::PatchInfo& info = frog.rest.info[i];
         const std::size_t p = s.frog.first + i;
         for (int k = 0; k < 4; ++k) s.texcoords[4 * p + k] = info.uv[k];
-        // Seed 002's per-patch bound of D over every texel the patch can sample (displacement.h).
+        // Sathe's per-patch bound of D over every texel the patch can sample (displacement.h).
         const pc::DisplacementRange r = s.height_map.patch_range(info.uv);
         s.margins[p] = r.max_abs();
         s.ranges[p] = {r.d_min, r.d_max};
@@ -655,7 +655,7 @@ int run(const Options& options) {
     r.margin_buffer = make_buffer(scene.margins);
     const GLuint range_buffer = make_buffer(scene.ranges);
     // First frame: no previous frame tagged anything, so tag the even-indexed patches visible
-    // (as CullPipeline does; seed 000 §3): pass 1 draws half, pass 2 the rest of what shows.
+    // (as CullPipeline does; Niessner & Loop §3): pass 1 draws half, pass 2 the rest of what shows.
     std::vector<std::uint32_t> words(n, 0);
     for (std::size_t p = 0; p < n; p += 2) words[p] = sh::kStatusVisible;
     r.flag_buffer = make_buffer(words, GL_DYNAMIC_STORAGE_BIT);
@@ -752,7 +752,7 @@ int run(const Options& options) {
         const std::vector<std::uint32_t> words_before = read_words(r.flag_buffer, n);
         glClearNamedBufferData(counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
 
-        // ---- the culled frame: seed 000 §3's two passes ----
+        // ---- the culled frame: Niessner & Loop §3's two passes ----
         // Pass 1: the patches the previous frame tagged visible.
         r.clear();
         r.draw(v, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);

@@ -1,6 +1,7 @@
-// patchcull_gen_ptp_table: writes seed 001's parametric tangent plane table (src/core/ptp_table.inc)
-// to stdout, derived from the definition in exact rational arithmetic (src/core/ptp_table_gen.cpp),
-// and a summary (term count, per-destination matrix, degree reduction) to stderr.
+// patchcull_gen_ptp_table: writes Loop, Niessner & Eisenacher's parametric tangent plane table
+// (src/core/ptp_table.inc) to stdout, derived from the definition in exact rational arithmetic
+// (src/core/ptp_table_gen.cpp), and a summary (term count, per-destination matrix, degree
+// reduction) to stderr.
 //
 //   patchcull_gen_ptp_table > src/core/ptp_table.inc
 #include <cstdio>
