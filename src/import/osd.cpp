@@ -3,10 +3,10 @@
 //
 // Source: OpenSubdiv 3.5 Far (feature-adaptive refinement, PatchTableFactory with
 // ENDCAP_BSPLINE_BASIS, StencilTableFactory + AppendLocalPointStencilTable, PtexIndices), the
-// patch setup of Niessner & Loop and Loop, Niessner & Eisenacher (bicubic Bezier patches from a Catmull-Clark control mesh). The
-// boundary extrapolation mirrors Far's own B-spline basis evaluation (PatchParam boundary mask:
-// the phantom row/column is 2*P1 - P2), so our Bezier patch equals PatchTable::EvaluateBasis
-// over the whole patch domain (tests/import/osd_test.cpp checks this).
+// patch setup of Niessner & Loop and Loop, Niessner & Eisenacher (bicubic Bezier patches from a
+// Catmull-Clark control mesh). The boundary extrapolation mirrors Far's own B-spline basis
+// evaluation (PatchParam boundary mask: the phantom row/column is 2*P1 - P2), so our Bezier patch
+// equals PatchTable::EvaluateBasis over the whole patch domain (tests/import/osd_test.cpp checks this).
 //
 // Pipeline, and why:
 // 1. ControlMesh -> Far::TopologyRefiner (import/osd_topology.h: validation, creases, corners,

@@ -2,9 +2,10 @@
 // the osd scheme (src/import/osd.cpp) and the uniform refinement (src/import/refine.cpp).
 //
 // Source: OpenSubdiv 3.5 Far (Far::TopologyDescriptor + TopologyRefinerFactory), set up as in
-// Niessner & Loop and Loop, Niessner & Eisenacher: Catmull-Clark, vertex boundary interpolation EDGE_AND_CORNER, creases and
-// corners from the mesh, one face-varying channel for texture coordinates (linear everywhere);
-// the mesh's SubdivisionOptions (boundary interpolation, crease method, triangle rule) and holes
+// Niessner & Loop and Loop, Niessner & Eisenacher: Catmull-Clark, vertex boundary interpolation
+// EDGE_AND_CORNER, creases and corners from the mesh, one face-varying channel for texture
+// coordinates (linear everywhere); the mesh's SubdivisionOptions (boundary interpolation, crease
+// method, triangle rule) and holes
 // (Far skips hole faces when it builds patches) replace the defaults where an OBJ tagged them.
 //
 // Why a validation pass of our own: Far reports topology errors through a process-wide printf
