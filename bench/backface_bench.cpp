@@ -1,4 +1,4 @@
-// Benchmarks of back-face culling (patchcull/backface.h, backface_clusters.h; G. Zachmann's
+// Benchmarks of back-face culling (patchcull/objects/backface.h, backface_clusters.h; G. Zachmann's
 // lecture "Advanced Visibility Computations": back-face culling, normal masks (Zhang & Hoff 1997),
 // clustered back-face culling (Johannsen & Carter 1998)).
 //
@@ -34,11 +34,11 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backface.h"
-#include "patchcull/backface_clusters.h"
-#include "patchcull/backpatch.h"
-#include "patchcull/frustum.h"  // simd_target_name
-#include "patchcull/scene.h"
+#include "patchcull/objects/backface.h"
+#include "patchcull/objects/backface_clusters.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/frustum.h"  // simd_target_name
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// Benchmarks of the cone back-patch kernels (patchcull/backpatch.h): tcone and ncone, scalar
+// Benchmarks of the cone back-patch kernels (patchcull/core/backpatch.h): tcone and ncone, scalar
 // reference vs SIMD (dispatched target), one thread vs all threads (parallel_for_ranges, grain
 // 1024), on 11532 (the killeroo's patch count in Loop, Niessner & Eisenacher) and 65536 random
 // patches: gently curved sheets of random size and orientation around the eye, ~1/3 of them
@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/frustum.h"  // simd_target_name
-#include "patchcull/parallel.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/frustum.h"  // simd_target_name
+#include "patchcull/core/parallel.h"
+#include "patchcull/core/patch.h"
 #include "cull_bench_loop.h"
 
 using namespace patchcull;

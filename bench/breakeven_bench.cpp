@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/camera.h"
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/frustum.h"
-#include "patchcull/gl_displaced.h"
-#include "patchcull/gl_renderer.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/gl/gl_displaced.h"
+#include "patchcull/gl/gl_renderer.h"
+#include "patchcull/import/scene.h"
 
 namespace {
 

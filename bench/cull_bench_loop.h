@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <string>
 
-#include "patchcull/parallel.h"
+#include "patchcull/core/parallel.h"
 
 namespace patchcull::bench {
 

@@ -1,4 +1,4 @@
-// Benchmarks of the displaced-patch bounds (patchcull/displaced_bounds.h): the six combinations
+// Benchmarks of the displaced-patch bounds (patchcull/core/displaced_bounds.h): the six combinations
 // {oobb, caf} x {full, acon, con}, scalar, one thread, as the frustum kernel (cull_displaced_frustum)
 // and as the frustum + Hi-Z occlusion kernel (cull_displaced_occlusion, 1920x1080 pyramid).
 // items_per_second is patches per second. Niessner & Loop, Fig. 7 expects NoDisp, Full and ACoN
@@ -25,9 +25,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/hiz.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/patch.h"
 
 using namespace patchcull;
 

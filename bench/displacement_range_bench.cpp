@@ -1,4 +1,4 @@
-// Benchmarks of the per-patch displacement range (patchcull/displacement.h).
+// Benchmarks of the per-patch displacement range (patchcull/core/displacement.h).
 //
 // displacement_range_{exact,pyramid}/S/F: DisplacementMap::patch_range_exact (the texel scan) and
 //   patch_range (the min/max pyramid) on an S x S map of random heights, for 1024 patches whose
@@ -16,7 +16,7 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/displacement.h"
+#include "patchcull/core/displacement.h"
 
 using namespace patchcull;
 

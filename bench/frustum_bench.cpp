@@ -1,4 +1,4 @@
-// Benchmarks of the view-frustum kernels (patchcull/frustum.h): frustum and frustum-disp, scalar
+// Benchmarks of the view-frustum kernels (patchcull/core/frustum.h): frustum and frustum-disp, scalar
 // reference vs SIMD (dispatched target), one thread vs all threads (parallel_for_ranges, grain
 // 1024), on random patches around a view. items_per_second is patches per second.
 //
@@ -23,9 +23,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "patchcull/frustum.h"
-#include "patchcull/parallel.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/parallel.h"
+#include "patchcull/core/patch.h"
 #include "cull_bench_loop.h"
 
 using namespace patchcull;

@@ -1,4 +1,4 @@
-// Benchmarks of the Hi-Z pyramid and the occlusion test (patchcull/hiz.h).
+// Benchmarks of the Hi-Z pyramid and the occlusion test (patchcull/core/hiz.h).
 //
 // hiz_build/WxH: HiZPyramid::build from a W x H float depth buffer (storage allocated before the
 //   timed loop; one thread). items_per_second = depth pixels/s, bytes_per_second = depth bytes read.
@@ -21,9 +21,9 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/hiz.h"
-#include "patchcull/parallel.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/parallel.h"
+#include "patchcull/core/patch.h"
 
 using namespace patchcull;
 

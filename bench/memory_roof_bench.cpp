@@ -1,5 +1,5 @@
 // Batches at the memory roof: the stream-read roof and the SIMD cull kernels on the
-// plain, plain + software prefetch and blocked layouts (patchcull/patch.h), at the working sets of
+// plain, plain + software prefetch and blocked layouts (patchcull/core/patch.h), at the working sets of
 // 1450, 5168, 65536 and 1M patches (256 bytes each: 0.37 MB, 1.3 MB, 16.8 MB, 268 MB), on one
 // thread and on all threads (parallel_for_ranges, grain 1024 patches, as cull_bench_loop.h).
 // bytes_per_second is the control-point bytes the kernel reads (256 per patch), so a row's ratio
@@ -31,12 +31,12 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/frustum.h"
-#include "patchcull/fused_cull.h"
-#include "patchcull/hiz.h"
-#include "patchcull/parallel.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/fused_cull.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/parallel.h"
+#include "patchcull/core/patch.h"
 #include "cull_bench_loop.h"
 
 using namespace patchcull;
@@ -55,7 +55,12 @@ __attribute__((target("avx512f"))) float sum_avx512(const float* p, std::size_t 
     for (; i + 128 <= n; i += 128)
         for (int k = 0; k < 8; ++k) a[k] = _mm512_add_ps(a[k], _mm512_load_ps(p + i + 16 * k));
     for (int k = 1; k < 8; ++k) a[0] = _mm512_add_ps(a[0], a[k]);
-    float s = _mm512_reduce_add_ps(a[0]);
+    // The 16 lanes summed from memory: GCC 12's _mm512_reduce_add_ps warns -Wuninitialized inside
+    // its own header.
+    alignas(64) float lanes[16];
+    _mm512_store_ps(lanes, a[0]);
+    float s = 0;
+    for (float lane : lanes) s += lane;
     for (; i < n; ++i) s += p[i];
     return s;
 }

@@ -1,4 +1,4 @@
-// Benchmarks of the object level (patchcull/bounding_volumes.h, patchcull/object_bvh.h; G.
+// Benchmarks of the object level (patchcull/objects/bounding_volumes.h, patchcull/objects/object_bvh.h; G.
 // Zachmann, "Advanced Visibility Computations"): object tests per second for the sphere,
 // AABB n/p-vertex, AABB 8-corner and OBB tests (single-volume calls, and the scalar and SIMD batch
 // kernels), BVH build and refit time for 200-5000 objects, and BVH culling against the flat list
@@ -20,9 +20,9 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/bounding_volumes.h"
-#include "patchcull/frustum.h"
-#include "patchcull/object_bvh.h"
+#include "patchcull/objects/bounding_volumes.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/objects/object_bvh.h"
 
 using namespace patchcull;
 

@@ -29,10 +29,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/camera.h"
-#include "patchcull/default_scene.h"
-#include "patchcull/object_culling.h"
-#include "patchcull/scene_object_level.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/objects/object_culling.h"
+#include "patchcull/import/scene_object_level.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// Benchmarks of the parametric tangent plane back-patch kernel (patchcull/backpatch.h,
+// Benchmarks of the parametric tangent plane back-patch kernel (patchcull/core/backpatch.h,
 // Loop, Niessner & Eisenacher §3-6): scalar reference vs SIMD (dispatched target, and forced to
 // 8-lane AVX2), one thread vs all threads (parallel_for_ranges, grain 1024), for 11532 patches
 // (the killeroo's count in Loop, Niessner & Eisenacher) and 65536. items_per_second is patches per second.
@@ -20,10 +20,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/frustum.h"
-#include "patchcull/parallel.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/parallel.h"
+#include "patchcull/core/patch.h"
 #include "cull_bench_loop.h"
 
 using namespace patchcull;

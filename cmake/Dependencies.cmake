@@ -6,7 +6,7 @@ find_package(nlohmann_json REQUIRED)
 
 # OpenSubdiv (osdCPU) and stb: imported by hand, by the same file the installed package uses.
 include(${CMAKE_CURRENT_LIST_DIR}/PatchcullImportedDeps.cmake)
-patchcull_import_core_deps(patchcull_missing)
+patchcull_import_model_deps(patchcull_missing)
 if(patchcull_missing)
   list(JOIN patchcull_missing ", " patchcull_missing)
   message(FATAL_ERROR "patchcull: not found: ${patchcull_missing} (scripts/install-deps.sh installs them)")

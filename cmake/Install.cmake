@@ -1,27 +1,37 @@
 # cmake --install: what an engine needs to use patchcull from its own CMake project.
 #
-#   include/patchcull/*.h                 public headers (+ the generated version.h)
+#   include/patchcull/<layer>/*.h         public headers by layer (core, objects, import, eval; gl
+#                                         with GL) and the generated include/patchcull/version.h
 #   include/patchcull/glsl/*.h            GLSL headers an engine's shaders include (with GL)
-#   lib/libpatchcull.a, libpatchcull_gl.a (patchcull_gl with GL)
+#   lib/libpatchcull_<layer>.a            one static library per layer (patchcull_gl with GL)
 #   lib/cmake/patchcull/                  patchcullConfig.cmake, patchcullConfigVersion.cmake, targets
 #   share/patchcull/{models,scenes}/      the shipped models and scenes (patchcull_DATA_DIR)
 #   share/doc/patchcull/                  LICENSE, NOTICE
 #   bin/patchcull                         the CLI (with GL and PATCHCULL_BUILD_TOOLS)
 #
-# find_package(patchcull CONFIG) gives patchcull::core (the CPU library: no GL, EGL, GLFW or
-# glslang needed to configure or link) and, when the package was built with GL, patchcull::gl.
+# find_package(patchcull CONFIG COMPONENTS ...) gives one target per layer asked for (and the
+# layers it needs): patchcull::core (the kernels: TBB and Highway), patchcull::objects,
+# patchcull::import (OpenSubdiv, stb), patchcull::eval and, when the package was built with GL,
+# patchcull::gl (patchcullConfig.cmake.in).
 include(CMakePackageConfigHelpers)
 set(PATCHCULL_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/patchcull)
 
-install(TARGETS patchcull EXPORT patchcullCoreTargets
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
-install(EXPORT patchcullCoreTargets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
+# One export set per layer, so that the config loads (and finds the dependencies of) only the
+# layers a consumer asks for.
+foreach(layer core objects import eval)
+  string(SUBSTRING ${layer} 0 1 first)
+  string(TOUPPER ${first} first)
+  string(SUBSTRING ${layer} 1 -1 rest)
+  install(TARGETS patchcull_${layer} EXPORT patchcull${first}${rest}Targets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(EXPORT patchcull${first}${rest}Targets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
+endforeach()
 
-# Headers: the GL ones (gl_*.h) only with GL, so a CPU-only install holds no header it cannot link.
+# Headers: the GL layer's folder only with GL, so a CPU-only install holds no header it cannot link.
 if(PATCHCULL_WITH_GL)
   set(patchcull_header_excludes)
 else()
-  set(patchcull_header_excludes PATTERN "gl_*.h" EXCLUDE)
+  set(patchcull_header_excludes PATTERN "gl" EXCLUDE)
 endif()
 install(DIRECTORY include/patchcull DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   FILES_MATCHING PATTERN "*.h" ${patchcull_header_excludes})
@@ -52,7 +62,7 @@ configure_package_config_file(cmake/patchcullConfig.cmake.in
   ${PROJECT_BINARY_DIR}/patchcullConfig.cmake
   INSTALL_DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR}
   PATH_VARS CMAKE_INSTALL_DATADIR CMAKE_INSTALL_INCLUDEDIR)
-# 0.x: a minor release may change the API, so 0.1 accepts 0.1.z only.
+# 0.x: a minor release may change the API, so 0.2 accepts 0.2.z only.
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/patchcullConfigVersion.cmake
   COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/patchcullConfig.cmake ${PROJECT_BINARY_DIR}/patchcullConfigVersion.cmake

@@ -4,13 +4,14 @@
 # build did. Both functions define only what is missing (a second find_package is harmless) and
 # never fail: they put what they could not find into <missing-var>, and the caller decides.
 #
-#   patchcull_import_core_deps(<missing-var>)  PatchcullDeps::OpenSubdiv (osdCPU), PatchcullDeps::stb
-#   patchcull_import_gl_deps(<missing-var>)    PatchcullDeps::epoxy
+#   patchcull_import_model_deps(<missing-var>) PatchcullDeps::OpenSubdiv (osdCPU), PatchcullDeps::stb
+#                                              (the import layer's)
+#   patchcull_import_gl_deps(<missing-var>)    PatchcullDeps::epoxy, PatchcullDeps::stb (the gl layer's)
 
 # OpenSubdiv 3.5's package config is broken on Debian 12 (its targets file names static
 # libraries that are not shipped) and there is no pkg-config file: osdCPU is imported by hand.
 # libstb (pkg-config stb) already contains the implementations: never define STB_*_IMPLEMENTATION.
-function(patchcull_import_core_deps missing_var)
+function(patchcull_import_model_deps missing_var)
   set(missing)
   if(NOT TARGET PatchcullDeps::OpenSubdiv)
     find_path(PATCHCULL_OPENSUBDIV_INCLUDE_DIR opensubdiv/version.h)
@@ -24,12 +25,7 @@ function(patchcull_import_core_deps missing_var)
       list(APPEND missing "OpenSubdiv (opensubdiv/version.h and libosdCPU: Debian libosd-dev)")
     endif()
   endif()
-  if(NOT TARGET PatchcullDeps::stb)
-    _patchcull_pkg_config_target(stb PATCHCULL_STB PatchcullDeps::stb)
-    if(NOT TARGET PatchcullDeps::stb)
-      list(APPEND missing "stb (pkg-config module stb: Debian libstb-dev)")
-    endif()
-  endif()
+  _patchcull_import_stb(missing)
   set(${missing_var} "${missing}" PARENT_SCOPE)
 endfunction()
 
@@ -42,8 +38,19 @@ function(patchcull_import_gl_deps missing_var)
       list(APPEND missing "libepoxy (pkg-config module epoxy: Debian libepoxy-dev)")
     endif()
   endif()
+  _patchcull_import_stb(missing)  # the PNG output of the renderer
   set(${missing_var} "${missing}" PARENT_SCOPE)
 endfunction()
+
+# PatchcullDeps::stb, or its name appended to the list named by list_var.
+macro(_patchcull_import_stb list_var)
+  if(NOT TARGET PatchcullDeps::stb)
+    _patchcull_pkg_config_target(stb PATCHCULL_STB PatchcullDeps::stb)
+    if(NOT TARGET PatchcullDeps::stb)
+      list(APPEND ${list_var} "stb (pkg-config module stb: Debian libstb-dev)")
+    endif()
+  endif()
+endmacro()
 
 # PatchcullDeps::<name> as an interface target over pkg-config's PkgConfig::<prefix>: a real
 # (not ALIAS) imported name, so that the exported link interfaces name it and the installed config

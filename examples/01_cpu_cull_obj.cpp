@@ -7,7 +7,7 @@
 //   MODEL.obj  a Catmull-Clark control mesh (default: the shipped data/models/bigguy.obj)
 //   --views N  random camera positions around and inside the model, N in 1..1000, default 8
 // Prints one line per view. Every decision is checked against the ground truth of
-// patchcull/ground_truth.h (17x17 dense samples of each culled patch, evaluated in double): a
+// patchcull/core/ground_truth.h (17x17 dense samples of each culled patch, evaluated in double): a
 // frustum-culled patch must have no sample in the view volume, a back-patch-culled one no sampled
 // tangent plane facing the eye; and the SIMD kernels must agree with the scalar references.
 // Exit status: 0 all checks passed; 1 a check failed, or a kernel culled nothing over the run
@@ -20,14 +20,14 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/camera.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/parallel.h"
-#include "patchcull/patch.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/core/parallel.h"
+#include "patchcull/core/patch.h"
+#include "patchcull/import/scene.h"
 
 namespace pc = patchcull;
 

@@ -1,6 +1,6 @@
 // examples/02_cpu_hiz_with_your_depth.cpp: occlusion culling on the CPU against a depth buffer
 // the caller supplies (an engine's depth pre-pass, a software rasteriser's occluders, last
-// frame's read-back): build the Hi-Z pyramid from it (patchcull/hiz.h), then test patches.
+// frame's read-back): build the Hi-Z pyramid from it (patchcull/core/hiz.h), then test patches.
 //
 // The depth buffer is given in hiz.h's convention: W x H floats, depth[y * W + x], row 0 = bottom
 // (what glReadPixels returns), window depth in [0, 1] (glDepthRange(0, 1)), larger = farther. The
@@ -29,13 +29,13 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/clip_space.h"
-#include "patchcull/error.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/hiz.h"
-#include "patchcull/math.h"
-#include "patchcull/patch.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/math.h"
+#include "patchcull/core/patch.h"
+#include "patchcull/core/teapot.h"
 
 namespace pc = patchcull;
 

@@ -1,4 +1,4 @@
-// examples/03_gpu_passes_in_your_engine.cpp: patchcull's GPU cull passes (patchcull/gl_passes.h)
+// examples/03_gpu_passes_in_your_engine.cpp: patchcull's GPU cull passes (patchcull/gl/gl_passes.h)
 // in a program that is NOT patchcull's renderer: it opens its own window and OpenGL 4.5 core
 // context with GLFW, loads GL through libepoxy, owns every buffer, texture, framebuffer and shader
 // program, draws with its own tessellation shaders, and calls only the passes. This is what an
@@ -75,16 +75,16 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/displacement.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
-#include "patchcull/gl_passes.h"
-#include "patchcull/math.h"
-#include "patchcull/patch.h"
-#include "patchcull/scene.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/displacement.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/gl/gl_passes.h"
+#include "patchcull/core/math.h"
+#include "patchcull/core/patch.h"
+#include "patchcull/import/scene.h"
+#include "patchcull/core/teapot.h"
 #include "shared.h"  // shaders/shared.h: C++ and GLSL at once
 
 namespace pc = patchcull;
@@ -254,7 +254,7 @@ void main() {
 
 // Evaluation and displacement. A patch with margin > 0 (the frog's) is displaced by
 // D(s, t) = scale * (h(s, t) - midlevel) along the UNIT normal of its own derivatives, (s, t)
-// bilinear in its corner texcoords (patchcull/displacement.h): what DisplacedPass bounds, with
+// bilinear in its corner texcoords (patchcull/core/displacement.h): what DisplacedPass bounds, with
 // |D| <= margin and D in its range. The height map is sampled as DisplacementMap::sample is
 // defined: bilinear, GL_REPEAT, no mipmaps (a mip level averages texels the range never saw).
 // Where du x dv = 0 the point stays on the base patch, as the bounds assume.

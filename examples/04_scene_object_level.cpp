@@ -1,5 +1,5 @@
 // examples/04_scene_object_level.cpp: a scene of many objects on the CPU. The object level
-// (patchcull/scene_object_level.h) culls whole objects by their boxes through a BVH, and the
+// (patchcull/import/scene_object_level.h) culls whole objects by their boxes through a BVH, and the
 // back-facing clusters of rigid one-sided objects (Johannsen & Carter's clustered back-face
 // culling); then the patch frustum kernel runs only on the patches it left
 // (cull_frustum_after_objects, object_culling.h), so a culled object costs no patch test.
@@ -24,13 +24,13 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/default_scene.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/object_culling.h"
-#include "patchcull/scene_file.h"
-#include "patchcull/scene_object_level.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/objects/object_culling.h"
+#include "patchcull/import/scene_file.h"
+#include "patchcull/import/scene_object_level.h"
 
 namespace pc = patchcull;
 

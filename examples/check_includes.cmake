@@ -1,5 +1,5 @@
 # Fails unless every example includes only what an installed patchcull offers a user: public
-# headers (patchcull/NAME.h that exist in include/patchcull), shared.h (the GLSL/C++ header on
+# headers (patchcull/LAYER/NAME.h that exist in include/patchcull; patchcull/version.h), shared.h (the GLSL/C++ header on
 # patchcull_gl's include path), the standard library and the examples' own GL stack (epoxy, GLFW).
 #   cmake -DSOURCE_DIR=<repository root> -P check_includes.cmake
 # Prints each offending example:line and include.
@@ -43,7 +43,7 @@ foreach(file IN LISTS examples)
       if(header STREQUAL "shared.h")
         continue()
       endif()
-      if(header MATCHES "^patchcull/[a-z0-9_]+\\.h$" AND EXISTS "${SOURCE_DIR}/include/${header}")
+      if(header MATCHES "^patchcull/([a-z]+/)?[a-z0-9_]+\\.h$" AND EXISTS "${SOURCE_DIR}/include/${header}")
         continue()
       endif()
     elseif(NOT header MATCHES "/" OR header MATCHES "^(epoxy/gl\\.h|GLFW/glfw3\\.h)$")

@@ -18,7 +18,7 @@ string(REPLACE "[" "<open>" content "${content}")
 string(REPLACE "]" "<close>" content "${content}")
 string(REPLACE "\n" ";" lines "${content}")
 
-set(prelude "#include <cstddef>\n#include <cstdint>\n#include <vector>\n#include \"patchcull/math.h\"\nnamespace pc = patchcull<semicolon>\n")
+set(prelude "#include <cstddef>\n#include <cstdint>\n#include <vector>\n#include \"patchcull/core/math.h\"\nnamespace pc = patchcull<semicolon>\n")
 set(signature "void snippet(const pc::Mat4& object_to_clip, const pc::Mat4& projection, std::vector<float>& depth, int width, int height, std::uint32_t patch_buffer, std::uint32_t flag_buffer, std::size_t patch_count, pc::Vec3 eye_in_object_space)")
 file(MAKE_DIRECTORY "${OUT_DIR}")
 set(in_block OFF)

@@ -16,10 +16,10 @@
 #include <sstream>
 #include <string>
 
-#include "patchcull/error.h"
-#include "patchcull/image.h"
-#include "patchcull/mesh.h"
-#include "patchcull/obj.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/image.h"
+#include "patchcull/core/mesh.h"
+#include "patchcull/import/obj.h"
 
 namespace patchcull::fuzz {
 

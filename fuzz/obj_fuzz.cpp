@@ -1,4 +1,4 @@
-// libFuzzer target: the OBJ reader (patchcull/obj.h) on arbitrary bytes. Only parsing and the
+// libFuzzer target: the OBJ reader (patchcull/import/obj.h) on arbitrary bytes. Only parsing and the
 // mesh checks of input_checks.h run: subdivision (OpenSubdiv) is not part of this target.
 #include <cstdio>
 #include <cstdlib>

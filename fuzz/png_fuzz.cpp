@@ -1,4 +1,4 @@
-// libFuzzer target: the PNG height-map loader (patchcull/image.h) on arbitrary bytes.
+// libFuzzer target: the PNG height-map loader (patchcull/import/image.h) on arbitrary bytes.
 #include <cstdio>
 #include <cstdlib>
 

@@ -29,7 +29,7 @@ mkdir -p "$OUT"
 
 if [ ! -x "$BUILD/patchcull" ]; then
     cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >"$OUT/cmake.log" 2>&1
-    cmake --build "$BUILD" -j"$(nproc)" --target patchcull >"$OUT/build.log" 2>&1
+    cmake --build "$BUILD" -j"$(nproc)" --target patchcull_cli >"$OUT/build.log" 2>&1
 fi
 CLI="$BUILD/patchcull"
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # README command 2: runs every test. Installs the Debian packages if missing, builds the core
 # tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs them, runs a short fuzz
-# campaign over the input loaders (scripts/fuzz.sh, clang), then builds everything in Release and
-# runs the whole suite (ctest's summary line comes last).
+# campaign over the input loaders (scripts/fuzz.sh, clang), then builds everything in Release with
+# warnings as errors (PATCHCULL_WERROR) and runs the whole suite (ctest's summary line comes last).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS="$(nproc)"
@@ -18,6 +18,6 @@ echo "== fuzz campaign (libFuzzer, clang: OBJ reader and PNG loader, 20 s each) 
 ./scripts/fuzz.sh 20
 
 echo "== full suite (Release) =="
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPATCHCULL_WERROR=ON >/dev/null
 cmake --build build -j"$JOBS"
 ctest --test-dir build --output-on-failure

@@ -1,5 +1,5 @@
 // Cone back-patch cull pass (BackpatchConePass, src/gl/backpatch_cones_pass.cpp), one invocation
-// per patch: the GPU twin of cull_tcone_scalar and cull_ncone_scalar (include/patchcull/backpatch.h,
+// per patch: the GPU twin of cull_tcone_scalar and cull_ncone_scalar (include/patchcull/core/backpatch.h,
 // src/core/backpatch_cones.cpp). TCONE (default): the Sederberg & Meyers cone of the tangent and
 // bitangent control vectors; NCONE (compiled with PATCHCULL_NCONE): the cone of the 36 control
 // vectors of the normal patch (Shirman & Abi-Ezzi). The cones and the test are backpatch_cones.h,

@@ -4,6 +4,7 @@
 // (backpatch_shared.h's kProbe*). Used by BackpatchCuller's start-up check of GLSL fma() on GPUs
 // and by tests/gl/backpatch_gpu_test.cpp (against std::fma, / and std::sqrt).
 #version 450 core
+#include "shared.h"
 #include "backpatch_shared.h"
 #include "exact_fma.h"
 #include "backpatch_exact.h"

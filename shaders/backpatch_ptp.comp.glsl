@@ -1,5 +1,5 @@
 // ptp back-patch cull pass (BackpatchPtpPass, src/gl/backpatch_ptp_pass.cpp; Loop, Niessner &
-// Eisenacher §3-6): the GPU twin of cull_ptp_scalar (include/patchcull/backpatch.h, src/core/ptp.cpp)
+// Eisenacher §3-6): the GPU twin of cull_ptp_scalar (include/patchcull/core/backpatch.h, src/core/ptp.cpp)
 // with Loop, Niessner & Eisenacher §6's parallel scheme:
 // kPtpLanes = 16 invocations per patch, kPtpPatchesPerGroup = 8 patches per work group.
 //

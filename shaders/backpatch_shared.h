@@ -1,5 +1,5 @@
 // shaders/backpatch_shared.h: constants shared by the GPU back-patch culler
-// (include/patchcull/gl_backpatch.h, src/gl/backpatch_culler.cpp) and its compute shaders
+// (include/patchcull/gl/gl_backpatch.h, src/gl/backpatch_culler.cpp) and its compute shaders
 // (backpatch_cones, backpatch_ptp, backpatch_probe). Valid C++20 and GLSL 4.50 at once, like
 // shared.h (whose buffer bindings the culler uses for the control points and the flag words:
 // kBindingControlPoints and kBindingCullFlags). Only `const uint` constants.
@@ -15,17 +15,14 @@ using uint = std::uint32_t;
 #define PATCHCULL_BP_CONST const
 #endif
 
-// Diagnostics buffer of backpatch_ptp (std430 float t[64 * patch_count]: patch p's control plane z
-// components at 64p + 8 jv + iu, exactly the CPU kernel's t), written only on request.
-PATCHCULL_BP_CONST uint kBindingPtpPlanes = 12u;
-// Diagnostics buffer of backpatch_cones (tcone / ncone) (std430 float c[kConeValues * patch_count]):
-// patch p's cone and sphere at kConeValues p + (axis.x, axis.y, axis.z, cos, sin, valid (1 or 0),
-// center.x, center.y, center.z, radius, 0, 0), written only on request.
-PATCHCULL_BP_CONST uint kBindingConeValues = 15u;
+// Buffers (binding points in shared.h): the diagnostics of backpatch_ptp at kBindingPtpPlanes
+// (std430 float t[64 * patch_count]: patch p's control plane z components at 64p + 8 jv + iu,
+// exactly the CPU kernel's t), written only on request; the diagnostics of backpatch_cones (tcone
+// / ncone) at kBindingConeValues (std430 float c[kConeValues * patch_count]: patch p's cone and
+// sphere at kConeValues p + (axis.x, axis.y, axis.z, cos, sin, valid (1 or 0), center.x, center.y,
+// center.z, radius, 0, 0)), written only on request; the input and output of
+// backpatch_probe.comp.glsl (tests and the start-up fma check) at kBindingProbeIn / Out.
 PATCHCULL_BP_CONST uint kConeValues = 12u;
-// Input / output of backpatch_probe.comp.glsl (tests and the start-up fma check).
-PATCHCULL_BP_CONST uint kBindingProbeIn = 13u;   // vec4 in[n]: (a, b, c, unused)
-PATCHCULL_BP_CONST uint kBindingProbeOut = 14u;  // float out[n]
 
 // Work groups: cones, one invocation per patch; ptp, kPtpLanes invocations per patch (Loop, Niessner &
 // Eisenacher §6: 16 threads per patch, each owning one 4x4 block's 4 destinations) and kPtpPatchesPerGroup

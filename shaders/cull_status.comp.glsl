@@ -1,5 +1,5 @@
 // Cull status pass (CullStatusPass, src/gl/cull_status_pass.cpp): the two ends of the flag chain
-// (include/patchcull/gl_passes.h), one invocation per patch.
+// (include/patchcull/gl/gl_passes.h), one invocation per patch.
 // - kStatusBegin: clears the reason bits (kCullReasonMask) of every patch of the range and keeps
 //   its status bits, so the frame's test passes start from "nothing culled" while the first
 //   drawing pass still sees last frame's statuses.

@@ -1,6 +1,6 @@
 // Displaced-patch cull pass (DisplacedPass, src/gl/displaced_pass.cpp; Niessner & Loop §4.2), one
 // invocation per patch: the GPU twin of
-// cull_displaced_frustum and cull_displaced_occlusion (include/patchcull/displaced_bounds.h,
+// cull_displaced_frustum and cull_displaced_occlusion (include/patchcull/core/displaced_bounds.h,
 // src/core/displaced_bounds.cpp). The bound (caf or oobb, u_bound_kind) and its decisions are
 // displaced_bounds.h (the GLSL one in shaders/); the cone kind is fixed at compile time by
 // PC_DISPLACED_CONE (kDisplacedConeFull 0, kDisplacedConeAcon 1, kDisplacedConeCon 2; the

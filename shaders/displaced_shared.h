@@ -1,5 +1,5 @@
 // shaders/displaced_shared.h: constants shared by the GPU displaced-patch culler
-// (include/patchcull/gl_displaced.h, src/gl/displaced_culler.cpp) and its compute shader
+// (include/patchcull/gl/gl_displaced.h, src/gl/displaced_culler.cpp) and its compute shader
 // (displaced.comp.glsl). Valid C++20 and GLSL 4.50 at once, like shared.h, whose bindings the
 // culler uses for the control points (kBindingControlPoints) and the flag words (kBindingCullFlags),
 // and whose texture unit kTextureUnitHiZ holds the Hi-Z pyramid. Only `const uint` constants.
@@ -15,13 +15,12 @@ using uint = std::uint32_t;
 #define PATCHCULL_DS_CONST const
 #endif
 
-// Per-patch displacement ranges (std430 vec2 range[patch_count]: (d_min, d_max)), read only when
-// the culler has ranges (else every patch is undisplaced, as a null ranges pointer on the CPU).
-PATCHCULL_DS_CONST uint kBindingDisplacementRanges = 8u;
-// Diagnostics (std430 float b[kDisplacedBoundValues * patch_count]): patch p's DisplacedBound at
-// kDisplacedBoundValues p + (ndc_xmin, ndc_xmax, ndc_ymin, ndc_ymax, depth_near, depth_far,
-// status as a float, 0), written only on request.
-PATCHCULL_DS_CONST uint kBindingDisplacedBounds = 9u;
+// Buffers (binding points in shared.h): per-patch displacement ranges at
+// kBindingDisplacementRanges (std430 vec2 range[patch_count]: (d_min, d_max)), read only when the
+// culler has ranges (else every patch is undisplaced, as a null ranges pointer on the CPU);
+// diagnostics at kBindingDisplacedBounds (std430 float b[kDisplacedBoundValues * patch_count]):
+// patch p's DisplacedBound at kDisplacedBoundValues p + (ndc_xmin, ndc_xmax, ndc_ymin, ndc_ymax,
+// depth_near, depth_far, status as a float, 0), written only on request.
 PATCHCULL_DS_CONST uint kDisplacedBoundValues = 8u;
 
 // One invocation per patch.

@@ -1,5 +1,5 @@
 // shaders/flag_chain.h (GLSL only; include after shared.h): the flag chain of the cull passes
-// (include/patchcull/gl_passes.h, "The flag chain"). Every test pass reads and writes the
+// (include/patchcull/gl/gl_passes.h, "The flag chain"). Every test pass reads and writes the
 // caller's flag buffer (kBindingCullFlags, one uint per patch); a patch whose reason bits
 // (kCullReasonMask) are set was culled by an earlier pass of the frame and is skipped, so each
 // patch ends with the reason of the first test that culled it, and the later, costlier tests only

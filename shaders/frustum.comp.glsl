@@ -1,5 +1,5 @@
 // Frustum cull pass (FrustumPass, src/gl/frustum_pass.cpp), one invocation per patch: the GPU twin
-// of cull_frustum_scalar (include/patchcull/frustum.h, src/core/frustum.cpp). Same arithmetic,
+// of cull_frustum_scalar (include/patchcull/core/frustum.h, src/core/frustum.cpp). Same arithmetic,
 // operation by operation, so the decisions are identical (the test itself is shaders/frustum_test.h,
 // shared with occlusion.comp.glsl). A link of the flag chain (gl_passes.h): a patch that an earlier
 // pass of the frame culled is left as it is; otherwise a culled patch gets the reason kCullFrustum.

@@ -1,5 +1,5 @@
 // Displaced-AABB frustum pass (FrustumDispPass, src/gl/frustum_disp_pass.cpp), one invocation per
-// patch: the GPU twin of cull_frustum_disp_scalar (include/patchcull/frustum.h, src/core/frustum.cpp),
+// patch: the GPU twin of cull_frustum_disp_scalar (include/patchcull/core/frustum.h, src/core/frustum.cpp),
 // Sathe's test ("View Frustum Culling of Catmull-Clark Patches in DirectX 11", Game Programming
 // Gems 8): the object-space AABB of the Cartesian control points, grown by the patch's max |D| on
 // every side, its 8 corners taken to clip space and tested against the clip planes.

@@ -1,5 +1,5 @@
 // shaders/frustum_test.h (GLSL only): the frustum decision of cull_frustum_scalar
-// (include/patchcull/frustum.h) for one patch, shared by frustum.comp.glsl, occlusion.comp.glsl
+// (include/patchcull/core/frustum.h) for one patch, shared by frustum.comp.glsl, occlusion.comp.glsl
 // and the fused pass, so that they all make the same decisions.
 //
 // For each control point k = (X, Y, Z, W): clip coordinates once,

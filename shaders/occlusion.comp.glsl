@@ -1,5 +1,5 @@
 // Hi-Z occlusion cull pass (OcclusionPass, src/gl/occlusion_pass.cpp; Niessner & Loop §4.1.1), one
-// invocation per patch: the GPU twin of cull_occlusion_scalar (include/patchcull/hiz.h,
+// invocation per patch: the GPU twin of cull_occlusion_scalar (include/patchcull/core/hiz.h,
 // src/core/hiz.cpp), steps numbered as in hiz.h. Operation by operation the same arithmetic, so the
 // decisions are identical: products and std::fma <-> `precise` products and pc_fma (exact_fma.h),
 // `a < b ? a : b` min/max, floor, integer shifts; the divisions of step 4 are correctly rounded

@@ -1,4 +1,4 @@
-// shaders/pass_params.h: the parameter block of every GPU cull pass (include/patchcull/gl_passes.h),
+// shaders/pass_params.h: the parameter block of every GPU cull pass (include/patchcull/gl/gl_passes.h),
 // declared once for C++ and GLSL.
 //
 // Valid C++20 and GLSL 4.50 at once, like shared.h. In GLSL each PC_PARAMS block is a std140

@@ -2,7 +2,7 @@
 // decisions (GLSL 4.50; include after shared.h, whose constants it uses). Shipped for engines:
 // patchcull's own patch.tesc.glsl uses exactly this file.
 //
-// The cull passes (include/patchcull/gl_passes.h) leave one flag word per patch in the caller's
+// The cull passes (include/patchcull/gl/gl_passes.h) leave one flag word per patch in the caller's
 // flag buffer; a draw reads it at kBindingCullFlags, indexed by the patch's position in the
 // caller's patch buffer (patch p = the p-th patch of the draw when the draw starts at patch 0;
 // derive it from gl_VertexID / 16 in the vertex shader rather than gl_PrimitiveID, which restarts

@@ -1,5 +1,5 @@
-// Stencil posing pass (gl::StencilPoser, include/patchcull/gl_posing.h, src/gl/stencil_poser.cpp):
-// the GPU twin of ScenePoser::pose (include/patchcull/default_scene.h). One invocation per output
+// Stencil posing pass (gl::StencilPoser, include/patchcull/gl/gl_posing.h, src/gl/stencil_poser.cpp):
+// the GPU twin of ScenePoser::pose (include/patchcull/import/default_scene.h). One invocation per output
 // row: first 16 per patch, its control points (patch.h order), then 24 per patch that has ACC
 // tangent patches, its tangent vectors (du[0..11], dv[0..11], shared.h's kTangentVec4s layout).
 // (Only the patches with tangents get tangent rows: with a fixed 40 rows per patch, llvmpipe ran
@@ -21,35 +21,36 @@
 
 layout(local_size_x = 256) in;
 
-// Bindings of this pass only (the renderer and the cull passes rebind theirs before they run).
-// Outputs at the renderer's own binding points (shared.h's kBindingControlPoints = 0 and
-// kBindingPatchTangents = 10), inputs above shared.h's range.
-layout(std430, binding = 0) writeonly buffer ControlPoints {
+#include "shared.h"
+
+// Outputs at the renderer's own binding points (kBindingControlPoints, kBindingPatchTangents),
+// inputs at this pass's own binding points (shared.h).
+layout(std430, binding = kBindingControlPoints) writeonly buffer ControlPoints {
     vec4 control_points[];  // 16 per patch
 };
-layout(std430, binding = 10) writeonly buffer Tangents {
+layout(std430, binding = kBindingPatchTangents) writeonly buffer Tangents {
     vec4 tangents[];  // 24 per patch (shared.h kTangentVec4s)
 };
-layout(std430, binding = 13) readonly buffer Vertices {
+layout(std430, binding = kBindingPoseVertices) readonly buffer Vertices {
     float vertices[];  // posed control meshes, x y z per vertex (packed Vec3)
 };
 struct Instance {
     mat4 to_world;     // column-major, as Mat4
     uvec4 info;        // first_vertex, first_patch, mirrored, first patch row of its model
 };
-layout(std430, binding = 14) readonly buffer Instances {
+layout(std430, binding = kBindingPoseInstances) readonly buffer Instances {
     Instance instances[];
 };
-layout(std430, binding = 15) readonly buffer PatchTable {
+layout(std430, binding = kBindingPosePatchTable) readonly buffer PatchTable {
     uint patch_instance[];  // per output patch: its instance
 };
-layout(std430, binding = 18) readonly buffer TangentTable {
+layout(std430, binding = kBindingPoseTangentTable) readonly buffer TangentTable {
     uvec2 tangent_table[];  // per output patch with tangents: (patch, first row of its tangent block)
 };
-layout(std430, binding = 16) readonly buffer Offsets {
+layout(std430, binding = kBindingPoseOffsets) readonly buffer Offsets {
     uint offsets[];  // rows + 1: row r's terms are [offsets[r], offsets[r+1])
 };
-layout(std430, binding = 17) readonly buffer Terms {
+layout(std430, binding = kBindingPoseTerms) readonly buffer Terms {
     uvec2 terms[];  // (model-local vertex index, floatBitsToUint(weight))
 };
 

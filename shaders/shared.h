@@ -41,6 +41,25 @@ PATCHCULL_CONST uint kBindingPatchMarks = 11u;
 // float scale[patch_count]: patch p's uniform tessellation level is min(64, level * scale[p]),
 // scale = 2^(D - depth) (PatchAttributes::depth): equal vertex density across refinement depths.
 PATCHCULL_CONST uint kBindingPatchTessScale = 12u;
+// The passes' own buffers (their layouts: backpatch_shared.h, displaced_shared.h and the headers
+// named). Every binding point of patchcull is declared here, once, and each is used by one
+// buffer only (tests/gl/shader_bindings_test.cpp): passes leave their buffers bound, so a shared
+// number would let one pass read another's buffer.
+PATCHCULL_CONST uint kBindingDisplacementRanges = 8u;  // displaced: vec2 (d_min, d_max) per patch
+PATCHCULL_CONST uint kBindingDisplacedBounds = 9u;     // displaced: diagnostics
+PATCHCULL_CONST uint kBindingPtpPlanes = 13u;          // backpatch_ptp: diagnostics
+PATCHCULL_CONST uint kBindingConeValues = 14u;         // backpatch_cones: diagnostics
+PATCHCULL_CONST uint kBindingProbeIn = 15u;            // backpatch_probe: vec4 in[n]: (a, b, c, unused)
+PATCHCULL_CONST uint kBindingProbeOut = 16u;           // backpatch_probe: float out[n]
+// pose_stencils (gl_posing.h's StencilPoser; outputs at kBindingControlPoints and
+// kBindingPatchTangents): posed control mesh vertices, instances, the per-patch instance table,
+// stencil row offsets and terms, the tangent table.
+PATCHCULL_CONST uint kBindingPoseVertices = 17u;
+PATCHCULL_CONST uint kBindingPoseInstances = 18u;
+PATCHCULL_CONST uint kBindingPosePatchTable = 19u;
+PATCHCULL_CONST uint kBindingPoseOffsets = 20u;
+PATCHCULL_CONST uint kBindingPoseTerms = 21u;
+PATCHCULL_CONST uint kBindingPoseTangentTable = 22u;
 
 // Uniform buffer binding of the passes' parameter blocks (pass_params.h; one pass runs at a time).
 PATCHCULL_CONST uint kUniformPassParams = 0u;

@@ -1,12 +1,13 @@
 # Fails unless README.md's "Header index" has exactly one line per public header: every
-# include/patchcull/*.h (and each generated header's *.h.in) is listed once, and every listed
+# include/patchcull/<layer>/*.h, named with its layer folder (core/frustum.h), and each generated
+# header's *.h.in is listed once, and every listed
 # header exists. Prints what is missing, repeated or stale.
 #   cmake -DSOURCE_DIR=<repository root> -P readme_header_index.cmake
 cmake_minimum_required(VERSION 3.25)
 if(NOT DEFINED SOURCE_DIR)
   message(FATAL_ERROR "usage: cmake -DSOURCE_DIR=<repository root> -P readme_header_index.cmake")
 endif()
-file(GLOB headers RELATIVE "${SOURCE_DIR}/include/patchcull" "${SOURCE_DIR}/include/patchcull/*.h")
+file(GLOB_RECURSE headers RELATIVE "${SOURCE_DIR}/include/patchcull" "${SOURCE_DIR}/include/patchcull/*.h")
 file(GLOB templates RELATIVE "${SOURCE_DIR}/include/patchcull" "${SOURCE_DIR}/include/patchcull/*.h.in")
 foreach(template IN LISTS templates)
   string(REGEX REPLACE "\\.in$" "" generated "${template}")
@@ -18,10 +19,10 @@ if(NOT headers)
 endif()
 
 # The index's rows: table lines whose first cell is one backquoted header name.
-file(STRINGS "${SOURCE_DIR}/README.md" rows REGEX "^\\| `[A-Za-z0-9_]+\\.h` \\|")
+file(STRINGS "${SOURCE_DIR}/README.md" rows REGEX "^\\| `[A-Za-z0-9_/]+\\.h` \\|")
 set(listed "")
 foreach(row IN LISTS rows)
-  string(REGEX MATCH "^\\| `([A-Za-z0-9_]+\\.h)` \\|" _ "${row}")
+  string(REGEX MATCH "^\\| `([A-Za-z0-9_/]+\\.h)` \\|" _ "${row}")
   list(APPEND listed "${CMAKE_MATCH_1}")
 endforeach()
 

@@ -13,7 +13,7 @@
 #include <system_error>
 
 #include "commands.h"
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull::cli {
 namespace {

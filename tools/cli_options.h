@@ -11,7 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "patchcull/clip_space.h"
+#include "patchcull/core/clip_space.h"
 
 #include <cstdint>
 #include <string>

@@ -11,9 +11,9 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "patchcull/cull_eval.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
+#include "patchcull/eval/cull_eval.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
 #include "progress.h"
 
 namespace patchcull::cli {

@@ -25,8 +25,8 @@
 #include "eval_fused.h"
 #include "eval_scene.h"
 #include "eval_temporal.h"
-#include "patchcull/error.h"
-#include "patchcull/gl_backpatch.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_backpatch.h"
 #include "progress.h"
 #include "render_support.h"
 

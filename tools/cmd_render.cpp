@@ -68,10 +68,10 @@
 #include "commands.h"
 #include "cull_auto.h"
 #include "object_level_options.h"
-#include "patchcull/default_scene.h"
-#include "patchcull/error.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/core/error.h"
 #include "render_dumps.h"
-#include "patchcull/scene_file.h"
+#include "patchcull/import/scene_file.h"
 #include "render_support.h"
 
 namespace patchcull::cli {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/displacement.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/displacement.h"
+#include "patchcull/import/scene.h"
 
 namespace patchcull::cli {
 

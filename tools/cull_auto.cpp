@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull::cli {
 namespace {

@@ -70,9 +70,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/math.h"
-#include "patchcull/patch.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/core/math.h"
+#include "patchcull/core/patch.h"
 
 namespace patchcull::cli {
 

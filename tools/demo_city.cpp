@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "object_level_options.h"
-#include "patchcull/default_scene.h"
-#include "patchcull/gl_pipeline.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/gl/gl_pipeline.h"
 #include "progress.h"
 #include "render_support.h"
 

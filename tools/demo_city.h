@@ -5,7 +5,7 @@
 
 #include <cstddef>
 
-#include "patchcull/gl_renderer.h"
+#include "patchcull/gl/gl_renderer.h"
 
 namespace patchcull::cli {
 

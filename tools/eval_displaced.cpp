@@ -1,6 +1,6 @@
 // `patchcull eval displaced MODEL [--split N] [--views N] [--displace FILE.png|procedural]
 // [--displace-scale X] --json`: Niessner & Loop's Table 1 (§4.2, §6.2): cull rates of the six bounds of a
-// displaced patch, {oobb, caf} x {full, acon, con} (patchcull/displaced_bounds.h), by the frustum
+// displaced patch, {oobb, caf} x {full, acon, con} (patchcull/core/displaced_bounds.h), by the frustum
 // and by occlusion inside the object, over views that contain the whole object.
 //
 // Per view (camera.h, contain mode): the displaced model is rendered unculled (GPU, the renderer's
@@ -30,8 +30,8 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/error.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/error.h"
 #include "eval_temporal.h"
 #include "progress.h"
 #include "render_support.h"

@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "patchcull/scene_occlusion.h"
+#include "patchcull/import/scene_occlusion.h"
 
 namespace patchcull::cli {
 

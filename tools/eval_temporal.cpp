@@ -41,8 +41,8 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "patchcull/default_scene.h"
-#include "patchcull/error.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/core/error.h"
 #include "progress.h"
 #include "render_support.h"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/gl_pipeline.h"
+#include "patchcull/gl/gl_pipeline.h"
 
 namespace patchcull::cli {
 

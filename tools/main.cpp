@@ -8,7 +8,7 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 #include "patchcull/version.h"
 
 int main(int argc, char** argv) {

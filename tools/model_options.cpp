@@ -4,8 +4,8 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "patchcull/error.h"
-#include "patchcull/image.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/image.h"
 
 namespace patchcull::cli {
 

@@ -9,7 +9,7 @@
 
 #include "cli_options.h"
 #include "render_support.h"
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull::cli {
 

@@ -12,10 +12,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "patchcull/gl_object_queries.h"
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/scene_occlusion.h"
-#include "patchcull/scene_object_level.h"
+#include "patchcull/gl/gl_object_queries.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/import/scene_occlusion.h"
+#include "patchcull/import/scene_object_level.h"
 
 namespace CLI {
 class App;

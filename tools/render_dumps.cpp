@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "patchcull/clip_space.h"
-#include "patchcull/error.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull::cli {
 namespace {

@@ -27,10 +27,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/hiz.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/patch.h"
 
 namespace patchcull::cli {
 

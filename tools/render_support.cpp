@@ -1,7 +1,7 @@
 // Helpers shared by the CLI's GPU commands (render_support.h).
 #include "render_support.h"
 
-#include "patchcull/scene_file.h"
+#include "patchcull/import/scene_file.h"
 
 #include <algorithm>
 #include <chrono>
@@ -12,8 +12,8 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "patchcull/error.h"
-#include "patchcull/image.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/image.h"
 
 namespace patchcull::cli {
 

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/camera.h"
-#include "patchcull/default_scene.h"
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/gl_posing.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/gl/gl_posing.h"
 
 namespace CLI {
 class App;

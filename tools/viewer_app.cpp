@@ -13,7 +13,7 @@
 
 #include "commands.h"
 #include "cull_auto.h"
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 #include "viewer_camera.h"
 #include "viewer_controls.h"
 #include "viewer_panel.h"

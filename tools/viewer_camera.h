@@ -3,7 +3,7 @@
 // pixels of mouse motion and seconds of key holding, so that a --script replays exactly. No GL.
 #pragma once
 
-#include "patchcull/camera.h"
+#include "patchcull/core/camera.h"
 
 namespace patchcull::cli {
 

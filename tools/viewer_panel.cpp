@@ -7,7 +7,7 @@
 
 #include <cstdio>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull::cli {
 namespace {

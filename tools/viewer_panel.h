@@ -6,8 +6,8 @@
 
 #include <string>
 
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/object_culling.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/objects/object_culling.h"
 #include "viewer_settings.h"
 
 struct GLFWwindow;

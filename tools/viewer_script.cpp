@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull::cli {
 namespace {

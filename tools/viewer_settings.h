@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/gl_passes.h"
-#include "patchcull/gl_renderer.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/gl/gl_passes.h"
+#include "patchcull/gl/gl_renderer.h"
 
 namespace patchcull::cli {
 

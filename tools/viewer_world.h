@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "object_level_options.h"
-#include "patchcull/default_scene.h"
-#include "patchcull/gl_pipeline.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/gl/gl_pipeline.h"
 #include "viewer_settings.h"
 
 namespace patchcull::cli {

@@ -1,4 +1,4 @@
-// Back-patch cull kernels tcone and ncone, scalar reference (patchcull/backpatch.h). Per patch:
+// Back-patch cull kernels tcone and ncone, scalar reference (patchcull/core/backpatch.h). Per patch:
 // rational (any w != 1) -> not culled; else the cone (TCONE: Sederberg & Meyers from the tangent
 // and bitangent control vectors; NCONE: the 36 control vectors of the normal patch), the
 // control-point sphere and the perspective back-facing test, all from cones_internal.h (formulas
@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "core/cones_internal.h"
-#include "patchcull/backpatch.h"
+#include "patchcull/core/backpatch.h"
 
 // std::fma is a libm call on the x86-64 baseline: as in frustum.cpp, an FMA clone of each scalar
 // kernel is compiled and picked once at load time (results are identical, fma is exactly rounded

@@ -1,4 +1,4 @@
-// Back-patch cull kernels tcone and ncone, SIMD (patchcull/backpatch.h), written once over
+// Back-patch cull kernels tcone and ncone, SIMD (patchcull/core/backpatch.h), written once over
 // Highway vectors and compiled for every x86 target Highway attains; the best one the CPU supports
 // is chosen once, at the first call (HWY_DYNAMIC_DISPATCH), as in frustum_simd.cpp.
 //
@@ -19,7 +19,7 @@
 #include <limits>
 
 #include "core/cones_internal.h"
-#include "patchcull/backpatch.h"
+#include "patchcull/core/backpatch.h"
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "core/backpatch_cones_simd.cpp"

@@ -1,7 +1,7 @@
-// Perspective cameras and seeded random views (patchcull/camera.h).
+// Perspective cameras and seeded random views (patchcull/core/camera.h).
 // contain mode follows Niessner & Loop §6.2 / Loop, Niessner & Eisenacher §7:
 // views that contain the whole object.
-#include "patchcull/camera.h"
+#include "patchcull/core/camera.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,10 +1,10 @@
-// Clip-depth conventions (patchcull/clip_space.h).
-#include "patchcull/clip_space.h"
+// Clip-depth conventions (patchcull/core/clip_space.h).
+#include "patchcull/core/clip_space.h"
 
 #include <cmath>
 #include <string>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull {
 

@@ -1,5 +1,5 @@
 // Cones of normals, the control-point sphere and the perspective back-facing test
-// (patchcull/cones.h). The formulas live in cones_internal.h (shared with the scalar kernels of
+// (patchcull/core/cones.h). The formulas live in cones_internal.h (shared with the scalar kernels of
 // backpatch_cones.cpp and mirrored by backpatch_cones_simd.cpp); this file holds the public entry
 // points and the derivations.
 //
@@ -95,7 +95,7 @@
 //   a . d <= -|d| (sin(alpha + beta) + kFacingSlack), kFacingSlack = 1e-5. NaN anywhere -> no cull
 //   (every comparison is written to fail on NaN).
 #include "core/cones_internal.h"
-#include "patchcull/cones.h"
+#include "patchcull/core/cones.h"
 
 namespace patchcull {
 

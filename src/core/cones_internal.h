@@ -1,5 +1,5 @@
 // Internal: the scalar reference of the cone constructions and of the back-facing test
-// (patchcull/cones.h, patchcull/backpatch.h). One copy of every formula, inlined into the public
+// (patchcull/core/cones.h, patchcull/core/backpatch.h). One copy of every formula, inlined into the public
 // functions (cones.cpp) and into the scalar kernels (backpatch_cones.cpp); the SIMD kernels
 // (backpatch_cones_simd.cpp) repeat it operation by operation. The derivations and the error
 // analysis that sets the constants below are in cones.cpp.
@@ -13,7 +13,7 @@
 #include <cmath>
 #include <limits>
 
-#include "patchcull/cones.h"
+#include "patchcull/core/cones.h"
 
 #if defined(__GNUC__)
 #define PATCHCULL_CONES_INLINE inline __attribute__((always_inline))

@@ -1,5 +1,5 @@
 // Bounds of displaced bicubic patches and their frustum / Hi-Z occlusion tests
-// (patchcull/displaced_bounds.h, where the conventions and every formula are written out).
+// (patchcull/core/displaced_bounds.h, where the conventions and every formula are written out).
 //
 // Sources:
 // - Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation" §4.2:
@@ -23,7 +23,7 @@
 // d_min * delta+ <= -d_min * delta- (because delta- >= -delta+), so the max of r.(D n) is
 // max(d_max delta+, -d_min delta-) and the min is -max(d_max delta-, -d_min delta+): the seed's
 // P_max / P_min.
-#include "patchcull/displaced_bounds.h"
+#include "patchcull/core/displaced_bounds.h"
 
 #include <cmath>
 #include <limits>

@@ -1,12 +1,12 @@
 // Displacement sampling and Sathe's per-patch maximum-displacement pre-processing step
-// (patchcull/displacement.h; Sathe, "View Frustum Culling of Catmull-Clark Patches in
+// (patchcull/core/displacement.h; Sathe, "View Frustum Culling of Catmull-Clark Patches in
 // DirectX 11", pre-processing step; the [D_min, D_max] of Niessner & Loop, "Patch-Based Occlusion
 // Culling for Hardware Tessellation", §4.2).
 //
 // Why a pyramid: the exact range scans every texel of a patch's footprint, and a face whose
 // texcoords span a 4096^2 map costs 16M reads per patch (56 s for BigGuy, docs/PERFORMANCE.md). A min/max
 // pyramid of blocks makes every query a bounded number of reads, built once per map.
-#include "patchcull/displacement.h"
+#include "patchcull/core/displacement.h"
 
 #include <algorithm>
 #include <cmath>

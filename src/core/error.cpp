@@ -1,5 +1,5 @@
-// Escaping of untrusted text in error messages (patchcull/error.h).
-#include "patchcull/error.h"
+// Escaping of untrusted text in error messages (patchcull/core/error.h).
+#include "patchcull/core/error.h"
 
 #include <cstdint>
 

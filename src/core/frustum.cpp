@@ -1,5 +1,5 @@
 // View-frustum cull kernels: plane extraction and the scalar reference kernels
-// (patchcull/frustum.h). The SIMD kernels live in frustum_simd.cpp.
+// (patchcull/core/frustum.h). The SIMD kernels live in frustum_simd.cpp.
 //
 // Bit-exact agreement with the SIMD kernels (tests/core/frustum_test.cpp) rests on three rules
 // that both files follow operation by operation:
@@ -10,7 +10,7 @@
 //   (Highway Min/Max) return for every input, signed zeros included;
 // - the same order of accumulation (points 0..15, planes 0..5, corners in the same order).
 // Decisions only look at the sign of the final values (< 0), so they are identical.
-#include "patchcull/frustum.h"
+#include "patchcull/core/frustum.h"
 
 #include <cmath>
 #include <limits>

@@ -2,7 +2,7 @@
 // kernel (frustum_simd.cpp) and the fused kernel (fused_cull_simd.cpp); private to patchcull.
 //
 // Lanes are patches (simd_groups-inl.h). Every operation mirrors frustum_plane_values /
-// add_frustum_margins (include/patchcull/frustum.h) operation by operation: Fma <-> std::fma (exact
+// add_frustum_margins (include/patchcull/core/frustum.h) operation by operation: Fma <-> std::fma (exact
 // on every target), Add/Sub/Mul <-> the rounded float operations, Max <-> `a > b ? a : b`. So the
 // decisions equal cull_frustum_scalar's bit for bit (tests/core/frustum_test.cpp).
 //
@@ -19,7 +19,7 @@
 
 #include <hwy/highway.h>
 
-#include "patchcull/frustum.h"
+#include "patchcull/core/frustum.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace patchcull {

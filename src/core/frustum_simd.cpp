@@ -1,4 +1,4 @@
-// View-frustum cull kernels, SIMD (patchcull/frustum.h), written once over Highway vectors and
+// View-frustum cull kernels, SIMD (patchcull/core/frustum.h), written once over Highway vectors and
 // compiled for every x86 target Highway attains (SSSE3, SSE4, AVX2, AVX3 + the baseline); the best
 // one the CPU supports is chosen once, at the first call (HWY_DYNAMIC_DISPATCH).
 //
@@ -14,7 +14,7 @@
 #include <cstring>
 #include <limits>
 
-#include "patchcull/frustum.h"
+#include "patchcull/core/frustum.h"
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "core/frustum_simd.cpp"

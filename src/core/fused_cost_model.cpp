@@ -1,5 +1,5 @@
-// The fused kernel's cost model (patchcull/fused_cost_model.h).
-#include "patchcull/fused_cost_model.h"
+// The fused kernel's cost model (patchcull/core/fused_cost_model.h).
+#include "patchcull/core/fused_cost_model.h"
 
 #include <algorithm>
 

@@ -1,11 +1,11 @@
-// The fused cull kernel's plans, setup and scalar reference (patchcull/fused_cull.h). The SIMD
+// The fused cull kernel's plans, setup and scalar reference (patchcull/core/fused_cull.h). The SIMD
 // kernel lives in fused_cull_simd.cpp.
 //
 // The scalar reference is deliberately made of the separate kernels' own per-patch code
 // (frustum_plane_values, the cone kernels on a one-patch batch, patch_screen_bounds and
 // hiz_rect_max), so "each stage's verdict equals the separate kernel's" holds by construction here,
 // and the SIMD kernel is tested against this reference.
-#include "patchcull/fused_cull.h"
+#include "patchcull/core/fused_cull.h"
 
 #include <algorithm>
 #include <limits>

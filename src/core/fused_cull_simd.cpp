@@ -1,4 +1,4 @@
-// The fused cull kernel, SIMD (patchcull/fused_cull.h), written once over Highway vectors and
+// The fused cull kernel, SIMD (patchcull/core/fused_cull.h), written once over Highway vectors and
 // compiled for every x86 target Highway attains; the best one is chosen once, at the first call.
 // Also cull_occlusion_simd (hiz.h), which is this kernel with the plan {frustum, occlusion}.
 //
@@ -28,7 +28,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "patchcull/fused_cull.h"
+#include "patchcull/core/fused_cull.h"
 
 #if defined(__x86_64__) || defined(_M_X64)
 #include <x86intrin.h>

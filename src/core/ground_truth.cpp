@@ -1,11 +1,11 @@
-// Dense-sample ground truth for cull tests (patchcull/ground_truth.h).
-#include "patchcull/ground_truth.h"
+// Dense-sample ground truth for cull tests (patchcull/core/ground_truth.h).
+#include "patchcull/core/ground_truth.h"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull {
 

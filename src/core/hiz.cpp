@@ -1,20 +1,20 @@
-// Hi-Z pyramid and the scalar occlusion test (patchcull/hiz.h; steps numbered as there).
+// Hi-Z pyramid and the scalar occlusion test (patchcull/core/hiz.h; steps numbered as there).
 // The SIMD kernel (hiz_simd.cpp) mirrors steps 2-6 of patch_bounds() below operation by operation:
 // std::fma <-> MulAdd, `a < b ? a : b` / `a > b ? a : b` <-> Min/Max (x86 minps/maxps), IEEE
 // division, floor; the build is ISO C++ (no -ffast-math, no contraction of a*b+c).
-#include "patchcull/hiz.h"
+#include "patchcull/core/hiz.h"
 
 #include <limits>
 #include <string>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 #include <algorithm>
 #include <bit>
 #include <cassert>
 #include <cmath>
 
-#include "patchcull/frustum.h"
+#include "patchcull/core/frustum.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__SANITIZE_ADDRESS__)
 #define PATCHCULL_HIZ_CLONES __attribute__((target_clones("fma", "default")))

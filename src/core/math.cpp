@@ -1,5 +1,5 @@
-// Matrix helpers for patchcull/math.h (OpenGL column-major, depth in [0,1]).
-#include "patchcull/math.h"
+// Matrix helpers for patchcull/core/math.h (OpenGL column-major, depth in [0,1]).
+#include "patchcull/core/math.h"
 
 namespace patchcull {
 

@@ -1,5 +1,5 @@
-// Control-mesh helpers (patchcull/mesh.h).
-#include "patchcull/mesh.h"
+// Control-mesh helpers (patchcull/core/mesh.h).
+#include "patchcull/core/mesh.h"
 
 #include <algorithm>
 #include <array>

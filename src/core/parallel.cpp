@@ -1,5 +1,5 @@
-// Multi-core range splitting over oneTBB (patchcull/parallel.h).
-#include "patchcull/parallel.h"
+// Multi-core range splitting over oneTBB (patchcull/core/parallel.h).
+#include "patchcull/core/parallel.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>

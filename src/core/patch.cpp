@@ -1,10 +1,10 @@
-// Bezier patch evaluation, de Casteljau split, plain (SoA) and blocked batches (patchcull/patch.h).
-#include "patchcull/patch.h"
+// Bezier patch evaluation, de Casteljau split, plain (SoA) and blocked batches (patchcull/core/patch.h).
+#include "patchcull/core/patch.h"
 
 #include <cstdio>
 #include <string>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 #include <algorithm>
 #include <atomic>

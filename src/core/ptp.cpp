@@ -1,4 +1,4 @@
-// Parametric tangent plane (ptp) back-patch cull kernel, scalar reference (patchcull/backpatch.h,
+// Parametric tangent plane (ptp) back-patch cull kernel, scalar reference (patchcull/core/backpatch.h,
 // Loop, Niessner & Eisenacher §3-6). The SIMD kernel (ptp_simd.cpp) does the same operations in
 // the same order; the schedule both follow, and the FLOP count before/after sharing minors, is in
 // ptp_schedule.h.
@@ -40,7 +40,7 @@
 
 #include "core/ptp_internal.h"
 #include "core/ptp_schedule.h"
-#include "patchcull/backpatch.h"
+#include "patchcull/core/backpatch.h"
 
 // As in frustum.cpp: a clone with FMA enabled so std::fma is one instruction (identical results).
 #include "core/scalar_clones.h"

@@ -1,8 +1,8 @@
 // Shared by the ptp kernels (ptp.cpp, ptp_simd.cpp); private to patchcull.
 #pragma once
 
-#include "patchcull/math.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/math.h"
+#include "patchcull/core/patch.h"
 
 namespace patchcull::ptp_detail {
 

@@ -1,4 +1,4 @@
-// Parametric tangent plane (ptp) back-patch cull kernel, SIMD (patchcull/backpatch.h), written
+// Parametric tangent plane (ptp) back-patch cull kernel, SIMD (patchcull/core/backpatch.h), written
 // once over Highway vectors and compiled for every x86 target Highway attains; the best one the
 // CPU supports is chosen once, at the first call (HWY_DYNAMIC_DISPATCH). Same structure as
 // frustum_simd.cpp.
@@ -22,7 +22,7 @@
 
 #include "core/ptp_internal.h"
 #include "core/ptp_schedule.h"
-#include "patchcull/backpatch.h"
+#include "patchcull/core/backpatch.h"
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "core/ptp_simd.cpp"

@@ -36,7 +36,7 @@
 #include <hwy/cache_control.h>
 #include <hwy/highway.h>
 
-#include "patchcull/patch.h"
+#include "patchcull/core/patch.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace patchcull {

@@ -1,4 +1,4 @@
-// The built-in Utah teapot (patchcull/teapot.h).
+// The built-in Utah teapot (patchcull/core/teapot.h).
 //
 // Data: Martin Newell's teapot (University of Utah, 1975), public domain: 32 bicubic Bezier
 // patches over 306 control points, z up, as circulated in the classic "teapot" data set
@@ -28,7 +28,7 @@
 // edge, out from the bottom's centre); on handle and spout u goes around the tube and v along it.
 // The teapot is not a closed solid: handle and spout pass through the body, and the lid sits
 // loose inside the rim.
-#include "patchcull/teapot.h"
+#include "patchcull/core/teapot.h"
 
 #include <cstdint>
 

@@ -1,9 +1,9 @@
-// Cull-method evaluation over random views with dense-sample ground truth (patchcull/cull_eval.h).
+// Cull-method evaluation over random views with dense-sample ground truth (patchcull/eval/cull_eval.h).
 // The methods run as an engine would run them: SIMD kernels over all cores, per view. The truth
 // is streamed: views go in blocks, and each block is judged chunk by chunk of patches
 // with the chunk's samples made in per-thread scratch and dropped, so memory does not grow with
 // the patch count beyond the batch and a byte per patch.
-#include "patchcull/cull_eval.h"
+#include "patchcull/eval/cull_eval.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,12 +11,12 @@
 #include <functional>
 #include <string>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/parallel.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/core/parallel.h"
+#include "patchcull/import/scene.h"
 
 #include <tbb/enumerable_thread_specific.h>
 

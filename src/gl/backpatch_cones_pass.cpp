@@ -1,4 +1,4 @@
-// BackpatchConePass (patchcull/gl_passes.h): cull_tcone_scalar and cull_ncone_scalar on the GPU,
+// BackpatchConePass (patchcull/gl/gl_passes.h): cull_tcone_scalar and cull_ncone_scalar on the GPU,
 // shaders/backpatch_cones.comp.glsl (ncone compiled with PATCHCULL_NCONE).
 #include "backpatch_shared.h"
 #include "pass_common.h"
@@ -30,7 +30,7 @@ void BackpatchConePass::run(const PatchBuffers& patches, BackpatchMethod method,
     const bool ncone = method == BackpatchMethod::ncone;
     glUseProgram(impl_->context.program("backpatch_cones.comp.glsl", ncone ? "#define PATCHCULL_NCONE 1\n" : ""));
     detail::bind_patch_buffers(patches);
-    if (cone_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, backpatch_shared::kBindingConeValues, cone_values);
+    if (cone_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingConeValues, cone_values);
     detail::dispatch_patches(impl_->block, params, patches.first, patches.count, backpatch_shared::kConeGroupSize);
     detail::finish_pass("BackpatchConePass");
 }

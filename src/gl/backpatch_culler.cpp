@@ -1,4 +1,4 @@
-// BackpatchCuller (patchcull/gl_backpatch.h): the back-patch passes of gl_passes.h
+// BackpatchCuller (patchcull/gl/gl_backpatch.h): the back-patch passes of gl_passes.h
 // (BackpatchConePass, BackpatchPtpPass) over buffers the culler owns, with read-backs.
 #include <epoxy/gl.h>
 
@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "backpatch_shared.h"
-#include "patchcull/error.h"
-#include "patchcull/gl_backpatch.h"
-#include "patchcull/gl_passes.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_backpatch.h"
+#include "patchcull/gl/gl_passes.h"
 #include "renderer_internal.h"
 #include "shader_sources.h"
 #include "shared.h"

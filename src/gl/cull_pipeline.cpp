@@ -1,4 +1,4 @@
-// CullPipeline (patchcull/gl_pipeline.h): Niessner & Loop §3's two-pass frame, the passes of
+// CullPipeline (patchcull/gl/gl_pipeline.h): Niessner & Loop §3's two-pass frame, the passes of
 // gl_passes.h chained through the renderer's flag buffer.
 #include <epoxy/gl.h>
 
@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/gl_pipeline.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_pipeline.h"
 #include "renderer_internal.h"
 
 namespace patchcull::gl {

@@ -1,4 +1,4 @@
-// CullStatusPass (patchcull/gl_passes.h): the two ends of the flag chain,
+// CullStatusPass (patchcull/gl/gl_passes.h): the two ends of the flag chain,
 // shaders/cull_status.comp.glsl.
 #include "pass_common.h"
 

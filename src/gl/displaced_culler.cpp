@@ -1,8 +1,8 @@
-// DisplacedCuller (patchcull/gl_displaced.h): GPU frustum and Hi-Z occlusion culling of displaced
+// DisplacedCuller (patchcull/gl/gl_displaced.h): GPU frustum and Hi-Z occlusion culling of displaced
 // patches with the bounds of Niessner & Loop §4.2 ("Patch-Based Occlusion Culling for
 // Hardware Tessellation": the camera-aligned frustum, CAF, with the Full / ACoN / CoN displacement
 // extensions) and Munkberg et al.'s object-oriented box (OOBB), the GPU twin of
-// src/core/displaced_bounds.cpp (include/patchcull/displaced_bounds.h defines every step).
+// src/core/displaced_bounds.cpp (include/patchcull/core/displaced_bounds.h defines every step).
 // DisplacedPass (gl_passes.h) over buffers and a Hi-Z texture that the culler owns, with read-backs.
 #include <epoxy/gl.h>
 
@@ -12,10 +12,10 @@
 #include <vector>
 
 #include "displaced_shared.h"
-#include "patchcull/error.h"
-#include "patchcull/gl_backpatch.h"
-#include "patchcull/gl_displaced.h"
-#include "patchcull/gl_passes.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_backpatch.h"
+#include "patchcull/gl/gl_displaced.h"
+#include "patchcull/gl/gl_passes.h"
 #include "renderer_internal.h"
 #include "shader_sources.h"
 #include "shared.h"

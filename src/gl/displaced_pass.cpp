@@ -1,4 +1,4 @@
-// DisplacedPass (patchcull/gl_passes.h): the bounds of displaced patches (Niessner & Loop §4.2: caf,
+// DisplacedPass (patchcull/gl/gl_passes.h): the bounds of displaced patches (Niessner & Loop §4.2: caf,
 // Munkberg et al.'s oobb; cones full, acon, con) and their frustum and Hi-Z decisions on the GPU,
 // shaders/displaced.comp.glsl (one program per cone kind).
 #include "displaced_shared.h"
@@ -78,8 +78,8 @@ void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, Displ
     const std::string defines = "#define PC_DISPLACED_CONE " + std::to_string(static_cast<int>(cone)) + "\n";
     glUseProgram(m.context.program("displaced.comp.glsl", defines));
     detail::bind_patch_buffers(patches);
-    if (ranges) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ds::kBindingDisplacementRanges, ranges);
-    if (bounds) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, ds::kBindingDisplacedBounds, bounds);
+    if (ranges) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDisplacementRanges, ranges);
+    if (bounds) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDisplacedBounds, bounds);
     glBindTextureUnit(shared::kTextureUnitHiZ, hiz ? hiz->texture : m.placeholder_hiz);
     detail::dispatch_patches(m.block, params, patches.first, patches.count, ds::kDisplacedGroupSize);
     detail::finish_pass("DisplacedPass");

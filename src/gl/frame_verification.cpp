@@ -1,15 +1,15 @@
 // PatchRenderer's status image (Niessner & Loop, Fig. 2's statuses), the comparison of a culled frame
 // with its unculled reference (compare_frames) and the cull-mode and timing names
-// (patchcull/gl_renderer.h).
+// (patchcull/gl/gl_renderer.h).
 #include <epoxy/gl.h>
 
 #include <cstring>
 #include <string>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/gl_renderer.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/gl/gl_renderer.h"
 #include "renderer_internal.h"
 
 namespace patchcull::gl {

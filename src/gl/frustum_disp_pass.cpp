@@ -1,4 +1,4 @@
-// FrustumDispPass (patchcull/gl_passes.h): cull_frustum_disp_scalar (Sathe's displaced AABB) on the
+// FrustumDispPass (patchcull/gl/gl_passes.h): cull_frustum_disp_scalar (Sathe's displaced AABB) on the
 // GPU, shaders/frustum_disp.comp.glsl.
 #include "pass_common.h"
 

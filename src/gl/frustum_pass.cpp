@@ -1,4 +1,4 @@
-// FrustumPass (patchcull/gl_passes.h): cull_frustum_scalar on the GPU, shaders/frustum.comp.glsl.
+// FrustumPass (patchcull/gl/gl_passes.h): cull_frustum_scalar on the GPU, shaders/frustum.comp.glsl.
 #include "pass_common.h"
 
 namespace patchcull::gl {

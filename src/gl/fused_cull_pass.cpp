@@ -1,4 +1,4 @@
-// FusedCullPass (patchcull/gl_passes.h): the frustum, cone back-patch and Hi-Z tests in one
+// FusedCullPass (patchcull/gl/gl_passes.h): the frustum, cone back-patch and Hi-Z tests in one
 // dispatch, shaders/fused_cull.comp.glsl (ncone compiled with PATCHCULL_NCONE).
 #include "pass_common.h"
 

@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/patch.h"
 #include "shader_sources.h"
 
 namespace patchcull::gl {

@@ -1,4 +1,4 @@
-// HiZBuildPass (patchcull/gl_passes.h): Niessner & Loop §4.1's pyramid, shaders/hiz_build.comp.glsl,
+// HiZBuildPass (patchcull/gl/gl_passes.h): Niessner & Loop §4.1's pyramid, shaders/hiz_build.comp.glsl,
 // one dispatch per level.
 #include "pass_common.h"
 

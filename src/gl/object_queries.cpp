@@ -1,4 +1,4 @@
-// ObjectQueries (patchcull/gl_object_queries.h): hardware occlusion queries, stop-and-wait,
+// ObjectQueries (patchcull/gl/gl_object_queries.h): hardware occlusion queries, stop-and-wait,
 // batched, CHC and CHC++, as a CullPipeline ObjectPass.
 //
 // The tree of CHC: the ObjectBvh's nodes 0 .. N-1, then the objects N .. N+n-1 as leaves (a BVH
@@ -19,11 +19,11 @@
 
 #include "gl_util.h"
 #include "shared.h"
-#include "patchcull/bounding_volumes.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
-#include "patchcull/gl_object_queries.h"
-#include "patchcull/object_bvh.h"
+#include "patchcull/objects/bounding_volumes.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/gl/gl_object_queries.h"
+#include "patchcull/objects/object_bvh.h"
 
 namespace patchcull::gl {
 

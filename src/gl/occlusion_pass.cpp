@@ -1,4 +1,4 @@
-// OcclusionPass (patchcull/gl_passes.h): cull_occlusion_scalar on the GPU against a Hi-Z
+// OcclusionPass (patchcull/gl/gl_passes.h): cull_occlusion_scalar on the GPU against a Hi-Z
 // pyramid, shaders/occlusion.comp.glsl.
 #include "pass_common.h"
 

@@ -1,4 +1,4 @@
-// PassContext and the helpers of the cull passes (src/gl/pass_common.h, patchcull/gl_passes.h).
+// PassContext and the helpers of the cull passes (src/gl/pass_common.h, patchcull/gl/gl_passes.h).
 #include "pass_common.h"
 
 #include <bit>
@@ -107,8 +107,8 @@ std::vector<float> PassContext::probe(BackpatchProbe op, const std::vector<Vec3>
     upload(m.probe_out, abc.size() * sizeof(float), nullptr);
     const GLuint program = m.program("backpatch_probe.comp.glsl");
     glUseProgram(program);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bs::kBindingProbeIn, m.probe_in);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, bs::kBindingProbeOut, m.probe_out);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingProbeIn, m.probe_in);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingProbeOut, m.probe_out);
     glUniform1ui(glGetUniformLocation(program, "u_count"), static_cast<GLuint>(abc.size()));
     GLuint mode = bs::kProbeFma;
     switch (op) {

@@ -1,4 +1,4 @@
-// What the cull passes (patchcull/gl_passes.h) share, not a public header: the PassContext's
+// What the cull passes (patchcull/gl/gl_passes.h) share, not a public header: the PassContext's
 // program cache and fma mode, the parameter-block upload, and the one rule for splitting a patch
 // range into dispatches.
 #pragma once
@@ -11,7 +11,7 @@
 
 #include "gl_util.h"
 #include "pass_params.h"
-#include "patchcull/gl_passes.h"
+#include "patchcull/gl/gl_passes.h"
 #include "shared.h"
 
 namespace patchcull::gl {

@@ -1,4 +1,4 @@
-// PatchRenderer (patchcull/gl_renderer.h): buffers, programs, the tessellated draw into an
+// PatchRenderer (patchcull/gl/gl_renderer.h): buffers, programs, the tessellated draw into an
 // off-screen framebuffer, triangle occluders, the status image and read-backs. GL 4.5 direct
 // state access. It draws only: the cull passes are gl_passes.h's, chained by CullPipeline
 // (cull_pipeline.cpp). The shared internals are in renderer_internal.h.
@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/gl_renderer.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_renderer.h"
 #include "renderer_internal.h"
 
 namespace patchcull::gl {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull::gl::detail {
 

@@ -1,4 +1,4 @@
-// Internals of PatchRenderer (patchcull/gl_renderer.h) shared by the renderer's sources:
+// Internals of PatchRenderer (patchcull/gl/gl_renderer.h) shared by the renderer's sources:
 // patch_renderer.cpp (buffers, programs, drawing, read-backs) and status_image.cpp (the status
 // image and frame comparison). Not a public header.
 #pragma once
@@ -15,9 +15,9 @@
 #include <utility>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/gl_renderer.h"
-#include "patchcull/hiz.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_renderer.h"
+#include "patchcull/core/hiz.h"
 #include "gl_util.h"
 #include "png_file.h"
 #include "shader_sources.h"

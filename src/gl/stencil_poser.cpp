@@ -1,4 +1,4 @@
-// StencilPoser (patchcull/gl_posing.h): stencil tables uploaded once, posed control meshes per
+// StencilPoser (patchcull/gl/gl_posing.h): stencil tables uploaded once, posed control meshes per
 // frame, shaders/pose_stencils.comp.glsl writing the renderer's control points and tangents.
 #include <epoxy/gl.h>
 
@@ -8,17 +8,20 @@
 #include <vector>
 
 #include "gl_util.h"
-#include "patchcull/error.h"
-#include "patchcull/gl_posing.h"
-#include "patchcull/gl_renderer.h"
+#include "shared.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_posing.h"
+#include "patchcull/gl/gl_renderer.h"
 
 namespace patchcull::gl {
 
 namespace {
 
-// Binding points of pose_stencils.comp.glsl.
-constexpr GLuint kOutPoints = 0, kOutTangents = 10, kVertices = 13, kInstances = 14, kPatchTable = 15,
-                 kOffsets = 16, kTerms = 17, kTangentTable = 18;
+// Binding points of pose_stencils.comp.glsl (shared.h).
+constexpr GLuint kOutPoints = shared::kBindingControlPoints, kOutTangents = shared::kBindingPatchTangents,
+                 kVertices = shared::kBindingPoseVertices, kInstances = shared::kBindingPoseInstances,
+                 kPatchTable = shared::kBindingPosePatchTable, kOffsets = shared::kBindingPoseOffsets,
+                 kTerms = shared::kBindingPoseTerms, kTangentTable = shared::kBindingPoseTangentTable;
 constexpr GLuint kGroupSize = 256;            // local_size_x of the shader
 constexpr std::uint64_t kPointRows = 16, kTangentRows = 24;  // invocations per patch, per tangent block
 

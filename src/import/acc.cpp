@@ -1,5 +1,5 @@
 // ACC: approximate Catmull-Clark surfaces with one bicubic Bezier patch per quad
-// (patchcull/subdivision.h, Scheme::acc).
+// (patchcull/import/subdivision.h, Scheme::acc).
 //
 // Source: C. Loop and S. Schaefer, "Approximating Catmull-Clark Subdivision Surfaces with Bicubic
 // Patches", ACM TOG 27(1), 2008, the scheme Sathe ("View Frustum Culling of
@@ -60,9 +60,9 @@
 
 #include "import/huge_pages.h"
 #include "import/quad_topology.h"
-#include "patchcull/error.h"
-#include "patchcull/parallel.h"
-#include "patchcull/subdivision.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/parallel.h"
+#include "patchcull/import/subdivision.h"
 
 namespace patchcull {
 

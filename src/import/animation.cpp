@@ -1,4 +1,4 @@
-// Procedural control-mesh animation (patchcull/animation.h).
+// Procedural control-mesh animation (patchcull/import/animation.h).
 //
 // Model. Let B be the rest bounds (compute_bounds), a the vertical axis (the axis of B's longest
 // extent; ties prefer z, then y, then x), h1 = (a+1)%3 and h2 = (a+2)%3 the horizontal axes,
@@ -26,7 +26,7 @@
 // A non-positive or non-finite period, or a non-finite time, leaves the mesh at rest; a point set
 // with zero extent along every axis is copied unchanged. out may be the same vector as rest.
 // Nothing is allocated beyond out.resize(rest.size()).
-#include "patchcull/animation.h"
+#include "patchcull/import/animation.h"
 
 #include <cmath>
 

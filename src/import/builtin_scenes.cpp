@@ -1,4 +1,4 @@
-// The built-in `city` and `building` scenes (patchcull/default_scene.h) and the lookup
+// The built-in `city` and `building` scenes (patchcull/import/default_scene.h) and the lookup
 // of built-in scenes by name.
 //
 // Both place BigGuys and MonsterFrogs by rejection sampling with std::mt19937 (whose output the
@@ -13,8 +13,8 @@
 #include <random>
 #include <string>
 
-#include "patchcull/default_scene.h"
-#include "patchcull/error.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/core/error.h"
 #include "scene_builder.h"
 
 namespace patchcull {

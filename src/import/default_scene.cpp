@@ -1,13 +1,13 @@
-// Scenes for the renderer (patchcull/default_scene.h): the built-in default scene in the spirit
+// Scenes for the renderer (patchcull/import/default_scene.h): the built-in default scene in the spirit
 // of Niessner & Loop, Fig. 1 (c) (animated characters among triangle occluders), and one-model scenes.
-#include "patchcull/default_scene.h"
+#include "patchcull/import/default_scene.h"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 #include "scene_builder.h"
 
 namespace patchcull {

@@ -1,9 +1,9 @@
-// PNG height maps through stb_image (patchcull/image.h). libstb ships the implementation.
+// PNG height maps through stb_image (patchcull/import/image.h). libstb ships the implementation.
 //
 // Only PNG is accepted (checked by its signature before stb_image sees the bytes): stb_image also
 // decodes JPEG, GIF, PSD, HDR, TGA and others, but a height map needs 8 or 16 bits of grey, and
 // every decoder not used is attack surface for a malformed file.
-#include "patchcull/image.h"
+#include "patchcull/import/image.h"
 
 #include <stb/stb_image.h>
 
@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 #include "input_file.h"
 
 namespace patchcull {

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <string>
 
-#include "patchcull/mesh.h"
+#include "patchcull/core/mesh.h"
 
 namespace patchcull::detail {
 

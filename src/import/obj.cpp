@@ -1,9 +1,9 @@
-// Strict Wavefront OBJ reader for subdivision control meshes (patchcull/obj.h).
+// Strict Wavefront OBJ reader for subdivision control meshes (patchcull/import/obj.h).
 //
 // Why not tinyobjloader: it reads malformed numbers ("abc") and "nan" as 0 and only warns on
 // out-of-range indices, i.e. it returns a silently wrong mesh. Control meshes need only v, vt, f
 // (and the "t" tags of OpenSubdiv's shape files), so a strict line-numbered reader is small.
-#include "patchcull/obj.h"
+#include "patchcull/import/obj.h"
 
 #include <algorithm>
 #include <charconv>
@@ -12,7 +12,7 @@
 #include <sstream>
 #include <string_view>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 #include "input_file.h"
 
 namespace patchcull {

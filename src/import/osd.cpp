@@ -1,5 +1,5 @@
 // The osd scheme: the Catmull-Clark limit surface through OpenSubdiv 3.5 Far, as bicubic Bezier
-// patches given by stencils over the control vertices (patchcull/subdivision.h).
+// patches given by stencils over the control vertices (patchcull/import/subdivision.h).
 //
 // Source: OpenSubdiv 3.5 Far (feature-adaptive refinement, PatchTableFactory with
 // ENDCAP_BSPLINE_BASIS, StencilTableFactory + AppendLocalPointStencilTable, PtexIndices), the
@@ -56,8 +56,8 @@
 #include <opensubdiv/far/topologyRefiner.h>
 
 #include "import/osd_topology.h"
-#include "patchcull/error.h"
-#include "patchcull/subdivision.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/subdivision.h"
 
 namespace patchcull {
 

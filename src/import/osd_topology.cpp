@@ -15,7 +15,7 @@
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include "import/mesh_messages.h"
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull::osd_detail {
 

@@ -21,7 +21,7 @@
 
 #include <opensubdiv/far/topologyRefiner.h>
 
-#include "patchcull/mesh.h"
+#include "patchcull/core/mesh.h"
 
 namespace patchcull::osd_detail {
 

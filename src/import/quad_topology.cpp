@@ -14,7 +14,7 @@
 #include <string>
 
 #include "import/mesh_messages.h"
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull::acc_detail {
 

@@ -16,7 +16,7 @@
 #include <span>
 #include <vector>
 
-#include "patchcull/mesh.h"
+#include "patchcull/core/mesh.h"
 
 namespace patchcull::acc_detail {
 

@@ -1,4 +1,4 @@
-// One uniform Catmull-Clark refinement through OpenSubdiv Far (patchcull/subdivision.h).
+// One uniform Catmull-Clark refinement through OpenSubdiv Far (patchcull/import/subdivision.h).
 //
 // Source: OpenSubdiv 3.5 Far: TopologyRefiner::RefineUniform(level 1), StencilTableFactory for
 // the level-1 vertex stencils over the control vertices, PrimvarRefiner::InterpolateFaceVarying
@@ -21,8 +21,8 @@
 #include <opensubdiv/far/topologyRefiner.h>
 
 #include "import/osd_topology.h"
-#include "patchcull/error.h"
-#include "patchcull/subdivision.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/subdivision.h"
 
 namespace patchcull {
 

@@ -1,5 +1,5 @@
-// Model loading by name for tools (patchcull/scene.h).
-#include "patchcull/scene.h"
+// Model loading by name for tools (patchcull/import/scene.h).
+#include "patchcull/import/scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "patchcull/error.h"
-#include "patchcull/obj.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/obj.h"
+#include "patchcull/core/teapot.h"
 
 namespace patchcull {
 namespace {

@@ -1,12 +1,12 @@
 // Building blocks of the scene builders (not a public header): the transforms that place models
-// and the environment objects they add (patchcull/default_scene.h), shared by the built-in scenes
+// and the environment objects they add (patchcull/import/default_scene.h), shared by the built-in scenes
 // (default_scene.cpp, builtin_scenes.cpp) and the scene file reader (scene_file.cpp).
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "patchcull/default_scene.h"
+#include "patchcull/import/default_scene.h"
 
 namespace patchcull::detail {
 

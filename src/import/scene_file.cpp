@@ -1,11 +1,11 @@
-// Scene files (patchcull/scene_file.h; the format: docs/SCENE_FORMAT.md).
+// Scene files (patchcull/import/scene_file.h; the format: docs/SCENE_FORMAT.md).
 //
 // The reader walks the parsed JSON with the JSON path of every value at hand, so each check can
 // name it. Objects are checked key by key against the keys their kind allows (unknown keys are
 // errors: a misspelt "displaced" must not silently leave an object undisplaced); duplicate keys,
 // which nlohmann-json would resolve silently (the last one wins), are caught while parsing by a
 // parser callback that keeps the path of the container being parsed.
-#include "patchcull/scene_file.h"
+#include "patchcull/import/scene_file.h"
 
 #include <algorithm>
 #include <cfloat>
@@ -22,9 +22,9 @@
 #include <nlohmann/json.hpp>
 
 #include "input_file.h"
-#include "patchcull/error.h"
-#include "patchcull/image.h"
-#include "patchcull/obj.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/image.h"
+#include "patchcull/import/obj.h"
 #include "scene_builder.h"
 
 namespace patchcull {

@@ -1,12 +1,12 @@
-// The object level of a Scene (patchcull/scene_object_level.h).
-#include "patchcull/scene_object_level.h"
+// The object level of a Scene (patchcull/import/scene_object_level.h).
+#include "patchcull/import/scene_object_level.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull {
 namespace {

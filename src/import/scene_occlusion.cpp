@@ -1,13 +1,13 @@
-// SceneOcclusion (patchcull/scene_occlusion.h): the occlusion horizon and cells and portals on a
+// SceneOcclusion (patchcull/import/scene_occlusion.h): the occlusion horizon and cells and portals on a
 // Scene's objects, after its object level.
-#include "patchcull/scene_occlusion.h"
+#include "patchcull/import/scene_occlusion.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "patchcull/bounding_volumes.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
+#include "patchcull/objects/bounding_volumes.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
 
 namespace patchcull {
 

@@ -1,12 +1,12 @@
-// Scheme dispatch, stencil tables and per-frame patch evaluation (patchcull/subdivision.h).
-#include "patchcull/subdivision.h"
+// Scheme dispatch, stencil tables and per-frame patch evaluation (patchcull/import/subdivision.h).
+#include "patchcull/import/subdivision.h"
 
 #include <algorithm>
 #include <string>
 
 #include "import/huge_pages.h"
-#include "patchcull/error.h"
-#include "patchcull/parallel.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/parallel.h"
 
 namespace patchcull {
 

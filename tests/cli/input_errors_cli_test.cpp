@@ -1,8 +1,8 @@
 // Bad input through the CLI: whatever bytes a model, an image or a path holds, the user sees one
-// printable line of bounded length and exit status 2 (tools/main.cpp, patchcull/error.h).
+// printable line of bounded length and exit status 2 (tools/main.cpp, patchcull/core/error.h).
 #include "cli_test_util.h"
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 using namespace patchcull::cli_test;
 

@@ -1,4 +1,4 @@
-// OpenSubdiv's own regression shapes (tests/data/opensubdiv, tags read by patchcull/obj.h) through
+// OpenSubdiv's own regression shapes (tests/data/opensubdiv, tags read by patchcull/import/obj.h) through
 // the CLI: they load with both schemes and the CPU cull check finds no false cull on them.
 #include <nlohmann/json.hpp>
 

@@ -1,4 +1,4 @@
-// The CLI on faces and vertices beyond the preprocessing limits (patchcull/subdivision.h): one
+// The CLI on faces and vertices beyond the preprocessing limits (patchcull/import/subdivision.h): one
 // line naming the file and the face or vertex (1-based, as in the OBJ), exit status 2, at once.
 // Before the limits `info` on a 10000-sided face exited 3 (std::bad_alloc) with acc and ran for
 // minutes with osd.
@@ -13,9 +13,19 @@ namespace {
 
 std::string ngon_obj(int n) {
     std::string s;
-    for (int k = 0; k < n; ++k) s += "v " + std::to_string(k % 7) + " " + std::to_string(k) + " 0\n";
+    // Appended piecewise: GCC 12's -Wrestrict misreads "literal" + std::string.
+    for (int k = 0; k < n; ++k) {
+        s += "v ";
+        s += std::to_string(k % 7);
+        s += ' ';
+        s += std::to_string(k);
+        s += " 0\n";
+    }
     s += "f";
-    for (int k = 1; k <= n; ++k) s += " " + std::to_string(k);
+    for (int k = 1; k <= n; ++k) {
+        s += ' ';
+        s += std::to_string(k);
+    }
     return s + "\n";
 }
 

@@ -1,4 +1,4 @@
-// Scene motion checked before rendering (check_scene_motion, patchcull/scene_file.h): `render`
+// Scene motion checked before rendering (check_scene_motion, patchcull/import/scene_file.h): `render`
 // of a scene whose object the time offset and velocity carry beyond the scene coordinate limit
 // is refused with one line naming the file, the JSON path and the frame, exit status 2, and
 // nothing rendered (no GL context is made: the check runs first). (The default names of one model

@@ -1,4 +1,4 @@
-// Clustered back-face culling (patchcull/backface_clusters.h; Johannsen & Carter 1998 as
+// Clustered back-face culling (patchcull/objects/backface_clusters.h; Johannsen & Carter 1998 as
 // G. Zachmann's lecture "Advanced Visibility Computations" presents it): the cluster test against
 // every member's exact dot product, the merge, the choice of c, the culling probability against
 // hand cases and Monte Carlo sampling, the merge criterion against the cost model, and the
@@ -15,9 +15,9 @@
 #include <cstdio>
 #include <vector>
 
-#include "patchcull/backface.h"
-#include "patchcull/backface_clusters.h"
-#include "patchcull/error.h"
+#include "patchcull/objects/backface.h"
+#include "patchcull/objects/backface_clusters.h"
+#include "patchcull/core/error.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// Back-face culling of triangles (patchcull/backface.h): the per-triangle test against exact
+// Back-face culling of triangles (patchcull/objects/backface.h): the per-triangle test against exact
 // integer arithmetic and double precision (scalar == SIMD bit for bit), and normal masks
 // (Zhang & Hoff 1997) against dense samples of the frustum and of the class cones.
 #include <gtest/gtest.h>
@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backface.h"
-#include "patchcull/clip_space.h"
-#include "patchcull/error.h"
-#include "patchcull/math.h"
+#include "patchcull/objects/backface.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/math.h"
 
 using namespace patchcull;
 

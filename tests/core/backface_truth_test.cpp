@@ -4,8 +4,8 @@
 
 #include <random>
 
-#include "patchcull/ground_truth.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/core/teapot.h"
 
 using namespace patchcull;
 

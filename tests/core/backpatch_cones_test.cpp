@@ -1,4 +1,4 @@
-// Back-patch cull kernels tcone and ncone (patchcull/backpatch.h): conservative against dense
+// Back-patch cull kernels tcone and ncone (patchcull/core/backpatch.h): conservative against dense
 // sampling of e . T = n . (e - p) in double precision (random patches, the teapot, eyes far away,
 // just outside the bounding sphere and close to the surface), identical decisions of the scalar
 // reference and every compiled SIMD target (random patches, rational ones, NaN, eyes placed on the
@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "core/cone_test_patches.h"
-#include "patchcull/backpatch.h"
-#include "patchcull/cones.h"
-#include "patchcull/frustum.h"  // simd_target_name
-#include "patchcull/ground_truth.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/cones.h"
+#include "patchcull/core/frustum.h"  // simd_target_name
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/core/teapot.h"
 
 using namespace patchcull;
 using namespace patchcull::cone_test;

@@ -1,4 +1,4 @@
-// The blocked patch layout (patchcull/patch.h: PatchBatchView::block_stride, PatchBlocks):
+// The blocked patch layout (patchcull/core/patch.h: PatchBatchView::block_stride, PatchBlocks):
 // at()/get()/set() round trips on both layouts and through subranges; and identical decisions of
 // every kernel that reads patches through at() or the SIMD groups (tcone, ncone, ptp with both
 // rules, scalar and every compiled SIMD target; the SIMD frustum kernels, which share
@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/frustum.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/patch.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// Bounding volumes and their frustum tests (patchcull/bounding_volumes.h), against ground truth:
+// Bounding volumes and their frustum tests (patchcull/objects/bounding_volumes.h), against ground truth:
 // points sampled inside each volume (in double, so they are points of the exact volume) are
 // tested against the clip volume of the float matrix in double. "outside" must never be reported
 // for a volume with such a point inside; "inside" only when every sampled point is inside. Random
@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/bounding_volumes.h"
-#include "patchcull/frustum.h"
-#include "patchcull/ground_truth.h"
+#include "patchcull/objects/bounding_volumes.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/ground_truth.h"
 
 using namespace patchcull;
 

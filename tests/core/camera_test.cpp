@@ -1,8 +1,8 @@
 // Cameras: projection conventions and the random view generators' guarantees.
 #include <gtest/gtest.h>
 
-#include "patchcull/camera.h"
-#include "patchcull/ground_truth.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/ground_truth.h"
 
 using namespace patchcull;
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "patchcull/patch.h"
+#include "patchcull/core/patch.h"
 
 namespace patchcull::cone_test {
 

@@ -1,4 +1,4 @@
-// Cones of normals (patchcull/cones.h): the normal patch's Bezier form against direct evaluation,
+// Cones of normals (patchcull/core/cones.h): the normal patch's Bezier form against direct evaluation,
 // the Sederberg-Meyers combination against random vectors in random cones, every sampled normal
 // inside the TCONE and NCONE cones, NCONE never wider than TCONE on average, the control-point
 // sphere, and the back-facing test on hand-built cases (including the alpha + beta <= 90deg guard).
@@ -12,8 +12,8 @@
 
 #include "core/cone_test_patches.h"
 #include "core/cones_internal.h"
-#include "patchcull/cones.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/cones.h"
+#include "patchcull/core/teapot.h"
 
 using namespace patchcull;
 using namespace patchcull::cone_test;

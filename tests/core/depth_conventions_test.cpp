@@ -12,15 +12,15 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/camera.h"
-#include "patchcull/clip_space.h"
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
-#include "patchcull/fused_cull.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/hiz.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/fused_cull.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/teapot.h"
 
 #include "core/test_patches.h"
 

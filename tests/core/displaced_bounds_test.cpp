@@ -1,4 +1,4 @@
-// Displaced-patch bounds (patchcull/displaced_bounds.h): hand-built values, names, NaN/inf and
+// Displaced-patch bounds (patchcull/core/displaced_bounds.h): hand-built values, names, NaN/inf and
 // unsupported views, batch == single, and ground truth: the displaced surface sampled densely
 // (33x33 (u,v), displacements d_min, 0, d_max and random values in between, along the true unit
 // normal, all in double precision) must lie inside every bound (caf and oobb x full, acon, con),
@@ -17,12 +17,12 @@
 #include <vector>
 
 #include "core/cone_test_patches.h"
-#include "patchcull/camera.h"
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/displacement.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/hiz.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/displacement.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/teapot.h"
 
 using namespace patchcull;
 using cone_test::kSanitizerDivisor;

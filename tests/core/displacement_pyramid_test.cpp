@@ -1,5 +1,5 @@
 // DisplacementMap::patch_range (the min/max pyramid) against patch_range_exact (the texel scan)
-// and dense bilinear samples (patchcull/displacement.h): always containing, equal on small
+// and dense bilinear samples (patchcull/core/displacement.h): always containing, equal on small
 // footprints, local on large ones, and constant-time on footprints that span a large map.
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <random>
 
-#include "patchcull/displacement.h"
+#include "patchcull/core/displacement.h"
 
 using namespace patchcull;
 

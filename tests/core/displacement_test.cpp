@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "patchcull/displacement.h"
+#include "patchcull/core/displacement.h"
 
 using namespace patchcull;
 

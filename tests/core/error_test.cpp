@@ -1,8 +1,8 @@
-// Escaping of untrusted text in error messages (patchcull/error.h): control bytes, invalid UTF-8
+// Escaping of untrusted text in error messages (patchcull/core/error.h): control bytes, invalid UTF-8
 // and long input never reach the terminal raw.
 #include <gtest/gtest.h>
 
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// View-frustum kernels (patchcull/frustum.h): hand-built cases for both kernels, exact agreement of
+// View-frustum kernels (patchcull/core/frustum.h): hand-built cases for both kernels, exact agreement of
 // every compiled SIMD target with the scalar reference, and conservativeness against dense
 // sampling of the displaced surface in double precision.
 #include <gtest/gtest.h>
@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/frustum.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/patch.h"
 
 using namespace patchcull;
 

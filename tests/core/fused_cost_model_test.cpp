@@ -1,4 +1,4 @@
-// The fused kernel's cost model (patchcull/fused_cost_model.h): the plan it chooses follows the
+// The fused kernel's cost model (patchcull/core/fused_cost_model.h): the plan it chooses follows the
 // expected time sum_i c(s_i) (1 - P(S_{i-1})) from measured stage costs and decided fractions
 // (profiles built by hand here: speed itself is measured by `patchcull eval fused`, never in a
 // test), its profiling schedule, and the refresh of prefix rates from ordinary runs; then, on
@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/fused_cost_model.h"
-#include "patchcull/fused_cull.h"
+#include "patchcull/core/fused_cost_model.h"
+#include "patchcull/core/fused_cull.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// The fused kernel (patchcull/fused_cull.h): for every valid plan, on random batches with a real
+// The fused kernel (patchcull/core/fused_cull.h): for every valid plan, on random batches with a real
 // depth pyramid, its decisions equal the separate kernels' (frustum, tcone or ncone, Hi-Z), the
 // reason being the first culling stage of the plan; scalar and SIMD (every Highway target) agree,
 // in both layouts, whole and in subranges; the profiling variant decides the same and its counts
@@ -13,12 +13,12 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/frustum.h"
-#include "patchcull/fused_cull.h"
-#include "patchcull/hiz.h"
-#include "patchcull/math.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/fused_cull.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/math.h"
+#include "patchcull/core/patch.h"
 
 using namespace patchcull;
 

@@ -9,11 +9,11 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/camera.h"
-#include "patchcull/error.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/mesh.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/core/mesh.h"
+#include "patchcull/core/teapot.h"
 
 using namespace patchcull;
 

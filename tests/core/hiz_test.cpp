@@ -1,4 +1,4 @@
-// Hi-Z pyramid and occlusion test (patchcull/hiz.h): the pyramid against brute-force maxima over
+// Hi-Z pyramid and occlusion test (patchcull/core/hiz.h): the pyramid against brute-force maxima over
 // exact footprints (NPOT sizes, and against the seed's POT-enlarged, zero-padded map), level
 // selection against a brute-force search (and a `floor` level that under-covers), hand-built
 // decisions, SIMD == scalar on every target, and ground truth: a tiny CPU rasterizer (pixel centres,
@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/frustum.h"
-#include "patchcull/hiz.h"
-#include "patchcull/math.h"
-#include "patchcull/patch.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/math.h"
+#include "patchcull/core/patch.h"
 
 using namespace patchcull;
 

@@ -1,84 +1,113 @@
-// The library's layering, checked by grepping includes: dependencies point one way, downwards.
-//   tools -> public headers; src/eval -> import + core; src/import -> core; src/core -> nothing
-//   of ours above it (and no OpenSubdiv, stb or GL).
+// The library's layering, checked by the folders: each layer is a folder of sources (src/<layer>)
+// and of public headers (include/patchcull/<layer>), and its files include the public headers of
+// the layers below it only:
+//   core <- objects <- import <- eval;  core, objects <- gl;  tools -> public headers.
+// The kernels and the object level include no OpenSubdiv, stb or GL.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <set>
+#include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
 namespace {
 
-// Public headers by layer.
-const std::set<std::string> kCoreHeaders = {"math.h", "patch.h", "mesh.h", "displacement.h", "camera.h",
-                                            "frustum.h", "ground_truth.h", "parallel.h", "teapot.h", "error.h",
-                                            "hiz.h", "cones.h", "backpatch.h", "displaced_bounds.h",
-                                            "clip_space.h", "bounding_volumes.h", "object_bvh.h", "backface.h",
-                                            "backface_clusters.h", "object_culling.h", "occlusion_horizon.h",
-                                            "portal_culling.h", "tight_bounds.h", "fused_cull.h",
-                                            "fused_cost_model.h"};
-const std::set<std::string> kImportHeaders = {"obj.h", "subdivision.h", "image.h", "animation.h", "scene.h",
-                                              "default_scene.h", "scene_file.h", "scene_object_level.h",
-                                              "scene_occlusion.h"};
+// The layers each layer may include (itself included).
+const std::map<std::string, std::set<std::string>> kAllowed = {
+    {"core", {"core"}},
+    {"objects", {"core", "objects"}},
+    {"import", {"core", "objects", "import"}},
+    {"eval", {"core", "objects", "import", "eval"}},
+    {"gl", {"core", "objects", "gl"}},
+};
 
-std::vector<std::pair<std::string, std::string>> includes_under(const std::string& dir) {
-    std::vector<std::pair<std::string, std::string>> found;
+struct Include {
+    std::string file, target;
+};
+
+std::vector<Include> includes_under(const fs::path& dir) {
+    std::vector<Include> found;
+    if (!fs::exists(dir)) return found;
     const std::regex include_re(R"(^\s*#\s*include\s*[<"]([^>"]+)[>"])");
-    for (const auto& entry : fs::recursive_directory_iterator(fs::path(PATCHCULL_SOURCE_DIR) / dir)) {
+    for (const auto& entry : fs::recursive_directory_iterator(dir)) {
         if (!entry.is_regular_file()) continue;
         std::ifstream in(entry.path());
         std::string line;
         std::smatch m;
         while (std::getline(in, line))
-            if (std::regex_search(line, m, include_re)) found.emplace_back(entry.path().string(), m[1]);
+            if (std::regex_search(line, m, include_re)) found.push_back({entry.path().string(), m[1]});
     }
     return found;
 }
 
-bool is_ours(const std::string& inc, std::string& header) {
-    if (inc.rfind("patchcull/", 0) != 0) return false;
-    header = inc.substr(10);
-    return true;
+// The layer of a public header include ("patchcull/core/frustum.h" -> "core"); "" for
+// patchcull/version.h (generated, every layer's), "?" for any other patchcull/ path.
+std::string layer_of(const std::string& inc) {
+    if (inc.rfind("patchcull/", 0) != 0) return "-";
+    const std::string rest = inc.substr(10);
+    if (rest == "version.h") return "";
+    const std::size_t slash = rest.find('/');
+    return slash == std::string::npos ? "?" : rest.substr(0, slash);
 }
+
+const fs::path kRoot = fs::path(PATCHCULL_SOURCE_DIR);
 
 }  // namespace
 
-TEST(Layering, CoreDependsOnNothingAboveIt) {
-    for (const auto& [file, inc] : includes_under("src/core")) {
-        std::string h;
-        if (is_ours(inc, h)) {
-            EXPECT_TRUE(kCoreHeaders.count(h)) << file << " includes " << inc;
+TEST(Layering, EveryPublicHeaderLivesInALayerFolder) {
+    std::size_t headers = 0;
+    for (const auto& entry : fs::directory_iterator(kRoot / "include/patchcull")) {
+        if (entry.is_directory()) {
+            EXPECT_TRUE(kAllowed.count(entry.path().filename().string())) << entry.path() << " is not a layer";
+            for (const auto& h : fs::directory_iterator(entry.path())) headers += h.path().extension() == ".h";
+            continue;
         }
-        EXPECT_EQ(inc.find("opensubdiv"), std::string::npos) << file;
-        EXPECT_EQ(inc.find("stb"), std::string::npos) << file;
-        EXPECT_EQ(inc.find("GL"), std::string::npos) << file;
+        const std::string name = entry.path().filename().string();
+        EXPECT_TRUE(name == "version.h.in") << entry.path() << " is outside every layer folder";
     }
-    for (const std::string& header : kCoreHeaders)
-        for (const auto& [file, inc] : includes_under("include/patchcull")) {
-            if (fs::path(file).filename() != header) continue;
-            std::string h;
-            if (is_ours(inc, h)) {
-                EXPECT_TRUE(kCoreHeaders.count(h)) << file << " includes " << inc;
-            }
-        }
+    EXPECT_GE(headers, 40u);
+    for (const auto& [layer, allowed] : kAllowed) {
+        (void)allowed;
+        EXPECT_TRUE(fs::is_directory(kRoot / "include/patchcull" / layer)) << layer;
+        EXPECT_TRUE(fs::is_directory(kRoot / "src" / layer)) << layer;
+    }
 }
 
-TEST(Layering, ImportDependsOnlyOnCore) {
-    for (const auto& [file, inc] : includes_under("src/import")) {
-        std::string h;
-        if (is_ours(inc, h)) {
-            EXPECT_TRUE(kCoreHeaders.count(h) || kImportHeaders.count(h)) << file << " includes " << inc;
+TEST(Layering, EachLayerIncludesOnlyTheLayersBelowIt) {
+    for (const auto& [layer, allowed] : kAllowed) {
+        std::vector<Include> all = includes_under(kRoot / "include/patchcull" / layer);
+        const std::vector<Include> sources = includes_under(kRoot / "src" / layer);
+        all.insert(all.end(), sources.begin(), sources.end());
+        EXPECT_FALSE(all.empty()) << layer;
+        for (const Include& i : all) {
+            const std::string to = layer_of(i.target);
+            if (to == "-" || to.empty()) continue;
+            EXPECT_TRUE(allowed.count(to)) << i.file << " (layer " << layer << ") includes " << i.target;
         }
     }
+}
+
+TEST(Layering, KernelsAndObjectLevelNeedNoOpenSubdivStbOrGl) {
+    for (const char* layer : {"core", "objects"})
+        for (const char* dir : {"src", "include/patchcull"})
+            for (const Include& i : includes_under(kRoot / dir / layer)) {
+                EXPECT_EQ(i.target.find("opensubdiv"), std::string::npos) << i.file;
+                EXPECT_EQ(i.target.find("stb"), std::string::npos) << i.file;
+                EXPECT_EQ(i.target.find("GL"), std::string::npos) << i.file;
+                EXPECT_EQ(i.target.find("epoxy"), std::string::npos) << i.file;
+            }
 }
 
 TEST(Layering, ToolsUseOnlyPublicHeaders) {
-    for (const auto& [file, inc] : includes_under("tools")) {
-        EXPECT_EQ(inc.find("src/"), std::string::npos) << file << " includes " << inc;
-        EXPECT_EQ(inc.find("../"), std::string::npos) << file << " includes " << inc;
-        EXPECT_EQ(inc.find("opensubdiv"), std::string::npos) << file << " includes " << inc;
+    for (const Include& i : includes_under(kRoot / "tools")) {
+        EXPECT_EQ(i.target.find("src/"), std::string::npos) << i.file << " includes " << i.target;
+        EXPECT_EQ(i.target.find("../"), std::string::npos) << i.file << " includes " << i.target;
+        EXPECT_EQ(i.target.find("opensubdiv"), std::string::npos) << i.file << " includes " << i.target;
+        EXPECT_NE(layer_of(i.target), "?") << i.file << " includes " << i.target;
     }
 }

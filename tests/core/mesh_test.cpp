@@ -1,11 +1,11 @@
-// ControlMesh::is_closed (patchcull/mesh.h): closed, consistently oriented meshes only, of one
+// ControlMesh::is_closed (patchcull/core/mesh.h): closed, consistently oriented meshes only, of one
 // shell or several.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <vector>
 
-#include "patchcull/mesh.h"
+#include "patchcull/core/mesh.h"
 
 using namespace patchcull;
 

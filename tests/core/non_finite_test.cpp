@@ -10,14 +10,14 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/camera.h"
-#include "patchcull/clip_space.h"
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
-#include "patchcull/fused_cull.h"
-#include "patchcull/hiz.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/fused_cull.h"
+#include "patchcull/core/hiz.h"
 
 #include "core/test_patches.h"
 

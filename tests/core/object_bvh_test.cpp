@@ -1,4 +1,4 @@
-// Object BVH (patchcull/object_bvh.h): build / refit / cull equal the flat list of classify_aabb
+// Object BVH (patchcull/objects/object_bvh.h): build / refit / cull equal the flat list of classify_aabb
 // tests, object for object, on random scenes (1..2000 objects, moving boxes, refit after motion,
 // every combination of plane masking and coherence), including all-outside, all-inside, one
 // object, duplicates, huge, tiny, empty and NaN boxes; objects culled have no sampled point in the
@@ -13,8 +13,8 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/bounding_volumes.h"
-#include "patchcull/object_bvh.h"
+#include "patchcull/objects/bounding_volumes.h"
+#include "patchcull/objects/object_bvh.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// ObjectCuller (patchcull/object_culling.h): the order and bookkeeping of the object level, and
+// ObjectCuller (patchcull/objects/object_culling.h): the order and bookkeeping of the object level, and
 // the CPU patch level after it (cull_frustum_after_objects). The tests' geometry answers are
 // checked against ground truth in tests/import/scene_object_level_test.cpp.
 #include <gtest/gtest.h>
@@ -6,8 +6,8 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/object_culling.h"
+#include "patchcull/core/error.h"
+#include "patchcull/objects/object_culling.h"
 
 namespace patchcull {
 namespace {

@@ -1,4 +1,4 @@
-// Occlusion horizon (patchcull/occlusion_horizon.h): on random city scenes (box buildings on a
+// Occlusion horizon (patchcull/objects/occlusion_horizon.h): on random city scenes (box buildings on a
 // ground, characters in the streets and behind buildings, floating, huge, flat, empty, NaN and
 // infinite boxes; eyes 0.2..20 up, pitched, rolled, on building faces; 1x1 .. 200x120 images;
 // both depth conventions; coordinates near 0 and 1e4 away) no object reported occluded has a
@@ -7,7 +7,7 @@
 // share of the truly hidden objects is culled. Then the cases that must come out one way: a
 // character behind a tall building in a street canyon is occluded, one in front is not; an
 // occluder behind an object never hides it; the horizon of a wall is its projected top edge.
-#include "patchcull/occlusion_horizon.h"
+#include "patchcull/objects/occlusion_horizon.h"
 
 #include <gtest/gtest.h>
 
@@ -19,8 +19,8 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/clip_space.h"
-#include "patchcull/error.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/error.h"
 
 using namespace patchcull;
 

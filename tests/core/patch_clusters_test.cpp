@@ -1,4 +1,4 @@
-// Clusters of patches for clustered back-face culling (patchcull/backface_clusters.h, beyond
+// Clusters of patches for clustered back-face culling (patchcull/objects/backface_clusters.h, beyond
 // G. Zachmann's lecture; the planes are Loop, Niessner & Eisenacher's tangent control planes,
 // "Effective Back-Patch Culling for Hardware Tessellation"): the object-space control planes
 // against the sampled tangent planes and a long-double reference, cluster culls against dense
@@ -13,12 +13,12 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/backface_clusters.h"
-#include "patchcull/backpatch.h"
-#include "patchcull/error.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/scene.h"
-#include "patchcull/teapot.h"
+#include "patchcull/objects/backface_clusters.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/import/scene.h"
+#include "patchcull/core/teapot.h"
 
 using namespace patchcull;
 

@@ -3,7 +3,7 @@
 
 #include <random>
 
-#include "patchcull/patch.h"
+#include "patchcull/core/patch.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// Cells and portals (patchcull/portal_culling.h): every point visible from the eye (inside the view
+// Cells and portals (patchcull/objects/portal_culling.h): every point visible from the eye (inside the view
 // frustum, the segment to it through no wall: CPU ray casting against the wall boxes, in double)
 // is in a reached cell and box_visible, over hundreds of random grid buildings (2x2..4x4 rooms of
 // random size, walls as thick boxes with doors and windows, cells from wall centre to wall centre
@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
-#include "patchcull/portal_culling.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/objects/portal_culling.h"
 
 namespace patchcull {
 namespace {

@@ -1,4 +1,4 @@
-// Parametric tangent plane back-patch culling (patchcull/backpatch.h, seed 001 §3-6):
+// Parametric tangent plane back-patch culling (patchcull/core/backpatch.h, seed 001 §3-6):
 // - the table: generated in-process from the definition, equal to the checked-in ptp_table.inc,
 //   516 terms with the seed's per-destination matrix, hazard-free 16-lane order;
 // - T(u,v) from the 64 control planes equals cross4(B, B_u, B_v) computed directly (double, all 4
@@ -27,10 +27,10 @@
 #include "core/ptp_internal.h"
 #include "core/ptp_schedule.h"
 #include "core/ptp_table_gen.h"
-#include "patchcull/backpatch.h"
-#include "patchcull/frustum.h"
-#include "patchcull/patch.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/patch.h"
+#include "patchcull/core/teapot.h"
 
 using namespace patchcull;
 

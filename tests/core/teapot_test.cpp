@@ -1,6 +1,6 @@
 // The built-in Utah teapot: data integrity (pinned against the published data set), shared
 // boundaries, degenerate patches and outward orientation.
-#include "patchcull/teapot.h"
+#include "patchcull/core/teapot.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <cmath>
 #include <vector>
 
-#include "patchcull/patch.h"
+#include "patchcull/core/patch.h"
 
 namespace patchcull {
 namespace {

@@ -5,9 +5,9 @@
 #include <limits>
 #include <vector>
 
-#include "patchcull/mesh.h"
-#include "patchcull/patch.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/mesh.h"
+#include "patchcull/core/patch.h"
+#include "patchcull/core/teapot.h"
 
 namespace patchcull::test_patches {
 

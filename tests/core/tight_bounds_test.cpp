@@ -1,4 +1,4 @@
-// Tight bounding volumes (patchcull/tight_bounds.h): on random patch-like objects (clusters of
+// Tight bounding volumes (patchcull/objects/tight_bounds.h): on random patch-like objects (clusters of
 // small boxes, near and far from the origin, refitted to other poses), every piece box lies inside
 // one selected box, each selected box is exactly the union of the pieces it holds, the cut obeys
 // the cap and the area budget sigma * area(root); the per-node rule and the budget each stop
@@ -18,8 +18,8 @@
 #include <tuple>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/tight_bounds.h"
+#include "patchcull/core/error.h"
+#include "patchcull/objects/tight_bounds.h"
 
 using namespace patchcull;
 

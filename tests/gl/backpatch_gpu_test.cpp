@@ -1,5 +1,5 @@
-// GPU back-patch culling (patchcull/gl_backpatch.h) against the CPU scalar kernels
-// (patchcull/backpatch.h): decisions must be equal on the same inputs, for tcone, ncone and ptp
+// GPU back-patch culling (patchcull/gl/gl_backpatch.h) against the CPU scalar kernels
+// (patchcull/core/backpatch.h): decisions must be equal on the same inputs, for tcone, ncone and ptp
 // with both rules; ptp's 64 control plane values must be bit-identical. The one-sided check
 // (the GPU never culls a patch the CPU keeps) is counted separately so that a failure says which
 // direction broke. Also: the generated shaders/ptp_schedule.h equals src/core/ptp_schedule.h's
@@ -28,9 +28,9 @@
 #include "core/ptp_internal.h"
 #include "core/ptp_schedule.h"
 #include "gl/gl_test_util.h"
-#include "patchcull/backpatch.h"
-#include "patchcull/gl_backpatch.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/gl/gl_backpatch.h"
+#include "patchcull/core/teapot.h"
 
 namespace patchcull::gl {
 namespace {

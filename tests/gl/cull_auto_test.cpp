@@ -14,7 +14,7 @@
 
 #include "cli/cli_test_util.h"
 #include "cull_auto.h"
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 
 using namespace patchcull;
 using patchcull::cli::CullAutoPolicy;

@@ -1,4 +1,4 @@
-// CullPipeline (patchcull/gl_pipeline.h): the GPU back-patch pass in seed 000 §3's frame (the flag
+// CullPipeline (patchcull/gl/gl_pipeline.h): the GPU back-patch pass in seed 000 §3's frame (the flag
 // chain of gl_passes.h), and the per-object switch (PipelineParams::objects). For tcone, ncone and ptp: the frame culls exactly the patches the
 // CPU scalar kernel culls (every patch is inside the frustum), the final id buffer equals the
 // unculled render's (no false cull), and after update_patches the pass reads the new pose.
@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/backpatch.h"
-#include "patchcull/camera.h"
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -23,10 +23,10 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/camera.h"
-#include "patchcull/clip_space.h"
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/hiz.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/hiz.h"
 #include "shared.h"
 
 using namespace patchcull;

@@ -1,5 +1,5 @@
-// GPU displaced-patch culling (patchcull/gl_displaced.h) against the CPU kernels of
-// patchcull/displaced_bounds.h: on the same patches, ranges, views and Hi-Z pyramid, every one of
+// GPU displaced-patch culling (patchcull/gl/gl_displaced.h) against the CPU kernels of
+// patchcull/core/displaced_bounds.h: on the same patches, ranges, views and Hi-Z pyramid, every one of
 // the 6 combinations {oobb, caf} x {full, acon, con} must give the same frustum decisions
 // (cull_displaced_frustum), the same occlusion decisions (cull_displaced_occlusion) and the same
 // bound values bit for bit (compute_displaced_bounds). The scene mixes the split teapot (degenerate
@@ -24,10 +24,10 @@
 
 #include "core/cone_test_patches.h"
 #include "gl/gl_test_util.h"
-#include "patchcull/camera.h"
-#include "patchcull/displaced_bounds.h"
-#include "patchcull/gl_displaced.h"
-#include "patchcull/hiz.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/gl/gl_displaced.h"
+#include "patchcull/core/hiz.h"
 
 namespace patchcull::gl {
 namespace {

@@ -15,8 +15,8 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/default_scene.h"
-#include "patchcull/scene.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

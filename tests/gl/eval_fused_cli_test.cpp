@@ -20,10 +20,10 @@ using nlohmann::json;
 namespace {
 
 void check_contract(const json& j, int frames) {
-    EXPECT_EQ(json_keys(j), (std::set<std::string>{"scene", "scheme", "target", "objects", "fused_objects", "patches",
-                                              "fused_patches", "frames", "size", "tess", "repeats", "profile_interval",
-                                              "cone", "culled", "plans", "best_plan", "model", "oracle", "separate",
-                                              "false_culls"}));
+    EXPECT_EQ(json_keys(j), (std::set<std::string>{"scene", "clip_depth", "scheme", "target", "objects",
+                                              "fused_objects", "patches", "fused_patches", "frames", "size", "tess",
+                                              "repeats", "profile_interval", "cone", "culled", "plans", "best_plan",
+                                              "model", "oracle", "separate", "false_culls"}));
     EXPECT_EQ(j["false_culls"], 0);
     EXPECT_EQ(j["frames"], frames);
     EXPECT_GT(j["fused_objects"].get<int>(), 0);

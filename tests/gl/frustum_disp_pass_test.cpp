@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/camera.h"
-#include "patchcull/clip_space.h"
-#include "patchcull/displacement.h"
-#include "patchcull/frustum.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/displacement.h"
+#include "patchcull/core/frustum.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/camera.h"
-#include "patchcull/displacement.h"
-#include "patchcull/frustum.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/displacement.h"
+#include "patchcull/core/frustum.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

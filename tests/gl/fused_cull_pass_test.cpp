@@ -19,10 +19,10 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/backpatch.h"
-#include "patchcull/camera.h"
-#include "patchcull/hiz.h"
-#include "patchcull/fused_cull.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/fused_cull.h"
 #include "shared.h"
 
 using namespace patchcull;

@@ -15,8 +15,8 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/default_scene.h"
-#include "patchcull/gl_pipeline.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/gl/gl_pipeline.h"
 
 namespace patchcull::gl {
 namespace {

@@ -1,5 +1,6 @@
-// The library's layering for the renderer: src/gl uses public headers (and its own files, the shared
-// shader header), never src/import or src/eval internals; shaders are real files, not C++ strings.
+// The library's layering for the renderer (the folders themselves: tests/core/layering_test.cpp):
+// src/gl uses public headers (and its own files, the shared shader header), never src/import or
+// src/eval internals; shaders are real files, not C++ strings.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -43,7 +44,7 @@ TEST(GlLayering, RendererUsesOnlyPublicHeadersAndItsOwnFiles) {
 TEST(GlLayering, PublicRendererHeaderUsesOnlyCoreHeaders) {
     const std::regex include_re(R"(^\s*#\s*include\s*[<"]([^>"]+)[>"])");
     for (const char* header : {"gl_renderer.h", "gl_posing.h"}) {  // gl_posing.h: tables as plain arrays
-        std::ifstream in(fs::path(PATCHCULL_SOURCE_DIR) / "include/patchcull" / header);
+        std::ifstream in(fs::path(PATCHCULL_SOURCE_DIR) / "include/patchcull/gl" / header);
         ASSERT_TRUE(in.good()) << header;
         std::string line;
         std::smatch m;

@@ -11,13 +11,13 @@
 #include <utility>
 #include <vector>
 
-#include "patchcull/displacement.h"
-#include "patchcull/gl_passes.h"
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/gl_renderer.h"
-#include "patchcull/mesh.h"
-#include "patchcull/patch.h"
-#include "patchcull/teapot.h"
+#include "patchcull/core/displacement.h"
+#include "patchcull/gl/gl_passes.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/gl/gl_renderer.h"
+#include "patchcull/core/mesh.h"
+#include "patchcull/core/patch.h"
+#include "patchcull/core/teapot.h"
 
 #include "core/test_patches.h"
 

@@ -19,12 +19,12 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/default_scene.h"
-#include "patchcull/error.h"
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/gl_posing.h"
-#include "patchcull/gl_renderer.h"
-#include "patchcull/scene.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/gl/gl_posing.h"
+#include "patchcull/gl/gl_renderer.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -1,4 +1,4 @@
-// The GPU Hi-Z pipeline against its CPU mirror (include/patchcull/hiz.h): on the same depth buffer
+// The GPU Hi-Z pipeline against its CPU mirror (include/patchcull/core/hiz.h): on the same depth buffer
 // (rendered by GL, read back) the compute-built pyramid (shaders/hiz_build.comp.glsl) is
 // bit-identical to HiZPyramid::build, and the combined cull pass (shaders/occlusion.comp.glsl, OcclusionPass)
 // makes the same decisions as cull_occlusion_scalar, patch by patch, on the same matrix: the teapot
@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/camera.h"
-#include "patchcull/hiz.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/hiz.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

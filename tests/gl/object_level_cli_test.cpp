@@ -21,8 +21,8 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/gl_renderer.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/gl/gl_renderer.h"
 
 using namespace patchcull::cli_test;
 

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/error.h"
-#include "patchcull/gl_object_queries.h"
-#include "patchcull/gl_pipeline.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_object_queries.h"
+#include "patchcull/gl/gl_pipeline.h"
 
 namespace patchcull::gl {
 namespace {

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/error.h"
-#include "patchcull/gl_pipeline.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_pipeline.h"
 
 namespace patchcull::gl {
 namespace {

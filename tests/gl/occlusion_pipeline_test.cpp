@@ -18,10 +18,10 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/animation.h"
-#include "patchcull/camera.h"
-#include "patchcull/displacement.h"
-#include "patchcull/scene.h"
+#include "patchcull/import/animation.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/core/displacement.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -1,4 +1,4 @@
-// OpenSubdiv's own regression shapes (tests/data/opensubdiv, tags read by patchcull/obj.h) through
+// OpenSubdiv's own regression shapes (tests/data/opensubdiv, tags read by patchcull/import/obj.h) through
 // the GPU pipeline: `render --verify` finds no false cull with either scheme, a shape with a hole
 // is drawn two-sided (no back-patch culling), and a closed one is back-patch culled.
 #include <gtest/gtest.h>

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <string>
 
-#include "patchcull/gl_passes.h"
+#include "patchcull/gl/gl_passes.h"
 #include "shared.h"  // shaders/, on patchcull_gl's public include path
 
 namespace {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/camera.h"
+#include "patchcull/core/camera.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/gl_pipeline.h"
-#include "patchcull/scene_occlusion.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/import/scene_occlusion.h"
 
 namespace patchcull::gl {
 namespace {

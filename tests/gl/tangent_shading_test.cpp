@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/camera.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "cli/cli_test_util.h"
-#include "patchcull/error.h"
+#include "patchcull/core/error.h"
 #include "viewer_camera.h"
 #include "viewer_controls.h"
 #include "viewer_script.h"

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/camera.h"
-#include "patchcull/gl_renderer.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/gl/gl_renderer.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

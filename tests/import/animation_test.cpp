@@ -1,6 +1,6 @@
 // Procedural control-mesh animation (src/import/animation.cpp), and the mesh.h helpers it uses
 // (compute_bounds, ControlMesh::all_quads; src/core/mesh.cpp) as AnimationSupport.*.
-#include "patchcull/animation.h"
+#include "patchcull/import/animation.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "patchcull/mesh.h"
+#include "patchcull/core/mesh.h"
 
 namespace patchcull {
 namespace {

@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <random>
 
-#include "patchcull/backpatch.h"
-#include "patchcull/cull_eval.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/parallel.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/eval/cull_eval.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/core/parallel.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 

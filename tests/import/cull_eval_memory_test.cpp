@@ -17,9 +17,9 @@
 #include <new>
 #include <vector>
 
-#include "patchcull/cull_eval.h"
-#include "patchcull/parallel.h"
-#include "patchcull/teapot.h"
+#include "patchcull/eval/cull_eval.h"
+#include "patchcull/core/parallel.h"
+#include "patchcull/core/teapot.h"
 
 namespace {
 

@@ -18,10 +18,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/cull_eval.h"
-#include "patchcull/displacement.h"
-#include "patchcull/error.h"
-#include "patchcull/scene.h"
+#include "patchcull/eval/cull_eval.h"
+#include "patchcull/core/displacement.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// Scenes for the renderer (patchcull/default_scene.h): the default scene's contents and placement,
+// Scenes for the renderer (patchcull/import/default_scene.h): the default scene's contents and placement,
 // ScenePoser's world-space poses (an instance's patches are its model's patches transformed), and
 // one-model scenes standing on the ground inside their camera path's view.
 #include <gtest/gtest.h>
@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/default_scene.h"
-#include "patchcull/error.h"
-#include "patchcull/frustum.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
 
 using namespace patchcull;
 

@@ -1,13 +1,13 @@
-// The "distance" view distribution of evaluate_cull (patchcull/cull_eval.h, DistanceViews; issue
+// The "distance" view distribution of evaluate_cull (patchcull/eval/cull_eval.h, DistanceViews; issue
 // 15): its contract at the library level, below the CLI's flag parsing (tests/cli/cli_test.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
-#include "patchcull/cull_eval.h"
-#include "patchcull/error.h"
-#include "patchcull/scene.h"
+#include "patchcull/eval/cull_eval.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 

@@ -15,11 +15,11 @@
 #include <unistd.h>
 
 #include "cli/cli_test_util.h"
-#include "patchcull/camera.h"
-#include "patchcull/cull_eval.h"
-#include "patchcull/frustum.h"
-#include "patchcull/obj.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/camera.h"
+#include "patchcull/eval/cull_eval.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/import/obj.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 

@@ -4,11 +4,11 @@
 // shows the ground truth does catch a kernel that is not conservative.
 #include <gtest/gtest.h>
 
-#include "patchcull/animation.h"
-#include "patchcull/cull_eval.h"
-#include "patchcull/frustum.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/scene.h"
+#include "patchcull/import/animation.h"
+#include "patchcull/eval/cull_eval.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/image.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/image.h"
 
 using namespace patchcull;
 

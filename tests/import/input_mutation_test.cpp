@@ -104,7 +104,10 @@ void mutate(Bytes& data, Rng& rng, bool text) {
             data.insert(rng.below(data.size() + 1), lines[choice]);
         } else {
             Bytes face = "\nf";
-            for (int k = 1; k <= 2000; ++k) face += " " + std::to_string(k);
+            for (int k = 1; k <= 2000; ++k) {
+                face += ' ';  // appended piecewise: GCC 12's -Wrestrict misreads " " + std::string
+                face += std::to_string(k);
+            }
             data += face + "\n";
         }
         break;

@@ -4,8 +4,8 @@
 #include <chrono>
 #include <sstream>
 
-#include "patchcull/error.h"
-#include "patchcull/obj.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/obj.h"
 
 using namespace patchcull;
 

@@ -1,4 +1,4 @@
-// OpenSubdiv's shape tags in OBJ files (patchcull/obj.h): how they are read, what each scheme
+// OpenSubdiv's shape tags in OBJ files (patchcull/import/obj.h): how they are read, what each scheme
 // makes of them (holes and boundary interpolation must leave out the same faces with acc as Far
 // leaves out with osd), OpenSubdiv's own regression shapes (tests/data/opensubdiv), and the
 // topology errors both schemes word alike.
@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/error.h"
-#include "patchcull/obj.h"
-#include "patchcull/scene.h"
-#include "patchcull/subdivision.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/obj.h"
+#include "patchcull/import/scene.h"
+#include "patchcull/import/subdivision.h"
 
 using namespace patchcull;
 

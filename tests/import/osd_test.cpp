@@ -29,10 +29,10 @@
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include "import/osd_topology.h"
-#include "patchcull/error.h"
-#include "patchcull/obj.h"
-#include "patchcull/patch.h"
-#include "patchcull/subdivision.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/obj.h"
+#include "patchcull/core/patch.h"
+#include "patchcull/import/subdivision.h"
 
 using namespace patchcull;
 namespace Far = OpenSubdiv::Far;

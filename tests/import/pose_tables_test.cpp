@@ -8,9 +8,9 @@
 #include <cstring>
 #include <vector>
 
-#include "patchcull/default_scene.h"
-#include "patchcull/error.h"
-#include "patchcull/scene.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 

@@ -28,9 +28,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/obj.h"
-#include "patchcull/scene.h"
-#include "patchcull/subdivision.h"
+#include "patchcull/import/obj.h"
+#include "patchcull/import/scene.h"
+#include "patchcull/import/subdivision.h"
 
 using namespace patchcull;
 

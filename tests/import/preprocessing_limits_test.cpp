@@ -1,4 +1,4 @@
-// Preprocessing cost on large faces and high valence (patchcull/subdivision.h, kMaxFaceCorners,
+// Preprocessing cost on large faces and high valence (patchcull/import/subdivision.h, kMaxFaceCorners,
 // kMaxValence): beyond the limits both schemes refuse the mesh at once with one line naming the
 // face or vertex (1-based, as in the OBJ); at the limits they build in bounded time. Before the
 // limits, a 10000-sided face ran out of memory with acc (std::bad_alloc) and did not finish
@@ -9,8 +9,8 @@
 #include <cmath>
 #include <string>
 
-#include "patchcull/error.h"
-#include "patchcull/subdivision.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/subdivision.h"
 
 using namespace patchcull;
 

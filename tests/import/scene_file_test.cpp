@@ -1,4 +1,4 @@
-// Scene files (patchcull/scene_file.h): the shipped files (default.json is the built-in default
+// Scene files (patchcull/import/scene_file.h): the shipped files (default.json is the built-in default
 // scene, bit for bit), every error message kind with its file and JSON path, relative paths,
 // models loaded once per (file, scheme), OBJ environment objects, far-from-origin and
 // degenerate inputs, and a deterministic mutation run (a few hundred mutants of a valid file
@@ -18,8 +18,8 @@
 #include <vector>
 
 
-#include "patchcull/error.h"
-#include "patchcull/scene_file.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/scene_file.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;

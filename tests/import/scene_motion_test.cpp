@@ -1,4 +1,4 @@
-// What a scene's motion reaches (check_scene_motion, patchcull/scene_file.h): objects moved by
+// What a scene's motion reaches (check_scene_motion, patchcull/import/scene_file.h): objects moved by
 // velocity x (time + time_offset), walk and orbit cameras, each refused at the first frame that
 // goes beyond kMaxSceneCoordinate with one line naming the JSON path and the frame; and the
 // scene reader's default object names, unique when one model stem stands for several models
@@ -12,8 +12,8 @@
 #include <string>
 
 
-#include "patchcull/error.h"
-#include "patchcull/scene_file.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/scene_file.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;

@@ -1,5 +1,5 @@
 // CPU ground truth of the object level on scenes (issue 11, "Correctness"): SceneObjectLevel
-// (patchcull/scene_object_level.h) driving ObjectCuller (object_culling.h) on small scenes (a 2 x 2
+// (patchcull/import/scene_object_level.h) driving ObjectCuller (object_culling.h) on small scenes (a 2 x 2
 // city, the default scene, a small building, a scene file, scenes far from the origin and with
 // degenerate objects), over camera paths and adversarial cameras (eyes inside boxes, boxes
 // straddling the near plane), for every method and variant: frustum, bvh, bvh+backface; plane
@@ -35,11 +35,11 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/default_scene.h"
-#include "patchcull/error.h"
-#include "patchcull/ground_truth.h"
-#include "patchcull/scene_file.h"
-#include "patchcull/scene_object_level.h"
+#include "patchcull/import/default_scene.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/ground_truth.h"
+#include "patchcull/import/scene_file.h"
+#include "patchcull/import/scene_object_level.h"
 #include "temp_dir.h"
 
 using namespace patchcull;

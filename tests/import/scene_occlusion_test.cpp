@@ -4,8 +4,8 @@
 
 #include <random>
 
-#include "patchcull/error.h"
-#include "patchcull/scene_occlusion.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/scene_occlusion.h"
 
 namespace patchcull {
 namespace {

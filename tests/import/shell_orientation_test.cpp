@@ -1,6 +1,6 @@
 // Meshes of several shells, loaded from OBJ files with both schemes (load_model): every shell
 // ends up facing out of the solid, a cavity's wall facing into the cavity (nesting parity,
-// patchcull/mesh.h), checked on the limit surface's normals. The whole-mesh rule (the sign of
+// patchcull/core/mesh.h), checked on the limit surface's normals. The whole-mesh rule (the sign of
 // the total signed volume) failed each of these: it called the reversed pairs flat (two-sided),
 // kept a cavity facing the material, and reversed the innermost of three nested spheres.
 #include <gtest/gtest.h>
@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/patch.h"
-#include "patchcull/scene.h"
+#include "patchcull/core/patch.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 

@@ -7,9 +7,9 @@
 #include <cmath>
 #include <filesystem>
 
-#include "patchcull/cull_eval.h"
-#include "patchcull/error.h"
-#include "patchcull/scene.h"
+#include "patchcull/eval/cull_eval.h"
+#include "patchcull/core/error.h"
+#include "patchcull/import/scene.h"
 
 using namespace patchcull;
 namespace fs = std::filesystem;

@@ -3,14 +3,16 @@
 #   cmake -DMODE=install -DBUILD_DIR=... -DWORK=... -DSOURCE_DIR=... -DCXX=... -DNEXT_MINOR=... -P run.cmake
 #     installs the build BUILD_DIR into WORK/prefix (cmake --install), checks the layout, that no
 #     PATCHCULL_* definition reaches a consumer, then configures, builds and runs
-#     tests/package/consumer with find_package(patchcull 0.1 CONFIG): with patchcull::gl
-#     (core_consumer, gl_consumer), and with COMPONENTS core alone, which must search for no GL
-#     package; find_package(patchcull NEXT_MINOR) must refuse the package (version file).
+#     tests/package/consumer with find_package(patchcull 0.2 CONFIG): with patchcull::import and
+#     patchcull::gl (core_consumer, import_consumer, gl_consumer), and with COMPONENTS core alone
+#     (the kernels), which must search for no GL, OpenSubdiv or stb package;
+#     find_package(patchcull NEXT_MINOR) must refuse the package (version file).
 #   cmake -DMODE=cpu -DCPU_BUILD_DIR=... -DWORK=... -DSOURCE_DIR=... -DCXX=... -P run.cmake
 #     configures SOURCE_DIR with PATCHCULL_WITH_GL=OFF and find_package(OpenGL/glfw3) disabled
 #     (a REQUIRED search for them is then an error), checks that nothing of GL was searched for
-#     and no GL target exists while the core tests do, builds and installs the core library alone
-#     (CPU_BUILD_DIR is kept between runs: incremental), runs core_consumer against that install,
+#     and no GL target exists while the core tests do, builds and installs the CPU layers alone
+#     (CPU_BUILD_DIR is kept between runs: incremental), runs core_consumer and import_consumer
+#     against that install,
 #     and checks that asking the CPU-only package for COMPONENTS gl fails.
 #   cmake -DMODE=version -DCLI=... -DVERSION=... -P run.cmake
 #     `patchcull --version` prints exactly "patchcull VERSION" and exits 0.
@@ -49,17 +51,31 @@ function(expect_no_gl_search step cache)
   endif()
 endfunction()
 
-# Configures, builds and runs the consumer (EXTRA: more -D options) in WORK/<name>.
-function(build_consumer name prefix consumer_gl)
+# Cache entries that betray a search for the import layer's packages (OpenSubdiv, stb).
+function(expect_no_model_search step cache)
+  file(STRINGS "${cache}" hits REGEX "^(PATCHCULL_OPENSUBDIV|PATCHCULL_STB)")
+  if(hits)
+    message(FATAL_ERROR "${step}: the import layer's packages were searched for (${cache}): ${hits}")
+  endif()
+endfunction()
+
+# Configures, builds and runs the consumer (EXTRA: more -D options) in WORK/<name>: with
+# patchcull::gl when consumer_gl, with patchcull::import when consumer_import.
+function(build_consumer name prefix consumer_gl consumer_import)
   set(dir "${WORK}/${name}")
   file(REMOVE_RECURSE "${dir}")
   run("${name}: configure" ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package/consumer" -B "${dir}"
       -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=${CXX} "-DCMAKE_PREFIX_PATH=${prefix}"
-      -DCONSUMER_GL=${consumer_gl} ${ARGN})
+      -DCONSUMER_GL=${consumer_gl} -DCONSUMER_IMPORT=${consumer_import} ${ARGN})
   run("${name}: build" ${CMAKE_COMMAND} --build "${dir}" -j2)
-  # The installed data, as a program moved away from the source tree finds it.
-  run("${name}: core_consumer" ${CMAKE_COMMAND} -E env "PATCHCULL_DATA_DIR=${prefix}/share/patchcull"
-      "${dir}/core_consumer")
+  run("${name}: core_consumer" "${dir}/core_consumer")
+  if(consumer_import)
+    # The installed data, as a program moved away from the source tree finds it.
+    run("${name}: import_consumer" ${CMAKE_COMMAND} -E env "PATCHCULL_DATA_DIR=${prefix}/share/patchcull"
+        "${dir}/import_consumer")
+  elseif(NOT consumer_gl)
+    expect_no_model_search("${name}" "${dir}/CMakeCache.txt")
+  endif()
   if(consumer_gl)
     run("${name}: gl_consumer" "${dir}/gl_consumer")
   else()
@@ -73,9 +89,12 @@ if(MODE STREQUAL "install")
   run("install" ${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${prefix}")
   set(cmakedir "${prefix}/lib/cmake/patchcull")
   expect_files("install" "${cmakedir}/patchcullConfig.cmake" "${cmakedir}/patchcullConfigVersion.cmake"
-    "${cmakedir}/patchcullCoreTargets.cmake" "${cmakedir}/patchcullGLTargets.cmake"
-    "${cmakedir}/PatchcullImportedDeps.cmake" "${prefix}/lib/libpatchcull.a" "${prefix}/lib/libpatchcull_gl.a"
-    "${prefix}/include/patchcull/frustum.h" "${prefix}/include/patchcull/gl_passes.h"
+    "${cmakedir}/patchcullCoreTargets.cmake" "${cmakedir}/patchcullObjectsTargets.cmake"
+    "${cmakedir}/patchcullImportTargets.cmake" "${cmakedir}/patchcullEvalTargets.cmake"
+    "${cmakedir}/patchcullGLTargets.cmake" "${cmakedir}/PatchcullImportedDeps.cmake"
+    "${prefix}/lib/libpatchcull_core.a" "${prefix}/lib/libpatchcull_objects.a" "${prefix}/lib/libpatchcull_import.a"
+    "${prefix}/lib/libpatchcull_eval.a" "${prefix}/lib/libpatchcull_gl.a"
+    "${prefix}/include/patchcull/core/frustum.h" "${prefix}/include/patchcull/gl/gl_passes.h"
     "${prefix}/include/patchcull/version.h" "${prefix}/include/patchcull/glsl/shared.h"
     "${prefix}/include/patchcull/glsl/patchcull_tcs.h" "${prefix}/share/patchcull/models/bigguy.obj"
     "${prefix}/share/patchcull/models/README.md" "${prefix}/share/doc/patchcull/LICENSE"
@@ -88,12 +107,13 @@ if(MODE STREQUAL "install")
       message(FATAL_ERROR "install: ${file} passes the build's settings to consumers: ${leaks}")
     endif()
   endforeach()
-  build_consumer(consumer "${prefix}" ON)
-  build_consumer(consumer_core_only "${prefix}" OFF)
+  build_consumer(consumer "${prefix}" ON ON)
+  # The kernels alone: no GL, OpenSubdiv or stb package searched for.
+  build_consumer(consumer_kernels_only "${prefix}" OFF OFF)
   # The version file: 0.x releases are compatible within a minor version only.
   execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package/consumer" -B "${WORK}/consumer_next_minor"
                   -DCMAKE_CXX_COMPILER=${CXX} "-DCMAKE_PREFIX_PATH=${prefix}" -DCONSUMER_GL=OFF
-                  -DCONSUMER_VERSION=${NEXT_MINOR}
+                  -DCONSUMER_IMPORT=OFF -DCONSUMER_VERSION=${NEXT_MINOR}
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(rc EQUAL 0 OR NOT err MATCHES "considered but not accepted")
     message(FATAL_ERROR "install: find_package(patchcull ${NEXT_MINOR}) accepted the package: exit ${rc}: ${err}")
@@ -111,7 +131,8 @@ elseif(MODE STREQUAL "cpu")
       -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON)
   expect_no_gl_search("cpu-only" "${CPU_BUILD_DIR}/CMakeCache.txt")
   execute_process(COMMAND ${CMAKE_COMMAND} --build "${CPU_BUILD_DIR}" --target help OUTPUT_VARIABLE targets)
-  foreach(target patchcull patchcull_core_tests patchcull_import_tests)
+  foreach(target patchcull_core patchcull_objects patchcull_import patchcull_eval patchcull_core_tests
+                 patchcull_import_tests)
     if(NOT targets MATCHES "\\.\\.\\. ${target}\n")
       message(FATAL_ERROR "cpu-only: no target ${target}")
     endif()
@@ -121,14 +142,15 @@ elseif(MODE STREQUAL "cpu")
       message(FATAL_ERROR "cpu-only: target ${target} exists without GL")
     endif()
   endforeach()
-  run("cpu-only: build" ${CMAKE_COMMAND} --build "${CPU_BUILD_DIR}" -j2 --target patchcull)
+  run("cpu-only: build" ${CMAKE_COMMAND} --build "${CPU_BUILD_DIR}" -j2 --target patchcull_eval)
   set(prefix "${WORK}/prefix")
   run("cpu-only: install" ${CMAKE_COMMAND} --install "${CPU_BUILD_DIR}" --prefix "${prefix}")
-  expect_files("cpu-only: install" "${prefix}/lib/libpatchcull.a" "${prefix}/include/patchcull/frustum.h"
+  expect_files("cpu-only: install" "${prefix}/lib/libpatchcull_core.a" "${prefix}/lib/libpatchcull_import.a"
+    "${prefix}/include/patchcull/core/frustum.h"
     "${prefix}/lib/cmake/patchcull/patchcullConfig.cmake")
-  expect_no_files("cpu-only: install" "${prefix}/lib/libpatchcull_gl.a" "${prefix}/include/patchcull/gl_passes.h"
+  expect_no_files("cpu-only: install" "${prefix}/lib/libpatchcull_gl.a" "${prefix}/include/patchcull/gl"
     "${prefix}/include/patchcull/glsl" "${prefix}/lib/cmake/patchcull/patchcullGLTargets.cmake")
-  build_consumer(consumer_cpu "${prefix}" OFF
+  build_consumer(consumer_cpu "${prefix}" OFF ON
     -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON)
   # A package without GL refuses COMPONENTS gl, and says why.
   execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package/consumer" -B "${WORK}/consumer_cpu_gl"

@@ -7,9 +7,9 @@
 #include <sstream>
 #include <string>
 
-#include "patchcull/error.h"
-#include "patchcull/gl_passes.h"
-#include "patchcull/gl_renderer.h"
+#include "patchcull/core/error.h"
+#include "patchcull/gl/gl_passes.h"
+#include "patchcull/gl/gl_renderer.h"
 #include "shared.h"  // include/patchcull/glsl/shared.h, on patchcull::gl's include path
 
 namespace {

@@ -1,0 +1,454 @@
+// patchcull/gl/gl_renderer.h: the OpenGL 4.5 renderer (library patchcull_gl): a headless EGL or
+// windowed context, and bicubic patches drawn through hardware tessellation (TCS/TES) into an
+// off-screen framebuffer, with per-patch cull flags read by the TCS and triangle-mesh occluders.
+// The renderer only draws: the cull passes are gl_passes.h's (they run on any context and any
+// buffers), and gl_pipeline.h's CullPipeline chains them with this renderer into Niessner & Loop §3's
+// two-pass temporal-coherence frame.
+//
+// Conventions (as math.h, frustum.h, hiz.h and displacement.h):
+// - Patches are in object space = world space (no model matrix); render parameters give view and
+//   projection, object_to_clip = projection * view. Clip space is GL's with
+//   glClipControl(GL_LOWER_LEFT, ...) in the depth convention RenderParams::depth names
+//   (clip_space.h): zero_to_one (the default: depth cleared to 1, GL_LESS), minus_one_to_one (GL's
+//   own, drawn with GL_NEGATIVE_ONE_TO_ONE), reversed and reversed_infinite (cleared to 0,
+//   GL_GREATER). RenderParams::projection must be written in it. An object far from the origin
+//   stays in its local frame (ControlMesh::origin) and the camera comes into it in double
+//   (WorldCamera::local, camera.h): every GL float then holds object-sized numbers.
+// - Framebuffer: RGBA8 colour, R32UI patch id, DEPTH32F; all read-backs of it are width*height
+//   values in image order: row 0 is the TOP row (GL window row height-1), pixel (x, row) at
+//   [row*width + x]. (Hi-Z read-backs, read_hiz_texture, keep hiz.h's order instead: row 0 = bottom.)
+// - Patch id buffer: 0 = background, patch index p (its position in the uploaded set) writes p + 1.
+//   Triangle t of the occluder mesh (set_occluders) writes kIdOccluderBit | t.
+// - Flag word: one uint per patch (flag_buffer()), read by the TCS (shaders/patchcull_tcs.h).
+//   Bits 0-7 = cull reason of the latest frame, 0 = not culled: kFlagFrustum (1), kFlagBackPatch
+//   (2), kFlagOcclusion (4) (shaders/shared.h). Bits 8-9 = temporal status of the pipeline:
+//   kStatusVisible (passed the latest tests) and kStatusNewlyVisible (passed them, and was not
+//   tagged visible before); gl_passes.h's flag chain writes both. A culled patch gets tessellation
+//   levels 0 in the TCS and is discarded by the tessellator (Niessner & Loop §3, Sathe: cull in the
+//   patch-constant phase).
+// - Tessellation: uniform integer level L (equal_spacing) on every edge and the interior, L in
+//   [1, 64], scaled by 2^(D - depth) per patch for sets of mixed refinement depth
+//   (PatchAttributes::depth), or adaptive by distance (RenderParams::adaptive_tess, Niessner & Loop
+//   §6.3); the surface is evaluated exactly (rational Bezier) at the tessellator points.
+// - Shading normal: du x dv of the patch's ACC tangent patches where it has them
+//   (PatchAttributes::tangents; continuous across extraordinary vertices), else of the patch's own
+//   derivatives. The geometry never depends on it.
+// - Displacement (optional, the rendered surface): S = B + D(s,t) n as in displacement.h, D from a
+//   DisplacementMap uploaded as an R32F GL_REPEAT bilinear texture, (s,t) from per-patch corner
+//   texcoords. Points where du x dv = 0 (degenerate patch corners) are not displaced. The cull
+//   margin (per-patch max |D|, PatchAttributes::max_displacement or the ranges' max_abs) is given
+//   separately, so tests can check that it bounds the surface. With margins, a patch whose margin
+//   is 0 is drawn undisplaced (D = 0 there anyway; shaders/patch_displaced.h), so one map can
+//   serve a scene of displaced and plain objects. Displaced patches are drawn two-sided and culled
+//   by the frustum pass (with their margin) and the displaced pass (Niessner & Loop §4.2's bounds, from
+//   PatchAttributes::displacement_ranges); never by the back-patch or control-point Hi-Z tests.
+//
+// Workarounds for Mesa llvmpipe (22.3.6 and still in 25.0.7), applied ALWAYS (they cost nothing
+// measurable on a GPU and keep one code path):
+// 1. gl_PrimitiveID restarts every 4096 input vertices on llvmpipe: the patch index is derived as
+//    gl_VertexID / 16 in the vertex shader and passed on; gl_PrimitiveID is never used (occluder
+//    triangle ids likewise come from gl_VertexID / 3).
+// 2. llvmpipe emits garbage when one 4096-vertex chunk yields more than 65536 tessellated vertices:
+//    every draw is split with glMultiDrawArrays into sub-draws of at most
+//    max(1, 65536 / (L+1)^2) patches (809 at L = 8, 226 at L = 16, 15 at L = 64), L the uniform
+//    level or the adaptive maximum.
+
+// Threads and lifetime: a GlContext is current on the thread that created it; every other object
+// here must be created, used and destroyed on that thread while the context lives (destroy
+// renderers before their context). Objects are move-only.
+//
+// Linking: patchcull_gl links libepoxy, which loads libEGL.so.1 and libOpenGL.so.0 (or libGL.so.1)
+// at run time; binaries start without them and create_headless() reports their absence.
+//
+// Contexts: headless EGL (create_headless) or a GLFW window (create_window); the renderer is the
+// same code in both.
+//
+// Errors: factories and calls that can fail throw patchcull::Error with a one-line message
+// ("EGL: no display ...", "GL: shader patch.tesc.glsl: <first log line>", "GL: error 0x0502 after
+// render"). patchcull prints nothing (Mesa itself may write driver warnings to stderr).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "patchcull/core/displacement.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/gl/gl_passes.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/math.h"
+#include "patchcull/core/patch.h"
+
+struct GLFWwindow;  // GLFW's window type (GlContext::glfw_window); GLFW's header is not needed here
+
+namespace patchcull::gl {
+
+// Flag word bits and id encoding (equal to shaders/shared.h's; static_asserts in the renderer).
+inline constexpr std::uint32_t kFlagFrustum = 1u;        ///< culled by the view frustum
+inline constexpr std::uint32_t kFlagBackPatch = 2u;      ///< culled as back-facing (a back-patch pass)
+inline constexpr std::uint32_t kFlagOcclusion = 4u;      ///< culled behind the Hi-Z pyramid
+inline constexpr std::uint32_t kFlagObject = 8u;         ///< culled with its object (object_culling.h)
+inline constexpr std::uint32_t kFlagReasonMask = 0xFFu;  ///< bits of the cull reason
+inline constexpr std::uint32_t kStatusVisible = 0x100u;  ///< passed the latest test
+inline constexpr std::uint32_t kStatusNewlyVisible = 0x200u;  ///< ... and was not tagged visible
+inline constexpr std::uint32_t kIdOccluderBit = 0x80000000u;  ///< id of occluder triangle t: bit | t
+
+/// Patches [first, first + count) of the set (object-level culling and draws restricted to spans).
+struct PatchSpan {
+    std::size_t first = 0;
+    std::size_t count = 0;
+};
+/// Occluder triangles [first, first + count) (set_occluders' triangle order).
+struct TriangleSpan {
+    std::size_t first = 0;
+    std::size_t count = 0;
+};
+
+/// Which tests a frame runs (CullPipeline, gl_pipeline.h); the values are the flag bits a culled
+/// patch gets.
+enum class CullMode : std::uint32_t {
+    none = 0,
+    frustum = kFlagFrustum,
+    backpatch = kFlagBackPatch,
+    occlusion = kFlagOcclusion,
+    all = kFlagFrustum | kFlagBackPatch | kFlagOcclusion,
+};
+/// "none", "frustum", "backpatch", "occlusion", "all".
+const char* cull_mode_name(CullMode mode);
+/// Parses cull_mode_name's names; returns false (mode unchanged) otherwise.
+bool parse_cull_mode(const char* text, CullMode& mode);
+
+/// An OpenGL 4.5 core context: headless (EGL) or in a window (GLFW).
+class GlContext {
+public:
+    /// Creates a headless context and makes it current on the calling thread. Tries, in order:
+    /// an EGL device (EGL_EXT_platform_device) that is not Mesa's software device (a GPU), then
+    /// Mesa's surfaceless platform (EGL_MESA_platform_surfaceless: llvmpipe without a GPU), then
+    /// the software EGL device. Throws patchcull::Error with a one-line message naming the last
+    /// failure when none gives a GL 4.5 core context (e.g. "EGL: no display: ...").
+    static GlContext create_headless();
+
+    GlContext(GlContext&&) noexcept;
+    GlContext& operator=(GlContext&&) noexcept;
+    GlContext(const GlContext&) = delete;
+    GlContext& operator=(const GlContext&) = delete;
+    ~GlContext();
+
+    /// Opens a window of width x height pixels with an OpenGL 4.5 core context, current on the
+    /// calling thread: the same renderer and cull pipeline as create_headless, shown on screen
+    /// (PatchRenderer::blit_color_to_window, swap_buffers). GLFW 3 on X11; without a screen, run
+    /// under a virtual X server (`xvfb-run -a -s "-screen 0 1280x1024x24" ...`, llvmpipe). At most
+    /// one window context at a time. Throws patchcull::Error with one line ("GLFW: ...") when
+    /// there is no X display or no 4.5 core context.
+    static GlContext create_window(int width, int height, const std::string& title);
+
+    /// Makes this context current on the calling thread (needed only after another context was).
+    void make_current() const;
+
+    /// True for a create_window context.
+    bool has_window() const;
+    /// Window: the GLFW window, for the caller's own input handling and UI (e.g. Dear ImGui's GLFW
+    /// backend; install callbacks before window_open() polls). Headless: nullptr.
+    GLFWwindow* glfw_window() const;
+    /// Window: processes pending events; false once the user has closed the window (or Escape).
+    /// Headless: always true.
+    bool window_open() const;
+    /// Window: shows the back buffer. Headless: nothing.
+    void swap_buffers() const;
+    /// Window: writes the back buffer (what the next swap_buffers shows) as an RGBA PNG, top row
+    /// first (a screenshot). Throws patchcull::Error for a headless context or an unwritable path.
+    void write_window_png(const std::string& path) const;
+
+    /// GL_RENDERER, GL_VENDOR and GL_VERSION strings.
+    const std::string& renderer() const;
+    const std::string& vendor() const;
+    const std::string& version() const;
+    /// How the display was obtained: "device" (GPU), "surfaceless", "software-device" or "window".
+    const std::string& platform() const;
+    /// True for a software rasterizer (llvmpipe, softpipe, swrast).
+    bool is_software() const;
+
+    struct Impl;
+
+private:
+    explicit GlContext(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> impl_;
+};
+
+/// Per-patch data beyond the control points. Each vector is empty (absent) or has one entry per
+/// patch.
+struct PatchAttributes {
+    /// Cull margin: bound on |D| of the rendered displacement (DisplacementRange::max_abs()), >= 0.
+    /// Read by the GPU frustum pass exactly as cull_frustum_scalar reads max_displacement. Empty:
+    /// the ranges' max_abs() when displacement_ranges is given, else no margins.
+    std::vector<float> max_displacement;
+    /// Corner texcoords at (u,v) = (0,0), (1,0), (0,1), (1,1) (PatchInfo::uv) for displacement;
+    /// absent means those same four values for every patch (PatchInfo's default).
+    std::vector<std::array<Vec2, 4>> texcoords;
+    /// ACC tangent patches (Loop & Schaefer 2008; PatchFrame::tangents and PatchInfo::tangent_index):
+    /// patch p uses tangents[tangent_index[p]] when tangent_index[p] >= 0. The TES then shades
+    /// with their normal du x dv, continuous across extraordinary vertices, instead of the
+    /// patch's own derivatives. Displacement keeps the patch's own normal: Niessner & Loop §4.2's cone
+    /// bounds (displaced_bounds.h), computed from the control points, bound that normal only.
+    /// tangent_index: empty (no tangents) or one per patch.
+    std::vector<std::int32_t> tangent_index;
+    std::vector<TangentPatches> tangents;
+    /// Refinement depth of each patch (PatchInfo::depth), or empty (all 0). With the uniform
+    /// level L a patch of depth d is tessellated at min(64, L * 2^(D - d)), D the largest depth of
+    /// the set: every patch then has the same vertex density along its base edges, so where an
+    /// adaptive (osd) patch meets two of the next depth, its edge vertices are exactly theirs and
+    /// no T-junction crack opens (up to float evaluation of the shared curve). Not applied to
+    /// adaptive_tess, whose levels follow the eye distance.
+    std::vector<std::uint8_t> depth;
+    /// DisplacementRange of each patch (min and max of D over it, displacement.h), or empty: the
+    /// input of the displaced pass (gl_passes.h's DisplacedPass, Niessner & Loop §4.2's bounds), uploaded
+    /// as vec2 per patch (range_buffer()). A patch with range (0, 0) is not displaced.
+    std::vector<DisplacementRange> displacement_ranges;
+};
+
+/// Parameters of one frame.
+struct RenderParams {
+    Mat4 view;        ///< world -> view (look_at); also gives the eye position for shading
+    Mat4 projection;  ///< view -> clip (perspective) in convention depth
+    /// The depth convention of projection (clip_space.h); the renderer draws in it: glClipControl
+    /// depth GL_ZERO_TO_ONE (GL_NEGATIVE_ONE_TO_ONE for minus_one_to_one), the depth test GL_LESS
+    /// with depth cleared to 1, or GL_GREATER with depth cleared to 0 for the reversed ones.
+    ClipDepth depth = ClipDepth::zero_to_one;
+    int width = 256;
+    int height = 256;
+    int tess_level = 8;           ///< uniform tessellation level (adaptive: the maximum), clamped to [1, 64]
+    bool use_cull_flags = true;   ///< false: ignore the flags and draw every patch (the reference)
+    bool displace = true;         ///< displace the surface when a displacement map is set
+    /// Adaptive tessellation by distance (Niessner & Loop §6.3): each edge gets
+    /// clamp(tess_level * tess_reference_distance / d, 1, tess_level), d = distance from the eye to
+    /// the midpoint of the edge's two corner points; interior levels the max of opposite edges.
+    /// Shared edges get equal levels (no T-junction cracks). false: tess_level everywhere.
+    bool adaptive_tess = false;
+    float tess_reference_distance = 1.0f;  ///< > 0, object-space units
+    /// One-sided drawing for closed, outward-oriented surfaces (LoadedModel::closed): a fragment
+    /// is kept only where the exact patch at its (u, v) faces the eye, cos(du x dv, to eye) >
+    /// kFrontFacingMinCosine (1e-3, shaders/shared.h); the rest is discarded, whatever the
+    /// triangles' own facing. This is the visibility the back-patch tests (gl_backpatch.h)
+    /// decide on, so they are conservative at every tessellation level (README: "What
+    /// contributes a pixel"). false (default): both sides of every patch are drawn (open
+    /// surfaces such as the teapot). Ignored while displacing (a displaced surface is two-sided).
+    bool discard_back_facing = false;
+};
+
+/// Draws one uploaded set of patches with hardware tessellation into its own framebuffer.
+class PatchRenderer {
+public:
+    /// Makes ctx current and compiles the embedded drawing shaders (shaders/*.glsl). Throws
+    /// patchcull::Error("GL: shader NAME: <log>") when the driver rejects one, or when ctx lacks
+    /// GL 4.5 core. Weights must be positive: set_patches and update_patches throw Error naming the
+    /// patch and point otherwise (patch.h).
+    explicit PatchRenderer(const GlContext& ctx);
+    PatchRenderer(PatchRenderer&&) noexcept;
+    PatchRenderer& operator=(PatchRenderer&&) noexcept;
+    PatchRenderer(const PatchRenderer&) = delete;
+    PatchRenderer& operator=(const PatchRenderer&) = delete;
+    ~PatchRenderer();
+
+    /// Uploads the patches (16 control points each, patch.h order) and their attributes, replacing
+    /// the previous set; all cull flags become 0 (draw). attributes' vectors must be empty or hold
+    /// patches.size() entries (else throws patchcull::Error). Patch index p is patches[p].
+    void set_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes = {});
+    /// Same from a structure-of-arrays batch (patches.count patches).
+    void set_patches(const PatchBatchView& patches, const PatchAttributes& attributes = {});
+    /// Animation: replaces the control points (and attributes) of the uploaded set by those of
+    /// the same patches in a new pose, KEEPING the flag words, so the pipeline's temporal status
+    /// carries over to the next frame (Niessner & Loop §3 with animated patches). Throws
+    /// patchcull::Error when patches.size() != patch_count() or an attribute vector has the
+    /// wrong size.
+    void update_patches(const std::vector<BezierPatch>& patches, const PatchAttributes& attributes = {});
+    std::size_t patch_count() const;
+    /// The renderer's GL objects, in gl_passes.h's layouts, for the cull passes (CullPipeline, or
+    /// a caller's own chain). Their names stay the same for the renderer's lifetime
+    /// (set_patches/update_patches re-specify the buffers' storage, not their names).
+    /// patch_buffer: vec4 cp[16 * patch_count()]; flag_buffer: uint per patch (the TCS reads it);
+    /// margin_buffer: float per patch, 0 when the set has no margins; range_buffer: vec2
+    /// DisplacementRange per patch, 0 when the set has no ranges; depth_texture: the framebuffer's
+    /// DEPTH32F attachment (width() x height(): the Hi-Z build's input).
+    std::uint32_t patch_buffer() const;
+    std::uint32_t flag_buffer() const;
+    std::uint32_t margin_buffer() const;
+    std::uint32_t range_buffer() const;
+    std::uint32_t depth_texture() const;
+    /// The ACC tangent vectors the TES shades with: 24 vec4 per patch (shaders/shared.h's
+    /// kBindingPatchTangents layout) when the set was given tangents (PatchAttributes::tangent_index
+    /// not empty), else a 16-byte placeholder. For writers that pose on the GPU (gl_posing.h).
+    std::uint32_t tangent_buffer() const;
+    /// Bytes the last set_patches / update_patches copied to GL (control points and every
+    /// attribute buffer): what re-posing on the CPU uploads per frame.
+    std::size_t last_upload_bytes() const;
+    /// {patch_buffer, flag_buffer, margin_buffer, 0, patch_count()}: the whole set for a pass.
+    PatchBuffers patch_buffers() const;
+    /// True while a displacement map is set (set_displacement_map with a non-empty map).
+    bool displaces() const;
+
+    /// Sets the height map the TES samples (a copy goes to the GPU); an empty map (the initial
+    /// state) turns displacement off. Throws patchcull::Error when texels.size() != width*height.
+    void set_displacement_map(const DisplacementMap& map);
+
+    // ---- cull flags --------------------------------------------------------------------------
+    /// Sets every flag word to 0 (draw every patch; no status).
+    void clear_cull_flags();
+    /// Uploads flags from a CPU kernel: culled[p] nonzero sets the word of patch p to kFlagFrustum
+    /// (1), zero sets 0; culled holds patch_count() bytes.
+    void set_cull_flags(const std::uint8_t* culled);
+    /// Reads the flag words back (patch_count() values; bits 0-7 = cull reason, 0 = drawn by
+    /// render(); bits 8-9 = status). Waits for the GPU.
+    std::vector<std::uint32_t> read_cull_flags() const;
+    /// Writes the flag words (patch_count() values, else throws), e.g. a pipeline's first-frame
+    /// statuses.
+    void set_flag_words(const std::vector<std::uint32_t>& words);
+    /// Counts the times the flag words were replaced from the CPU (set_patches, clear_cull_flags,
+    /// set_cull_flags, set_flag_words; not update_patches or GPU passes): a pipeline that sees it
+    /// change starts again from a first frame.
+    std::uint64_t flag_generation() const;
+
+    // ---- occluders ---------------------------------------------------------------------------
+    /// Sets the triangle-mesh occluders (Niessner & Loop §3), replacing the previous ones: triangle t has
+    /// corners vertices[indices[3t + i]] (object space). They are drawn by render() and
+    /// begin_frame() before any patch, with ids kIdOccluderBit | t, so they occlude
+    /// patches through the depth buffer and the Hi-Z pyramid. Empty vectors remove them. Throws
+    /// patchcull::Error when indices.size() is not a multiple of 3, an index is out of range, or
+    /// there are 2^31 triangles or more.
+    /// one_sided: triangle spans drawn with back faces culled (counter-clockwise = front, as
+    /// GL's default): the environment objects that show nothing from behind (closed outward solids,
+    /// a ground seen from above), so that back-face culling them at the object level removes no
+    /// pixel (object_culling.h). The other triangles are drawn two-sided. Spans must lie within the
+    /// triangles (else throws). Clears the culled spans (set_culled_occluders).
+    void set_occluders(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& indices,
+                       const std::vector<TriangleSpan>& one_sided = {});
+    std::size_t occluder_triangle_count() const;
+    /// Occluder triangles culled by the object level: begin_frame() and render() with
+    /// use_cull_flags skip them; render() without use_cull_flags (the unculled reference) draws
+    /// every triangle. Spans may overlap and come in any order; each must lie within the triangles
+    /// (else throws). An empty vector culls none.
+    void set_culled_occluders(const std::vector<TriangleSpan>& culled);
+
+    /// For occlusion queries on the frame being drawn (gl_object_queries.h): binds the frame's
+    /// framebuffer (after begin_frame) with depth test GL_LEQUAL, neither colour nor depth
+    /// writes and no face culling, so that the caller's proxies, drawn with its own program and
+    /// vertex array, only test against the depth drawn so far. end_depth_test_draws restores the
+    /// state the renderer's draws assume and unbinds; call it before the next draw_selected.
+    void begin_depth_test_draws();
+    void end_depth_test_draws();
+
+    // ---- drawing -----------------------------------------------------------------------------
+    /// Clears the framebuffer (colour dark grey, id 0, depth 1), draws the occluders, then every
+    /// patch whose cull reason (flag bits 0-7) is 0 (every patch when !use_cull_flags), resizing
+    /// the framebuffer to width x height when it changed (each in [1, 8192], else throws). Does not
+    /// wait for the GPU. Throws patchcull::Error("GL: error 0x.... after render") when GL reports
+    /// an error.
+    void render(const RenderParams& params);
+
+    /// The two steps of render() for a pipeline's passes: begin_frame clears the framebuffer
+    /// (resized to params' size as render() does), draws the occluders and makes params the
+    /// frame's camera and tessellation (and clears the drawn marks, read_drawn_patches);
+    /// draw_selected then draws, over what is there, the patches whose flag word w has
+    /// (w & mask) == value (shaders/patchcull_tcs.h's selections, e.g. kStatusVisible twice for
+    /// the first pass of Niessner & Loop §3), as many times as needed. params.use_cull_flags is ignored.
+    void begin_frame(const RenderParams& params);
+    void draw_selected(std::uint32_t mask, std::uint32_t value);
+    /// draw_selected restricted to the patches of spans (disjoint, any order, within the set, else
+    /// throws): the patches of objects culled whole are never issued, so they cost no TCS work.
+    void draw_selected(std::uint32_t mask, std::uint32_t value, const std::vector<PatchSpan>& spans);
+
+    /// Visualisation (Niessner & Loop, Fig. 2's statuses): renders every patch, ignoring the flags, with a
+    /// colour from its flag word, and the occluders in grey, seen through `view` (its camera, size
+    /// and tessellation; use_cull_flags ignored), into a separate image (the framebuffer keeps the
+    /// last frame). Legend:
+    ///   green   visible (passed the latest test, was tagged visible: drawn in pass 1)
+    ///   yellow  newly visible (passed, was not tagged visible: drawn in pass 2)
+    ///   blue    frustum-culled
+    ///   magenta back-patch-culled
+    ///   red     occlusion-culled
+    ///   cyan    culled with its object (object level, before the patch passes)
+    ///   grey    no status yet (before any test); occluders a darker neutral grey
+    /// With the frame's own camera no red or magenta patch may show in front (that would be a false
+    /// cull); another camera shows the culled patches. Returns RGBA8, row 0 = top. Waits.
+    std::vector<std::uint8_t> render_status_image(const RenderParams& view);
+    /// render_status_image written as a PNG. Throws patchcull::Error("PATH: cannot write PNG").
+    void write_status_png(const std::string& path, const RenderParams& view);
+
+    /// Waits until every command issued so far has completed (glFinish): the end point of a
+    /// wall-clock measurement.
+    void finish() const;
+
+    // ---- what a frame drew, for verification (waits for the GPU) -----------------------------
+    /// One byte per patch: 1 when the last render(), or a draw_selected() since the last
+    /// begin_frame(), tessellated it (levels > 0 in the TCS, in any pass), else 0 (culled). This, not the id buffer, is what a false cull
+    /// is judged on: a drawn patch that loses a depth tie is absent from the id buffer.
+    std::vector<std::uint8_t> read_drawn_patches() const;
+    /// The front set of the last render: redraws the patches (params must be the last render's:
+    /// camera, size, tessellation, use_cull_flags, discard_back_facing) with depth test GL_EQUAL
+    /// against its depth buffer, no colour or depth writes, and returns one byte per patch: 1 when
+    /// some fragment of the patch lies exactly at the front depth of its pixel (the patch
+    /// contributes a pixel, including every patch of a depth tie, which the id buffer shows only
+    /// one of). Leaves the framebuffer as it was. Throws patchcull::Error on a size mismatch.
+    std::vector<std::uint8_t> mark_front_patches(const RenderParams& params);
+
+    // ---- read-back of the last render (waits for the GPU; image order, row 0 = top) ----------
+    int width() const;
+    int height() const;
+    std::vector<std::uint32_t> read_ids() const;     ///< patch index + 1, 0 = background
+    std::vector<float> read_depth() const;           ///< window depth in [0,1], background 1 (0 reversed)
+    /// The depth buffer with row 0 = bottom, hiz.h's order: what HiZPyramid::build takes as it is.
+    std::vector<float> read_depth_bottom_up() const;
+    std::vector<std::uint8_t> read_color() const;    ///< RGBA8, 4 bytes per pixel
+    /// Writes the colour image of the last render as a PNG. Throws patchcull::Error("PATH: cannot
+    /// write PNG") on failure.
+    void write_color_png(const std::string& path) const;
+    /// Copies the colour image of the last frame to the current context's window (the default
+    /// framebuffer's back buffer) of window_width x window_height pixels, scaled to fill it
+    /// (nearest texel). For GlContext::create_window contexts; then swap_buffers shows it.
+    void blit_color_to_window(int window_width, int window_height) const;
+
+    struct Impl;
+
+private:
+    void begin_frame_drawing(const RenderParams& params, bool honour_occluder_culls);
+    std::unique_ptr<Impl> impl_;
+    std::size_t last_upload_bytes_ = 0;
+};
+
+/// One frame as --verify compares it: id and depth buffers (read_ids, read_depth) and one byte
+/// per patch: for the unculled reference its front set (mark_front_patches), for a culled frame
+/// its drawn set (read_drawn_patches).
+struct FrameCapture {
+    std::vector<std::uint32_t> ids;
+    std::vector<float> depth;
+    std::vector<std::uint8_t> patches;
+};
+
+/// A culled frame against the unculled render of the same camera, resolution and tessellation
+/// (the GPU ground truth), e.g. for a --verify option.
+struct FrameComparison {
+    std::size_t differing_pixels = 0;  ///< pixels whose id differs
+    /// Of those, pixels where both ids are patches and the depths are equal: two patches with
+    /// fragments at exactly the same depth, drawn in another order (GL_LESS keeps the first).
+    /// Reported apart from false culls; they never count as one and never hide one.
+    std::size_t depth_ties = 0;
+    /// False culls (ascending patch indices): patches in the reference's front set that the
+    /// culled frame did not draw. Judged per patch, not per pixel, so a patch that was drawn but
+    /// lost a depth tie is not one, and a culled patch that only ties at the front still is.
+    std::vector<std::uint32_t> false_culled;
+    bool identical() const { return differing_pixels == 0; }
+    /// No false cull and nothing but depth ties differs.
+    bool conservative() const { return false_culled.empty() && differing_pixels == depth_ties; }
+};
+/// Compares a culled frame with its reference. Throws patchcull::Error when the buffer sizes or
+/// patch counts differ.
+FrameComparison compare_frames(const FrameCapture& reference, const FrameCapture& culled);
+
+/// Writes an id buffer (as read_ids returns it) as a PNG with one distinct colour per id, black
+/// for the background: for looking at false culls. Throws patchcull::Error on failure.
+void write_ids_png(const std::string& path, const std::vector<std::uint32_t>& ids, int width, int height);
+
+}  // namespace patchcull::gl
