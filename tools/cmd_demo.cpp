@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <iterator>
 #include <memory>
+#include <string>
 
 #include "cli_options.h"
 #include "commands.h"
@@ -40,7 +41,7 @@ struct DemoOptions {
 };
 
 struct Method {
-    const char* label;
+    std::string label;
     gl::CullMode cull;
     gl::BackpatchMethod backpatch;
     bool automatic = false;  ///< --cull auto: `cull` on the objects CullAutoPolicy turns on
@@ -96,24 +97,23 @@ int run_demo(const DemoOptions& options) {
                 height, options.tess, context.renderer().c_str(),
                 context.is_software() ? "software: wall-clock pass times" : "GPU timer queries");
 
-    const Method methods[] = {
-        {"frustum", gl::CullMode::frustum, gl::BackpatchMethod::tcone},
-        {"backpatch tcone", gl::CullMode::backpatch, gl::BackpatchMethod::tcone},
-        {"backpatch ncone", gl::CullMode::backpatch, gl::BackpatchMethod::ncone},
-        {"backpatch ptp", gl::CullMode::backpatch, gl::BackpatchMethod::ptp},
-        {"occlusion", gl::CullMode::occlusion, gl::BackpatchMethod::tcone},
-        {"all (tcone)", gl::CullMode::all, gl::BackpatchMethod::tcone},
-        {"auto (tcone)", gl::CullMode::all, gl::BackpatchMethod::tcone, true},
-    };
-    // Frames rendered so far, on stderr when it is a terminal (progress.h): the 3 warm-up frames,
+    // The rows: frustum, each back-patch method (gl::kBackpatchMethods), occlusion, all and auto.
+    std::vector<Method> methods = {{"frustum", gl::CullMode::frustum, gl::BackpatchMethod::tcone}};
+    for (gl::BackpatchMethod m : gl::kBackpatchMethods)
+        methods.push_back({std::string("backpatch ") + gl::backpatch_method_name(m), gl::CullMode::backpatch, m});
+    methods.push_back({"occlusion", gl::CullMode::occlusion, gl::BackpatchMethod::tcone});
+    methods.push_back({"all (tcone)", gl::CullMode::all, gl::BackpatchMethod::tcone});
+    methods.push_back({"auto (tcone)", gl::CullMode::all, gl::BackpatchMethod::tcone, true});
+    // Frames rendered so far, on stderr when it is a terminal (progress.h): one warm-up frame per back-patch method,
     // the references and every method's frames. Cleared before each line printed on stdout.
     const std::uint64_t frames = static_cast<std::uint64_t>(options.frames);
-    Progress progress("demo", "frames", 3 + frames + std::size(methods) * frames, progress_wanted(false));
+    Progress progress("demo", "frames", std::size(gl::kBackpatchMethods) + frames + methods.size() * frames,
+                      progress_wanted(false));
     progress.erase_when_done();
     std::uint64_t frames_done = 0;
     // Compiles every pass's program before anything is timed (llvmpipe takes seconds for ncone):
     // one untimed frame per back-patch method with every test.
-    for (gl::BackpatchMethod m : {gl::BackpatchMethod::tcone, gl::BackpatchMethod::ncone, gl::BackpatchMethod::ptp}) {
+    for (gl::BackpatchMethod m : gl::kBackpatchMethods) {
         gl::PipelineParams warm_up;
         warm_up.frame.render = params_of(0);
         warm_up.frame.cull = gl::CullMode::all;
@@ -154,7 +154,7 @@ int run_demo(const DemoOptions& options) {
             frames_done += frames;  // not rendered: counted as done
             progress.clear();
             std::printf("%-17s (left out: the scene has an open model, back-patch culling is not conservative on it)\n",
-                        method.label);
+                        method.label.c_str());
             continue;
         }
         pipeline.set_patches(poses[0], attributes[0]);  // fresh statuses: a first frame
@@ -192,7 +192,7 @@ int run_demo(const DemoOptions& options) {
         const double n = sums.frames, pct = 100.0 / (n * double(patches));
         progress.clear();
         std::printf("%-17s %6.1f%% %6.1f%% %6.1f%% %6.1f%% %6.1f%% %7.1f %7.1f %7.1f %7.1f %8.1f %6.2f %6zu\n",
-                    method.label, (sums.frustum + sums.backpatch + sums.occlusion) * pct, sums.frustum * pct,
+                    method.label.c_str(), (sums.frustum + sums.backpatch + sums.occlusion) * pct, sums.frustum * pct,
                     sums.backpatch * pct, sums.occlusion * pct, sums.drawn * pct, sums.pass1 / n, sums.hiz / n,
                     sums.cull / n, sums.pass2 / n, sums.total / n, sums.total / n / reference_ms, sums.false_culls);
         total_false += sums.false_culls;

@@ -124,9 +124,9 @@ Runner add_render_command(CLI::App& app) {
     add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 1, 1000, "number of frames");
-    add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all", "auto"},
+    add_choice_option(*command, "--cull", state->cull, cull_mode_choices(),
                       "cull tests of the pipeline (auto: all, per object where it pays, Niessner & Loop §6.3)");
-    add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
+    add_choice_option(*command, "--backpatch", state->backpatch, backpatch_method_choices(),
                       "back-patch test of backpatch/all");
     add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
                       "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");

@@ -65,9 +65,9 @@ Runner add_view_command(CLI::App& app) {
     add_int_option(*command, "--frames", state->frames, 0, 1000000,
                    "stop after N frames; without --script: render's camera path, no panel (0: interactive, until "
                    "the window is closed)");
-    add_choice_option(*command, "--cull", state->cull, {"none", "frustum", "backpatch", "occlusion", "all", "auto"},
+    add_choice_option(*command, "--cull", state->cull, cull_mode_choices(),
                       "cull tests at the start (auto: all, per object where it pays, Niessner & Loop §6.3)");
-    add_choice_option(*command, "--backpatch", state->backpatch, {"tcone", "ncone", "ptp"},
+    add_choice_option(*command, "--backpatch", state->backpatch, backpatch_method_choices(),
                       "back-patch test of backpatch/all");
     add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
                       "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");

@@ -184,7 +184,13 @@ std::size_t displaced_patch_count(const ScenePoser& poser);
 DisplacedBoundKind displace_bound(const DisplaceOptions& options);
 NormalConeKind displace_cone(const DisplaceOptions& options);
 
-/// "tcone", "ncone", "ptp" -> method; throws patchcull::Error naming flag otherwise.
+/// --cull's choices: the name of every gl::kCullModes mode, then "auto".
+std::vector<std::string> cull_mode_choices();
+/// --backpatch's choices: the name of every gl::kBackpatchMethods method.
+std::vector<std::string> backpatch_method_choices();
+/// "a, b or c": names as a message lists them.
+std::string names_text(const std::vector<std::string>& names);
+/// backpatch_method_choices()'s names -> method; throws patchcull::Error naming flag otherwise.
 gl::BackpatchMethod parse_backpatch_method(const std::string& flag, const std::string& text);
 /// cull_mode_name's names -> mode; throws patchcull::Error naming flag otherwise.
 gl::CullMode parse_cull_mode_option(const std::string& flag, const std::string& text);

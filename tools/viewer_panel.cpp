@@ -6,6 +6,7 @@
 #include <imgui.h>
 
 #include <cstdio>
+#include <iterator>
 
 #include "patchcull/core/error.h"
 
@@ -63,9 +64,14 @@ void culling_section(ViewerSettings& s, const PanelInfo& info) {
     if (s.backpatch && !info.one_sided)
         ImGui::TextColored(ImVec4(1, 0.5f, 0.3f, 1), "open surface: back-patch culling is not conservative here");
     ImGui::Checkbox("auto: cull only where it pays [4]", &s.cull_auto);
-    static const char* const methods[] = {"tcone", "ncone", "ptp"};
-    int method = static_cast<int>(s.backpatch_method);
-    if (combo("back-patch test [b]", method, methods, 3)) s.backpatch_method = static_cast<gl::BackpatchMethod>(method);
+    const char* methods[std::size(gl::kBackpatchMethods)];
+    int method = 0;
+    for (std::size_t i = 0; i < std::size(gl::kBackpatchMethods); ++i) {
+        methods[i] = gl::backpatch_method_name(gl::kBackpatchMethods[i]);
+        if (gl::kBackpatchMethods[i] == s.backpatch_method) method = static_cast<int>(i);
+    }
+    if (combo("back-patch test [b]", method, methods, static_cast<int>(std::size(methods))))
+        s.backpatch_method = gl::kBackpatchMethods[method];
     ImGui::Checkbox("aggressive: no second pass [g]", &s.aggressive);
     if (s.displace) {
         static const char* const bounds[] = {"oobb", "caf"};

@@ -3,7 +3,9 @@
 
 #include <charconv>
 #include <cmath>
+#include <iterator>
 #include <utility>
+#include <vector>
 
 namespace patchcull::cli {
 namespace {
@@ -53,7 +55,6 @@ const std::vector<std::pair<const char*, ViewerKey>>& key_table() {
 }  // namespace
 
 std::string apply_setting(ViewerSettings& settings, const std::string& name, const std::string& value) {
-    using B = gl::BackpatchMethod;
     if (name == "cull.frustum") return set_switch(settings.frustum, name, value);
     if (name == "cull.backpatch") return set_switch(settings.backpatch, name, value);
     if (name == "cull.occlusion") return set_switch(settings.occlusion, name, value);
@@ -63,8 +64,11 @@ std::string apply_setting(ViewerSettings& settings, const std::string& name, con
     if (name == "displace") return set_switch(settings.displace, name, value);
     if (name == "pause") return set_switch(settings.paused, name, value);
     if (name == "panel") return set_switch(settings.panel, name, value);
-    if (name == "backpatch")
-        return set_choice(settings.backpatch_method, name, value, {{"tcone", B::tcone}, {"ncone", B::ncone}, {"ptp", B::ptp}});
+    if (name == "backpatch") {
+        std::vector<std::pair<const char*, gl::BackpatchMethod>> methods;
+        for (gl::BackpatchMethod m : gl::kBackpatchMethods) methods.emplace_back(gl::backpatch_method_name(m), m);
+        return set_choice(settings.backpatch_method, name, value, methods);
+    }
     if (name == "bound")
         return set_choice(settings.bound, name, value, {{"caf", DisplacedBoundKind::caf}, {"oobb", DisplacedBoundKind::oobb}});
     if (name == "cone")
@@ -126,11 +130,13 @@ bool apply_settings_key(ViewerSettings& s, ViewerKey key) {
     case ViewerKey::toggle_backpatch: s.backpatch = !s.backpatch; return true;
     case ViewerKey::toggle_occlusion: s.occlusion = !s.occlusion; return true;
     case ViewerKey::toggle_auto: s.cull_auto = !s.cull_auto; return true;
-    case ViewerKey::next_backpatch:
-        s.backpatch_method = s.backpatch_method == gl::BackpatchMethod::tcone   ? gl::BackpatchMethod::ncone
-                             : s.backpatch_method == gl::BackpatchMethod::ncone ? gl::BackpatchMethod::ptp
-                                                                                : gl::BackpatchMethod::tcone;
+    case ViewerKey::next_backpatch: {  // the next of gl::kBackpatchMethods, round
+        const std::size_t n = std::size(gl::kBackpatchMethods);
+        std::size_t at = 0;
+        while (at < n && gl::kBackpatchMethods[at] != s.backpatch_method) ++at;
+        s.backpatch_method = gl::kBackpatchMethods[(at + 1) % n];
         return true;
+    }
     case ViewerKey::toggle_aggressive: s.aggressive = !s.aggressive; return true;
     case ViewerKey::next_view:
         s.view = s.view == ViewerView::colour   ? ViewerView::status

@@ -94,7 +94,7 @@ const char* cull_mode_name(CullMode mode) {
 
 bool parse_cull_mode(const char* text, CullMode& mode) {
     if (!text) return false;
-    for (CullMode m : {CullMode::none, CullMode::frustum, CullMode::backpatch, CullMode::occlusion, CullMode::all})
+    for (CullMode m : kCullModes)
         if (std::strcmp(text, cull_mode_name(m)) == 0) {
             mode = m;
             return true;

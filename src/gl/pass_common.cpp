@@ -145,6 +145,16 @@ const char* backpatch_method_name(BackpatchMethod method) {
     return "?";
 }
 
+bool parse_backpatch_method(const char* text, BackpatchMethod& method) {
+    if (!text) return false;
+    for (BackpatchMethod m : kBackpatchMethods)
+        if (std::strcmp(text, backpatch_method_name(m)) == 0) {
+            method = m;
+            return true;
+        }
+    return false;
+}
+
 // ---- Hi-Z textures ------------------------------------------------------------------------
 
 namespace {

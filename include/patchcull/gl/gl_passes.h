@@ -96,8 +96,14 @@ namespace patchcull::gl {
 /// Back-patch test of Loop, Niessner & Eisenacher: the tangent cone, the normal cone,
 /// or the parametric tangent plane.
 enum class BackpatchMethod { tcone, ncone, ptp };
+/// Every back-patch method, in the order the tools list them (render's and view's --backpatch, the
+/// viewer's key and panel, the demo's rows): the one list a new method joins.
+inline constexpr BackpatchMethod kBackpatchMethods[] = {BackpatchMethod::tcone, BackpatchMethod::ncone,
+                                                        BackpatchMethod::ptp};
 /// "tcone", "ncone", "ptp" (the `patchcull cull` method names).
 const char* backpatch_method_name(BackpatchMethod method);
+/// Parses backpatch_method_name's names; returns false (method unchanged) otherwise.
+bool parse_backpatch_method(const char* text, BackpatchMethod& method);
 
 /// The text of a GLSL header shipped for an engine's own shaders, embedded in the library:
 /// "shared.h" (the constants shared by C++ and GLSL: bindings, flag bits, draw selections,

@@ -117,6 +117,9 @@ enum class CullMode : std::uint32_t {
     occlusion = kFlagOcclusion,
     all = kFlagFrustum | kFlagBackPatch | kFlagOcclusion,
 };
+/// Every cull mode, in the order the tools list them (render's and view's --cull).
+inline constexpr CullMode kCullModes[] = {CullMode::none, CullMode::frustum, CullMode::backpatch, CullMode::occlusion,
+                                          CullMode::all};
 /// "none", "frustum", "backpatch", "occlusion", "all".
 const char* cull_mode_name(CullMode mode);
 /// Parses cull_mode_name's names; returns false (mode unchanged) otherwise.
