@@ -93,7 +93,10 @@ void Progress::finish() {
 
 void Progress::clear() {
     if (!enabled_ || drawn_width_ == 0) return;
-    sink_("\r" + std::string(drawn_width_, ' ') + "\r");
+    std::string erase(drawn_width_ + 2, ' ');  // built in place: GCC 12's -Wrestrict misreads "\r" + string
+    erase.front() = '\r';
+    erase.back() = '\r';
+    sink_(erase);
     drawn_width_ = 0;
 }
 
