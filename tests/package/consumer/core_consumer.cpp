@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "check.h"
 #include "patchcull/core/camera.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/teapot.h"
@@ -14,13 +15,6 @@
 namespace pc = patchcull;
 
 namespace {
-
-int failures = 0;
-
-void check(bool ok, const std::string& what) {
-    std::printf("%s: %s\n", ok ? "ok" : "FAILED", what.c_str());
-    if (!ok) ++failures;
-}
 
 // Whether some sampled point of the patch is inside the clip volume (0 <= z <= w): then the
 // kernel must not have culled it.

@@ -7,19 +7,13 @@
 #include <sstream>
 #include <string>
 
+#include "check.h"
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_passes.h"
 #include "patchcull/gl/gl_renderer.h"
 #include "shared.h"  // include/patchcull/glsl/shared.h, on patchcull::gl's include path
 
 namespace {
-
-int failures = 0;
-
-void check(bool ok, const std::string& what) {
-    std::printf("%s: %s\n", ok ? "ok" : "FAILED", what.c_str());
-    if (!ok) ++failures;
-}
 
 std::string read_file(const std::string& path) {
     std::ifstream in(path, std::ios::binary);

@@ -1,25 +1,14 @@
 // Uses patchcull::import from an installed package: with PATCHCULL_DATA_DIR set, a shipped model
 // loaded from the installed data (ACC patches, one per quad). Prints one line per check; exit
 // status 1 on any failure.
-#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <string>
 
+#include "check.h"
 #include "patchcull/import/scene.h"
 
 namespace pc = patchcull;
-
-namespace {
-
-int failures = 0;
-
-void check(bool ok, const std::string& what) {
-    std::printf("%s: %s\n", ok ? "ok" : "FAILED", what.c_str());
-    if (!ok) ++failures;
-}
-
-}  // namespace
 
 int main() {
     // The installed data: the test sets PATCHCULL_DATA_DIR to the package's share/patchcull.
