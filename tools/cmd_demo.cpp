@@ -26,6 +26,7 @@
 #include "patchcull/core/error.h"
 #include "progress.h"
 #include "patchcull/import/scene_file.h"
+#include "patchcull/gl/gl_verification.h"
 #include "render_support.h"
 
 namespace patchcull::cli {

@@ -27,6 +27,7 @@
 #include "eval_temporal.h"
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_backpatch.h"
+#include "patchcull/gl/gl_verification.h"
 #include "progress.h"
 #include "render_support.h"
 

@@ -72,6 +72,7 @@
 #include "patchcull/core/error.h"
 #include "render_dumps.h"
 #include "patchcull/import/scene_file.h"
+#include "patchcull/gl/gl_verification.h"
 #include "render_support.h"
 
 namespace patchcull::cli {

@@ -9,6 +9,7 @@
 #include "object_level_options.h"
 #include "patchcull/import/default_scene.h"
 #include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/gl/gl_verification.h"
 #include "progress.h"
 #include "render_support.h"
 

@@ -32,6 +32,7 @@
 #include "commands.h"
 #include "patchcull/core/displaced_bounds.h"
 #include "patchcull/core/error.h"
+#include "patchcull/gl/gl_verification.h"
 #include "eval_temporal.h"
 #include "progress.h"
 #include "render_support.h"

@@ -50,6 +50,7 @@
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/gl/gl_object_queries.h"
+#include "patchcull/gl/gl_verification.h"
 #include "patchcull/import/scene_object_level.h"
 #include "patchcull/import/scene_occlusion.h"
 #include "patchcull/import/scene_file.h"

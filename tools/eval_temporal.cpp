@@ -43,6 +43,7 @@
 #include "commands.h"
 #include "patchcull/import/default_scene.h"
 #include "patchcull/core/error.h"
+#include "patchcull/gl/gl_verification.h"
 #include "progress.h"
 #include "render_support.h"
 

@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "patchcull/core/error.h"
 #include "patchcull/import/image.h"
+#include "patchcull/gl/gl_verification.h"
 
 namespace patchcull::cli {
 

@@ -12,6 +12,7 @@
 #include "patchcull/import/default_scene.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_posing.h"
+#include "patchcull/gl/gl_verification.h"
 
 namespace CLI {
 class App;

@@ -1,4 +1,4 @@
-// OpenGL contexts (patchcull/gl/gl_renderer.h: GlContext): headless EGL, or a GLFW window.
+// OpenGL contexts (patchcull/gl/gl_context.h: GlContext): headless EGL, or a GLFW window.
 //
 // libepoxy dispatches EGL and GL; it loads libEGL.so.1 and libOpenGL.so.0 / libGL.so.1 at run
 // time, and aborts the process when they are missing, so create_headless() dlopen()s them first
@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "patchcull/core/error.h"
-#include "patchcull/gl/gl_renderer.h"
+#include "patchcull/gl/gl_context.h"
 #include "png_file.h"
 
 namespace patchcull::gl {

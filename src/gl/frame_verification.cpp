@@ -1,6 +1,7 @@
-// PatchRenderer's status image (Niessner & Loop, Fig. 2's statuses), the comparison of a culled frame
-// with its unculled reference (compare_frames) and the cull-mode and timing names
-// (patchcull/gl/gl_renderer.h).
+// PatchRenderer's status image (Niessner & Loop, Fig. 2's statuses; patchcull/gl/gl_renderer.h), the
+// comparison of a culled frame with its unculled reference and the id image (compare_frames,
+// write_ids_png: patchcull/gl/gl_verification.h), and the cull-mode and timing names
+// (gl_cull_flags.h, gl_pipeline.h).
 #include <epoxy/gl.h>
 
 #include <cstring>
@@ -10,6 +11,7 @@
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_renderer.h"
+#include "patchcull/gl/gl_verification.h"
 #include "renderer_internal.h"
 
 namespace patchcull::gl {
@@ -77,6 +79,21 @@ FrameComparison compare_frames(const FrameCapture& reference, const FrameCapture
     for (std::size_t p = 0; p < reference.patches.size(); ++p)
         if (reference.patches[p] && !culled.patches[p]) c.false_culled.push_back(static_cast<std::uint32_t>(p));
     return c;
+}
+
+void write_ids_png(const std::string& path, const std::vector<std::uint32_t>& ids, int width, int height) {
+    if (width < 1 || height < 1 || ids.size() != static_cast<std::size_t>(width) * height)
+        throw Error(path + ": cannot write PNG: id buffer is not width x height");
+    std::vector<std::uint8_t> rgb(ids.size() * 3);
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+        std::uint32_t h = ids[i] * 0x9E3779B9u;
+        h ^= h >> 16;
+        h *= 0x85EBCA6Bu;
+        h ^= h >> 13;
+        for (int c = 0; c < 3; ++c)
+            rgb[3 * i + c] = ids[i] == sh::kIdBackground ? 0 : static_cast<std::uint8_t>(64 + ((h >> (8 * c)) & 191));
+    }
+    write_png_file(path, width, height, 3, rgb.data(), width * 3);
 }
 
 // ---- names ------------------------------------------------------------------------------------

@@ -376,19 +376,4 @@ void PatchRenderer::write_color_png(const std::string& path) const {
     write_png_file(path, impl_->width, impl_->height, 4, rgba.data(), impl_->width * 4);
 }
 
-void write_ids_png(const std::string& path, const std::vector<std::uint32_t>& ids, int width, int height) {
-    if (width < 1 || height < 1 || ids.size() != static_cast<std::size_t>(width) * height)
-        throw Error(path + ": cannot write PNG: id buffer is not width x height");
-    std::vector<std::uint8_t> rgb(ids.size() * 3);
-    for (std::size_t i = 0; i < ids.size(); ++i) {
-        std::uint32_t h = ids[i] * 0x9E3779B9u;
-        h ^= h >> 16;
-        h *= 0x85EBCA6Bu;
-        h ^= h >> 13;
-        for (int c = 0; c < 3; ++c)
-            rgb[3 * i + c] = ids[i] == sh::kIdBackground ? 0 : static_cast<std::uint8_t>(64 + ((h >> (8 * c)) & 191));
-    }
-    write_png_file(path, width, height, 3, rgb.data(), width * 3);
-}
-
 }  // namespace patchcull::gl

@@ -13,6 +13,7 @@
 #include "patchcull/core/camera.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/import/scene.h"
+#include "patchcull/gl/gl_verification.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -17,6 +17,7 @@
 #include "gl_test_util.h"
 #include "patchcull/import/default_scene.h"
 #include "patchcull/import/scene.h"
+#include "patchcull/gl/gl_verification.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

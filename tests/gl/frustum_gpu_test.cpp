@@ -14,6 +14,7 @@
 #include "patchcull/core/camera.h"
 #include "patchcull/core/displacement.h"
 #include "patchcull/core/frustum.h"
+#include "patchcull/gl/gl_verification.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -23,6 +23,7 @@
 #include "gl_test_util.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_renderer.h"
+#include "patchcull/gl/gl_verification.h"
 
 using namespace patchcull::cli_test;
 

@@ -13,6 +13,7 @@
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_object_queries.h"
 #include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/gl/gl_verification.h"
 
 namespace patchcull::gl {
 namespace {

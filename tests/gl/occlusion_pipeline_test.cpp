@@ -22,6 +22,7 @@
 #include "patchcull/core/camera.h"
 #include "patchcull/core/displacement.h"
 #include "patchcull/import/scene.h"
+#include "patchcull/gl/gl_verification.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

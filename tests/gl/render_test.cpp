@@ -10,6 +10,7 @@
 
 #include "gl_test_util.h"
 #include "patchcull/core/camera.h"
+#include "patchcull/gl/gl_verification.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

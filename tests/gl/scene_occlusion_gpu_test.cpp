@@ -9,6 +9,7 @@
 
 #include "gl_test_util.h"
 #include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/gl/gl_verification.h"
 #include "patchcull/import/scene_occlusion.h"
 
 namespace patchcull::gl {

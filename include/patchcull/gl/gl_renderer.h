@@ -1,6 +1,8 @@
-// patchcull/gl/gl_renderer.h: the OpenGL 4.5 renderer (library patchcull_gl): a headless EGL or
-// windowed context, and bicubic patches drawn through hardware tessellation (TCS/TES) into an
-// off-screen framebuffer, with per-patch cull flags read by the TCS and triangle-mesh occluders.
+// patchcull/gl/gl_renderer.h: the OpenGL 4.5 renderer (library patchcull_gl): bicubic patches
+// drawn through hardware tessellation (TCS/TES) into an off-screen framebuffer, with per-patch cull
+// flags read by the TCS and triangle-mesh occluders, on a GlContext (gl_context.h: headless EGL or
+// a window). The flag word, spans and cull modes are gl_cull_flags.h's; comparing a culled frame
+// with its reference is gl_verification.h's. This header includes gl_context.h and gl_cull_flags.h.
 // The renderer only draws: the cull passes are gl_passes.h's (they run on any context and any
 // buffers), and gl_pipeline.h's CullPipeline chains them with this renderer into Niessner & Loop §3's
 // two-pass temporal-coherence frame.
@@ -19,13 +21,9 @@
 //   [row*width + x]. (Hi-Z read-backs, read_hiz_texture, keep hiz.h's order instead: row 0 = bottom.)
 // - Patch id buffer: 0 = background, patch index p (its position in the uploaded set) writes p + 1.
 //   Triangle t of the occluder mesh (set_occluders) writes kIdOccluderBit | t.
-// - Flag word: one uint per patch (flag_buffer()), read by the TCS (shaders/patchcull_tcs.h).
-//   Bits 0-7 = cull reason of the latest frame, 0 = not culled: kFlagFrustum (1), kFlagBackPatch
-//   (2), kFlagOcclusion (4) (shaders/shared.h). Bits 8-9 = temporal status of the pipeline:
-//   kStatusVisible (passed the latest tests) and kStatusNewlyVisible (passed them, and was not
-//   tagged visible before); gl_passes.h's flag chain writes both. A culled patch gets tessellation
-//   levels 0 in the TCS and is discarded by the tessellator (Niessner & Loop §3, Sathe: cull in the
-//   patch-constant phase).
+// - Flag word: one uint per patch (flag_buffer()), read by the TCS: bits 0-7 the cull reason
+//   (kFlagFrustum, kFlagBackPatch, kFlagOcclusion), bits 8-9 the temporal status (kStatusVisible,
+//   kStatusNewlyVisible), as gl_cull_flags.h states. A culled patch is not tessellated.
 // - Tessellation: uniform integer level L (equal_spacing) on every edge and the interior, L in
 //   [1, 64], scaled by 2^(D - depth) per patch for sets of mixed refinement depth
 //   (PatchAttributes::depth), or adaptive by distance (RenderParams::adaptive_tess, Niessner & Loop
@@ -52,20 +50,11 @@
 //    every draw is split with glMultiDrawArrays into sub-draws of at most
 //    max(1, 65536 / (L+1)^2) patches (809 at L = 8, 226 at L = 16, 15 at L = 64), L the uniform
 //    level or the adaptive maximum.
-
-// Threads and lifetime: a GlContext is current on the thread that created it; every other object
-// here must be created, used and destroyed on that thread while the context lives (destroy
-// renderers before their context). Objects are move-only.
 //
-// Linking: patchcull_gl links libepoxy, which loads libEGL.so.1 and libOpenGL.so.0 (or libGL.so.1)
-// at run time; binaries start without them and create_headless() reports their absence.
-//
-// Contexts: headless EGL (create_headless) or a GLFW window (create_window); the renderer is the
-// same code in both.
-//
-// Errors: factories and calls that can fail throw patchcull::Error with a one-line message
-// ("EGL: no display ...", "GL: shader patch.tesc.glsl: <first log line>", "GL: error 0x0502 after
-// render"). patchcull prints nothing (Mesa itself may write driver warnings to stderr).
+// Threads, lifetime and errors as gl_context.h: renderers are created, used and destroyed on their
+// context's thread while it lives (destroy them before it), are move-only, and throw
+// patchcull::Error with a one-line message ("GL: shader patch.tesc.glsl: <first log line>", "GL:
+// error 0x0502 after render").
 #pragma once
 
 #include <array>
@@ -75,112 +64,18 @@
 #include <string>
 #include <vector>
 
+#include "patchcull/core/clip_space.h"
 #include "patchcull/core/displacement.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
-#include "patchcull/gl/gl_passes.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/math.h"
 #include "patchcull/core/patch.h"
-
-struct GLFWwindow;  // GLFW's window type (GlContext::glfw_window); GLFW's header is not needed here
+#include "patchcull/gl/gl_context.h"
+#include "patchcull/gl/gl_cull_flags.h"
+#include "patchcull/gl/gl_passes.h"
 
 namespace patchcull::gl {
-
-// Flag word bits and id encoding (equal to shaders/shared.h's; static_asserts in the renderer).
-inline constexpr std::uint32_t kFlagFrustum = 1u;        ///< culled by the view frustum
-inline constexpr std::uint32_t kFlagBackPatch = 2u;      ///< culled as back-facing (a back-patch pass)
-inline constexpr std::uint32_t kFlagOcclusion = 4u;      ///< culled behind the Hi-Z pyramid
-inline constexpr std::uint32_t kFlagObject = 8u;         ///< culled with its object (object_culling.h)
-inline constexpr std::uint32_t kFlagReasonMask = 0xFFu;  ///< bits of the cull reason
-inline constexpr std::uint32_t kStatusVisible = 0x100u;  ///< passed the latest test
-inline constexpr std::uint32_t kStatusNewlyVisible = 0x200u;  ///< ... and was not tagged visible
-inline constexpr std::uint32_t kIdOccluderBit = 0x80000000u;  ///< id of occluder triangle t: bit | t
-
-/// Patches [first, first + count) of the set (object-level culling and draws restricted to spans).
-struct PatchSpan {
-    std::size_t first = 0;
-    std::size_t count = 0;
-};
-/// Occluder triangles [first, first + count) (set_occluders' triangle order).
-struct TriangleSpan {
-    std::size_t first = 0;
-    std::size_t count = 0;
-};
-
-/// Which tests a frame runs (CullPipeline, gl_pipeline.h); the values are the flag bits a culled
-/// patch gets.
-enum class CullMode : std::uint32_t {
-    none = 0,
-    frustum = kFlagFrustum,
-    backpatch = kFlagBackPatch,
-    occlusion = kFlagOcclusion,
-    all = kFlagFrustum | kFlagBackPatch | kFlagOcclusion,
-};
-/// Every cull mode, in the order the tools list them (render's and view's --cull).
-inline constexpr CullMode kCullModes[] = {CullMode::none, CullMode::frustum, CullMode::backpatch, CullMode::occlusion,
-                                          CullMode::all};
-/// "none", "frustum", "backpatch", "occlusion", "all".
-const char* cull_mode_name(CullMode mode);
-/// Parses cull_mode_name's names; returns false (mode unchanged) otherwise.
-bool parse_cull_mode(const char* text, CullMode& mode);
-
-/// An OpenGL 4.5 core context: headless (EGL) or in a window (GLFW).
-class GlContext {
-public:
-    /// Creates a headless context and makes it current on the calling thread. Tries, in order:
-    /// an EGL device (EGL_EXT_platform_device) that is not Mesa's software device (a GPU), then
-    /// Mesa's surfaceless platform (EGL_MESA_platform_surfaceless: llvmpipe without a GPU), then
-    /// the software EGL device. Throws patchcull::Error with a one-line message naming the last
-    /// failure when none gives a GL 4.5 core context (e.g. "EGL: no display: ...").
-    static GlContext create_headless();
-
-    GlContext(GlContext&&) noexcept;
-    GlContext& operator=(GlContext&&) noexcept;
-    GlContext(const GlContext&) = delete;
-    GlContext& operator=(const GlContext&) = delete;
-    ~GlContext();
-
-    /// Opens a window of width x height pixels with an OpenGL 4.5 core context, current on the
-    /// calling thread: the same renderer and cull pipeline as create_headless, shown on screen
-    /// (PatchRenderer::blit_color_to_window, swap_buffers). GLFW 3 on X11; without a screen, run
-    /// under a virtual X server (`xvfb-run -a -s "-screen 0 1280x1024x24" ...`, llvmpipe). At most
-    /// one window context at a time. Throws patchcull::Error with one line ("GLFW: ...") when
-    /// there is no X display or no 4.5 core context.
-    static GlContext create_window(int width, int height, const std::string& title);
-
-    /// Makes this context current on the calling thread (needed only after another context was).
-    void make_current() const;
-
-    /// True for a create_window context.
-    bool has_window() const;
-    /// Window: the GLFW window, for the caller's own input handling and UI (e.g. Dear ImGui's GLFW
-    /// backend; install callbacks before window_open() polls). Headless: nullptr.
-    GLFWwindow* glfw_window() const;
-    /// Window: processes pending events; false once the user has closed the window (or Escape).
-    /// Headless: always true.
-    bool window_open() const;
-    /// Window: shows the back buffer. Headless: nothing.
-    void swap_buffers() const;
-    /// Window: writes the back buffer (what the next swap_buffers shows) as an RGBA PNG, top row
-    /// first (a screenshot). Throws patchcull::Error for a headless context or an unwritable path.
-    void write_window_png(const std::string& path) const;
-
-    /// GL_RENDERER, GL_VENDOR and GL_VERSION strings.
-    const std::string& renderer() const;
-    const std::string& vendor() const;
-    const std::string& version() const;
-    /// How the display was obtained: "device" (GPU), "surfaceless", "software-device" or "window".
-    const std::string& platform() const;
-    /// True for a software rasterizer (llvmpipe, softpipe, swrast).
-    bool is_software() const;
-
-    struct Impl;
-
-private:
-    explicit GlContext(std::unique_ptr<Impl> impl);
-    std::unique_ptr<Impl> impl_;
-};
 
 /// Per-patch data beyond the control points. Each vector is empty (absent) or has one entry per
 /// patch.
@@ -420,38 +315,5 @@ private:
     std::unique_ptr<Impl> impl_;
     std::size_t last_upload_bytes_ = 0;
 };
-
-/// One frame as --verify compares it: id and depth buffers (read_ids, read_depth) and one byte
-/// per patch: for the unculled reference its front set (mark_front_patches), for a culled frame
-/// its drawn set (read_drawn_patches).
-struct FrameCapture {
-    std::vector<std::uint32_t> ids;
-    std::vector<float> depth;
-    std::vector<std::uint8_t> patches;
-};
-
-/// A culled frame against the unculled render of the same camera, resolution and tessellation
-/// (the GPU ground truth), e.g. for a --verify option.
-struct FrameComparison {
-    std::size_t differing_pixels = 0;  ///< pixels whose id differs
-    /// Of those, pixels where both ids are patches and the depths are equal: two patches with
-    /// fragments at exactly the same depth, drawn in another order (GL_LESS keeps the first).
-    /// Reported apart from false culls; they never count as one and never hide one.
-    std::size_t depth_ties = 0;
-    /// False culls (ascending patch indices): patches in the reference's front set that the
-    /// culled frame did not draw. Judged per patch, not per pixel, so a patch that was drawn but
-    /// lost a depth tie is not one, and a culled patch that only ties at the front still is.
-    std::vector<std::uint32_t> false_culled;
-    bool identical() const { return differing_pixels == 0; }
-    /// No false cull and nothing but depth ties differs.
-    bool conservative() const { return false_culled.empty() && differing_pixels == depth_ties; }
-};
-/// Compares a culled frame with its reference. Throws patchcull::Error when the buffer sizes or
-/// patch counts differ.
-FrameComparison compare_frames(const FrameCapture& reference, const FrameCapture& culled);
-
-/// Writes an id buffer (as read_ids returns it) as a PNG with one distinct colour per id, black
-/// for the background: for looking at false culls. Throws patchcull::Error on failure.
-void write_ids_png(const std::string& path, const std::vector<std::uint32_t>& ids, int width, int height);
 
 }  // namespace patchcull::gl
