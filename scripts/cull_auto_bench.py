@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""`--cull auto` against `none` and `all` on the default scene (tools/cull_auto.h: the per-object
+"""`--cull auto` against `none` and `all` on the default scene (gl/cull_auto_policy.h: the per-object
 switch of Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation", §6.3),
 for docs/PERFORMANCE.md.
 
@@ -17,7 +17,7 @@ times, hence the rounds. Prints per level the medians over rounds of auto/none, 
 best/none (best = the faster of none and all in that round) and auto/best, with their min..max
 over rounds, and each mode's run-to-run spread ((max - min) / median of its per-round times).
 Also prints the fit of none's per-patch time against the level, p(L) = A + B L^2 (A / B: the
-per-patch cost that does not grow with the factor, in units of t^2; cull_auto.h's c0).
+per-patch cost that does not grow with the factor, in units of t^2; cull_auto_policy.h's c0).
 """
 import json
 import os

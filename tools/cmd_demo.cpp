@@ -6,7 +6,7 @@
 // false cull fails the job, exit 1).
 // Writes OUT/frame.png (colour, last frame, cull mode all) and OUT/cull.png (the patch statuses of
 // that frame seen from another camera, turned 90 degrees and above, so that culled patches show) and
-// prints, per method, cull rates and pass times. The `auto` row is --cull auto (cull_auto.h: Niessner
+// prints, per method, cull rates and pass times. The `auto` row is --cull auto (cull_auto_policy.h: Niessner
 // & Loop §6.3's per-object switch, the tests of `all` on the objects where culling pays), measured
 // and verified as the other rows. Then the object level (demo_city.h): the built-in city with
 // each --objects method in front of the patch passes.
@@ -20,12 +20,12 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "cull_auto.h"
 #include "demo_city.h"
 #include "patchcull/import/default_scene.h"
 #include "patchcull/core/error.h"
 #include "progress.h"
 #include "patchcull/import/scene_file.h"
+#include "patchcull/gl/cull_auto_policy.h"
 #include "patchcull/gl/gl_verification.h"
 #include "render_support.h"
 
@@ -160,7 +160,7 @@ int run_demo(const DemoOptions& options) {
         }
         pipeline.set_patches(poses[0], attributes[0]);  // fresh statuses: a first frame
         Sums sums;
-        CullAutoPolicy policy(ranges, patches);
+        gl::CullAutoPolicy policy(ranges, patches);
         for (int f = 0; f < options.frames; ++f) {
             if (f > 0) pipeline.update_patches(poses[static_cast<std::size_t>(f)], attributes[static_cast<std::size_t>(f)]);
             gl::PipelineParams params;
@@ -168,7 +168,7 @@ int run_demo(const DemoOptions& options) {
             params.frame.cull = method.cull;
             params.backpatch = method.backpatch;
             if (method.automatic) {
-                policy.decide(object_tess_factors(poses[static_cast<std::size_t>(f)], ranges, params.frame.render));
+                policy.decide(gl::object_tess_factors(poses[static_cast<std::size_t>(f)], ranges, params.frame.render));
                 params.objects = policy.objects();
                 params.frame.cull = policy.frame_cull_mode(method.cull);
             }

@@ -25,7 +25,7 @@
 // --frustum hull|aabb (gl_pipeline.h's FrustumTest; "frustum" in the JSON): the frustum test of the
 // chain, hull (Niessner & Loop: the control points, the default) or aabb (Sathe: the control
 // points' box grown by max |D|, which also bounds the displaced patches against the frustum).
-// --cull auto (cull_auto.h: Niessner & Loop §6.3's per-object switch): each object of the scene
+// --cull auto (cull_auto_policy.h: Niessner & Loop §6.3's per-object switch): each object of the scene
 // (render_support.h scene_objects: one per instance) is culled with the tests of `all` (back-patch
 // only where applicable_cull_mode allows) or drawn whole, decided per frame from the measured pass
 // costs, its recent cull rate and its tessellation factor; "cull" is "auto" and every frame gains
@@ -66,12 +66,12 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "cull_auto.h"
 #include "object_level_options.h"
 #include "patchcull/import/default_scene.h"
 #include "patchcull/core/error.h"
 #include "render_dumps.h"
 #include "patchcull/import/scene_file.h"
+#include "patchcull/gl/cull_auto_policy.h"
 #include "patchcull/gl/gl_verification.h"
 #include "render_support.h"
 
@@ -82,7 +82,7 @@ namespace {
 nlohmann::json number_or_null(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
 nlohmann::json auto_objects_json(const std::vector<SceneObject>& objects,
-                                 const std::vector<CullAutoPolicy::Decision>& decisions) {
+                                 const std::vector<gl::CullAutoPolicy::Decision>& decisions) {
     nlohmann::json out = nlohmann::json::array();
     for (std::size_t i = 0; i < objects.size(); ++i)
         out.push_back({{"name", objects[i].name},
@@ -228,7 +228,7 @@ Runner add_render_command(CLI::App& app) {
         for (const SceneObject& o : objects) ranges.push_back(o.range);
         std::vector<std::string> names;
         for (const SceneObject& o : objects) names.push_back(o.name);
-        CullAutoPolicy policy(ranges, scene.patch_count());
+        gl::CullAutoPolicy policy(ranges, scene.patch_count());
 
         nlohmann::json frames = nlohmann::json::array();
         std::size_t total_false = 0;

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "commands.h"
-#include "cull_auto.h"
 #include "patchcull/core/error.h"
+#include "patchcull/gl/cull_auto_policy.h"
 #include "viewer_camera.h"
 #include "viewer_controls.h"
 #include "viewer_panel.h"
@@ -127,7 +127,7 @@ int run_viewer(ViewerConfig& config) {
     const std::vector<Camera> cameras = world.scene().camera_path(lap, float(width) / float(height));
     ViewerCamera camera(cameras[0], cameras[0].target);
     ViewerControls controls(settings, camera);
-    CullAutoPolicy policy(world.ranges(), world.scene().patch_count());
+    gl::CullAutoPolicy policy(world.ranges(), world.scene().patch_count());
 
     InputQueue queue;
     GLFWwindow* window = context.glfw_window();
@@ -231,7 +231,7 @@ int run_viewer(ViewerConfig& config) {
         world.object_level().apply(world.poser(), world.current_pose(), anim_frame * kSecondsPerFrame, view_camera,
                                    height, params);
         if (settings.cull_auto) {
-            policy.decide(object_tess_factors(world.current_pose(), world.ranges(), params.frame.render));
+            policy.decide(gl::object_tess_factors(world.current_pose(), world.ranges(), params.frame.render));
             params.objects = policy.objects();
             params.frame.cull = policy.frame_cull_mode(params.frame.cull);
         }
@@ -295,7 +295,7 @@ int run_viewer(ViewerConfig& config) {
                         f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
                         stats.backpatch_culled, stats.occlusion_culled, stats.displaced_occlusion_culled,
                         stats.total_ms);
-            if (settings.cull_auto) std::printf("%s\n", auto_summary_line(world.names(), policy.decisions()).c_str());
+            if (settings.cull_auto) std::printf("%s\n", gl::auto_summary_line(world.names(), policy.decisions()).c_str());
             if (world.object_level().enabled())
                 std::printf("  objects (%s): %zu frustum-culled, %zu back-face-culled of %zu; %zu patches skipped\n",
                             world.object_level().method_name(), world.object_level().result().stats.frustum_culled,

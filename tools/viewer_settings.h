@@ -22,7 +22,7 @@ enum class ViewerCameraMode { path, orbit, fly };
 
 struct ViewerSettings {
     bool frustum = true, backpatch = true, occlusion = true;
-    bool cull_auto = false;  ///< --cull auto: the tests only on the objects where they pay (cull_auto.h)
+    bool cull_auto = false;  ///< --cull auto: the tests only on the objects where they pay (gl/cull_auto_policy.h)
     gl::BackpatchMethod backpatch_method = gl::BackpatchMethod::tcone;
     DisplacedBoundKind bound = DisplacedBoundKind::caf;
     NormalConeKind cone = NormalConeKind::acon;

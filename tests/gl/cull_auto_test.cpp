@@ -1,7 +1,7 @@
-// `--cull auto` (tools/cull_auto.h, Niessner & Loop §6.3's per-object switch): the policy class
-// alone, with given costs and cull rates (tools/cull_auto.cpp is compiled into this suite; no GL),
-// and through `render`: the JSON shape of the objects array, 0 false culls under --verify, bad
-// values exit 2. The CLI runs use the default scene at 96x54, level 4, a few frames.
+// `--cull auto` (gl/cull_auto_policy.h, Niessner & Loop §6.3's per-object switch): the policy class
+// alone, with given costs and cull rates (no GL of its own), and through `render`: the JSON shape
+// of the objects array, 0 false culls under --verify, bad values exit 2. The CLI runs use the
+// default scene at 96x54, level 4, a few frames.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,11 +13,11 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_test_util.h"
-#include "cull_auto.h"
 #include "patchcull/core/error.h"
+#include "patchcull/gl/cull_auto_policy.h"
 
 using namespace patchcull;
-using patchcull::cli::CullAutoPolicy;
+using patchcull::gl::CullAutoPolicy;
 
 namespace {
 
@@ -205,11 +205,11 @@ TEST(CullAutoPolicy, ALowTessFactorAtTheCentroidTurnsAnObjectOff) {
         patches[1].cp[k] = {0, 0, -8, 1};
     }
     const std::vector<gl::ObjectRange> objects = {{0, 1, true}, {1, 1, true}};
-    const std::vector<double> factors = cli::object_tess_factors(patches, objects, Vec3{0, 0, 0}, 8, true, 1.0f);
+    const std::vector<double> factors = gl::object_tess_factors(patches, objects, Vec3{0, 0, 0}, 8, true, 1.0f);
     ASSERT_EQ(factors.size(), 2u);
     EXPECT_NEAR(factors[0], 8.0, 1e-6);
     EXPECT_NEAR(factors[1], 1.0, 1e-6);
-    EXPECT_EQ(cli::object_tess_factors(patches, objects, Vec3{0, 0, 0}, 8, false, 1.0f), kLevel8);
+    EXPECT_EQ(gl::object_tess_factors(patches, objects, Vec3{0, 0, 0}, 8, false, 1.0f), kLevel8);
 
     CullAutoPolicy::Config config;
     config.tess_cost_offset = 10;

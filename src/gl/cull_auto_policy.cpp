@@ -1,5 +1,6 @@
-// `--cull auto`: the per-object culling switch of Niessner & Loop §6.3 (cull_auto.h).
-#include "cull_auto.h"
+// CullAutoPolicy: the per-object culling switch of Niessner & Loop §6.3
+// (patchcull/gl/cull_auto_policy.h; its estimates: docs/METHODS.md, "Culling only where it pays").
+#include "patchcull/gl/cull_auto_policy.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,7 @@
 
 #include "patchcull/core/error.h"
 
-namespace patchcull::cli {
+namespace patchcull::gl {
 namespace {
 
 double average(double old_value, double new_value, double weight) {
@@ -33,7 +34,7 @@ bool CullAutoPolicy::Costs::known() const {
     return !std::isnan(issue_ms) && !std::isnan(cull_ms) && !std::isnan(tess_unit_ms) && !std::isnan(hiz_ms);
 }
 
-CullAutoPolicy::CullAutoPolicy(std::vector<gl::ObjectRange> objects, std::size_t patch_count, Config config)
+CullAutoPolicy::CullAutoPolicy(std::vector<ObjectRange> objects, std::size_t patch_count, Config config)
     : config_(config), patch_count_(patch_count) {
     if (config.probe_interval < 1) throw Error("cull auto: probe_interval must be >= 1");
     if (config.max_probe_interval < config.probe_interval)
@@ -42,7 +43,7 @@ CullAutoPolicy::CullAutoPolicy(std::vector<gl::ObjectRange> objects, std::size_t
         throw Error("cull auto: the average weights must be in (0, 1]");
     if (!(config.tess_cost_offset >= 0)) throw Error("cull auto: tess_cost_offset must be >= 0");
     if (config.cost_frames < 1) throw Error("cull auto: cost_frames must be >= 1");
-    for (const gl::ObjectRange& o : objects) {
+    for (const ObjectRange& o : objects) {
         if (o.first > patch_count || o.count > patch_count - o.first)
             throw Error("cull auto: an object leaves the set of " + std::to_string(patch_count) + " patches");
         ObjectState s;
@@ -121,7 +122,7 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
                        ", measured " + std::to_string(since) + " frames ago";
         }
     } else if (known) {
-        // The frame rule (cull_auto.h): culling anything costs the Hi-Z build and pass 2's issue of
+        // The frame rule (docs/METHODS.md): culling anything costs the Hi-Z build and pass 2's issue of
         // every patch; the culled objects must save more than that.
         double saving = 0;
         std::size_t culled_patches = 0;
@@ -145,10 +146,10 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
     return decisions_;
 }
 
-std::vector<gl::ObjectRange> CullAutoPolicy::objects() const {
-    std::vector<gl::ObjectRange> ranges;
+std::vector<ObjectRange> CullAutoPolicy::objects() const {
+    std::vector<ObjectRange> ranges;
     for (std::size_t i = 0; i < objects_.size(); ++i) {
-        gl::ObjectRange r = objects_[i].range;
+        ObjectRange r = objects_[i].range;
         r.cull = i < decisions_.size() ? decisions_[i].cull : true;
         ranges.push_back(r);
     }
@@ -159,11 +160,11 @@ std::size_t CullAutoPolicy::culled_objects() const {
     return static_cast<std::size_t>(std::count_if(decisions_.begin(), decisions_.end(), [](const Decision& d) { return d.cull; }));
 }
 
-gl::CullMode CullAutoPolicy::frame_cull_mode(gl::CullMode tests) const {
-    return culled_objects() > 0 ? tests : gl::CullMode::none;
+CullMode CullAutoPolicy::frame_cull_mode(CullMode tests) const {
+    return culled_objects() > 0 ? tests : CullMode::none;
 }
 
-void CullAutoPolicy::observe(const gl::FrameStats& stats) {
+void CullAutoPolicy::observe(const FrameStats& stats) {
     if (!pending_) throw std::logic_error("CullAutoPolicy::observe: no decision to observe");
     if (stats.objects.size() != objects_.size())
         throw std::logic_error("CullAutoPolicy::observe: the frame has " + std::to_string(stats.objects.size()) +
@@ -174,7 +175,7 @@ void CullAutoPolicy::observe(const gl::FrameStats& stats) {
     double weighted = 0, weights = 0;  // (c0 + t^2) over the patches that passed (drawn this frame or the next)
     for (std::size_t i = 0; i < objects_.size(); ++i) {
         ObjectState& o = objects_[i];
-        const gl::ObjectStats& s = stats.objects[i];
+        const ObjectStats& s = stats.objects[i];
         const double w = config_.tess_cost_offset + factors_[i] * factors_[i];
         weighted += w * static_cast<double>(s.visible);
         weights += static_cast<double>(s.visible);
@@ -195,7 +196,7 @@ void CullAutoPolicy::observe(const gl::FrameStats& stats) {
     ++frame_;
 
     // (a) costs, from the pass times.
-    if (stats.timing == gl::TimingMethod::off || stats.patches == 0) return;
+    if (stats.timing == TimingMethod::off || stats.patches == 0) return;
     bool& seen = stats.two_pass ? seen_two_pass_ : seen_one_pass_;
     const bool first_of_kind = !seen;
     seen = true;
@@ -251,11 +252,11 @@ std::string auto_summary_line(const std::vector<std::string>& names,
 }
 
 std::vector<double> object_tess_factors(const std::vector<BezierPatch>& patches,
-                                        const std::vector<gl::ObjectRange>& objects, Vec3 eye, int tess_level,
+                                        const std::vector<ObjectRange>& objects, Vec3 eye, int tess_level,
                                         bool adaptive, float reference_distance) {
     std::vector<double> factors;
     const double level = static_cast<double>(tess_level);
-    for (const gl::ObjectRange& o : objects) {
+    for (const ObjectRange& o : objects) {
         if (!adaptive || o.count == 0) {
             factors.push_back(level);
             continue;
@@ -279,9 +280,9 @@ std::vector<double> object_tess_factors(const std::vector<BezierPatch>& patches,
 }
 
 std::vector<double> object_tess_factors(const std::vector<BezierPatch>& patches,
-                                        const std::vector<gl::ObjectRange>& objects, const gl::RenderParams& params) {
-    return object_tess_factors(patches, objects, gl::eye_of_view(params.view), std::clamp(params.tess_level, 1, 64),
+                                        const std::vector<ObjectRange>& objects, const RenderParams& params) {
+    return object_tess_factors(patches, objects, eye_of_view(params.view), std::clamp(params.tess_level, 1, 64),
                                params.adaptive_tess, params.tess_reference_distance);
 }
 
-}  // namespace patchcull::cli
+}  // namespace patchcull::gl
