@@ -38,7 +38,7 @@
 #include "patchcull/objects/backface_clusters.h"
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/frustum.h"  // simd_target_name
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 

@@ -24,7 +24,7 @@
 #include "patchcull/core/frustum.h"
 #include "patchcull/gl/gl_displaced.h"
 #include "patchcull/gl/gl_renderer.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 namespace {
 

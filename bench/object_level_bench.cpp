@@ -30,7 +30,8 @@
 #include <vector>
 
 #include "patchcull/core/camera.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/objects/object_culling.h"
 #include "patchcull/import/scene_object_level.h"
 

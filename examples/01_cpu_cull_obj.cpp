@@ -27,7 +27,7 @@
 #include "patchcull/core/ground_truth.h"
 #include "patchcull/core/parallel.h"
 #include "patchcull/core/patch.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 namespace pc = patchcull;
 

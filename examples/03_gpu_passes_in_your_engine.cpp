@@ -83,7 +83,7 @@
 #include "patchcull/gl/gl_passes.h"
 #include "patchcull/core/math.h"
 #include "patchcull/core/patch.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 #include "patchcull/core/teapot.h"
 #include "shared.h"  // shaders/shared.h: C++ and GLSL at once
 

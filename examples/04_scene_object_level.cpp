@@ -24,7 +24,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/ground_truth.h"

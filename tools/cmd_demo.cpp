@@ -1,5 +1,5 @@
 // The main job (`patchcull` with no arguments, or `patchcull demo`): renders the built-in default
-// scene (patchcull/import/default_scene.h; Niessner & Loop, Fig. 1 (c): animated characters among triangle
+// scene (patchcull/import/builtin_scenes.h; Niessner & Loop, Fig. 1 (c): animated characters among triangle
 // occluders) headless with the GPU pipeline (Niessner & Loop §3; Loop, Niessner & Eisenacher's
 // back-patch tests), along the scene's camera path, once without culling (the reference) and
 // once per cull method. Every culled frame is compared with the unculled one (compare_frames; a
@@ -21,7 +21,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "demo_city.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "progress.h"
 #include "patchcull/import/scene_file.h"

@@ -67,7 +67,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "object_level_options.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "render_dumps.h"
 #include "patchcull/import/scene_file.h"
@@ -180,7 +180,7 @@ Runner add_render_command(CLI::App& app) {
         const gl::CullMode applied = applicable_cull_mode(scene, cull, "render");
         const bool backpatch_applied = (static_cast<std::uint32_t>(applied) & gl::kFlagBackPatch) != 0;
         const bool one_sided = scene_is_one_sided(scene);
-        // Camera-relative frames (default_scene.h's rebase_scene): each frame is drawn and culled
+        // Camera-relative frames (scene_model.h's rebase_scene): each frame is drawn and culled
         // in the float frame of the grid point nearest its eye, everything in it composed in
         // double and rounded once. A scene whose eyes stay within 1024 of the origin never leaves
         // the world frame (its cameras are camera_path's, as always).

@@ -13,7 +13,7 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "object_level_options.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/scene_model.h"
 #include "patchcull/core/error.h"
 #include "patchcull/import/scene_file.h"
 #include "render_support.h"

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "patchcull/core/displacement.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 namespace patchcull::cli {
 

@@ -7,7 +7,8 @@
 #include <vector>
 
 #include "object_level_options.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_verification.h"
 #include "progress.h"

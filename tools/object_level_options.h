@@ -16,6 +16,7 @@
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/import/scene_occlusion.h"
 #include "patchcull/import/scene_object_level.h"
+#include "patchcull/import/scene_poser.h"
 
 namespace CLI {
 class App;

@@ -9,7 +9,8 @@
 #include <vector>
 
 #include "patchcull/core/camera.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_posing.h"
 #include "patchcull/gl/gl_verification.h"

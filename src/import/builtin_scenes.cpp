@@ -1,19 +1,18 @@
-// The built-in `city` and `building` scenes (patchcull/import/default_scene.h) and the lookup
-// of built-in scenes by name.
+// The built-in scenes (patchcull/import/builtin_scenes.h): `default` (Niessner & Loop, Fig. 1 (c)),
+// the one-model scene, `city` and `building`, and the lookup of built-in scenes by name.
 //
-// Both place BigGuys and MonsterFrogs by rejection sampling with std::mt19937 (whose output the
-// standard fixes, so a seed gives the same scene everywhere; only its raw output is used, no
-// std:: distributions). Every clearance is a square one (axis-aligned), the shape of the
-// characters' bounding boxes: a character at p with reach r (animated_reach: the farthest its
-// control points get from its vertical axis over one animation period, at any yaw) is kept out
-// of a box B when p lies outside B grown by r + kClearance on x and z, which holds its
-// axis-aligned bounds (within r of p on each axis) outside B at any yaw and pose.
+// The city and the building place characters by rejection sampling with std::mt19937 (raw output
+// only: a seed gives the same scene everywhere) and square clearances: a character at p with reach
+// r (animated_reach) is kept out of a box B when p lies outside B grown by r + kClearance on x
+// and z (why that suffices at any yaw and pose: docs/SCENES.md).
+#include "patchcull/import/builtin_scenes.h"
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <random>
 #include <string>
 
-#include "patchcull/import/default_scene.h"
 #include "patchcull/core/error.h"
 #include "scene_builder.h"
 
@@ -114,6 +113,79 @@ void character_shapes(const Scene& scene, Mat4 standing[2], float reach[2]) {
 }
 
 }  // namespace
+
+Scene make_default_scene(Scheme scheme) {
+    Scene scene;
+    scene.name = "default";
+    load_characters(scene, scheme);
+    const Mat4 bigguy = standing_transform(scene.models[0], 1.0f);
+    const Mat4 frog = standing_transform(scene.models[1], 0.6f);  // a frog is lower than BigGuy
+    // Two loose rows facing the camera's side (+z); the front row partly hides the back row,
+    // the wall hides the front row's legs, the pillars cut into both.
+    struct Placement {
+        std::size_t model;
+        Vec3 position;
+        float yaw_degrees;
+    };
+    const Placement placements[] = {
+        {0, {-1.3f, 0, -1.4f}, 20}, {1, {0.1f, 0, -1.6f}, -15}, {0, {1.5f, 0, -1.3f}, -30},
+        {1, {-0.7f, 0, -0.1f}, 35}, {0, {0.6f, 0, 0.0f}, 0},    {1, {1.9f, 0, 0.2f}, -40},
+    };
+    float offset = 0;
+    int copies[2] = {0, 0};
+    for (const Placement& p : placements) {
+        const Mat4& standing = p.model == 0 ? bigguy : frog;
+        SceneInstance instance;
+        instance.model = p.model;
+        instance.object_to_world = translation(p.position) * rotation_y(p.yaw_degrees) * standing;
+        instance.time_offset = offset;
+        instance.displaced = p.model == 1;  // the frogs
+        instance.name = std::string(p.model == 0 ? "bigguy#" : "monsterfrog#") + std::to_string(copies[p.model]++);
+        scene.instances.push_back(std::move(instance));
+        offset += 0.37f;
+    }
+    scene.displacement = make_procedural_displacement(512, kDefaultSceneDisplaceScale);
+    scene.displacement_name = "procedural";
+    add_ground(scene, 6.0f);
+    add_box(scene, "wall", {-2.6f, 0, 0.75f}, {0.9f, 0.42f, 0.9f});         // low wall in front of the front row
+    add_box(scene, "pillar#0", {-0.45f, 0, -0.85f}, {-0.2f, 1.5f, -0.6f});  // pillar between the rows
+    add_box(scene, "pillar#1", {1.0f, 0, -0.75f}, {1.2f, 1.3f, -0.55f});    // a second, thinner pillar
+    // Low and close, with a 45-degree vertical field of view: the wall hides the front row's legs,
+    // the front row hides parts of the back row, and the frog on the right leaves the view.
+    scene.camera.target = {0.3f, 0.4f, -0.5f};
+    scene.camera.distance = 2.3f;
+    scene.camera.height = 0.35f;
+    scene.camera.start_degrees = -20;
+    scene.camera.degrees_per_frame = 5;
+    scene.camera.fovy_radians = 45.0f * kPi / 180.0f;
+    scene.camera.z_near = 0.05f;
+    scene.camera.z_far = 30;
+    return scene;
+}
+
+Scene make_model_scene(LoadedModel model, float degrees_per_frame) {
+    Scene scene;
+    scene.name = model.name;
+    const Mat4 standing = standing_transform(model, 1.0f);
+    const Bounds b = transformed_bounds(model.rest, standing);
+    SceneInstance instance;
+    instance.object_to_world = standing;
+    instance.name = std::filesystem::path(model.name).stem().string() + "#0";
+    scene.models.push_back(std::move(model));
+    scene.instances.push_back(std::move(instance));
+    add_ground(scene, 3.0f);
+    // As orbit_sequence: far enough that the bounding sphere fits in the vertical field of view.
+    const float radius = b.radius();
+    const float distance = radius / std::sin(0.5f * scene.camera.fovy_radians) * 1.2f;
+    scene.camera.target = b.center();
+    scene.camera.distance = distance * std::cos(30.0f * kPi / 180.0f);
+    scene.camera.height = distance * std::sin(30.0f * kPi / 180.0f);
+    scene.camera.start_degrees = 0;
+    scene.camera.degrees_per_frame = degrees_per_frame;
+    scene.camera.z_near = std::max(1e-3f, 0.5f * (distance - radius));
+    scene.camera.z_far = 2 * (distance + radius) + 6.0f;  // the ground quad reaches 3 units out
+    return scene;
+}
 
 Scene make_city_scene(Scheme scheme, const CityParams& params) {
     check_range("city blocks_x", params.blocks_x, 1, 64);

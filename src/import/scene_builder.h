@@ -1,12 +1,13 @@
 // Building blocks of the scene builders (not a public header): the transforms that place models
-// and the environment objects they add (patchcull/import/default_scene.h), shared by the built-in scenes
-// (default_scene.cpp, builtin_scenes.cpp) and the scene file reader (scene_file.cpp).
+// and the environment objects they add (patchcull/import/scene_model.h), shared by the built-in
+// scenes (builtin_scenes.cpp) and the scene file reader (scene_file.cpp); scene_builder.cpp.
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/model_loader.h"
+#include "patchcull/import/scene_model.h"
 
 namespace patchcull::detail {
 

@@ -89,7 +89,7 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
         if (instance.deforms && model.subdiv) continue;  // deforming: its tangent planes change every frame
         if (displaced || model.rest.patches.empty()) continue;
         // A mirroring transform (det < 0) would flip du x dv against the planes moved into world
-        // space, but ScenePoser poses mirrored instances transposed (default_scene.h), which keeps
+        // space, but ScenePoser poses mirrored instances transposed (scene_poser.h), which keeps
         // the drawn side the model-space clusters' front side for the eye moved into model space:
         // they get clusters. A singular transform (det == 0) has no inverse to move the eye: none.
         if (linear_determinant(instance.object_to_world) == 0) continue;

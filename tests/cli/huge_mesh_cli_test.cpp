@@ -1,4 +1,4 @@
-// Meshes whose size float arithmetic cannot hold (patchcull/import/scene.h, kMaxMeshExtent): a box with
+// Meshes whose size float arithmetic cannot hold (patchcull/import/model_loader.h, kMaxMeshExtent): a box with
 // corners at +-3e38 is finite in the OBJ, but every squared length of it overflows float, so the
 // views and kernels saw infinities and culled nothing without a word; at +-1e13 ptp's rounding
 // margin already blocks every cull. Both are refused with one line, exit 2; a box at the limit

@@ -17,7 +17,7 @@
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/ground_truth.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 #include "patchcull/core/teapot.h"
 
 using namespace patchcull;

@@ -2,7 +2,7 @@
 // frustum, the segment to it through no wall: CPU ray casting against the wall boxes, in double)
 // is in a reached cell and box_visible, over hundreds of random grid buildings (2x2..4x4 rooms of
 // random size, walls as thick boxes with doors and windows, cells from wall centre to wall centre
-// as in default_scene.h's `building`), eyes in rooms, doorways, exactly on portal planes and
+// as in builtin_scenes.h's `building`), eyes in rooms, doorways, exactly on portal planes and
 // portal edges, views grazing a portal's edge, buildings 1e4 from the origin, small caps; culling
 // does happen (a closed wall and misaligned doors hide the rooms behind them, aligned doors show
 // them); an eye outside every cell culls nothing; bad input throws.

@@ -12,7 +12,7 @@
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/camera.h"
 #include "patchcull/gl/gl_pipeline.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 #include "patchcull/gl/gl_verification.h"
 
 using namespace patchcull;

@@ -15,8 +15,9 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/import/default_scene.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
+#include "patchcull/import/model_loader.h"
 #include "patchcull/gl/gl_verification.h"
 
 using namespace patchcull;

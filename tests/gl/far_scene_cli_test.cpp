@@ -1,4 +1,4 @@
-// Scenes far from the origin, drawn camera-relative (default_scene.h's rebase_scene): `render
+// Scenes far from the origin, drawn camera-relative (scene_model.h's rebase_scene): `render
 // SCENE --verify` reports 0 false culls for a chase at 8000 units per second (a BigGuy and a
 // displaced MonsterFrog, both deforming, a walk camera following them to 1.3e5 units in 200
 // frames) and for characters, a ground and a wall placed 1e5 and 1e6 units out by their time

@@ -15,7 +15,8 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_verification.h"
 

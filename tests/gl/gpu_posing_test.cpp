@@ -19,12 +19,13 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_posing.h"
 #include "patchcull/gl/gl_renderer.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -1,4 +1,4 @@
-// Mirrored instances drawn right side out (issue 11 follow-up; default_scene.h, ScenePoser): a
+// Mirrored instances drawn right side out (issue 11 follow-up; scene_poser.h, ScenePoser): a
 // closed model placed with a mirroring transform is posed with its patches transposed, so that
 // du x dv, which the one-sided fragment test keeps where it faces the eye (README "What
 // contributes a pixel"), points out of the mirrored solid. On the GPU: the id buffer of a
@@ -20,9 +20,10 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/gl/gl_renderer.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

@@ -210,7 +210,7 @@ TEST(ObjectLevelCli, BadObjectFlagsAreOneLineErrors) {
 // in object space, where facing is the opposite of the drawn (world-space) one, and cull what is
 // drawn (~270 false culls per frame, found by this suite's probe; the CPU truth is
 // tests/import/scene_object_level_test.cpp MirroredRigidInstanceIsNotBackFaceCulledWrongly).
-// Fixed: ScenePoser poses mirrored instances transposed (default_scene.h), so they are drawn
+// Fixed: ScenePoser poses mirrored instances transposed (scene_poser.h), so they are drawn
 // right side out and their model-space patch clusters hold.
 TEST(ObjectLevelCli, MirroredRigidInstanceHasNoFalseCulls) {
     const Summary s = verified_render("render " + test_scene("mirrored_rigid.json") +

@@ -21,7 +21,7 @@
 #include "patchcull/import/animation.h"
 #include "patchcull/core/camera.h"
 #include "patchcull/core/displacement.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 #include "patchcull/gl/gl_verification.h"
 
 using namespace patchcull;
@@ -379,7 +379,7 @@ TEST(OcclusionPipeline, StrictIdBufferIdenticalThroughAnimatedTeapotSequence) {
 }
 
 TEST(OcclusionPipeline, StrictIdBufferIdenticalThroughAnimatedBigGuy) {
-    // BigGuy through the import layer (scene.h, allowed in tests only): ~1.3k ACC patches, the
+    // BigGuy through the import layer (model_loader.h, allowed in tests only): ~1.3k ACC patches, the
     // control mesh deformed every frame, the camera orbiting.
     const LoadedModel model = load_model(shipped_model_path("bigguy.obj"), Scheme::acc, 0);
     ASSERT_TRUE(model.subdiv.has_value());

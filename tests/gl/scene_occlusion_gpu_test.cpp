@@ -10,7 +10,9 @@
 #include "gl_test_util.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_verification.h"
+#include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/scene_occlusion.h"
+#include "patchcull/import/scene_poser.h"
 
 namespace patchcull::gl {
 namespace {

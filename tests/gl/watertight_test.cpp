@@ -15,7 +15,7 @@
 #include "gl_test_util.h"
 #include "patchcull/core/camera.h"
 #include "patchcull/gl/gl_renderer.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

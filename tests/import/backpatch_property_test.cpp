@@ -12,7 +12,7 @@
 #include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/ground_truth.h"
 #include "patchcull/core/parallel.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 

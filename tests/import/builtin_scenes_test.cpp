@@ -1,4 +1,4 @@
-// The built-in `city` and `building` scenes (patchcull/import/default_scene.h): their layout contracts
+// The built-in `city` and `building` scenes (patchcull/import/builtin_scenes.h): their layout contracts
 // checked on the posed patches over the frames the CLI renders (60 frames at 1/12 s): no
 // character inside a building or wall, on the ground, the camera in the streets or rooms and
 // never inside a character; environment objects tile the occluders, boxes are outward; cells and
@@ -12,7 +12,8 @@
 #include <set>
 #include <string>
 
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 
 using namespace patchcull;

@@ -21,7 +21,7 @@
 #include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/displacement.h"
 #include "patchcull/core/error.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 

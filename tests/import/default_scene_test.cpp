@@ -1,4 +1,4 @@
-// Scenes for the renderer (patchcull/import/default_scene.h): the default scene's contents and placement,
+// Scenes for the renderer (builtin_scenes.h, scene_poser.h): the default scene's contents and placement,
 // ScenePoser's world-space poses (an instance's patches are its model's patches transformed), and
 // one-model scenes standing on the ground inside their camera path's view.
 #include <gtest/gtest.h>
@@ -8,7 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
 

@@ -19,7 +19,7 @@
 #include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/import/obj.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 

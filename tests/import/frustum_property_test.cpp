@@ -8,7 +8,7 @@
 #include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/ground_truth.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 

@@ -14,7 +14,7 @@
 
 #include "patchcull/core/error.h"
 #include "patchcull/import/obj.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 #include "patchcull/import/subdivision.h"
 
 using namespace patchcull;

@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "patchcull/import/obj.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 #include "patchcull/import/subdivision.h"
 
 using namespace patchcull;

@@ -19,7 +19,9 @@
 
 
 #include "patchcull/core/error.h"
+#include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/scene_file.h"
+#include "patchcull/import/scene_poser.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;

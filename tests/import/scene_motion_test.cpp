@@ -14,6 +14,7 @@
 
 #include "patchcull/core/error.h"
 #include "patchcull/import/scene_file.h"
+#include "patchcull/import/scene_poser.h"
 #include "temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -278,7 +279,7 @@ TEST(SceneMotion, OneFrameCommandsDrawAtTheirFirstCamera) {
     }
 }
 
-// Frames near the camera (default_scene.h): scene_frame_near's grid, instance_to_frame composed
+// Frames near the camera (scene_model.h): scene_frame_near's grid, instance_to_frame composed
 // in double, rebase_scene rounding world coordinates into a frame once, camera paths in double.
 TEST(SceneFrames, FrameOriginsAreTheWorldNearTheOriginAndAGridFarOut) {
     const DVec3 near = scene_frame_near({1000, -1024, 3});

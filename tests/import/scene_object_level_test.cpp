@@ -35,7 +35,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/ground_truth.h"
 #include "patchcull/import/scene_file.h"
@@ -869,7 +870,7 @@ TEST(SceneObjectLevelTruth, DegenerateObjects) {
 // the opposite of the drawn one: they cull the patches the renderer draws (render
 // tests/data/scenes/mirrored_rigid.json --objects bvh+backface --verify: ~270 false culls per
 // frame, tests/gl/object_level_cli_test.cpp). Fixed: ScenePoser
-// poses mirrored instances transposed (default_scene.h), drawn right side out, clusters kept.
+// poses mirrored instances transposed (scene_poser.h), drawn right side out, clusters kept.
 TEST(SceneObjectLevelTruth, MirroredRigidInstanceIsNotBackFaceCulledWrongly) {
     Scene scene = make_model_scene(load_model(shipped_model_path("bigguy.obj"), Scheme::acc, 0));
     ASSERT_EQ(scene.instances.size(), 1u);

@@ -5,7 +5,9 @@
 #include <random>
 
 #include "patchcull/core/error.h"
+#include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/scene_occlusion.h"
+#include "patchcull/import/scene_poser.h"
 
 namespace patchcull {
 namespace {

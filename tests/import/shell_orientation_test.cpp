@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "patchcull/core/patch.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 

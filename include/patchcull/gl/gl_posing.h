@@ -9,7 +9,7 @@
 // gl_passes.h's layouts. What changes per frame on the CPU is the animation of the control
 // meshes (animation.h), not the patches: no patch is evaluated or uploaded.
 //
-// Exactness: the output is BIT-IDENTICAL to ScenePoser::pose() (default_scene.h) for the same
+// Exactness: the output is BIT-IDENTICAL to ScenePoser::pose() (scene_poser.h) for the same
 // control meshes and transforms, on any conforming GL 4.5 implementation with IEEE double
 // addition and round-to-nearest double-to-float conversion (the shader's head comment gives the
 // argument: each stencil product is exact in double, the sum is taken in the CPU's order and
@@ -18,7 +18,7 @@
 // NVIDIA through the device script).
 //
 // The layer stays below the import layer: the tables come as plain arrays (no subdivision.h or
-// scene.h here); ScenePoser::gpu_tables / gpu_meshes (default_scene.h) produce them for a Scene.
+// scene_poser.h here); ScenePoser::gpu_tables / gpu_meshes (scene_poser.h) produce them for a Scene.
 //
 // Threads and lifetime as gl_renderer.h: create, use and destroy on the context's thread.
 // State contract of pose(): it binds its program and its buffers at shader storage bindings 0, 10
@@ -63,7 +63,7 @@ struct PosingModel {
 
 /// One instance in a frame: where its posed control mesh starts in pose()'s vertex array, its
 /// affine transform (ScenePoser: instance_to_world), and whether it mirrors (its patches are then
-/// transposed, as ScenePoser does: default_scene.h).
+/// transposed, as ScenePoser does: scene_poser.h).
 struct PosingInstance {
     std::size_t first_vertex = 0;
     Mat4 to_world;

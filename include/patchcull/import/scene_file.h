@@ -1,4 +1,4 @@
-// patchcull/import/scene_file.h: scene files, the JSON form of a Scene (patchcull/import/default_scene.h): placed,
+// patchcull/import/scene_file.h: scene files, the JSON form of a Scene (patchcull/import/scene_model.h): placed,
 // animated subdivision characters and triangle-mesh environment objects that are drawn and
 // occlude, a displacement map, a camera path, and optional cells and portals (the
 // object-level scenes of G. Zachmann's lecture "Advanced Visibility Computations", and of
@@ -22,14 +22,14 @@
 // world's origin the origin is 0 and transforms are composed in float exactly as the built-in scenes compose them
 // (so default.json reproduces make_default_scene bit for bit). Placed models and environment
 // vertices must lie within kMaxSceneCoordinate of the origin and be at least kMinMeshDiagonal
-// across (scene.h's load_model limit, applied in world space); cells and portals are world
+// across (model_loader.h's load_model limit, applied in world space); cells and portals are world
 // positions in double too (Scene::cell_world, Scene::portal_world).
 #pragma once
 
 #include <cstdint>
 #include <string>
 
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/scene_model.h"
 
 namespace patchcull {
 

@@ -1,5 +1,5 @@
 // patchcull/import/scene_object_level.h: the object level (object_culling.h) set up for a Scene
-// (default_scene.h): one object per instance (its patches in ScenePoser's order) and one per
+// (scene_model.h): one object per instance (its patches in ScenePoser's order) and one per
 // environment object (its triangles), their world boxes each frame, and their back-face clusters.
 //
 // - Boxes: an instance's box is the AABB of its posed control points (the convex hull holds the
@@ -30,7 +30,7 @@ inline constexpr float kClusterRoundingRatio = 256;
 #include <string>
 #include <vector>
 
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/scene_model.h"
 #include "patchcull/objects/object_culling.h"
 
 namespace patchcull {

@@ -1,5 +1,5 @@
 // patchcull/import/scene_occlusion.h: the CPU object-level occlusion methods set up for a
-// Scene (default_scene.h), after the object level of scene_object_level.h:
+// Scene (scene_model.h), after the object level of scene_object_level.h:
 //   horizon  the occlusion horizon (occlusion_horizon.h; Downs, Möller & Séquin, "Occlusion
 //            Horizons for Driving through Urban Scenery"): the occluders are the environment
 //            objects that are closed boxes (a city's buildings, box_environment_objects), the
@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "patchcull/core/camera.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/scene_model.h"
 #include "patchcull/objects/object_culling.h"
 #include "patchcull/objects/occlusion_horizon.h"
 #include "patchcull/objects/portal_culling.h"

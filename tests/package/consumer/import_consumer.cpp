@@ -6,7 +6,7 @@
 #include <string>
 
 #include "check.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 namespace pc = patchcull;
 

@@ -1,5 +1,5 @@
-// Model loading by name for tools (patchcull/import/scene.h).
-#include "patchcull/import/scene.h"
+// Model loading by name for tools (patchcull/import/model_loader.h).
+#include "patchcull/import/model_loader.h"
 
 #include <algorithm>
 #include <cmath>
