@@ -365,117 +365,135 @@ struct ModelKey {
     bool operator<(const ModelKey& o) const { return file != o.file ? file < o.file : scheme < o.scheme; }
 };
 
-}  // namespace
+// Names of objects, environment objects or cells -> their indices (for the lists that name them).
+using NameIndex = std::map<std::string, std::size_t>;
 
-Scene load_scene_file(const std::string& path) {
-    Reader r{path, fs::path(path).parent_path()};
+// The whole file, size-checked, parsed (parse_strict), its root object's keys checked.
+json read_root(const Reader& r, const std::string& path) {
     const std::string problem = detail::input_file_problem(path, kMaxSceneFileBytes, "scene");
     if (!problem.empty()) r.fail("", problem);
     std::ifstream in(path, std::ios::binary);
     if (!in) r.fail("", "cannot open file");
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) r.fail("", "cannot read the file");
-    const json root = parse_strict(r, text);
+    json root = parse_strict(r, text);
     r.object(root, "", {"name", "objects", "environment", "displacement", "animation", "camera", "cells", "portals"});
+    return root;
+}
 
-    Scene scene;
-    const json* name = r.find(root, "name");
-    scene.name = name ? r.string(*name, "name") : fs::path(path).stem().string();
+// "animation": the scene's AnimationParams, each key defaulting to the struct's value.
+void read_animation(const Reader& r, const json& a, AnimationParams& animation) {
+    r.object(a, "animation", {"bend_radians", "twist_radians", "breathe_amplitude", "period_seconds"});
+    animation.bend_radians = r.number_or(a, "animation", "bend_radians", animation.bend_radians, -10, 10);
+    animation.twist_radians = r.number_or(a, "animation", "twist_radians", animation.twist_radians, -10, 10);
+    animation.breathe_amplitude = r.number_or(a, "animation", "breathe_amplitude", animation.breathe_amplitude, 0, 0.5);
+    animation.period_seconds = r.number_or(a, "animation", "period_seconds", animation.period_seconds, 0, 1e6, true);
+}
 
-    // Animation and displacement first: objects refer to them.
-    if (const json* a = r.find(root, "animation")) {
-        r.object(*a, "animation", {"bend_radians", "twist_radians", "breathe_amplitude", "period_seconds"});
-        scene.animation.bend_radians = r.number_or(*a, "animation", "bend_radians", scene.animation.bend_radians, -10, 10);
-        scene.animation.twist_radians = r.number_or(*a, "animation", "twist_radians", scene.animation.twist_radians, -10, 10);
-        scene.animation.breathe_amplitude =
-            r.number_or(*a, "animation", "breathe_amplitude", scene.animation.breathe_amplitude, 0, 0.5);
-        scene.animation.period_seconds =
-            r.number_or(*a, "animation", "period_seconds", scene.animation.period_seconds, 0, 1e6, true);
+// "displacement": map "none", "procedural" (scale, size, seed) or a PNG path (scale).
+void read_displacement(const Reader& r, const json& d, Scene& scene) {
+    r.object(d, "displacement", {"map", "scale", "size", "seed"});
+    const std::string map = r.string(r.require(d, "displacement", "map"), "displacement.map");
+    if (map == "none") {
+        for (const char* key : {"scale", "size", "seed"})
+            if (r.find(d, key)) r.fail(join("displacement", key), "not used with map 'none'");
+        return;
     }
-    if (const json* d = r.find(root, "displacement")) {
-        r.object(*d, "displacement", {"map", "scale", "size", "seed"});
-        const std::string map = r.string(r.require(*d, "displacement", "map"), "displacement.map");
-        if (map == "none") {
-            for (const char* key : {"scale", "size", "seed"})
-                if (r.find(*d, key)) r.fail(join("displacement", key), "not used with map 'none'");
-        } else {
-            const float scale = r.number(r.require(*d, "displacement", "scale"), "displacement.scale", 0, 1e6, true);
-            if (map == "procedural") {
-                const json* size = r.find(*d, "size");
-                const json* seed = r.find(*d, "seed");
-                const int n = size ? static_cast<int>(r.integer(*size, "displacement.size", 1, 4096)) : 512;
-                const auto s = seed ? static_cast<std::uint32_t>(r.integer(*seed, "displacement.seed", 0, 4294967295LL)) : 7u;
-                scene.displacement = make_procedural_displacement(n, scale, s);
-            } else {
-                for (const char* key : {"size", "seed"})
-                    if (r.find(*d, key)) r.fail(join("displacement", key), "only for map 'procedural'");
-                try {
-                    scene.displacement = load_displacement_png(r.resolve(map), scale);
-                } catch (const Error& e) {
-                    r.fail("displacement.map", e.what());
-                }
-            }
-            scene.displacement_name = map == "procedural" ? map : r.resolve(map);
+    const float scale = r.number(r.require(d, "displacement", "scale"), "displacement.scale", 0, 1e6, true);
+    if (map == "procedural") {
+        const json* size = r.find(d, "size");
+        const json* seed = r.find(d, "seed");
+        const int n = size ? static_cast<int>(r.integer(*size, "displacement.size", 1, 4096)) : 512;
+        const auto s = seed ? static_cast<std::uint32_t>(r.integer(*seed, "displacement.seed", 0, 4294967295LL)) : 7u;
+        scene.displacement = make_procedural_displacement(n, scale, s);
+    } else {
+        for (const char* key : {"size", "seed"})
+            if (r.find(d, key)) r.fail(join("displacement", key), "only for map 'procedural'");
+        try {
+            scene.displacement = load_displacement_png(r.resolve(map), scale);
+        } catch (const Error& e) {
+            r.fail("displacement.map", e.what());
         }
     }
+    scene.displacement_name = map == "procedural" ? map : r.resolve(map);
+}
 
-    // Objects.
+// The file a model name stands for.
+std::string model_file(const Reader& r, const std::string& spec) {
+    if (spec == "bigguy" || spec == "monsterfrog") return shipped_model_path(spec + ".obj");
+    return spec == "teapot" ? std::string("teapot") : r.resolve(spec);
+}
+
+// The model's key (file and scheme).
+ModelKey model_key(const Reader& r, const std::string& spec, Scheme scheme) {
+    ModelKey key{model_file(r, spec), spec == "teapot" ? Scheme::acc : scheme};
+    if (spec != "teapot") {
+        std::error_code ec;
+        const fs::path canonical = fs::weakly_canonical(key.file, ec);
+        if (!ec) key.file = canonical.string();
+    }
+    return key;
+}
+
+// Default names are "STEM#k", k counting the objects of one model (file and scheme). Where
+// models of one stem differ (one model in both schemes, or two files of one name), the stem
+// alone would name two objects alike: their default names then say the model as the file
+// writes it (when the files differ) and the scheme (when the schemes differ), e.g.
+// "bigguy:osd#0", "a/bigguy.obj#0". This first pass finds them (without loading, and without
+// failing: read_objects reports malformed objects in file order).
+std::map<ModelKey, std::string> default_name_stems(const Reader& r, const json& objects) {
+    std::map<ModelKey, std::string> default_keys;
+    std::map<std::string, std::vector<std::pair<ModelKey, std::string>>> by_stem;  // stem -> (key, spec)
+    for (const json& o : objects) {
+        const auto m = o.is_object() ? o.find("model") : o.end();
+        if (m == o.end() || !m->is_string() || m->get<std::string>().empty()) continue;
+        const auto sc = o.find("scheme");
+        Scheme scheme = Scheme::acc;
+        if (sc != o.end() && !(sc->is_string() && parse_scheme(sc->get<std::string>(), scheme))) continue;
+        const std::string spec = m->get<std::string>();
+        const ModelKey key = model_key(r, spec, scheme);
+        auto& group = by_stem[fs::path(model_file(r, spec)).stem().string()];
+        if (std::none_of(group.begin(), group.end(), [&](const auto& g) { return !(g.first < key) && !(key < g.first); }))
+            group.emplace_back(key, spec);
+    }
+    for (const auto& [stem, group] : by_stem) {
+        bool files_differ = false, schemes_differ = false;
+        for (const auto& g : group) {
+            files_differ = files_differ || g.first.file != group.front().first.file;
+            schemes_differ = schemes_differ || g.first.scheme != group.front().first.scheme;
+        }
+        for (const auto& [key, spec] : group)
+            default_keys[key] = (files_differ ? spec : stem) + (schemes_differ ? std::string(":") + scheme_name(key.scheme) : "");
+    }
+    return default_keys;
+}
+
+// An object's "animation": deform, time_offset, velocity.
+void read_object_animation(const Reader& r, const json& a, const std::string& ap, SceneInstance& instance) {
+    r.object(a, ap, {"deform", "time_offset", "velocity"});
+    instance.deforms = r.boolean_or(a, ap, "deform", true);
+    instance.time_offset = r.number_or(a, ap, "time_offset", 0, -1e6, 1e6);
+    if (const json* v = r.find(a, "velocity")) {
+        instance.velocity = r.vec3(*v, join(ap, "velocity"));
+        if (length(instance.velocity) > 1e6f) r.fail(join(ap, "velocity"), "expected a speed of at most 1e6 units per second");
+    }
+}
+
+// "objects": the models (each file and scheme loaded once) and their instances. Returns the
+// instances' names.
+NameIndex read_objects(const Reader& r, const json& root, Scene& scene) {
     std::map<ModelKey, std::size_t> loaded;
-    std::map<std::string, std::size_t> instance_names;
+    NameIndex instance_names;
     std::vector<std::size_t> copies;
     const json& objects = r.array(r.require(root, "", "objects"), "objects", true);
-    // The file a model name stands for, and the model's key (file and scheme).
-    auto model_file = [&](const std::string& spec) {
-        if (spec == "bigguy" || spec == "monsterfrog") return shipped_model_path(spec + ".obj");
-        return spec == "teapot" ? std::string("teapot") : r.resolve(spec);
-    };
-    auto model_key = [&](const std::string& spec, Scheme scheme) {
-        ModelKey key{model_file(spec), spec == "teapot" ? Scheme::acc : scheme};
-        if (spec != "teapot") {
-            std::error_code ec;
-            const fs::path canonical = fs::weakly_canonical(key.file, ec);
-            if (!ec) key.file = canonical.string();
-        }
-        return key;
-    };
-    // Default names are "STEM#k", k counting the objects of one model (file and scheme). Where
-    // models of one stem differ (one model in both schemes, or two files of one name), the stem
-    // alone would name two objects alike: their default names then say the model as the file
-    // writes it (when the files differ) and the scheme (when the schemes differ), e.g.
-    // "bigguy:osd#0", "a/bigguy.obj#0". A first pass finds them (without loading, and without
-    // failing: the main pass reports malformed objects in file order).
-    std::map<ModelKey, std::string> default_keys;
-    {
-        std::map<std::string, std::vector<std::pair<ModelKey, std::string>>> by_stem;  // stem -> (key, spec)
-        for (const json& o : objects) {
-            const auto m = o.is_object() ? o.find("model") : o.end();
-            if (m == o.end() || !m->is_string() || m->get<std::string>().empty()) continue;
-            const auto sc = o.find("scheme");
-            Scheme scheme = Scheme::acc;
-            if (sc != o.end() && !(sc->is_string() && parse_scheme(sc->get<std::string>(), scheme))) continue;
-            const std::string spec = m->get<std::string>();
-            const ModelKey key = model_key(spec, scheme);
-            auto& group = by_stem[fs::path(model_file(spec)).stem().string()];
-            if (std::none_of(group.begin(), group.end(), [&](const auto& g) { return !(g.first < key) && !(key < g.first); }))
-                group.emplace_back(key, spec);
-        }
-        for (const auto& [stem, group] : by_stem) {
-            bool files_differ = false, schemes_differ = false;
-            for (const auto& g : group) {
-                files_differ = files_differ || g.first.file != group.front().first.file;
-                schemes_differ = schemes_differ || g.first.scheme != group.front().first.scheme;
-            }
-            for (const auto& [key, spec] : group)
-                default_keys[key] = (files_differ ? spec : stem) + (schemes_differ ? std::string(":") + scheme_name(key.scheme) : "");
-        }
-    }
+    const std::map<ModelKey, std::string> default_keys = default_name_stems(r, objects);
     for (std::size_t i = 0; i < objects.size(); ++i) {
         const std::string p = index("objects", i);
         const json& o = r.object(objects[i], p, {"name", "model", "scheme", "transform", "animation", "displaced"});
         const std::string spec = r.string(r.require(o, p, "model"), join(p, "model"));
         const Scheme scheme = read_scheme(r, o, p);
-        const std::string file = model_file(spec);
-        const ModelKey key = model_key(spec, scheme);
+        const std::string file = model_file(r, spec);
+        const ModelKey key = model_key(r, spec, scheme);
         auto found = loaded.find(key);
         if (found == loaded.end()) {
             try {
@@ -494,16 +512,7 @@ Scene load_scene_file(const std::string& path) {
                                    : read_transform(r, json::object(), join(p, "transform"), &model, model.origin);
         instance.object_to_world = placed.m;
         instance.origin = placed.origin;
-        if (const json* a = r.find(o, "animation")) {
-            const std::string ap = join(p, "animation");
-            r.object(*a, ap, {"deform", "time_offset", "velocity"});
-            instance.deforms = r.boolean_or(*a, ap, "deform", true);
-            instance.time_offset = r.number_or(*a, ap, "time_offset", 0, -1e6, 1e6);
-            if (const json* v = r.find(*a, "velocity")) {
-                instance.velocity = r.vec3(*v, join(ap, "velocity"));
-                if (length(instance.velocity) > 1e6f) r.fail(join(ap, "velocity"), "expected a speed of at most 1e6 units per second");
-            }
-        }
+        if (const json* a = r.find(o, "animation")) read_object_animation(r, *a, join(p, "animation"), instance);
         instance.displaced = r.boolean_or(o, p, "displaced", false);
         if (instance.displaced && scene.displacement.empty())
             r.fail(join(p, "displaced"), "true, but the scene has no displacement map (\"displacement\")");
@@ -521,207 +530,272 @@ Scene load_scene_file(const std::string& path) {
                                         std::to_string(instance_names[instance.name]) + "])");
         scene.instances.push_back(std::move(instance));
     }
+    return instance_names;
+}
 
-    // Environment objects.
-    std::map<std::string, std::size_t> environment_names;
+// An environment object's triangles before its transform: vertices (plus `origin`, an OBJ's
+// local frame), 3 indices per triangle, and whether its kind is one-sided by default.
+struct EnvironmentShape {
+    std::vector<DVec3> local;
+    std::vector<std::uint32_t> indices;
+    DVec3 origin{};
+    bool one_sided = false;
+};
+
+// "box": {min, max}, add_box's triangles over its corners, one-sided.
+EnvironmentShape read_box(const Reader& r, const json& box, const std::string& bp) {
+    EnvironmentShape shape;
+    r.object(box, bp, {"min", "max"});
+    const DVec3 lo = r.position(r.require(box, bp, "min"), join(bp, "min"));
+    const DVec3 hi = r.position(r.require(box, bp, "max"), join(bp, "max"));
+    if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
+        r.fail(bp, "max must be greater than min on every axis (a flat or empty box)");
+    // add_box's triangles over its corners (bit 0 = x, bit 1 = y, bit 2 = z), in double.
+    Scene tmp;
+    add_box(tmp, "", {0, 0, 0}, {1, 1, 1});
+    for (const Vec3& v : tmp.occluder_vertices)
+        shape.local.push_back({v.x > 0 ? hi.x : lo.x, v.y > 0 ? hi.y : lo.y, v.z > 0 ? hi.z : lo.z});
+    shape.indices = tmp.occluder_indices;
+    shape.one_sided = true;
+    return shape;
+}
+
+// "quad": 4 corners spanning an area, two triangles.
+EnvironmentShape read_quad(const Reader& r, const json& quad, const std::string& qp) {
+    EnvironmentShape shape;
+    if (!quad.is_array() || quad.size() != 4) r.fail(qp, "expected 4 corners");
+    DVec3 c[4];
+    for (std::size_t k = 0; k < 4; ++k) c[k] = r.position(quad[k], index(qp, k));
+    // The area from offsets to the first corner (small numbers, whatever the position).
+    const Vec3 e1 = to_float(c[1] - c[0]), e2 = to_float(c[2] - c[0]), e3 = to_float(c[3] - c[0]);
+    const float area = length(cross(e1, e2)) + length(cross(e2, e3));
+    if (!(area > 0)) r.fail(qp, "the corners span no area");
+    for (const DVec3& v : c) shape.local.push_back(v);
+    shape.indices = {0, 1, 2, 0, 2, 3};
+    return shape;
+}
+
+// "obj": an OBJ file's faces as fans of triangles, in its local frame.
+EnvironmentShape read_obj_shape(const Reader& r, const json& obj, const std::string& op) {
+    EnvironmentShape shape;
+    const std::string file = r.resolve(r.string(obj, op));
+    ControlMesh mesh;
+    try {
+        mesh = load_obj(file);
+    } catch (const Error& err) {
+        r.fail(op, err.what());
+    }
+    if (mesh.face_count() == 0) r.fail(op, file + ": the mesh has no faces");
+    for (const Vec3& v : mesh.positions) shape.local.push_back({v.x, v.y, v.z});
+    shape.origin = mesh.origin;
+    for (std::size_t f = 0; f < mesh.face_count(); ++f) {
+        const std::uint32_t first = mesh.face_offsets[f];
+        for (std::uint32_t k = 1; k + 1 < mesh.face_size(f); ++k)
+            for (std::uint32_t c : {first, first + k, first + k + 1}) shape.indices.push_back(mesh.face_vertices[c]);
+    }
+    return shape;
+}
+
+// One entry of "environment": its shape placed in world space and added to the scene.
+void read_environment_object(const Reader& r, const json& e, std::size_t i, Scene& scene, NameIndex& environment_names) {
+    const std::string p = index("environment", i);
+    r.object(e, p, {"name", "box", "quad", "obj", "transform", "one_sided"});
+    const int kinds = (r.find(e, "box") ? 1 : 0) + (r.find(e, "quad") ? 1 : 0) + (r.find(e, "obj") ? 1 : 0);
+    if (kinds != 1) r.fail(p, "expected exactly one of 'box', 'quad' or 'obj'");
+    EnvironmentShape shape = r.find(e, "box")    ? read_box(r, *r.find(e, "box"), join(p, "box"))
+                             : r.find(e, "quad") ? read_quad(r, *r.find(e, "quad"), join(p, "quad"))
+                                                 : read_obj_shape(r, *r.find(e, "obj"), join(p, "obj"));
+    const bool one_sided = r.boolean_or(e, p, "one_sided", shape.one_sided);
+    // The transform maps the object's coordinates (an OBJ's own, with its local frame's
+    // origin added back) to world space, in double.
+    const json* t = r.find(e, "transform");
+    const Placement placed = t ? read_transform(r, *t, join(p, "transform"), nullptr, {}) : Placement{};
+    const Mat4& m = placed.m;
+    const double det = linear_determinant(m);
+    if (!(std::fabs(det) > 0)) r.fail(join(p, "transform"), "the transform is singular (a zero scale)");
+    std::vector<DVec3> world;
+    world.reserve(shape.local.size());
+    for (const DVec3& v : shape.local) {
+        const double x = v.x + shape.origin.x, y = v.y + shape.origin.y, z = v.z + shape.origin.z;
+        double w[3];
+        for (int row = 0; row < 3; ++row)
+            w[row] = double(m.at(row, 0)) * x + double(m.at(row, 1)) * y + double(m.at(row, 2)) * z + double(m.at(row, 3));
+        world.push_back(DVec3{w[0], w[1], w[2]} + placed.origin);
+    }
+    check_placed(r, t ? join(p, "transform") : p, world, "environment object");
+    // The scene's frame is the world's (origin 0): float world vertices, and the exact
+    // ones in double for rebase_scene.
+    std::vector<Vec3> world_float;
+    world_float.reserve(world.size());
+    for (const DVec3& v : world) world_float.push_back({to_float(v.x), to_float(v.y), to_float(v.z)});
+    scene.occluder_world.insert(scene.occluder_world.end(), world.begin(), world.end());
+    // A mirroring transform turns counter-clockwise into clockwise: flip the triangles back.
+    std::vector<std::uint32_t>& indices = shape.indices;
+    if (det < 0)
+        for (std::size_t k = 0; k + 2 < indices.size(); k += 3) std::swap(indices[k + 1], indices[k + 2]);
+    const json* n = r.find(e, "name");
+    const std::string object_name = n ? r.string(*n, join(p, "name")) : "environment#" + std::to_string(i);
+    if (!environment_names.emplace(object_name, i).second)
+        r.fail(join(p, "name"), "duplicate environment name " + quote_input(object_name) + " (also environment[" +
+                                    std::to_string(environment_names[object_name]) + "])");
+    add_triangles(scene, object_name, world_float, indices, one_sided);
+}
+
+// "environment" (optional). Returns the environment objects' names.
+NameIndex read_environment(const Reader& r, const json& root, Scene& scene) {
+    NameIndex environment_names;
     if (const json* env = r.find(root, "environment")) {
         r.array(*env, "environment", false);
-        for (std::size_t i = 0; i < env->size(); ++i) {
-            const std::string p = index("environment", i);
-            const json& e = r.object((*env)[i], p, {"name", "box", "quad", "obj", "transform", "one_sided"});
-            const int kinds = (r.find(e, "box") ? 1 : 0) + (r.find(e, "quad") ? 1 : 0) + (r.find(e, "obj") ? 1 : 0);
-            if (kinds != 1) r.fail(p, "expected exactly one of 'box', 'quad' or 'obj'");
-            std::vector<DVec3> local;  // before the transform
-            std::vector<std::uint32_t> indices;
-            DVec3 origin{};
-            bool one_sided = false;
-            if (const json* box = r.find(e, "box")) {
-                const std::string bp = join(p, "box");
-                r.object(*box, bp, {"min", "max"});
-                const DVec3 lo = r.position(r.require(*box, bp, "min"), join(bp, "min"));
-                const DVec3 hi = r.position(r.require(*box, bp, "max"), join(bp, "max"));
-                if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z))
-                    r.fail(bp, "max must be greater than min on every axis (a flat or empty box)");
-                // add_box's triangles over its corners (bit 0 = x, bit 1 = y, bit 2 = z), in double.
-                Scene tmp;
-                add_box(tmp, "", {0, 0, 0}, {1, 1, 1});
-                for (const Vec3& v : tmp.occluder_vertices)
-                    local.push_back({v.x > 0 ? hi.x : lo.x, v.y > 0 ? hi.y : lo.y, v.z > 0 ? hi.z : lo.z});
-                indices = tmp.occluder_indices;
-                one_sided = true;
-            } else if (const json* quad = r.find(e, "quad")) {
-                const std::string qp = join(p, "quad");
-                if (!quad->is_array() || quad->size() != 4) r.fail(qp, "expected 4 corners");
-                DVec3 c[4];
-                for (std::size_t k = 0; k < 4; ++k) c[k] = r.position((*quad)[k], index(qp, k));
-                // The area from offsets to the first corner (small numbers, whatever the position).
-                const Vec3 e1 = to_float(c[1] - c[0]), e2 = to_float(c[2] - c[0]), e3 = to_float(c[3] - c[0]);
-                const float area = length(cross(e1, e2)) + length(cross(e2, e3));
-                if (!(area > 0)) r.fail(qp, "the corners span no area");
-                for (const DVec3& v : c) local.push_back(v);
-                indices = {0, 1, 2, 0, 2, 3};
-            } else {
-                const std::string file = r.resolve(r.string(*r.find(e, "obj"), join(p, "obj")));
-                ControlMesh mesh;
-                try {
-                    mesh = load_obj(file);
-                } catch (const Error& err) {
-                    r.fail(join(p, "obj"), err.what());
-                }
-                if (mesh.face_count() == 0) r.fail(join(p, "obj"), file + ": the mesh has no faces");
-                for (const Vec3& v : mesh.positions) local.push_back({v.x, v.y, v.z});
-                origin = mesh.origin;
-                for (std::size_t f = 0; f < mesh.face_count(); ++f) {
-                    const std::uint32_t first = mesh.face_offsets[f];
-                    for (std::uint32_t k = 1; k + 1 < mesh.face_size(f); ++k)
-                        for (std::uint32_t c : {first, first + k, first + k + 1}) indices.push_back(mesh.face_vertices[c]);
-                }
-            }
-            one_sided = r.boolean_or(e, p, "one_sided", one_sided);
-            // The transform maps the object's coordinates (an OBJ's own, with its local frame's
-            // origin added back) to world space, in double.
-            const json* t = r.find(e, "transform");
-            const Placement placed = t ? read_transform(r, *t, join(p, "transform"), nullptr, {}) : Placement{};
-            const Mat4& m = placed.m;
-            const double det = linear_determinant(m);
-            if (!(std::fabs(det) > 0)) r.fail(join(p, "transform"), "the transform is singular (a zero scale)");
-            std::vector<DVec3> world;
-            world.reserve(local.size());
-            for (const DVec3& v : local) {
-                const double x = v.x + origin.x, y = v.y + origin.y, z = v.z + origin.z;
-                double w[3];
-                for (int row = 0; row < 3; ++row)
-                    w[row] = double(m.at(row, 0)) * x + double(m.at(row, 1)) * y + double(m.at(row, 2)) * z + double(m.at(row, 3));
-                world.push_back(DVec3{w[0], w[1], w[2]} + placed.origin);
-            }
-            check_placed(r, t ? join(p, "transform") : p, world, "environment object");
-            // The scene's frame is the world's (origin 0): float world vertices, and the exact
-            // ones in double for rebase_scene.
-            std::vector<Vec3> world_float;
-            world_float.reserve(world.size());
-            for (const DVec3& v : world) world_float.push_back({to_float(v.x), to_float(v.y), to_float(v.z)});
-            scene.occluder_world.insert(scene.occluder_world.end(), world.begin(), world.end());
-            // A mirroring transform turns counter-clockwise into clockwise: flip the triangles back.
-            if (det < 0)
-                for (std::size_t k = 0; k + 2 < indices.size(); k += 3) std::swap(indices[k + 1], indices[k + 2]);
-            const json* n = r.find(e, "name");
-            const std::string object_name = n ? r.string(*n, join(p, "name")) : "environment#" + std::to_string(i);
-            if (!environment_names.emplace(object_name, i).second)
-                r.fail(join(p, "name"), "duplicate environment name " + quote_input(object_name) + " (also environment[" +
-                                            std::to_string(environment_names[object_name]) + "])");
-            add_triangles(scene, object_name, world_float, indices, one_sided);
-        }
+        for (std::size_t i = 0; i < env->size(); ++i) read_environment_object(r, (*env)[i], i, scene, environment_names);
     }
+    return environment_names;
+}
 
-    // Camera.
-    {
-        const json& c = r.object(r.require(root, "", "camera"), "camera", {"orbit", "walk", "fovy_degrees", "z_near", "z_far"});
-        const json* orbit = r.find(c, "orbit");
-        const json* walk = r.find(c, "walk");
-        if ((orbit ? 1 : 0) + (walk ? 1 : 0) != 1) r.fail("camera", "expected exactly one of 'orbit' or 'walk'");
-        CameraPath& cam = scene.camera;
-        if (orbit) {
-            r.object(*orbit, "camera.orbit", {"target", "distance", "height", "start_degrees", "degrees_per_frame"});
-            const json* target = r.find(*orbit, "target");
-            const DVec3 t = target ? r.position(*target, "camera.orbit.target") : DVec3{};
-            cam.origin = scene_frame_near(t);
-            cam.target = to_float(t - cam.origin);
-            cam.distance = r.number(r.require(*orbit, "camera.orbit", "distance"), "camera.orbit.distance", 0, kMaxMeshExtent, true);
-            cam.height = r.number_or(*orbit, "camera.orbit", "height", 0, -kMaxMeshExtent, kMaxMeshExtent);
-            cam.start_degrees = r.number_or(*orbit, "camera.orbit", "start_degrees", 0, -1e6, 1e6);
-            cam.degrees_per_frame = r.number_or(*orbit, "camera.orbit", "degrees_per_frame", 5, -360, 360);
-        } else {
-            r.object(*walk, "camera.walk", {"start", "step", "direction", "view_distance"});
-            cam.walk = true;
-            const DVec3 start = r.position(r.require(*walk, "camera.walk", "start"), "camera.walk.start");
-            cam.origin = scene_frame_near(start);
-            cam.walk_start = to_float(start - cam.origin);
-            cam.walk_step = r.vec3(r.require(*walk, "camera.walk", "step"), "camera.walk.step");
-            cam.walk_direction = r.vec3(r.require(*walk, "camera.walk", "direction"), "camera.walk.direction");
-            const Vec3 d = cam.walk_direction;
-            if (!(std::hypot(d.x, d.z) > 1e-6f * std::fabs(d.y)) || !(length(d) > 0))
-                r.fail("camera.walk.direction", "expected a direction that is not zero or vertical");
-            cam.distance = r.number_or(*walk, "camera.walk", "view_distance", 5, 0, kMaxMeshExtent, true);
-            cam.height = 0;
-            cam.target = cam.walk_start + cam.walk_direction;
-        }
-        const float fovy = r.number_or(c, "camera", "fovy_degrees", 60, 0, 179, true);
-        cam.fovy_radians = fovy * kPi / 180.0f;
-        cam.z_near = r.number_or(c, "camera", "z_near", 0.05f, 0, kMaxMeshExtent, true);
-        cam.z_far = r.number_or(c, "camera", "z_far", 50, 0, 1e30, true);
-        if (!(cam.z_far > cam.z_near)) r.fail("camera.z_far", "must be greater than z_near");
-    }
+// "camera.orbit": target (a world position), distance, height, start and step in degrees.
+void read_orbit(const Reader& r, const json& orbit, CameraPath& cam) {
+    r.object(orbit, "camera.orbit", {"target", "distance", "height", "start_degrees", "degrees_per_frame"});
+    const json* target = r.find(orbit, "target");
+    const DVec3 t = target ? r.position(*target, "camera.orbit.target") : DVec3{};
+    cam.origin = scene_frame_near(t);
+    cam.target = to_float(t - cam.origin);
+    cam.distance = r.number(r.require(orbit, "camera.orbit", "distance"), "camera.orbit.distance", 0, kMaxMeshExtent, true);
+    cam.height = r.number_or(orbit, "camera.orbit", "height", 0, -kMaxMeshExtent, kMaxMeshExtent);
+    cam.start_degrees = r.number_or(orbit, "camera.orbit", "start_degrees", 0, -1e6, 1e6);
+    cam.degrees_per_frame = r.number_or(orbit, "camera.orbit", "degrees_per_frame", 5, -360, 360);
+}
 
-    // Cells and portals.
-    std::map<std::string, std::size_t> cell_names;
-    if (const json* cells = r.find(root, "cells")) {
-        r.array(*cells, "cells", false);
-        for (std::size_t i = 0; i < cells->size(); ++i) {
-            const std::string p = index("cells", i);
-            const json& c = r.object((*cells)[i], p, {"name", "min", "max", "objects", "environment"});
-            SceneCell cell;
-            cell.name = r.string(r.require(c, p, "name"), join(p, "name"));
-            if (!cell_names.emplace(cell.name, i).second)
-                r.fail(join(p, "name"), "duplicate cell name " + quote_input(cell.name));
-            // World positions in double (rebase_scene rounds them into each frame); the scene's
-            // frame is the world's, so the floats are the world coordinates rounded.
-            const DVec3 lo = r.position(r.require(c, p, "min"), join(p, "min"));
-            const DVec3 hi = r.position(r.require(c, p, "max"), join(p, "max"));
-            if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) r.fail(p, "max must be greater than min on every axis");
-            cell.box = {patchcull::to_float(lo), patchcull::to_float(hi)};
-            scene.cell_world.push_back({lo, hi});
-            auto names = [&](const char* key, const std::map<std::string, std::size_t>& known, const char* what,
-                             std::vector<std::size_t>& out) {
-                const json* list = r.find(c, key);
-                if (!list) return;
-                const std::string lp = join(p, key);
-                r.array(*list, lp, false);
-                for (std::size_t k = 0; k < list->size(); ++k) {
-                    const std::string n = r.string((*list)[k], index(lp, k));
-                    const auto it = known.find(n);
-                    if (it == known.end()) r.fail(index(lp, k), std::string("no ") + what + " named " + quote_input(n));
-                    if (std::find(out.begin(), out.end(), it->second) != out.end())
-                        r.fail(index(lp, k), quote_input(n) + " is listed twice");
-                    out.push_back(it->second);
-                }
-            };
-            names("objects", instance_names, "object", cell.instances);
-            names("environment", environment_names, "environment object", cell.environment);
-            scene.cells.push_back(std::move(cell));
-        }
+// "camera.walk": start (a world position), step, direction (not zero or vertical), view_distance.
+void read_walk(const Reader& r, const json& walk, CameraPath& cam) {
+    r.object(walk, "camera.walk", {"start", "step", "direction", "view_distance"});
+    cam.walk = true;
+    const DVec3 start = r.position(r.require(walk, "camera.walk", "start"), "camera.walk.start");
+    cam.origin = scene_frame_near(start);
+    cam.walk_start = to_float(start - cam.origin);
+    cam.walk_step = r.vec3(r.require(walk, "camera.walk", "step"), "camera.walk.step");
+    cam.walk_direction = r.vec3(r.require(walk, "camera.walk", "direction"), "camera.walk.direction");
+    const Vec3 d = cam.walk_direction;
+    if (!(std::hypot(d.x, d.z) > 1e-6f * std::fabs(d.y)) || !(length(d) > 0))
+        r.fail("camera.walk.direction", "expected a direction that is not zero or vertical");
+    cam.distance = r.number_or(walk, "camera.walk", "view_distance", 5, 0, kMaxMeshExtent, true);
+    cam.height = 0;
+    cam.target = cam.walk_start + cam.walk_direction;
+}
+
+// "camera": exactly one of orbit or walk, and the projection.
+void read_camera(const Reader& r, const json& root, CameraPath& cam) {
+    const json& c = r.object(r.require(root, "", "camera"), "camera", {"orbit", "walk", "fovy_degrees", "z_near", "z_far"});
+    const json* orbit = r.find(c, "orbit");
+    const json* walk = r.find(c, "walk");
+    if ((orbit ? 1 : 0) + (walk ? 1 : 0) != 1) r.fail("camera", "expected exactly one of 'orbit' or 'walk'");
+    if (orbit) read_orbit(r, *orbit, cam);
+    else read_walk(r, *walk, cam);
+    const float fovy = r.number_or(c, "camera", "fovy_degrees", 60, 0, 179, true);
+    cam.fovy_radians = fovy * kPi / 180.0f;
+    cam.z_near = r.number_or(c, "camera", "z_near", 0.05f, 0, kMaxMeshExtent, true);
+    cam.z_far = r.number_or(c, "camera", "z_far", 50, 0, 1e30, true);
+    if (!(cam.z_far > cam.z_near)) r.fail("camera.z_far", "must be greater than z_near");
+}
+
+// A cell's list `key` of names from `known` (what: the kind, for the messages) as indices.
+void read_cell_names(const Reader& r, const json& c, const std::string& p, const char* key, const NameIndex& known,
+                     const char* what, std::vector<std::size_t>& out) {
+    const json* list = r.find(c, key);
+    if (!list) return;
+    const std::string lp = join(p, key);
+    r.array(*list, lp, false);
+    for (std::size_t k = 0; k < list->size(); ++k) {
+        const std::string n = r.string((*list)[k], index(lp, k));
+        const auto it = known.find(n);
+        if (it == known.end()) r.fail(index(lp, k), std::string("no ") + what + " named " + quote_input(n));
+        if (std::find(out.begin(), out.end(), it->second) != out.end())
+            r.fail(index(lp, k), quote_input(n) + " is listed twice");
+        out.push_back(it->second);
     }
-    if (const json* portals = r.find(root, "portals")) {
-        r.array(*portals, "portals", false);
-        if (!portals->empty() && scene.cells.empty()) r.fail("portals", "portals need cells (\"cells\")");
-        for (std::size_t i = 0; i < portals->size(); ++i) {
-            const std::string p = index("portals", i);
-            const json& o = r.object((*portals)[i], p, {"cells", "corners"});
-            const json& pair = r.require(o, p, "cells");
-            if (!pair.is_array() || pair.size() != 2) r.fail(join(p, "cells"), "expected 2 cell names");
-            ScenePortal portal;
-            std::size_t* ends[2] = {&portal.cell_a, &portal.cell_b};
-            for (std::size_t k = 0; k < 2; ++k) {
-                const std::string n = r.string(pair[k], index(join(p, "cells"), k));
-                const auto it = cell_names.find(n);
-                if (it == cell_names.end()) r.fail(index(join(p, "cells"), k), "no cell named " + quote_input(n));
-                *ends[k] = it->second;
-            }
-            if (portal.cell_a == portal.cell_b) r.fail(join(p, "cells"), "a portal joins two different cells");
-            const json& corners = r.require(o, p, "corners");
-            if (!corners.is_array() || corners.size() != 4) r.fail(join(p, "corners"), "expected 4 corners");
-            std::array<DVec3, 4> world;
-            for (std::size_t k = 0; k < 4; ++k) {
-                world[k] = r.position(corners[k], index(join(p, "corners"), k));
-                portal.corners[k] = patchcull::to_float(world[k]);
-            }
-            // The area in double, relative to the first corner (floats far out would round it).
-            const Vec3 e1 = patchcull::to_float(world[1] - world[0]), e2 = patchcull::to_float(world[2] - world[0]),
-                       e3 = patchcull::to_float(world[3] - world[0]);
-            if (!(length(cross(e1, e2)) + length(cross(e2, e3)) > 0)) r.fail(join(p, "corners"), "the corners span no area");
-            scene.portals.push_back(portal);
-            scene.portal_world.push_back(world);
-        }
+}
+
+// "cells" (optional): named boxes listing their objects and environment objects. Returns the
+// cells' names.
+NameIndex read_cells(const Reader& r, const json& root, const NameIndex& instance_names,
+                     const NameIndex& environment_names, Scene& scene) {
+    NameIndex cell_names;
+    const json* cells = r.find(root, "cells");
+    if (!cells) return cell_names;
+    r.array(*cells, "cells", false);
+    for (std::size_t i = 0; i < cells->size(); ++i) {
+        const std::string p = index("cells", i);
+        const json& c = r.object((*cells)[i], p, {"name", "min", "max", "objects", "environment"});
+        SceneCell cell;
+        cell.name = r.string(r.require(c, p, "name"), join(p, "name"));
+        if (!cell_names.emplace(cell.name, i).second)
+            r.fail(join(p, "name"), "duplicate cell name " + quote_input(cell.name));
+        // World positions in double (rebase_scene rounds them into each frame); the scene's
+        // frame is the world's, so the floats are the world coordinates rounded.
+        const DVec3 lo = r.position(r.require(c, p, "min"), join(p, "min"));
+        const DVec3 hi = r.position(r.require(c, p, "max"), join(p, "max"));
+        if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) r.fail(p, "max must be greater than min on every axis");
+        cell.box = {patchcull::to_float(lo), patchcull::to_float(hi)};
+        scene.cell_world.push_back({lo, hi});
+        read_cell_names(r, c, p, "objects", instance_names, "object", cell.instances);
+        read_cell_names(r, c, p, "environment", environment_names, "environment object", cell.environment);
+        scene.cells.push_back(std::move(cell));
     }
+    return cell_names;
+}
+
+// One entry of "portals": the two cells it joins and its 4 corners (spanning an area).
+void read_portal(const Reader& r, const json& entry, const std::string& p, const NameIndex& cell_names, Scene& scene) {
+    const json& o = r.object(entry, p, {"cells", "corners"});
+    const json& pair = r.require(o, p, "cells");
+    if (!pair.is_array() || pair.size() != 2) r.fail(join(p, "cells"), "expected 2 cell names");
+    ScenePortal portal;
+    std::size_t* ends[2] = {&portal.cell_a, &portal.cell_b};
+    for (std::size_t k = 0; k < 2; ++k) {
+        const std::string n = r.string(pair[k], index(join(p, "cells"), k));
+        const auto it = cell_names.find(n);
+        if (it == cell_names.end()) r.fail(index(join(p, "cells"), k), "no cell named " + quote_input(n));
+        *ends[k] = it->second;
+    }
+    if (portal.cell_a == portal.cell_b) r.fail(join(p, "cells"), "a portal joins two different cells");
+    const json& corners = r.require(o, p, "corners");
+    if (!corners.is_array() || corners.size() != 4) r.fail(join(p, "corners"), "expected 4 corners");
+    std::array<DVec3, 4> world;
+    for (std::size_t k = 0; k < 4; ++k) {
+        world[k] = r.position(corners[k], index(join(p, "corners"), k));
+        portal.corners[k] = patchcull::to_float(world[k]);
+    }
+    // The area in double, relative to the first corner (floats far out would round it).
+    const Vec3 e1 = patchcull::to_float(world[1] - world[0]), e2 = patchcull::to_float(world[2] - world[0]),
+               e3 = patchcull::to_float(world[3] - world[0]);
+    if (!(length(cross(e1, e2)) + length(cross(e2, e3)) > 0)) r.fail(join(p, "corners"), "the corners span no area");
+    scene.portals.push_back(portal);
+    scene.portal_world.push_back(world);
+}
+
+// "portals" (optional; they need cells).
+void read_portals(const Reader& r, const json& root, const NameIndex& cell_names, Scene& scene) {
+    const json* portals = r.find(root, "portals");
+    if (!portals) return;
+    r.array(*portals, "portals", false);
+    if (!portals->empty() && scene.cells.empty()) r.fail("portals", "portals need cells (\"cells\")");
+    for (std::size_t i = 0; i < portals->size(); ++i) read_portal(r, (*portals)[i], index("portals", i), cell_names, scene);
+}
+
+}  // namespace
+
+Scene load_scene_file(const std::string& path) {
+    const Reader r{path, fs::path(path).parent_path()};
+    const json root = read_root(r, path);
+    Scene scene;
+    const json* name = r.find(root, "name");
+    scene.name = name ? r.string(*name, "name") : fs::path(path).stem().string();
+    // Animation and displacement first: objects refer to them.
+    if (const json* a = r.find(root, "animation")) read_animation(r, *a, scene.animation);
+    if (const json* d = r.find(root, "displacement")) read_displacement(r, *d, scene);
+    const NameIndex instance_names = read_objects(r, root, scene);
+    const NameIndex environment_names = read_environment(r, root, scene);
+    read_camera(r, root, scene.camera);
+    const NameIndex cell_names = read_cells(r, root, instance_names, environment_names, scene);
+    read_portals(r, root, cell_names, scene);
     return scene;
 }
 
