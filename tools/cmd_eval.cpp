@@ -1,10 +1,10 @@
 // `patchcull eval ...`: the papers' evaluations, a subcommand group: `eval occlusion` (here),
-// `eval displaced` (tools/eval_displaced.cpp) and `eval temporal` (tools/eval_temporal.cpp).
+// `eval displaced` (tools/eval/eval_displaced.cpp) and `eval temporal` (tools/eval/eval_temporal.cpp).
 //
 // `eval occlusion MODEL [--split N] [--views N] --json` reproduces Niessner & Loop §6.2 for non-displaced
 // models (culling within one object): views that contain the whole object (camera.h, contain
 // mode); on each view the pipeline (Niessner & Loop §3, cull mode occlusion) runs on the static model from
-// a first frame until its visible set is stable (converge_frame, eval_temporal.h: two consecutive
+// a first frame until its visible set is stable (converge_frame, eval/eval_temporal.h: two consecutive
 // frames tag the same patches visible; at most --max-frames frames), and the occluded fraction of that frame is recorded. Every
 // final frame is compared with the unculled render (false culls). For comparison with Niessner & Loop's
 // back-patch figures it also reports the GPU tcone/ncone back-patch cull fractions of each view.
@@ -21,10 +21,10 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "eval_displaced.h"
-#include "eval_fused.h"
-#include "eval_scene.h"
-#include "eval_temporal.h"
+#include "eval/eval_displaced.h"
+#include "eval/eval_fused.h"
+#include "eval/eval_scene.h"
+#include "eval/eval_temporal.h"
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_backpatch.h"
 #include "patchcull/gl/gl_verification.h"

@@ -1,8 +1,8 @@
 // `patchcull view [MODEL|default] ...`: the `render` pipeline (Niessner & Loop §3, with Loop,
-// Niessner & Eisenacher's GPU back-patch pass) in a window (viewer_app.h). Interactive (no --frames, or with --script): an
+// Niessner & Eisenacher's GPU back-patch pass) in a window (viewer/viewer_app.h). Interactive (no --frames, or with --script): an
 // orbit/fly camera, a Dear ImGui panel with every cull test, method, bound and cone, the
 // tessellation, the displacement and the status colouring of cull.png live, keys for the main
-// toggles and a screenshot key; --script FILE drives it by frame number (viewer_script.h).
+// toggles and a screenshot key; --script FILE drives it by frame number (viewer/viewer_script.h).
 // --frames N without a script plays render's camera path for N frames with no panel (the window
 // shows `render --out`'s images; --screenshot writes the last one), a line per frame.
 // --tess-mode / --tess-distance, --displace, --cull auto and the object-level flags as `render`.
@@ -17,8 +17,8 @@
 #include "patchcull/core/error.h"
 #include "patchcull/import/scene_file.h"
 #include "render_support.h"
-#include "viewer_app.h"
-#include "viewer_script.h"
+#include "viewer/viewer_app.h"
+#include "viewer/viewer_script.h"
 
 namespace patchcull::cli {
 namespace {

@@ -22,7 +22,7 @@ Runner add_render_command(CLI::App& app);
 /// `view`: the render pipeline shown in a window (GLFW), optionally saving a screenshot.
 Runner add_view_command(CLI::App& app);
 /// `eval occlusion`, `eval displaced`, `eval temporal`: Niessner & Loop's §6.2, Table 1 and Fig. 9 right
-/// (tools/cmd_eval.cpp, eval_displaced.cpp, eval_temporal.cpp).
+/// (tools/cmd_eval.cpp, eval/eval_displaced.cpp, eval/eval_temporal.cpp).
 Runner add_eval_command(CLI::App& app);
 /// The main job: renders the built-in default scene (also `patchcull demo`). The runner returned
 /// here runs with the options given to `demo`, or with the defaults when there is no subcommand.

@@ -1,4 +1,4 @@
-// `patchcull eval temporal` (tools/eval_temporal.cpp; Fig. 9 right of Niessner & Loop,
+// `patchcull eval temporal` (tools/eval/eval_temporal.cpp; Fig. 9 right of Niessner & Loop,
 // "Patch-Based Occlusion Culling for Hardware Tessellation"): the JSON contract, no false culls
 // against the unculled render of every frame, fractions in [0, 1], and bad flags as one-line
 // errors with exit status 2. In the gl suite because it needs OpenGL; BigGuy at 96x96, level 2,

@@ -1,6 +1,6 @@
 // Issue 12's object-level occlusion through the CLI (under tests/gl: the GL-heavy CLI runs stay
 // out of the ASan build's core|cli run, where one eval scene took over 9 minutes): `eval scene SCENE --json` (the JSON contract in
-// tools/eval_scene.cpp's head comment) and `render ... --objects M --object-occlusion O --verify
+// tools/eval/eval_scene.cpp's head comment) and `render ... --objects M --object-occlusion O --verify
 // --json` (tools/object_level_options.cpp). The methods: hardware occlusion queries stop-and-wait and
 // batched, CHC (Bittner, Wimmer, Piringer, Purgathofer, "Coherent Hierarchical Culling: Hardware
 // Occlusion Queries Made Useful") and CHC++ (Mattausch, Bittner, Wimmer, "CHC++: Coherent

@@ -13,10 +13,10 @@
 
 #include "cli/cli_test_util.h"
 #include "patchcull/core/error.h"
-#include "viewer_camera.h"
-#include "viewer_controls.h"
-#include "viewer_script.h"
-#include "viewer_settings.h"
+#include "viewer/viewer_camera.h"
+#include "viewer/viewer_controls.h"
+#include "viewer/viewer_script.h"
+#include "viewer/viewer_settings.h"
 
 using namespace patchcull;
 using namespace patchcull::cli;
