@@ -16,7 +16,7 @@
 // "backpatch" is "off" when no back-patch test ran (--cull none/frustum/occlusion, or `all` on a
 // scene with an open surface, see applicable_cull_mode). "tess_mode" is "uniform" (--tess on every
 // patch) or "adaptive" (--tess-mode adaptive: tessellation by distance, Niessner & Loop §6.3, "tess" is
-// the maximum; render_support.h's resolve_tess_mode gives the reference distance). "displace" is
+// the maximum; render_options.h's resolve_tess_mode gives the reference distance). "displace" is
 // the scene's map ("none", "procedural" or the PNG path; the default scene displaces its
 // MonsterFrogs), "displaced_patches" the patches with a nonzero displacement range; displaced
 // patches are culled by the frustum and the running pipeline's Hi-Z with the bound ("caf" or
@@ -48,7 +48,7 @@
 // object (gl_pipeline.h's PipelineParams::fused_pass; same decisions); "fused_pass" in the JSON is
 // the flag, each frame's "fused_pass" whether the fused pass ran (not with --backpatch ptp or
 // --frustum aabb, which keep the separate passes).
-// --pose cpu|gpu (render_support.h's PoseWhere): where each frame's animated patches
+// --pose cpu|gpu (frame_poser.h's PoseWhere): where each frame's animated patches
 // are evaluated: cpu (the default: ScenePoser on the CPU, every patch and attribute re-uploaded)
 // or gpu (only the control meshes go up, gl_posing.h's StencilPoser evaluates the stencils into
 // the renderer's buffers, bit-identical). "pose" in the JSON is the flag; every frame gains
@@ -73,6 +73,9 @@
 #include "patchcull/import/scene_file.h"
 #include "patchcull/gl/cull_auto_policy.h"
 #include "patchcull/gl/gl_verification.h"
+#include "cull_mode_names.h"
+#include "frame_poser.h"
+#include "render_options.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -194,12 +197,7 @@ Runner add_render_command(CLI::App& app) {
             rebases = rebases || !same(frame_origins.back(), scene.frame_origin);
         }
         Scene world;  // the placements in world coordinates (without the models), when frames move
-        if (rebases) {
-            std::vector<LoadedModel> models = std::move(scene.models);
-            world = scene;
-            scene.models = std::move(models);
-            rebase_scene(world, frame_origins[0], scene);
-        }
+        if (rebases) world = rebase_scene_in_place(scene, frame_origins[0]);
         auto object_level = std::make_unique<ObjectLevelRun>(state->objects, scene, one_sided);  // before the occluders go up
         if (automatic && object_level->sets_objects())
             throw Error("--object-occlusion: a query method decides per object itself; not with --cull auto");

@@ -16,6 +16,8 @@
 #include "patchcull/import/scene_model.h"
 #include "patchcull/core/error.h"
 #include "patchcull/import/scene_file.h"
+#include "cull_mode_names.h"
+#include "render_options.h"
 #include "render_support.h"
 #include "viewer/viewer_app.h"
 #include "viewer/viewer_script.h"

@@ -945,12 +945,7 @@ void place_scene_at_first_camera(Scene& scene, const std::string& source, int fr
     check_scene_motion(scene, source, frames, seconds_per_frame);
     const DVec3 origin = scene_frame_near(scene.world_camera_path(1, 1.0f).front().eye);
     const DVec3 now = scene.frame_origin;
-    if (origin.x != now.x || origin.y != now.y || origin.z != now.z) {
-        std::vector<LoadedModel> models = std::move(scene.models);
-        const Scene world = scene;  // the placements, without the models
-        scene.models = std::move(models);
-        rebase_scene(world, origin, scene);
-    }
+    if (origin.x != now.x || origin.y != now.y || origin.z != now.z) rebase_scene_in_place(scene, origin);
     check_scene_motion(scene, source, frames, seconds_per_frame, kMaxSingleFrameReach, origin);
 }
 

@@ -81,6 +81,14 @@ void rebase_scene(const Scene& world, DVec3 origin, Scene& frame) {
     frame.frame_origin = origin;
 }
 
+Scene rebase_scene_in_place(Scene& scene, DVec3 origin) {
+    std::vector<LoadedModel> models = std::move(scene.models);
+    Scene world = scene;  // the placements, without the models
+    scene.models = std::move(models);
+    rebase_scene(world, origin, scene);
+    return world;
+}
+
 std::size_t Scene::patch_count() const {
     std::size_t n = 0;
     for (const SceneInstance& instance : instances) n += models.at(instance.model).rest.patches.size();

@@ -42,7 +42,7 @@ std::vector<T> read_buffer(std::uint32_t buffer, std::size_t count) {
 
 StencilTableView view_of(const PointStencils& s) { return {s.offsets.data(), s.rows(), s.indices.data(), s.weights.data()}; }
 
-// A StencilPoser over the scene's tables (ScenePoser::gpu_tables), as tools/render_support.cpp
+// A StencilPoser over the scene's tables (ScenePoser::gpu_tables), as tools/frame_poser.cpp
 // makes it.
 StencilPoser make_poser(ScenePoser& poser) {
     std::vector<PosingModel> models;

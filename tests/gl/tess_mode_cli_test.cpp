@@ -1,4 +1,4 @@
-// `render --tess-mode uniform|adaptive [--tess-distance D]` (tools/render_support.h, TessOptions;
+// `render --tess-mode uniform|adaptive [--tess-distance D]` (tools/render_options.h, TessOptions;
 // seed 000 §6.3's adaptive tessellation by distance): `--verify` finds no false culls under
 // adaptive tessellation on the default scene, the JSON names the mode, adaptive tessellation
 // draws a different surface sampling than uniform at the same maximum, and bad values are

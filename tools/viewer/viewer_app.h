@@ -8,6 +8,7 @@
 
 #include "object_level_options.h"
 #include "patchcull/import/default_scene.h"
+#include "render_options.h"
 #include "render_support.h"
 #include "viewer_script.h"
 #include "viewer_settings.h"

@@ -198,4 +198,8 @@ DVec3 scene_frame_near(DVec3 eye);
 /// back in world's order).
 void rebase_scene(const Scene& world, DVec3 origin, Scene& frame);
 
+/// rebase_scene of a scene onto itself: moves `scene`'s frame to origin, keeping its models, and
+/// returns the placements it had (a copy without the models) for later rebase_scene calls.
+Scene rebase_scene_in_place(Scene& scene, DVec3 origin);
+
 }  // namespace patchcull

@@ -1,0 +1,64 @@
+// The tessellation and displacement options of `render` and `view` (--tess-mode, --tess-distance,
+// --displace, --displace-scale, --bound, --cone): registration, checks and what they set
+// (tools/render_options.cpp).
+#pragma once
+
+#include <string>
+
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/gl/gl_renderer.h"
+#include "patchcull/import/scene_model.h"
+
+namespace CLI {
+class App;
+}
+
+namespace patchcull::cli {
+
+/// --tess-mode uniform|adaptive and --tess-distance D of `render` and `view` (as parsed).
+struct TessOptions {
+    std::string mode = "uniform";
+    float distance = 0;  ///< 0: not given (add_tess_options refuses 0 itself)
+};
+/// Registers --tess-mode (uniform|adaptive) and --tess-distance (a finite number > 0, at most
+/// 1e9; parse errors name the flag) on command.
+void add_tess_options(CLI::App& command, TessOptions& options);
+
+/// The tessellation of a run (Niessner & Loop §6.3's adaptive case): uniform (--tess everywhere), or
+/// adaptive by distance (gl::RenderParams::adaptive_tess: level --tess at reference_distance from
+/// the eye and nearer, proportionally less farther away, at least 1).
+struct TessMode {
+    bool adaptive = false;
+    float reference_distance = 1;
+};
+/// Resolves the options for a scene seen along path: the reference distance is --tess-distance,
+/// or by default the camera path's eye-to-target distance (camera_path_eye_distance), so that the
+/// surface at the centre of the orbit gets the full level. Throws patchcull::Error naming
+/// --tess-distance when it is given without --tess-mode adaptive.
+TessMode resolve_tess_mode(const TessOptions& options, const CameraPath& path);
+/// Sets params.adaptive_tess and params.tess_reference_distance from mode.
+void apply_tess_mode(const TessMode& mode, gl::RenderParams& params);
+/// Distance from every eye of path to its target: sqrt(distance^2 + height^2).
+float camera_path_eye_distance(const CameraPath& path);
+
+/// --displace, --displace-scale, --bound and --cone of `render` and `view` (Niessner & Loop §4.2, §6):
+/// displaced patches tested against the frustum and the running pipeline's Hi-Z with the chosen
+/// bound (gl_passes.h's DisplacedPass inside CullPipeline::render_frame).
+struct DisplaceOptions {
+    std::string displace;      ///< "" (the scene's own), "none", "procedural" or a PNG path
+    float scale = -1;          ///< world units (a character is 1 high); < 0: not given (0.02)
+    std::string bound = "caf";
+    std::string cone = "acon";
+};
+/// Registers the four options (--displace-scale needs --displace; parse errors name the flag).
+void add_displace_options(CLI::App& command, DisplaceOptions& options);
+/// Applies --displace to the scene: "none" removes its displacement, "procedural" or a PNG
+/// displaces every instance with that map (make_procedural_displacement(512, scale) or
+/// load_displacement_png), scale --displace-scale or 0.02; "" keeps the scene's own (the default
+/// scene's MonsterFrogs). Throws patchcull::Error naming the flag or file.
+void apply_displace_options(const DisplaceOptions& options, Scene& scene);
+/// --bound and --cone as the pipeline's enums.
+DisplacedBoundKind displace_bound(const DisplaceOptions& options);
+NormalConeKind displace_cone(const DisplaceOptions& options);
+
+}  // namespace patchcull::cli
