@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Seed 000 §6.3's adaptive-tessellation experiment (Niessner & Loop, "Patch-Based Occlusion
-Culling for Hardware Tessellation"): frame time with and without culling under tessellation by
+"""The adaptive-tessellation experiment of Niessner & Loop, "Patch-Based Occlusion Culling for
+Hardware Tessellation" §6.3: frame time with and without culling under tessellation by
 distance, on the default scene, measured with `patchcull render --json` (docs/PERFORMANCE.md).
 
 Usage: python3 scripts/adaptive_tess_figures.py [BUILD_DIR] [ROUNDS]   (defaults: build, 2)

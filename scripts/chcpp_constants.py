@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""CHC++'s two constants measured on this pipeline (issue 12; docs/PERFORMANCE.md, "CHC++'s
+"""CHC++'s two constants measured on this pipeline (docs/PERFORMANCE.md, "CHC++'s
 constants"): the multiquery cost per object c1 (C(M) = 1 + c1 |M|, Mattausch, Bittner & Wimmer,
 "CHC++: Coherent Hierarchical Culling Revisited") and the tight-bounding-volume factor sigma (boxes
 refined while their area stays below sigma times the parent's). For each value it runs

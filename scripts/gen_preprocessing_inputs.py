@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Inputs of docs/PERFORMANCE.md's preprocessing figures (issue 9).
+"""Inputs of docs/PERFORMANCE.md's preprocessing figures.
 
   gen_preprocessing_inputs.py ngon N [closed]   one N-gon (closed: a second one, reversed, on the same corners)
   gen_preprocessing_inputs.py fan N [closed]    vertex 1 of valence N: N triangles (closed: a second fan below)

@@ -4,11 +4,12 @@
 Usage: python3 scripts/gpu_figures.py [BUILD_DIR]   (default: build)
 
 1. Default scene: frame time with culling (cull all, tcone) against without (cull none), per
-   tessellation level, as a ratio (seed 000 Fig. 9's payoff).
+   tessellation level, as a ratio (the payoff in Fig. 9 of Niessner & Loop, "Patch-Based Occlusion
+   Culling for Hardware Tessellation").
 2. Hi-Z build time against resolution (default scene, cull occlusion).
 3. Cull-pass time against patch count (MonsterFrog and BigGuy split 0..2: closed solids, so that
    `all` includes the back-patch pass; cull occlusion alone, and all with each back-patch method;
-   seed 000 Fig. 7).
+   Niessner & Loop's Fig. 7).
 Every figure is the mean over frames 1..N-1 (frame 0 compiles and primes the statuses). On
 llvmpipe the times are wall clock around glFinish (gl_renderer.h); on a GPU, timer queries.
 """

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 14's GPU figures for the fused cull pass, ready for the day a GPU is lent (the `device`
+# GPU figures for the fused cull pass, ready for the day a GPU is lent (the `device`
 # tool runs it in the repository root; on llvmpipe it runs too, slowly: SIDE=41 for a try).
 #
 # usage: OUT=DIR scripts/gpu_fused_figures.sh [BUILD_DIR]
@@ -7,7 +7,7 @@
 #   no binary yet. Writes under $OUT (default: ./gpu_fused_out):
 #   (in ${TMPDIR:-/tmp}, not $OUT: ~40 MB) cube_SIDE.obj, a closed cube of SIDE x SIDE quads a side
 #                             (SIDE=408: 998,784 quads, one acc patch each: the "1M patches" of
-#                             issue 14), faces outward
+#                             the goal below), faces outward
 #   render_*.json             every `patchcull render --json` run, as printed
 #   gpu_fused_figures.json    the summary: per model and back-patch cone, the cull-pass time per
 #                             frame (FrameStats::cull_ms: the whole flag chain, status passes
@@ -17,7 +17,7 @@
 # Every figure is the mean over frames 1..N-1 (frame 0 compiles the programs and primes the
 # statuses). On a GPU the pipeline times its passes with GL_TIMESTAMP queries (gl_pipeline.h's
 # TimingMethod::automatic), on llvmpipe with a wall clock around glFinish.
-# Goal (issue 14): the cull passes for 1M patches under 0.1 ms on an H100/H200-class GPU.
+# Goal: the cull passes for 1M patches under 0.1 ms on an H100/H200-class GPU.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# 2-core scaling of every SIMD cull kernel (issue 14): runs bench/memory_roof_bench.cpp's
+# 2-core scaling of every SIMD cull kernel: runs bench/memory_roof_bench.cpp's
 # scaling/<kernel>/{1_thread,all_threads}/N rows (plain layout, N = 256 .. 65536 patches; all
 # threads = the batch split into one range per thread, a multiple of 16 patches each, over
 # parallel_for_ranges) and prints, per kernel and size, M patches/s on one thread and on all

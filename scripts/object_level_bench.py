@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""The object level's effect on `city` frames (issue 11; G. Zachmann's lecture "Advanced
-Visibility Computations", seed 004), from `patchcull render --json`, for docs/PERFORMANCE.md.
+"""The object level's effect on `city` frames (G. Zachmann's lecture "Advanced
+Visibility Computations"), from `patchcull render --json`, for docs/PERFORMANCE.md.
 
 Usage: python3 scripts/object_level_bench.py [BUILD_DIR] [ROUNDS] [FRAMES] [TESS] [SCENE]
        (defaults: build, 4, 6, 8, city)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""`render --verify` over the matrix of issue 9's "Done when" (docs/RESULTS.md, "Verified matrix").
+"""`render --verify` over the verified matrix of inputs (docs/RESULTS.md, "Verified matrix").
 
 Usage: python3 scripts/verify_matrix.py [BUILD_DIR] [--levels 1,4,16,64] [--size WxH] [--frames N]
 

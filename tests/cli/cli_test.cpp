@@ -1,4 +1,4 @@
-// The CLI contract (issue 2): `info` and `cull` JSON shapes and counts, and one-line errors with
+// The CLI contract: `info` and `cull` JSON shapes and counts, and one-line errors with
 // exit status 2 for every kind of bad input.
 #include <gtest/gtest.h>
 
@@ -120,14 +120,15 @@ TEST(Cli, CullBackPatchMethodsOnTheTeapot) {
         EXPECT_GT(j["methods"][m]["cull_rate"].get<double>(), 0.005) << m;
     }
     // The teapot's 32 patches are large and curved: few are wholly back-facing, and the tighter
-    // bounds cull more (seed 001's order).
+    // bounds cull more (the order of Loop, Niessner & Eisenacher, "Effective Back-Patch Culling for
+    // Hardware Tessellation").
     EXPECT_GE(j["methods"]["ptp"]["cull_rate"].get<double>(), j["methods"]["ncone"]["cull_rate"].get<double>());
     EXPECT_GE(j["methods"]["ncone"]["cull_rate"].get<double>(), j["methods"]["tcone"]["cull_rate"].get<double>());
-    // Pcnt additionally culls the degenerate lid and bottom patches (seed 001 §7).
+    // Pcnt additionally culls the degenerate lid and bottom patches (Loop, Niessner & Eisenacher §7).
     EXPECT_GE(j["methods"]["ptp-pcnt"]["cull_rate"].get<double>(), j["methods"]["ptp"]["cull_rate"].get<double>());
 }
 
-// Issue 15: `--view-mode distance` (cull_eval.h, DistanceViews). Every view holds the whole
+// `--view-mode distance` (cull_eval.h, DistanceViews). Every view holds the whole
 // object, so the frustum tests cull nothing; the ground truth still finds no false cull; and the
 // eye distance moves the back-patch rates: near eyes (1..1.2 times the containing distance) see
 // less of BigGuy than far ones (4..6 times) and cull more with each method.
@@ -179,7 +180,7 @@ TEST(Cli, BackPatchMethodsRefuseDisplacement) {
     expect_one_line_error(run("cull teapot --methods ptp --displace procedural --views 1 --json"), "--displace");
 }
 
-// Issue 9, flags: every numeric or string option of every command is parsed strictly
+// Flags: every numeric or string option of every command is parsed strictly
 // (tools/cli_options.h). Each bad value is one line on stderr naming the flag, exit status 2.
 // The GPU commands' flags are checked as they are parsed, before any OpenGL context exists, so
 // they are tested here too. The old CLI accepted most of these: `--views 0` ran with rate 0,
@@ -270,7 +271,7 @@ TEST(Cli, StrictFlagsStillTakeEveryValidValue) {
     }
 }
 
-// Issue 9, output paths: checked before any work (no model loaded, no OpenGL context), one line
+// Output paths: checked before any work (no model loaded, no OpenGL context), one line
 // naming the flag and the path, exit 2. The old `demo --out-dir /proc/nonexistent` rendered the
 // whole job and then exited 3 ("internal error: filesystem error").
 TEST(Cli, OutputPathsAreCheckedBeforeTheWork) {

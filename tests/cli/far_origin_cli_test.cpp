@@ -1,4 +1,4 @@
-// `patchcull cull` on BigGuy translated far from the origin (issue 9): no false culls and the
+// `patchcull cull` on BigGuy translated far from the origin: no false culls and the
 // untranslated model's cull rates. Before the OBJ reader re-centred in double, a translation of
 // 1e6 gave hundreds of frustum false culls per 200 free views and ptp culled nothing.
 #include <gtest/gtest.h>

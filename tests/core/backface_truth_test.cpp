@@ -1,4 +1,5 @@
-// The back-facing ground truth itself (seed 001 eq. 1): tangent planes and tessellation
+// The back-facing ground truth itself (eq. 1 of Loop, Niessner & Eisenacher, "Effective Back-Patch Culling for
+// Hardware Tessellation"): tangent planes and tessellation
 // triangles, checked on cases whose answer is known.
 #include <gtest/gtest.h>
 
@@ -80,8 +81,8 @@ TEST(BackfaceTruth, RationalWeightsScaleThePlaneNotItsSide) {
 }
 
 TEST(BackfaceTruth, TeapotDegenerateTopHasZeroPlanesOnItsCollapsedEdge) {
-    // The lid knob's v = 0 edge collapses to a point: T vanishes there (the reason for seed 001's
-    // Pcnt rule). Patches 20-23 are the knob.
+    // The lid knob's v = 0 edge collapses to a point: T vanishes there (the reason for Loop, Niessner &
+    // Eisenacher's Pcnt rule). Patches 20-23 are the knob.
     const auto patches = teapot_patches();
     const auto planes = planes_of(patches[20], 17);
     for (int i = 0; i < 17; ++i) {

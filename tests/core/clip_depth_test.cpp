@@ -1,4 +1,4 @@
-// The clip-depth convention is explicit (clip_space.h, issue 9): one camera written as a
+// The clip-depth convention is explicit (clip_space.h): one camera written as a
 // zero-to-one projection (patchcull's, GL_ZERO_TO_ONE) or as a standard OpenGL one (depth
 // -1..1) gets the same decisions from every depth-sensitive entry, when the caller names the
 // convention. Before, the entries took a bare matrix and read every matrix as zero-to-one: an

@@ -479,8 +479,9 @@ TEST(DisplacedBounds, FacingSquareByHand) {
             EXPECT_NEAR(bound.ndc_ymax, f * side / 9.5, 2e-3);
             EXPECT_NEAR(bound.ndc_ymin, -f * side / 9.5, 2e-3);
         }
-    // Without displacement the CAF is the screen box of the control points (seed 000 §4.2: "the same
-    // result as non-displaced patches"): corners at x = +-1, t = 10.
+    // Without displacement the CAF is the screen box of the control points (Niessner & Loop, "Patch-Based
+    // Occlusion Culling for Hardware Tessellation" §4.2: "the same result as non-displaced patches"): corners
+    // at x = +-1, t = 10.
     const DisplacedBound flat = compute_displaced_bound(square, {}, DisplacedBoundKind::caf, NormalConeKind::acon, view);
     EXPECT_FLOAT_EQ(flat.ndc_xmax, float(f / 10));
     EXPECT_FLOAT_EQ(flat.depth_near, float(depth_at(10)));

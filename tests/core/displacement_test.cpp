@@ -1,5 +1,5 @@
-// Displacement sampling and seed 002's per-patch range: every displacement a patch can take lies
-// in its [D_min, D_max].
+// Displacement sampling and the per-patch range of Niessner & Loop, "Analytic Displacement Mapping using
+// Hardware Tessellation": every displacement a patch can take lies in its [D_min, D_max].
 #include <gtest/gtest.h>
 
 #include <random>

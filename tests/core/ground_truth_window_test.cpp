@@ -1,4 +1,4 @@
-// PatchTruthWindow (ground_truth.h, issue 14), the streamed ground truth, against the eager
+// PatchTruthWindow (ground_truth.h), the streamed ground truth, against the eager
 // functions it replaces in `cull`: the same answer for every patch, view and slot, across window
 // moves (clear), displaced or not, near and far from the origin, for degenerate patches, and with
 // the samples of a slot made once per window however many views ask.

@@ -1,5 +1,6 @@
 // Hi-Z pyramid and occlusion test (patchcull/core/hiz.h): the pyramid against brute-force maxima over
-// exact footprints (NPOT sizes, and against the seed's POT-enlarged, zero-padded map), level
+// exact footprints (NPOT sizes, and against the POT-enlarged, zero-padded map of Niessner & Loop,
+// "Patch-Based Occlusion Culling for Hardware Tessellation"), level
 // selection against a brute-force search (and a `floor` level that under-covers), hand-built
 // decisions, SIMD == scalar on every target, and ground truth: a tiny CPU rasterizer (pixel centres,
 // interpolated depth, less-test) draws random occluders, and no sample of an occluded patch's
@@ -126,7 +127,7 @@ TEST(HiZPyramid, EveryTexelIsTheMaxOverExactlyItsFootprint) {
     }
 }
 
-// The seed's construction: enlarge to the next power of two, unused texels 0, plain 2x2 max mips
+// Niessner & Loop's construction: enlarge to the next power of two, unused texels 0, plain 2x2 max mips
 // (what a GL implementation with a POT texture does). Its used texels equal ours, bit for bit.
 TEST(HiZPyramid, EqualsTheSeedsZeroPaddedPowerOfTwoMap) {
     std::mt19937 rng(11);
@@ -176,7 +177,7 @@ namespace {
 
 int texels_spanned(int lo, int hi, int level) { return (hi >> (level + 1)) - (lo >> (level + 1)) + 1; }
 
-// The `floor` variant: the seed's formula with floor instead of ceil, in this pyramid's levels
+// The `floor` variant: Niessner & Loop's formula with floor instead of ceil, in this pyramid's levels
 // (level l has texels of 2^(l+1) pixels): floor(log2(span)) - 1.
 int floor_level(const PixelRect& r, int levels) {
     const int span = std::max(r.x1 - r.x0, r.y1 - r.y0);

@@ -1,6 +1,6 @@
 // Orientation from geometry (patchcull/core/mesh.h): the signed volume of closed control meshes, and
 // orient_outward reversing inside-out ones, so that back-patch culling and one-sided drawing use
-// the side that faces out (issue 9, class 2: topology alone cannot tell inside from outside).
+// the side that faces out (topology alone cannot tell inside from outside).
 // Meshes of several shells are oriented shell by shell, by nesting parity.
 #include <gtest/gtest.h>
 

@@ -1,6 +1,7 @@
-// Parametric tangent plane back-patch culling (patchcull/core/backpatch.h, seed 001 §3-6):
+// Parametric tangent plane back-patch culling (patchcull/core/backpatch.h; Loop, Niessner & Eisenacher,
+// "Effective Back-Patch Culling for Hardware Tessellation" §3-6):
 // - the table: generated in-process from the definition, equal to the checked-in ptp_table.inc,
-//   516 terms with the seed's per-destination matrix, hazard-free 16-lane order;
+//   516 terms with the paper's per-destination matrix, hazard-free 16-lane order;
 // - T(u,v) from the 64 control planes equals cross4(B, B_u, B_v) computed directly (double, all 4
 //   components, object space), for polynomial and rational patches; a mutated table fails that;
 // - the kernels' compile-time schedule (shared minors, corner anchors) reproduces the table;
@@ -53,7 +54,7 @@ double det3(double a, double b, double c, double d, double e, double f, double g
     return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
 }
 
-// Seed 001 Appendix A.
+// Loop, Niessner & Eisenacher, Appendix A.
 D4 cross4(D4 a, D4 b, D4 c) {
     return {det3(a.y, b.y, c.y, a.z, b.z, c.z, a.w, b.w, c.w), -det3(a.x, b.x, c.x, a.z, b.z, c.z, a.w, b.w, c.w),
             det3(a.x, b.x, c.x, a.y, b.y, c.y, a.w, b.w, c.w), -det3(a.x, b.x, c.x, a.y, b.y, c.y, a.z, b.z, c.z)};
@@ -318,7 +319,7 @@ TEST(PtpTable, CheckedInTableEqualsTheGeneratorOutput) {
 TEST(PtpTable, SixteenLaneOrderIsHazardFreeAndBalanced) {
     const std::vector<ptp_gen::Term> ordered = ptp_gen::order_for_16_lanes(ptp_gen::expand_ptp().terms);
     EXPECT_TRUE(ptp_gen::rounds_are_hazard_free(ordered));
-    EXPECT_EQ((ordered.size() + 15) / 16, 33u);  // seed §6: ceil(516 / 16) = 33 rounds
+    EXPECT_EQ((ordered.size() + 15) / 16, 33u);  // Loop, Niessner & Eisenacher §6: ceil(516 / 16) = 33 rounds
     // Rounds 0..30: lane tau works on its own block {iu, iu+4} x {jv, jv+4}.
     for (std::size_t p = 0; p < 31 * 16; ++p) {
         const int d = ordered[p].dest;

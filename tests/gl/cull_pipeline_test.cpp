@@ -1,4 +1,5 @@
-// CullPipeline (patchcull/gl/gl_pipeline.h): the GPU back-patch pass in seed 000 §3's frame (the flag
+// CullPipeline (patchcull/gl/gl_pipeline.h): the GPU back-patch pass in the frame of Niessner & Loop,
+// "Patch-Based Occlusion Culling for Hardware Tessellation" §3 (the flag
 // chain of gl_passes.h), and the per-object switch (PipelineParams::objects). For tcone, ncone and ptp: the frame culls exactly the patches the
 // CPU scalar kernel culls (every patch is inside the frustum), the final id buffer equals the
 // unculled render's (no false cull), and after update_patches the pass reads the new pose.

@@ -1,4 +1,4 @@
-// `patchcull eval fused SCENE --json` (tools/eval/eval_fused.cpp, issue 14): the JSON contract of its head
+// `patchcull eval fused SCENE --json` (tools/eval/eval_fused.cpp): the JSON contract of its head
 // comment on data/scenes/city_small.json and on the default scene with both schemes, every culled
 // patch checked against the unculled frame's id buffer (0 false culls), the fixed plans' ratios
 // relative to the best, the model's choices adding up to its object-frames; bad flags are one-line

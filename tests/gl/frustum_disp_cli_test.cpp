@@ -1,4 +1,4 @@
-// `render --frustum hull|aabb` (issue 15): the pipeline's frustum test chosen on the command line.
+// `render --frustum hull|aabb`: the pipeline's frustum test chosen on the command line.
 // With aabb (FrustumDispPass, Sathe's box grown by max |D|) `--verify` finds no false culls against
 // the unculled render on BigGuy half outside the view, for acc and osd patches, undisplaced and
 // displaced (procedural map; frustum alone and with the two-pass occlusion pipeline), and the

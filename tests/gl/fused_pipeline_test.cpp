@@ -1,4 +1,4 @@
-// The strict test of the fused pass in the frame (PipelineParams::fused_pass, issue 14): on the
+// The strict test of the fused pass in the frame (PipelineParams::fused_pass): on the
 // default scene and a small city, both schemes (acc, osd), at the origin and 3000+ units from it,
 // at low tessellation (1) on a small image (128x80) and high tessellation (8) on a large one
 // (480x272), every frame's id buffer with the fused pass shows every patch the unculled frame

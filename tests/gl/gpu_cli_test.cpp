@@ -1,4 +1,4 @@
-// The CLI contract of issue 4 (the GPU pipeline): `render --json` shape and keys, `--verify`
+// The CLI contract of the GPU pipeline: `render --json` shape and keys, `--verify`
 // finding no false culls in any cull mode (strict: compare_frames against the unculled render of
 // every frame) and catching the ones back-patch culling makes on an open surface, one-line errors
 // with exit status 2 (bad flags, missing OpenGL), the main job writing both PNGs, and
@@ -109,7 +109,7 @@ TEST(GpuCli, VerifyCatchesBackFacingPatchesSeenThroughTheTeapotsLidGap) {
     // far upper body (patches 4-7, whose outside faces away) shows through the gap. An explicit
     // --cull backpatch still runs there (with a warning): its test culls those patches although
     // they contribute pixels, and --verify must report them, and fail: exit status 1, as the main
-    // job does (issue 9: it exited 0).
+    // job does (it once exited 0).
     const CliRun r = run(kSmallTeapot + "--frames 3 --cull backpatch --backpatch tcone --verify --json");
     ASSERT_EQ(r.status, 1) << r.err;
     EXPECT_NE(r.err.find("warning: render: teapot is not a closed solid"), std::string::npos) << r.err;
@@ -183,7 +183,8 @@ TEST(GpuCli, BadRenderFlagsAreOneLineErrors) {
     expect_one_line_error(run("eval occlusion /nonexistent/model.obj"), "/nonexistent/model.obj");
 }
 
-// eval displaced (seed 000 Table 1): six rows with the contract's keys, no false culls against
+// eval displaced (Table 1 of Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation"):
+// six rows with the contract's keys, no false culls against
 // the unculled displaced render (converged depth and running pipeline), and the nesting that is a theorem: a CAF with a cone lies inside
 // the CAF without one (DisplacedBounds.CafWithAConeLiesInsideTheFullCaf), so per view it culls
 // at least as much (a smaller rectangle reads a finer Hi-Z level, whose max is not larger).

@@ -1,4 +1,4 @@
-// Posing on the GPU (issue 14; gl_posing.h's StencilPoser, ScenePoser::gpu_tables/gpu_meshes,
+// Posing on the GPU (gl_posing.h's StencilPoser, ScenePoser::gpu_tables/gpu_meshes,
 // render --pose): the control points and ACC tangent vectors the compute pass writes into the
 // renderer's buffers are BIT-IDENTICAL to ScenePoser::pose() (read back, compared as bytes), for
 // both schemes, over several frames, with a mirrored, a walking and a rigid instance; the teapot

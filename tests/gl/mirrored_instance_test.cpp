@@ -1,4 +1,4 @@
-// Mirrored instances drawn right side out (issue 11 follow-up; scene_poser.h, ScenePoser): a
+// Mirrored instances drawn right side out (scene_poser.h, ScenePoser): a
 // closed model placed with a mirroring transform is posed with its patches transposed, so that
 // du x dv, which the one-sided fragment test keeps where it faces the eye (README "What
 // contributes a pixel"), points out of the mirrored solid. On the GPU: the id buffer of a

@@ -1,4 +1,4 @@
-// The object level through the CLI and on the GPU (issue 11, "CLI" and "Correctness"): `render
+// The object level through the CLI and on the GPU: `render
 // SCENE --objects M --verify --json` on data/scenes/city_small.json for every method and variant,
 // the built-in building (small parameters are not reachable from the CLI: a few frames of the
 // default building at a tiny size), the default scene (acc and osd), with 0 false culls each
@@ -8,8 +8,8 @@
 // cull: CullPipeline with a visible object's span in PipelineParams::object_culled (and a visible
 // occluder triangle in culled_occluders), compared with the unculled render as the CLI does
 // (compare_frames and the reference's id buffer). The object level follows G. Zachmann's lecture
-// "Advanced Visibility Computations" (seed 004) before Niessner & Loop's patch passes
-// ("Patch-Based Occlusion Culling for Hardware Tessellation", seed 000). Everything runs on
+// "Advanced Visibility Computations" before Niessner & Loop's patch passes
+// ("Patch-Based Occlusion Culling for Hardware Tessellation"). Everything runs on
 // llvmpipe at tiny sizes and tessellation 1-2 (seconds per run).
 #include <gtest/gtest.h>
 
@@ -110,7 +110,7 @@ TEST(ObjectLevelCli, CitySmallEveryMethodHasNoFalseCulls) {
             EXPECT_EQ(s.backface, 0u) << method;
         }
     }
-    // --objects none: the objects JSON is there (the issue's contract lists none too), nothing is
+    // --objects none: the objects JSON is there (the contract lists none too), nothing is
     // culled by the object level, and 0 false culls.
     const CliRun r = run(kCitySmall + "--objects none --verify --json");
     ASSERT_EQ(r.status, 0) << r.err;

@@ -1,4 +1,4 @@
-// Issue 12's object-level occlusion through the CLI (under tests/gl: the GL-heavy CLI runs stay
+// Object-level occlusion through the CLI (under tests/gl: the GL-heavy CLI runs stay
 // out of the ASan build's core|cli run, where one eval scene took over 9 minutes): `eval scene SCENE --json` (the JSON contract in
 // tools/eval/eval_scene.cpp's head comment) and `render ... --objects M --object-occlusion O --verify
 // --json` (tools/object_level_options.cpp). The methods: hardware occlusion queries stop-and-wait and
@@ -188,7 +188,7 @@ const json* row_named(const std::vector<json>& rows, const std::string& name) {
     return nullptr;
 }
 
-// What probing found (issue 12), kept as cases: a mesh whose triangles sit on a box's corners and
+// What probing found, kept as cases: a mesh whose triangles sit on a box's corners and
 // faces but leave half of two faces open (a doubled triangle makes up the area) is no box occluder;
 // nor is a one-sided box whose front face is missing; and an eye within z_near of a wall (the near
 // plane clips the wall away) must not let portal culling hide the next room.

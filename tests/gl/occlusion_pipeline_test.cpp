@@ -1,4 +1,5 @@
-// The frame pipeline (CullPipeline::render_frame, seed 000 §3) and the strict id-buffer test:
+// The frame pipeline (CullPipeline::render_frame; §3 of Niessner & Loop, "Patch-Based Occlusion Culling for
+// Hardware Tessellation") and the strict id-buffer test:
 // for the cull modes none / frustum / occlusion / all, at several fixed cameras and through
 // animated moving sequences (the split teapot and BigGuy, deformed every frame, the camera moving
 // along orbit_sequence, with a ground quad and a wall as triangle occluders), the FINAL patch-id

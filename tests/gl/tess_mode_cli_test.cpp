@@ -1,5 +1,6 @@
 // `render --tess-mode uniform|adaptive [--tess-distance D]` (tools/render_options.h, TessOptions;
-// seed 000 §6.3's adaptive tessellation by distance): `--verify` finds no false culls under
+// the adaptive tessellation by distance of Niessner & Loop, "Patch-Based Occlusion Culling for Hardware
+// Tessellation" §6.3): `--verify` finds no false culls under
 // adaptive tessellation on the default scene, the JSON names the mode, adaptive tessellation
 // draws a different surface sampling than uniform at the same maximum, and bad values are
 // one-line errors with exit status 2. In the gl suite because it needs OpenGL; the default scene

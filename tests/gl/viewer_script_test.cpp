@@ -1,4 +1,4 @@
-// The interactive viewer (`patchcull view`, issue 13): its --script parser and settings (no GL),
+// The interactive viewer (`patchcull view`): its --script parser and settings (no GL),
 // its orbit/fly camera, the one-line errors of malformed scripts (before any window opens), and a
 // scripted session under a virtual X server (xvfb-run): a camera move, a cull toggle through
 // `set` and through its key, and the panel, each checked on the screenshots.

@@ -1,6 +1,6 @@
 // What "contributes a pixel" means (README: "What contributes a pixel"), checked end to end with
 // `render --verify` on inputs where the old two-sided rendering and pixel-based verification
-// broke the conservative promise (issue 9, false-cull classes 1, 2, 3 and 5):
+// broke the conservative promise (false-cull classes 1, 2, 3 and 5):
 //   1. osd patches with back-patch culling at a low tessellation level: the cracks between
 //      patches of different refinement levels showed the back-facing inside of the surface
 //      (75 false culls at 256x256, level 1, before one-sided drawing);

@@ -1,5 +1,6 @@
-// Property tests of the back-patch kernels (seed 001) on real models against both ground truths
-// of issue 3: no culled patch may have e . T(u,v) > 0 at a dense sample, and no triangle of its
+// Property tests of the back-patch kernels (Loop, Niessner & Eisenacher, "Effective Back-Patch Culling for
+// Hardware Tessellation") on real models against both ground truths: no culled patch may have
+// e . T(u,v) > 0 at a dense sample, and no triangle of its
 // level-16 tessellation may face the eye. Views: whole-object views, free views (eyes inside
 // the model), and eyes very close to the surface. The last test shows the truth catches a
 // kernel that is not conservative.
@@ -35,7 +36,7 @@ void expect_no_false_culls(const CullEvalResult& r, const char* what) {
 
 // Level-16 tessellation triangles of every culled patch, for eyes the caller chooses.
 //
-// Finding (docs/RESULTS.md, "secant triangles"): seed 001's criterion is the continuous surface,
+// Finding (docs/RESULTS.md, "secant triangles"): Loop, Niessner & Eisenacher's criterion is the continuous surface,
 // e . T(u,v) <= 0. A secant triangle of a back-facing curved patch near the silhouette can face
 // an eye that is close to the surface even though every tangent plane faces away (seen: eye
 // 0.2-0.5 units from a 31.7-unit model, behind all sampled tangent planes by 0.03-0.07 units).
@@ -119,7 +120,7 @@ TEST(BackpatchProperty, BigGuyAccWholeObjectFreeAndCloseViews) {
     const CullEvalResult contain = run_methods(m.rest, ViewMode::contain, 400, 1);
     expect_no_false_culls(contain, "contain");
     expect_no_false_culls(run_methods(m.rest, ViewMode::free, 400, 2), "free");
-    // Not vacuous, and in seed 001's order on a real model: ptp >= ncone >= tcone > 0.
+    // Not vacuous, and in Loop, Niessner & Eisenacher's order on a real model: ptp >= ncone >= tcone > 0.
     EXPECT_GT(contain.methods[0].cull_rate, 0.15);
     EXPECT_GE(contain.methods[1].cull_rate, contain.methods[0].cull_rate);
     EXPECT_GE(contain.methods[2].cull_rate, contain.methods[1].cull_rate);

@@ -1,4 +1,4 @@
-// evaluate_cull's memory does not grow with the ground truth (issue 14): the heap's high-water
+// evaluate_cull's memory does not grow with the ground truth: the heap's high-water
 // mark during a run over N patches stays within a few hundred bytes per patch (the batch, the
 // displacement bounds, a decision byte) plus a fixed amount per thread, where the eager truth it
 // replaced held N * 289 * (12 + 32) bytes of samples (12.7 KB per patch at grid 17) for the whole

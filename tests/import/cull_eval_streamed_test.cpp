@@ -1,4 +1,4 @@
-// evaluate_cull with the streamed ground truth (issue 14) gives the answers of the eager one it
+// evaluate_cull with the streamed ground truth gives the answers of the eager one it
 // replaced: the culled patch-view counts below are those printed by `patchcull cull ... --json`
 // built at 18c0849, before the change (cull_rate * patches * views; every false-cull count was 0),
 // for teapot and BigGuy, acc and osd, displaced and not, free and distance views. The

@@ -1,5 +1,5 @@
-// The "distance" view distribution of evaluate_cull (patchcull/eval/cull_eval.h, DistanceViews; issue
-// 15): its contract at the library level, below the CLI's flag parsing (tests/cli/cli_test.cpp).
+// The "distance" view distribution of evaluate_cull (patchcull/eval/cull_eval.h, DistanceViews):
+// its contract at the library level, below the CLI's flag parsing (tests/cli/cli_test.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Models far from the origin (issue 9, "Far from the origin"): engines place objects at world
+// Models far from the origin: engines place objects at world
 // coordinates of 1e4 - 1e7 units. Before the OBJ reader re-centred positions in double
 // (ControlMesh::origin), BigGuy translated by 1e5 had CPU frustum false culls (5 and 25 in 200
 // free views) and ptp culled nothing (its rounding margin grows with |position|); at 1e7 float

@@ -1,4 +1,4 @@
-// Property tests of the frustum kernels against the dense-sample ground truth (issue 2):
+// Property tests of the frustum kernels against the dense-sample ground truth:
 // thousands of random cameras, including cameras inside the model and near planes that cut
 // patches, on real models, displaced and animated. A false cull fails the test; the last test
 // shows the ground truth does catch a kernel that is not conservative.

@@ -7,7 +7,9 @@
 // point stencils, then PatchMap::FindPatch + PatchTable::EvaluateBasis at (ptex face, u, v).
 // That path never uses our stencil tables or our B-spline -> Bezier conversion, so agreement
 // checks the conversion, the boundary extrapolation, the (u,v) orientation and the stencils
-// (seeds 000/001 patch setup: bicubic Bezier patches of the Catmull-Clark limit surface).
+// (the patch setup of Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation", and
+// Loop, Niessner & Eisenacher, "Effective Back-Patch Culling for Hardware Tessellation": bicubic Bezier
+// patches of the Catmull-Clark limit surface).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -475,7 +477,7 @@ TEST(Osd, NormalsPointOutwardOnConvexMeshes) {
     }
 }
 
-// Closed meshes give crack-free patches (watertight joins matter for a Hi-Z map, seed 000 §4.1),
+// Closed meshes give crack-free patches (watertight joins matter for a Hi-Z map, Niessner & Loop §4.1),
 // including end caps against regular patches and patches of different depths: every patch-edge
 // sample at parameter k/4 has a sample of another patch's edge (sampled at k/16) within float
 // precision. Depths of neighbours differ by at most 2 at isolation level 2, so k/4 on the deeper

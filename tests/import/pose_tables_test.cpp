@@ -1,4 +1,4 @@
-// ScenePoser::gpu_tables / gpu_meshes (scene_poser.h, issue 14's GPU posing): the stencil rows
+// ScenePoser::gpu_tables / gpu_meshes (scene_poser.h, GPU posing): the stencil rows
 // applied to the posed control meshes and mapped by each instance's transform (rows read
 // transposed for mirrored instances) reproduce pose() and tangents() bit for bit, on the CPU (the
 // compute pass repeats this arithmetic: tests/gl/gpu_posing_test.cpp checks the GPU's). Groups

@@ -1,5 +1,5 @@
-// Preprocessing is bit-identical across its speed and memory work (issue 14, "preprocessing that
-// scales"): every stencil table, patch record and evaluated patch of a fixed set of meshes hashes
+// Preprocessing is bit-identical across its speed and memory work (the work that made
+// preprocessing scale): every stencil table, patch record and evaluated patch of a fixed set of meshes hashes
 // to the value the code produced before that work (captured at 18c0849, before any change to
 // src/import/acc.cpp, quad_topology.cpp, subdivision.cpp, refine.cpp or osd_topology.cpp).
 //
@@ -265,7 +265,7 @@ ControlMesh mesh_of(const std::string& name) {
     return prism_house();
 }
 
-// Captured at 18c0849 (before the issue-14 preprocessing work).
+// Captured at 18c0849 (before the preprocessing speed and memory work).
 const Case kCases[] = {
     {"bigguy",
      {0xd266c3255b0f0a21ull, 0xe538f67cd2b85797ull, 0xd6a2dd91032be23dull, 0xb662ca8e0b71c1e6ull, 0xd3ec6372b7c82122ull, 0xa8c7f832281a39c5ull},

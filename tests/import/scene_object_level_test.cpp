@@ -1,12 +1,12 @@
-// CPU ground truth of the object level on scenes (issue 11, "Correctness"): SceneObjectLevel
+// CPU ground truth of the object level on scenes: SceneObjectLevel
 // (patchcull/import/scene_object_level.h) driving ObjectCuller (object_culling.h) on small scenes (a 2 x 2
 // city, the default scene, a small building, a scene file, scenes far from the origin and with
 // degenerate objects), over camera paths and adversarial cameras (eyes inside boxes, boxes
 // straddling the near plane), for every method and variant: frustum, bvh, bvh+backface; plane
 // masking, plane coherence and meta-BVs on and off; AABB alone or followed by the sphere or OBB;
 // clusters, normal masks (1, 2, 3 and 8 sectors) and per-triangle tests. The object-level tests of G. Zachmann's lecture "Advanced Visibility
-// Computations" (seed 004) and the patch clusters built from Loop, Niessner & Eisenacher's tangent
-// control planes ("Effective Back-Patch Culling for Hardware Tessellation", seed 001).
+// Computations" and the patch clusters built from Loop, Niessner & Eisenacher's tangent
+// control planes ("Effective Back-Patch Culling for Hardware Tessellation").
 //
 // Ground truth, independent of the kernels (double precision, ground_truth.h):
 // - an object culled by the frustum has no dense sample (17 x 17 per patch, displaced by the

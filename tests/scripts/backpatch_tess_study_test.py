@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """ctest for scripts/backpatch_tess_study.py (docs/PERFORMANCE.md, "Back-patch culling against
 the tessellation level"): a tiny run (levels 1 and 2, 64x36, two frames) must give one row per
-level in which no culling culls nothing and the back-patch tests cull in seed 001's order,
+level in which no culling culls nothing and the back-patch tests cull in the order of Loop, Niessner &
+Eisenacher, "Effective Back-Patch Culling for Hardware Tessellation",
 0 < TCONE <= NCONE <= PTP, with positive frame-time ratios; then bad input (a level list that is
 not one, a level out of range, a size, a frame count, an unknown option, a CLI that is not there),
 each exit status 2 and one line naming the flag or the path.
