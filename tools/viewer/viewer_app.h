@@ -7,7 +7,7 @@
 #include <string>
 
 #include "object_level_options.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/scene_model.h"
 #include "render_options.h"
 #include "render_support.h"
 #include "viewer_script.h"

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "object_level_options.h"
-#include "patchcull/import/default_scene.h"
+#include "patchcull/import/scene_poser.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "viewer_settings.h"
 
