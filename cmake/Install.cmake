@@ -1,9 +1,9 @@
 # cmake --install: what an engine needs to use patchcull from its own CMake project.
 #
 #   include/patchcull/<layer>/*.h         public headers by layer (core, objects, import, eval; gl
-#                                         with GL) and the generated include/patchcull/version.h
+#                                         and eval_gl with GL) and the generated include/patchcull/version.h
 #   include/patchcull/glsl/*.h            GLSL headers an engine's shaders include (with GL)
-#   lib/libpatchcull_<layer>.a            one static library per layer (patchcull_gl with GL)
+#   lib/libpatchcull_<layer>.a            one static library per layer (patchcull_gl, patchcull_eval_gl with GL)
 #   lib/cmake/patchcull/                  patchcullConfig.cmake, patchcullConfigVersion.cmake, targets
 #   share/patchcull/{models,scenes}/      the shipped models and scenes (patchcull_DATA_DIR)
 #   share/doc/patchcull/                  LICENSE, NOTICE
@@ -12,7 +12,7 @@
 # find_package(patchcull CONFIG COMPONENTS ...) gives one target per layer asked for (and the
 # layers it needs): patchcull::core (the kernels: TBB and Highway), patchcull::objects,
 # patchcull::import (OpenSubdiv, stb), patchcull::eval and, when the package was built with GL,
-# patchcull::gl (patchcullConfig.cmake.in).
+# patchcull::gl and patchcull::eval_gl (patchcullConfig.cmake.in).
 include(CMakePackageConfigHelpers)
 set(PATCHCULL_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/patchcull)
 
@@ -27,11 +27,11 @@ foreach(layer core objects import eval)
   install(EXPORT patchcull${first}${rest}Targets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
 endforeach()
 
-# Headers: the GL layer's folder only with GL, so a CPU-only install holds no header it cannot link.
+# Headers: the GL layers' folders only with GL, so a CPU-only install holds no header it cannot link.
 if(PATCHCULL_WITH_GL)
   set(patchcull_header_excludes)
 else()
-  set(patchcull_header_excludes PATTERN "gl" EXCLUDE)
+  set(patchcull_header_excludes PATTERN "gl" EXCLUDE PATTERN "eval_gl" EXCLUDE)
 endif()
 install(DIRECTORY include/patchcull DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   FILES_MATCHING PATTERN "*.h" ${patchcull_header_excludes})
@@ -41,6 +41,9 @@ if(PATCHCULL_WITH_GL)
   install(TARGETS patchcull_gl EXPORT patchcullGLTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
   install(EXPORT patchcullGLTargets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
+  install(TARGETS patchcull_eval_gl EXPORT patchcullEvalGLTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(EXPORT patchcullEvalGLTargets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
   # The GLSL headers of gl_passes.h's shipped_glsl (shared.h: the constants of C++ and GLSL,
   # patchcull_tcs.h: the TCS include) and the bindings of the back-patch and displaced passes
   # (gl_backpatch.h, gl_displaced.h). They include nothing but each other's constants (shared.h
