@@ -44,11 +44,11 @@ if(PATCHCULL_WITH_GL)
   install(TARGETS patchcull_eval_gl EXPORT patchcullEvalGLTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
   install(EXPORT patchcullEvalGLTargets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
-  # The GLSL headers of gl_passes.h's shipped_glsl (shared.h: the constants of C++ and GLSL,
-  # patchcull_tcs.h: the TCS include) and the bindings of the back-patch and displaced passes
-  # (gl_backpatch.h, gl_displaced.h). They include nothing but each other's constants (shared.h
-  # first); patchcull::gl puts this folder on the include path, as the build puts shaders/.
-  install(FILES shaders/shared.h shaders/patchcull_tcs.h shaders/backpatch_shared.h shaders/displaced_shared.h
+  # The GLSL headers of gl_passes.h's shipped_glsl (shared.h: the constants of C++ and GLSL, those
+  # of the back-patch and displaced passes included (gl_backpatch.h, gl_displaced.h);
+  # patchcull_tcs.h: the TCS include, which uses shared.h's constants); patchcull::gl puts this
+  # folder on the include path, as the build puts shaders/.
+  install(FILES shaders/shared.h shaders/patchcull_tcs.h
     DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/patchcull/glsl)
 endif()
 if(TARGET patchcull_cli)

@@ -11,7 +11,10 @@
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
-#include "backpatch_shared.h"
+#define PC_CONTROL_POINTS readonly
+#define PC_CULL_FLAGS
+#define PC_MAX_DISPLACEMENT readonly
+#include "patch_buffers.h"
 #include "exact_fma.h"
 #include "backpatch_exact.h"
 #define u_zero cones.zero
@@ -26,9 +29,6 @@
 
 layout(local_size_x = kConeGroupSize) in;
 
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];  // patch p's point k at 16p + k (patch.h order)
-};
 layout(std430, binding = kBindingConeValues) writeonly buffer ConeValues {
     float cone_values[];  // kConeValues per patch, written only when write_cones
 };

@@ -1,11 +1,10 @@
 // Probe of the back-patch shaders' exact arithmetic (shaders/exact_fma.h, backpatch_exact.h):
 // out[i] = pc_fma(a, b, c), pc_div(a, b), pc_sqrt(a), pc_div_from(a, b, c) or pc_sqrt_from(a, b)
 // of in[i] = (a, b, c, -) by u_mode
-// (backpatch_shared.h's kProbe*). Used by BackpatchCuller's start-up check of GLSL fma() on GPUs
+// (shared.h's kProbe*). Used by BackpatchCuller's start-up check of GLSL fma() on GPUs
 // and by tests/gl/backpatch_gpu_test.cpp (against std::fma, / and std::sqrt).
 #version 450 core
 #include "shared.h"
-#include "backpatch_shared.h"
 #include "exact_fma.h"
 #include "backpatch_exact.h"
 

@@ -28,16 +28,16 @@
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
-#include "backpatch_shared.h"
+#define PC_CONTROL_POINTS readonly
+#define PC_CULL_FLAGS
+#define PC_MAX_DISPLACEMENT readonly
+#include "patch_buffers.h"
 #include "exact_fma.h"
 #include "ptp_schedule.h"
 #include "flag_chain.h"
 
 layout(local_size_x = kPtpLanes, local_size_y = kPtpPatchesPerGroup) in;
 
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];  // patch p's point k at 16p + k (patch.h order)
-};
 layout(std430, binding = kBindingPtpPlanes) writeonly buffer PtpPlanes {
     float ptp_planes[];  // 128 per patch (t[64], thr[64]), written only when u_write_planes
 };

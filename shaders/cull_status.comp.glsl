@@ -12,6 +12,9 @@
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
+#define PC_CULL_FLAGS
+#define PC_MAX_DISPLACEMENT readonly
+#include "patch_buffers.h"
 #include "flag_chain.h"
 
 layout(local_size_x = kCullGroupSize) in;

@@ -15,8 +15,10 @@
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
-#include "displaced_shared.h"
-#include "backpatch_shared.h"
+#define PC_CONTROL_POINTS readonly
+#define PC_CULL_FLAGS
+#define PC_MAX_DISPLACEMENT readonly
+#include "patch_buffers.h"
 #include "exact_fma.h"
 #include "backpatch_exact.h"
 #define u_zero displaced.zero
@@ -29,9 +31,6 @@
 
 layout(local_size_x = kDisplacedGroupSize) in;
 
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];  // patch p's point k at 16p + k (patch.h order)
-};
 layout(std430, binding = kBindingDisplacementRanges) readonly buffer Ranges {
     vec2 ranges[];  // (d_min, d_max) per patch, read when u_has_ranges
 };

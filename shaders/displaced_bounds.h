@@ -1,5 +1,5 @@
-// shaders/displaced_bounds.h (GLSL only; include after shared.h, displaced_shared.h, exact_fma.h,
-// backpatch_exact.h and backpatch_cones.h): the GPU twin of src/core/displaced_bounds.cpp, the
+// shaders/displaced_bounds.h (GLSL only; include after shared.h, exact_fma.h, backpatch_exact.h
+// and backpatch_cones.h): the GPU twin of src/core/displaced_bounds.cpp, the
 // bounds of displaced patches of include/patchcull/core/displaced_bounds.h (Niessner & Loop §4.2: the
 // camera-aligned frustum `caf`; Munkberg et al.'s object-oriented box `oobb`; cones full / acon /
 // con) and their frustum and Hi-Z decisions. Every step is written in the CPU's order with the

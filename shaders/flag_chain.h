@@ -1,19 +1,17 @@
-// shaders/flag_chain.h (GLSL only; include after shared.h): the flag chain of the cull passes
-// (include/patchcull/gl/gl_passes.h, "The flag chain"). Every test pass reads and writes the
-// caller's flag buffer (kBindingCullFlags, one uint per patch); a patch whose reason bits
-// (kCullReasonMask) are set was culled by an earlier pass of the frame and is skipped, so each
-// patch ends with the reason of the first test that culled it, and the later, costlier tests only
-// see the survivors. Status bits (kStatusVisible, kStatusNewlyVisible) are left alone; only the
-// status pass (cull_status.comp.glsl) writes them.
+// shaders/flag_chain.h (GLSL only; include after shared.h and patch_buffers.h, with its blocks
+// CullFlags read-write and MaxDisplacement: define PC_CULL_FLAGS and PC_MAX_DISPLACEMENT): the
+// flag chain of the cull passes (include/patchcull/gl/gl_passes.h, "The flag chain"). Every test
+// pass reads and writes the caller's flag buffer (kBindingCullFlags, one uint per patch); a patch
+// whose reason bits (kCullReasonMask) are set was culled by an earlier pass of the frame and is
+// skipped, so each patch ends with the reason of the first test that culled it, and the later,
+// costlier tests only see the survivors. Status bits (kStatusVisible, kStatusNewlyVisible) are
+// left alone; only the status pass (cull_status.comp.glsl) writes them.
 // The optional margin buffer (kBindingMaxDisplacement, float per patch, >= 0) marks displaced
-// patches: margin > 0.
+// patches: margin > 0. Each invocation reads and writes its own patch's flag word only.
 
-layout(std430, binding = kBindingCullFlags) buffer CullFlags {
-    uint cull_flags[];  // each invocation reads and writes its own patch's word only
-};
-layout(std430, binding = kBindingMaxDisplacement) readonly buffer MaxDisplacement {
-    float max_displacement[];
-};
+#if !defined(PC_CULL_FLAGS) || !defined(PC_MAX_DISPLACEMENT)
+#error flag_chain.h needs patch_buffers.h's CullFlags and MaxDisplacement (PC_CULL_FLAGS, PC_MAX_DISPLACEMENT)
+#endif
 
 // True when an earlier pass of the chain culled patch p.
 bool pc_chain_culled(uint p) { return (cull_flags[p] & kCullReasonMask) != 0u; }

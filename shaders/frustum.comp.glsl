@@ -6,17 +6,15 @@
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
+#define PC_CONTROL_POINTS readonly
+#define PC_CULL_FLAGS
+#define PC_MAX_DISPLACEMENT readonly
+#define PC_PLANE_VALUES writeonly  // written only when write_plane_values
+#include "patch_buffers.h"
 #include "exact_fma.h"
 #include "flag_chain.h"
 
 layout(local_size_x = kCullGroupSize) in;
-
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];
-};
-layout(std430, binding = kBindingPlaneValues) writeonly buffer PlaneValues {
-    float plane_values[];  // 6 per patch, written only when write_plane_values
-};
 
 // frustum_test.h's names.
 #define u_clip_rows frustum.clip_rows

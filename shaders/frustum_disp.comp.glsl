@@ -14,18 +14,16 @@
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
+#define PC_CONTROL_POINTS readonly
+#define PC_CULL_FLAGS
+#define PC_MAX_DISPLACEMENT readonly
+#define PC_PLANE_VALUES writeonly  // written only when write_plane_values
+#include "patch_buffers.h"
 #include "exact_fma.h"
 #include "backpatch_exact.h"
 #include "flag_chain.h"
 
 layout(local_size_x = kCullGroupSize) in;
-
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];
-};
-layout(std430, binding = kBindingPlaneValues) writeonly buffer PlaneValues {
-    float plane_values[];  // 6 per patch, written only when write_plane_values
-};
 
 // Corner c (= i*4 + j*2 + s, as the CPU kernel numbers them) of box (x from box[0][i], y from
 // box[1][j], z from box[2][s]) in clip-space row r.

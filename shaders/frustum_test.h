@@ -13,7 +13,7 @@
 // llvmpipe (exact_fma.h).
 //
 // The including shader declares, before including this file: exact_fma.h, the buffer
-// control_points[] (kBindingControlPoints) and the names u_clip_rows (vec4[4], FrustumPlanes::clip_rows)
+// control_points[] (patch_buffers.h, PC_CONTROL_POINTS) and the names u_clip_rows (vec4[4], FrustumPlanes::clip_rows)
 // , u_plane_normal_length (vec4[2]: FrustumPlanes::normal_length[q] at [q >> 2][q & 3]) and
 // u_plane_depth (vec4: FrustumPlanes::near_w, far_w, far_limit), #defines
 // onto its parameter block (pass_params.h).

@@ -16,7 +16,10 @@
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
-#include "backpatch_shared.h"
+#define PC_CONTROL_POINTS readonly
+#define PC_CULL_FLAGS
+#define PC_MAX_DISPLACEMENT readonly
+#include "patch_buffers.h"
 #include "exact_fma.h"
 #include "backpatch_exact.h"
 #define u_zero fused.zero
@@ -31,9 +34,6 @@
 
 layout(local_size_x = kCullGroupSize) in;
 
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];  // patch p's point k at 16p + k (patch.h order)
-};
 layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 
 // frustum_test.h's and hiz_box_test.h's names.

@@ -11,14 +11,15 @@
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
+#define PC_CONTROL_POINTS readonly
+#define PC_CULL_FLAGS
+#define PC_MAX_DISPLACEMENT readonly
+#include "patch_buffers.h"
 #include "exact_fma.h"
 #include "flag_chain.h"
 
 layout(local_size_x = kCullGroupSize) in;
 
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];
-};
 layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 
 // frustum_test.h's and hiz_box_test.h's names.

@@ -18,23 +18,18 @@
 // depth is found, including both sides of a depth tie.
 #version 450 core
 #include "shared.h"
+#define PC_CONTROL_POINTS readonly
+#define PC_CULL_FLAGS readonly
+#define PC_MAX_DISPLACEMENT readonly
+#ifdef PATCHCULL_MARK_FRONT
+#define PC_PATCH_MARKS writeonly
+#endif
+#include "patch_buffers.h"
 #include "patch_eval.h"
 #include "patch_displaced.h"
 
 #ifdef PATCHCULL_MARK_FRONT
 layout(early_fragment_tests) in;
-#endif
-
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];
-};
-layout(std430, binding = kBindingCullFlags) readonly buffer CullFlags {
-    uint cull_flags[];
-};
-#ifdef PATCHCULL_MARK_FRONT
-layout(std430, binding = kBindingPatchMarks) writeonly buffer PatchMarks {
-    uint patch_marks[];
-};
 #endif
 
 uniform vec3 u_eye;  // object-space eye position

@@ -13,17 +13,13 @@
 // them), so two patches sharing an edge give it the same level.
 #version 450 core
 #include "shared.h"
+#define PC_PATCH_TESS_SCALE readonly
+// Drawn patches of this render (PatchRenderer::read_drawn_patches: what --verify compares).
+#define PC_PATCH_MARKS writeonly
+#include "patch_buffers.h"
 #include "patchcull_tcs.h"
 
 layout(vertices = 16) out;
-
-layout(std430, binding = kBindingPatchTessScale) readonly buffer PatchTessScale {
-    float patch_tess_scale[];
-};
-// Drawn patches of this render (PatchRenderer::read_drawn_patches: what --verify compares).
-layout(std430, binding = kBindingPatchMarks) writeonly buffer PatchMarks {
-    uint patch_marks[];
-};
 
 uniform float u_tess_level;    // uniform level (or the adaptive maximum), in [1, 64]
 uniform uint u_draw_mask;

@@ -7,17 +7,14 @@
 // follows the latter, which the cone bounds of Niessner & Loop §4.2 bound (gl_renderer.h).
 #version 450 core
 #include "shared.h"
+#define PC_MAX_DISPLACEMENT readonly
+#define PC_PATCH_TEXCOORDS readonly
+#define PC_PATCH_TANGENTS readonly
+#include "patch_buffers.h"
 #include "patch_eval.h"
 #include "patch_displaced.h"
 
 layout(quads, equal_spacing, ccw) in;
-
-layout(std430, binding = kBindingPatchTexcoords) readonly buffer PatchTexcoords {
-    vec2 patch_texcoords[];  // 4 per patch: (u,v) = (0,0), (1,0), (0,1), (1,1)
-};
-layout(std430, binding = kBindingPatchTangents) readonly buffer PatchTangents {
-    vec4 patch_tangents[];  // kTangentVec4s per patch: du[12], dv[12]; [0].w = 1 when present
-};
 
 uniform mat4 u_object_to_clip;
 uniform bool u_has_tangents;  // the tangent buffer holds kTangentVec4s entries per patch

@@ -3,10 +3,8 @@
 // 4096 input vertices (Mesa 22.3.6 to 25.0.7), so no later stage uses gl_PrimitiveID.
 #version 450 core
 #include "shared.h"
-
-layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints {
-    vec4 control_points[];
-};
+#define PC_CONTROL_POINTS readonly
+#include "patch_buffers.h"
 
 out vec4 vs_point;       // object-space homogeneous control point (x*w, y*w, z*w, w)
 flat out uint vs_patch;  // patch index

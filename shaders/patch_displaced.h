@@ -1,4 +1,5 @@
-// shaders/patch_displaced.h (GLSL only; include after shared.h): which patches the draw displaces,
+// shaders/patch_displaced.h (GLSL only; include after shared.h and patch_buffers.h, with its block
+// MaxDisplacement: define PC_MAX_DISPLACEMENT readonly): which patches the draw displaces,
 // shared by patch.tese.glsl (displacement) and patch.frag.glsl (one-sided drawing).
 // With a displacement map (u_displace) a patch is displaced unless the per-patch margins are given
 // (u_has_margins) and its margin is 0: a margin bounds |D| over the patch, so a zero margin means
@@ -6,11 +7,11 @@
 // objects under one map (the plain ones get margin 0). A displaced patch is drawn two-sided; the
 // others follow u_discard_back_facing.
 
-layout(std430, binding = kBindingMaxDisplacement) readonly buffer PatchMargins {
-    float patch_margins[];
-};
+#ifndef PC_MAX_DISPLACEMENT
+#error patch_displaced.h needs patch_buffers.h's MaxDisplacement (PC_MAX_DISPLACEMENT)
+#endif
 
 uniform bool u_displace;
 uniform bool u_has_margins;
 
-bool patch_is_displaced(uint p) { return u_displace && (!u_has_margins || patch_margins[p] > 0.0); }
+bool patch_is_displaced(uint p) { return u_displace && (!u_has_margins || max_displacement[p] > 0.0); }

@@ -23,14 +23,12 @@ layout(local_size_x = 256) in;
 
 #include "shared.h"
 
-// Outputs at the renderer's own binding points (kBindingControlPoints, kBindingPatchTangents),
-// inputs at this pass's own binding points (shared.h).
-layout(std430, binding = kBindingControlPoints) writeonly buffer ControlPoints {
-    vec4 control_points[];  // 16 per patch
-};
-layout(std430, binding = kBindingPatchTangents) writeonly buffer Tangents {
-    vec4 tangents[];  // 24 per patch (shared.h kTangentVec4s)
-};
+// Outputs at the renderer's own binding points (patch_buffers.h's control_points, 16 per patch,
+// and patch_tangents, kTangentVec4s = 24 per patch), inputs at this pass's own binding points
+// (shared.h).
+#define PC_CONTROL_POINTS writeonly
+#define PC_PATCH_TANGENTS writeonly
+#include "patch_buffers.h"
 layout(std430, binding = kBindingPoseVertices) readonly buffer Vertices {
     float vertices[];  // posed control meshes, x y z per vertex (packed Vec3)
 };
@@ -119,5 +117,5 @@ void main() {
     }
     const vec3 d = stencil_row(entry.y + source, inst.info.x);
     const vec4 mapped = transform(inst.to_world, vec4(d, 0.0));
-    tangents[24u * entry.x + t] = vec4(mapped.xyz, t == 0u ? 1.0 : 0.0);
+    patch_tangents[24u * entry.x + t] = vec4(mapped.xyz, t == 0u ? 1.0 : 0.0);
 }

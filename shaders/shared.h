@@ -5,6 +5,10 @@
 // shader with glslangValidator and embedding it into the binary; C++ includes it directly.
 // Constants only (uint and float): they are the contract between the two languages (buffer
 // binding points, flag bits, work-group sizes, id encoding, the front-facing threshold).
+// Sections: every binding point, texture and image unit (each declared once); the flag word, its
+// draw selections and counters; drawing and id constants; then one section per pass family with
+// its buffer layouts, work groups and modes (back-patch, displaced). The GLSL storage blocks of the
+// per-patch buffers that several shaders share are in patch_buffers.h (GLSL, patchcull's shaders).
 #ifndef PATCHCULL_SHADERS_SHARED_H
 #define PATCHCULL_SHADERS_SHARED_H
 
@@ -41,8 +45,8 @@ PATCHCULL_CONST uint kBindingPatchMarks = 11u;
 // float scale[patch_count]: patch p's uniform tessellation level is min(64, level * scale[p]),
 // scale = 2^(D - depth) (PatchAttributes::depth): equal vertex density across refinement depths.
 PATCHCULL_CONST uint kBindingPatchTessScale = 12u;
-// The passes' own buffers (their layouts: backpatch_shared.h, displaced_shared.h and the headers
-// named). Every binding point of patchcull is declared here, once, and each is used by one
+// The passes' own buffers (their layouts: the pass sections below and the headers named). Every
+// binding point of patchcull is declared here, once, and each is used by one
 // buffer only (tests/gl/shader_bindings_test.cpp): passes leave their buffers bound, so a shared
 // number would let one pass read another's buffer.
 PATCHCULL_CONST uint kBindingDisplacementRanges = 8u;  // displaced: vec2 (d_min, d_max) per patch
@@ -138,6 +142,49 @@ PATCHCULL_CONST uint kHiZGroupSize = 8u;
 // before its key is taken: half a step for GL_LEQUAL / GL_GEQUAL ties, one step for the driver's
 // conversion of the integer to float (below 2^-24).
 PATCHCULL_CONST float kHiZUnorm24Slack = 1.5f / 16777215.0f;
+
+// ---- Back-patch passes (BackpatchCuller of gl_backpatch.h and the passes it runs) --------------
+// Diagnostics, written only on request: backpatch_ptp at kBindingPtpPlanes (float t[64 *
+// patch_count]: patch p's control plane z components at 64p + 8 jv + iu, exactly the CPU kernel's
+// t); backpatch_cones (tcone / ncone) at kBindingConeValues (float c[kConeValues * patch_count]:
+// patch p's cone and sphere at kConeValues p + (axis.x, axis.y, axis.z, cos, sin, valid (1 or 0),
+// center.x, center.y, center.z, radius, 0, 0)). backpatch_probe.comp.glsl (tests and the start-up
+// fma check) reads kBindingProbeIn and writes kBindingProbeOut.
+PATCHCULL_CONST uint kConeValues = 12u;
+
+// Work groups: cones, one invocation per patch; ptp, kPtpLanes invocations per patch (Loop, Niessner &
+// Eisenacher §6: 16 threads per patch, each owning one 4x4 block's 4 destinations) and kPtpPatchesPerGroup
+// patches per work group (local size kPtpLanes x kPtpPatchesPerGroup).
+PATCHCULL_CONST uint kConeGroupSize = 64u;
+PATCHCULL_CONST uint kPtpLanes = 16u;
+PATCHCULL_CONST uint kPtpPatchesPerGroup = 8u;
+PATCHCULL_CONST uint kProbeGroupSize = 64u;
+
+// backpatch_probe modes (u_mode).
+PATCHCULL_CONST uint kProbeFma = 0u;       // out = pc_fma(a, b, c)
+PATCHCULL_CONST uint kProbeDiv = 1u;       // out = pc_div(a, b)
+PATCHCULL_CONST uint kProbeSqrt = 2u;      // out = pc_sqrt(a)
+PATCHCULL_CONST uint kProbeDivFrom = 3u;   // out = pc_div_from(a, b, c): c a guess of a / b
+PATCHCULL_CONST uint kProbeSqrtFrom = 4u;  // out = pc_sqrt_from(a, b): b a guess of sqrt(a)
+
+// ---- Displaced pass (gl_displaced.h, DisplacedPass: displaced.comp.glsl) ---------------------
+// Per-patch displacement ranges at kBindingDisplacementRanges (vec2 range[patch_count]: (d_min,
+// d_max)), read only when the pass has ranges (else every patch is undisplaced, as a null ranges
+// pointer on the CPU); diagnostics at kBindingDisplacedBounds (float b[kDisplacedBoundValues *
+// patch_count]): patch p's DisplacedBound at kDisplacedBoundValues p + (ndc_xmin, ndc_xmax,
+// ndc_ymin, ndc_ymax, depth_near, depth_far, status as a float, 0), written only on request.
+// The Hi-Z pyramid is on kTextureUnitHiZ.
+PATCHCULL_CONST uint kDisplacedBoundValues = 8u;
+
+// One invocation per patch.
+PATCHCULL_CONST uint kDisplacedGroupSize = 64u;
+
+// u_bound_kind (DisplacedBoundKind) and the PC_DISPLACED_CONE compile-time define (NormalConeKind).
+PATCHCULL_CONST uint kDisplacedBoundOobb = 0u;
+PATCHCULL_CONST uint kDisplacedBoundCaf = 1u;
+PATCHCULL_CONST uint kDisplacedConeFull = 0u;
+PATCHCULL_CONST uint kDisplacedConeAcon = 1u;
+PATCHCULL_CONST uint kDisplacedConeCon = 2u;
 
 #ifdef __cplusplus
 }  // namespace patchcull::gl::shared

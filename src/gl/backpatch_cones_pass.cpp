@@ -1,6 +1,5 @@
 // BackpatchConePass (patchcull/gl/gl_passes.h): cull_tcone_scalar and cull_ncone_scalar on the GPU,
 // shaders/backpatch_cones.comp.glsl (ncone compiled with PATCHCULL_NCONE).
-#include "backpatch_shared.h"
 #include "pass_common.h"
 
 namespace patchcull::gl {
@@ -20,7 +19,7 @@ void BackpatchConePass::run(const PatchBuffers& patches, BackpatchMethod method,
     detail::check_patch_buffers("BackpatchConePass", patches);
     if (cone_values)
         detail::check_buffer_size("BackpatchConePass", "cone-value", cone_values,
-                                  (patches.first + patches.count) * backpatch_shared::kConeValues * sizeof(float));
+                                  (patches.first + patches.count) * shared::kConeValues * sizeof(float));
     if (patches.count == 0) return;
     pp::BackpatchConeParams params;
     params.eye = {eye.x, eye.y, eye.z, 1.0f};
@@ -31,7 +30,7 @@ void BackpatchConePass::run(const PatchBuffers& patches, BackpatchMethod method,
     glUseProgram(impl_->context.program("backpatch_cones.comp.glsl", ncone ? "#define PATCHCULL_NCONE 1\n" : ""));
     detail::bind_patch_buffers(patches);
     if (cone_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingConeValues, cone_values);
-    detail::dispatch_patches(impl_->block, params, patches.first, patches.count, backpatch_shared::kConeGroupSize);
+    detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kConeGroupSize);
     detail::finish_pass("BackpatchConePass");
 }
 

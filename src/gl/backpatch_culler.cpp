@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "backpatch_shared.h"
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_backpatch.h"
 #include "patchcull/gl/gl_passes.h"
@@ -20,8 +19,6 @@
 namespace patchcull::gl {
 
 namespace {
-
-namespace bs = backpatch_shared;
 
 static_assert(kFlagBackPatch == sh::kCullBackPatch);
 
@@ -69,10 +66,10 @@ struct BackpatchCuller::Impl {
 
     void cull_cone(BackpatchMethod method, Vec3 eye, std::vector<std::uint8_t>* culled, std::vector<float>* cones_out) {
         clear_flags();
-        if (cones_out) upload(diagnostics, count * bs::kConeValues * sizeof(float), nullptr);
+        if (cones_out) upload(diagnostics, count * shared::kConeValues * sizeof(float), nullptr);
         cones.run(buffers(), method, eye, cones_out ? diagnostics : 0);
         if (culled) read_flags(*culled);
-        if (cones_out) *cones_out = read_floats(diagnostics, count * bs::kConeValues);
+        if (cones_out) *cones_out = read_floats(diagnostics, count * shared::kConeValues);
     }
 };
 

@@ -1,6 +1,5 @@
 // BackpatchPtpPass (patchcull/gl/gl_passes.h): cull_ptp_scalar on the GPU with Loop, Niessner & Eisenacher §6's 16
 // invocations per patch, shaders/backpatch_ptp.comp.glsl.
-#include "backpatch_shared.h"
 #include "pass_common.h"
 
 namespace patchcull::gl {
@@ -48,7 +47,7 @@ bool BackpatchPtpPass::run(const PatchBuffers& patches, const Mat4& object_to_cl
     glUseProgram(impl_->context.program("backpatch_ptp.comp.glsl"));
     detail::bind_patch_buffers(patches);
     if (plane_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingPtpPlanes, plane_values);
-    detail::dispatch_patches(impl_->block, params, patches.first, patches.count, backpatch_shared::kPtpPatchesPerGroup);
+    detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kPtpPatchesPerGroup);
     detail::finish_pass("BackpatchPtpPass");
     return true;
 }

@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "displaced_shared.h"
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_backpatch.h"
 #include "patchcull/gl/gl_displaced.h"
@@ -23,8 +22,6 @@
 namespace patchcull::gl {
 
 namespace {
-
-namespace ds = displaced_shared;
 
 static_assert(kFlagFrustum == sh::kCullFrustum && kFlagOcclusion == sh::kCullOcclusion);
 
@@ -73,18 +70,18 @@ struct DisplacedCuller::Impl {
              std::vector<DisplacedBound>* bound_out) {
         if (occlusion && !hiz.texture) throw Error("GL: DisplacedCuller::cull_occlusion: no Hi-Z pyramid (call set_hiz)");
         glClearNamedBufferData(flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-        if (bound_out) upload(bounds, count * ds::kDisplacedBoundValues * sizeof(float), nullptr);
+        if (bound_out) upload(bounds, count * shared::kDisplacedBoundValues * sizeof(float), nullptr);
         pass.run({points, flags, 0, 0, count}, has_ranges ? ranges : 0, bound, cone, view, occlusion ? &hiz : nullptr,
                  false, bound_out ? bounds : 0);
         if (!bound_out) return;
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-        std::vector<float> values(count * ds::kDisplacedBoundValues);
+        std::vector<float> values(count * shared::kDisplacedBoundValues);
         if (count)
             glGetNamedBufferSubData(bounds, 0, static_cast<GLsizeiptr>(values.size() * sizeof(float)), values.data());
         check_gl("displaced bounds read-back");
         bound_out->resize(count);
         for (std::size_t p = 0; p < count; ++p) {
-            const float* v = &values[p * ds::kDisplacedBoundValues];
+            const float* v = &values[p * shared::kDisplacedBoundValues];
             DisplacedBound& b = (*bound_out)[p];
             b.ndc_xmin = v[0];
             b.ndc_xmax = v[1];

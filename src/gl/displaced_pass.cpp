@@ -1,18 +1,15 @@
 // DisplacedPass (patchcull/gl/gl_passes.h): the bounds of displaced patches (Niessner & Loop §4.2: caf,
 // Munkberg et al.'s oobb; cones full, acon, con) and their frustum and Hi-Z decisions on the GPU,
 // shaders/displaced.comp.glsl (one program per cone kind).
-#include "displaced_shared.h"
 #include "pass_common.h"
 
 namespace patchcull::gl {
 
-namespace ds = displaced_shared;
-
-static_assert(static_cast<unsigned>(DisplacedBoundKind::oobb) == ds::kDisplacedBoundOobb &&
-              static_cast<unsigned>(DisplacedBoundKind::caf) == ds::kDisplacedBoundCaf);
-static_assert(static_cast<unsigned>(NormalConeKind::full) == ds::kDisplacedConeFull &&
-              static_cast<unsigned>(NormalConeKind::acon) == ds::kDisplacedConeAcon &&
-              static_cast<unsigned>(NormalConeKind::con) == ds::kDisplacedConeCon);
+static_assert(static_cast<unsigned>(DisplacedBoundKind::oobb) == shared::kDisplacedBoundOobb &&
+              static_cast<unsigned>(DisplacedBoundKind::caf) == shared::kDisplacedBoundCaf);
+static_assert(static_cast<unsigned>(NormalConeKind::full) == shared::kDisplacedConeFull &&
+              static_cast<unsigned>(NormalConeKind::acon) == shared::kDisplacedConeAcon &&
+              static_cast<unsigned>(NormalConeKind::con) == shared::kDisplacedConeCon);
 static_assert(sizeof(DisplacementRange) == 2 * sizeof(float), "DisplacementRange must be two packed floats (vec2)");
 
 struct DisplacedPass::Impl {
@@ -38,7 +35,7 @@ void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, Displ
     detail::check_patch_buffers("DisplacedPass", patches);
     const std::size_t end = patches.first + patches.count;
     if (ranges) detail::check_buffer_size("DisplacedPass", "range", ranges, end * sizeof(DisplacementRange));
-    if (bounds) detail::check_buffer_size("DisplacedPass", "bound", bounds, end * ds::kDisplacedBoundValues * sizeof(float));
+    if (bounds) detail::check_buffer_size("DisplacedPass", "bound", bounds, end * shared::kDisplacedBoundValues * sizeof(float));
     if (hiz && (!glIsTexture(hiz->texture) || hiz->width < 1 || hiz->height < 1))
         throw Error("GL: DisplacedPass: no Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
     if (hiz && hiz->reversed != is_reversed(view.depth))
@@ -81,7 +78,7 @@ void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, Displ
     if (ranges) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDisplacementRanges, ranges);
     if (bounds) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDisplacedBounds, bounds);
     glBindTextureUnit(shared::kTextureUnitHiZ, hiz ? hiz->texture : m.placeholder_hiz);
-    detail::dispatch_patches(m.block, params, patches.first, patches.count, ds::kDisplacedGroupSize);
+    detail::dispatch_patches(m.block, params, patches.first, patches.count, shared::kDisplacedGroupSize);
     detail::finish_pass("DisplacedPass");
 }
 

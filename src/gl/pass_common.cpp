@@ -6,11 +6,8 @@
 #include <cstring>
 #include <limits>
 
-#include "backpatch_shared.h"
-
 namespace patchcull::gl {
 
-namespace bs = backpatch_shared;
 using namespace detail;
 
 // The C++ structs are the GLSL std140 blocks (pass_params.h): sizes a multiple of 16, members in
@@ -96,7 +93,7 @@ PassContext::Impl& PassContext::impl() { return *impl_; }
 
 std::vector<float> PassContext::probe(BackpatchProbe op, const std::vector<Vec3>& abc) {
     Impl& m = *impl_;
-    if (abc.size() > 65535u * bs::kProbeGroupSize) throw Error("GL: probe: too many inputs");
+    if (abc.size() > 65535u * shared::kProbeGroupSize) throw Error("GL: probe: too many inputs");
     std::vector<float> in(abc.size() * 4);
     for (std::size_t i = 0; i < abc.size(); ++i) {
         in[4 * i] = abc[i].x;
@@ -110,17 +107,17 @@ std::vector<float> PassContext::probe(BackpatchProbe op, const std::vector<Vec3>
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingProbeIn, m.probe_in);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingProbeOut, m.probe_out);
     glUniform1ui(glGetUniformLocation(program, "u_count"), static_cast<GLuint>(abc.size()));
-    GLuint mode = bs::kProbeFma;
+    GLuint mode = shared::kProbeFma;
     switch (op) {
-        case BackpatchProbe::fma: mode = bs::kProbeFma; break;
-        case BackpatchProbe::div: mode = bs::kProbeDiv; break;
-        case BackpatchProbe::sqrt: mode = bs::kProbeSqrt; break;
-        case BackpatchProbe::div_from: mode = bs::kProbeDivFrom; break;
-        case BackpatchProbe::sqrt_from: mode = bs::kProbeSqrtFrom; break;
+        case BackpatchProbe::fma: mode = shared::kProbeFma; break;
+        case BackpatchProbe::div: mode = shared::kProbeDiv; break;
+        case BackpatchProbe::sqrt: mode = shared::kProbeSqrt; break;
+        case BackpatchProbe::div_from: mode = shared::kProbeDivFrom; break;
+        case BackpatchProbe::sqrt_from: mode = shared::kProbeSqrtFrom; break;
     }
     glUniform1ui(glGetUniformLocation(program, "u_mode"), mode);
     if (!abc.empty())
-        glDispatchCompute(static_cast<GLuint>((abc.size() + bs::kProbeGroupSize - 1) / bs::kProbeGroupSize), 1, 1);
+        glDispatchCompute(static_cast<GLuint>((abc.size() + shared::kProbeGroupSize - 1) / shared::kProbeGroupSize), 1, 1);
     glUseProgram(0);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     std::vector<float> out(abc.size());

@@ -69,3 +69,24 @@ TEST(ShaderBindings, EveryStorageBindingIsDeclaredOnceWithItsOwnNumber) {
         }
     EXPECT_GE(shaders, 10u);
 }
+
+TEST(ShaderBindings, SharedPatchBlocksAreDeclaredOnlyInPatchBuffers) {
+    // shaders/patch_buffers.h declares the storage blocks of the per-patch buffers that several
+    // shaders share; no other shader or header of shaders/ declares a block at one of its bindings
+    // (patchcull_tcs.h excepted: shipped to engines on its own, it names its flag block itself).
+    const std::string blocks = read_text(kRoot / "shaders/patch_buffers.h");
+    const std::regex block_re(R"(binding\s*=\s*(kBinding\w+)\))");
+    std::set<std::string> declared;
+    for (std::sregex_iterator it(blocks.begin(), blocks.end(), block_re), end; it != end; ++it)
+        declared.insert((*it)[1]);
+    EXPECT_GE(declared.size(), 8u);
+    EXPECT_TRUE(declared.count("kBindingControlPoints"));
+    for (const auto& entry : fs::directory_iterator(kRoot / "shaders")) {
+        const std::string name = entry.path().filename().string();
+        if (!entry.is_regular_file() || name == "patch_buffers.h" || name == "patchcull_tcs.h") continue;
+        const std::string text = read_text(entry.path());
+        for (std::sregex_iterator it(text.begin(), text.end(), block_re), end; it != end; ++it)
+            EXPECT_FALSE(declared.count((*it)[1])) << name << " declares the block at " << (*it)[1]
+                                                   << " (patch_buffers.h declares it)";
+    }
+}

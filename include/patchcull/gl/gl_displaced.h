@@ -12,7 +12,7 @@
 // mirror of src/core/cones_internal.h that BackpatchCuller's tcone / ncone use) and the Hi-Z
 // steps 5-9 of occlusion.comp.glsl (shaders/hiz_box_test.h).
 //
-// Buffers and textures (bindings of shaders/shared.h and shaders/displaced_shared.h):
+// Buffers and textures (bindings and layouts of shaders/shared.h):
 // - control points, kBindingControlPoints (0): vec4 cp[16 * patch_count], patch p's point k at
 //   16p + k (the renderer's layout): uploaded by set_patches, or a caller's buffer of that layout
 //   (use_patch_buffer, e.g. PatchRenderer::patch_buffer()).
