@@ -4,8 +4,9 @@
 // `eval occlusion MODEL [--split N] [--views N] --json` reproduces Niessner & Loop §6.2 for non-displaced
 // models (culling within one object): views that contain the whole object (camera.h, contain
 // mode); on each view the pipeline (Niessner & Loop §3, cull mode occlusion) runs on the static model from
-// a first frame until its visible set is stable (converge_frame, eval/eval_temporal.h: two consecutive
-// frames tag the same patches visible; at most --max-frames frames), and the occluded fraction of that frame is recorded. Every
+// a first frame until its visible set is stable (converge_frame, eval_gl/reference_frame.h; the run:
+// eval_gl/occlusion_eval.h: two consecutive frames tag the same patches visible; at most
+// --max-frames frames), and the occluded fraction of that frame is recorded. Every
 // final frame is compared with the unculled render (false culls). For comparison with Niessner & Loop's
 // back-patch figures it also reports the GPU tcone/ncone back-patch cull fractions of each view.
 // Output (--json): {"model","scheme","split","patches","views","size","tess","seed",
@@ -16,6 +17,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -23,13 +25,11 @@
 #include "commands.h"
 #include "eval/eval_displaced.h"
 #include "eval/eval_fused.h"
+#include "eval/eval_progress.h"
 #include "eval/eval_scene.h"
 #include "eval/eval_temporal.h"
 #include "patchcull/core/error.h"
-#include "patchcull/gl/gl_backpatch.h"
-#include "patchcull/gl/gl_verification.h"
-#include "progress.h"
-#include "render_support.h"
+#include "patchcull/eval_gl/occlusion_eval.h"
 
 namespace patchcull::cli {
 namespace {
@@ -46,61 +46,21 @@ struct OcclusionOptions {
     bool json = false;
 };
 
-double fraction_culled(const std::vector<std::uint8_t>& culled) {
-    if (culled.empty()) return 0;
-    return double(std::count_if(culled.begin(), culled.end(), [](std::uint8_t c) { return c != 0; })) / double(culled.size());
-}
-
 int run_occlusion(const OcclusionOptions& o) {
-    int width = 0, height = 0;
-    parse_size("--size", o.size, width, height);
+    eval_gl::OcclusionEvalOptions run;
+    parse_size("--size", o.size, run.width, run.height);
     Scheme scheme = Scheme::acc;
     if (!parse_scheme(o.scheme, scheme)) throw Error("--scheme: unknown scheme '" + o.scheme + "'");
     const LoadedModel model = load_model(o.model, scheme, o.split);
     print_warnings(model.warnings);
-    const std::size_t patches = model.rest.patches.size();
-
-    gl::GlContext context = gl::GlContext::create_headless();
-    gl::CullPipeline pipeline(context);
-    gl::PatchAttributes attributes;  // refinement depths: osd patches meet without cracks
-    for (const PatchInfo& info : model.rest.info) attributes.depth.push_back(info.depth);
-    pipeline.set_patches(model.rest.patches, attributes);
-    gl::BackpatchCuller culler(context);  // the back-patch fractions, on the pipeline's patches
-    culler.use_patch_buffer(pipeline.renderer().patch_buffer(), patches);
-    ViewGenerator views(patch_bounds(model.rest), ViewMode::contain, o.seed, float(width) / float(height));
-
-    double occluded_sum = 0, occluded_min = 1, occluded_max = 0, frustum_sum = 0, tcone_sum = 0, ncone_sum = 0;
-    double frames_sum = 0;
-    std::size_t false_culls = 0, unstable = 0;
-    std::vector<std::uint8_t> culled;
-    Progress progress("eval occlusion", "views", std::uint64_t(o.views), progress_wanted(o.json));
-    for (int v = 0; v < o.views; ++v) {
-        const Camera camera = views.next();
-        gl::PipelineParams params;
-        params.frame.render = render_params(camera, width, height, o.tess, model.closed);
-        params.frame.cull = gl::CullMode::occlusion;
-        params.frame.timing = gl::TimingMethod::off;
-        const ConvergedFrame converged = converge_frame(pipeline, params, o.max_frames);
-        const gl::FrameStats& stats = converged.stats;
-        if (!converged.stable) ++unstable;
-        frames_sum += converged.frames;
-        const double occluded = double(stats.occlusion_culled) / double(std::max<std::size_t>(patches, 1));
-        occluded_sum += occluded;
-        occluded_min = std::min(occluded_min, occluded);
-        occluded_max = std::max(occluded_max, occluded);
-        frustum_sum += double(stats.frustum_culled) / double(std::max<std::size_t>(patches, 1));
-        const gl::FrameCapture culled_frame = capture_culled_frame(pipeline.renderer());
-        const ReferenceFrame reference = render_reference(pipeline.renderer(), params.frame.render);
-        false_culls += gl::compare_frames(reference.capture, culled_frame).false_culled.size();
-
-        const gl::RenderParams& rp = params.frame.render;
-        const Vec3 eye = gl::eye_of_view(rp.view);
-        culler.cull(gl::BackpatchMethod::tcone, rp.projection * rp.view, eye, 0, PtpRule::ncnt, &culled);
-        tcone_sum += fraction_culled(culled);
-        culler.cull(gl::BackpatchMethod::ncone, rp.projection * rp.view, eye, 0, PtpRule::ncnt, &culled);
-        ncone_sum += fraction_culled(culled);
-        progress.step(std::uint64_t(v) + 1);
-    }
+    run.views = o.views;
+    run.seed = o.seed;
+    run.tess = o.tess;
+    run.max_frames = o.max_frames;
+    EvalProgress progress("eval occlusion", "views", o.json);
+    const eval_gl::OcclusionEvalResult r = eval_gl::run_occlusion_eval(model, run, progress.hooks());
+    const int width = run.width, height = run.height;
+    const std::size_t patches = r.patches;
     const double n = std::max(o.views, 1);
     nlohmann::json out;
     out["model"] = model.name;
@@ -111,14 +71,14 @@ int run_occlusion(const OcclusionOptions& o) {
     out["size"] = {width, height};
     out["tess"] = o.tess;
     out["seed"] = o.seed;
-    out["occluded_fraction"] = occluded_sum / n;
-    out["occluded_fraction_min"] = o.views ? occluded_min : 0.0;
-    out["occluded_fraction_max"] = occluded_max;
-    out["frustum_fraction"] = frustum_sum / n;
-    out["backpatch_fraction"] = {{"tcone", tcone_sum / n}, {"ncone", ncone_sum / n}};
-    out["frames_mean"] = frames_sum / n;
-    out["unstable_views"] = unstable;
-    out["false_culls"] = false_culls;
+    out["occluded_fraction"] = r.occluded_sum / n;
+    out["occluded_fraction_min"] = o.views ? r.occluded_min : 0.0;
+    out["occluded_fraction_max"] = r.occluded_max;
+    out["frustum_fraction"] = r.frustum_sum / n;
+    out["backpatch_fraction"] = {{"tcone", r.tcone_sum / n}, {"ncone", r.ncone_sum / n}};
+    out["frames_mean"] = r.frames_sum / n;
+    out["unstable_views"] = r.unstable_views;
+    out["false_culls"] = r.false_culls;
     if (o.json) {
         std::cout << out.dump() << "\n";
     } else {
@@ -126,10 +86,10 @@ int run_occlusion(const OcclusionOptions& o) {
                     width, height, o.tess);
         std::printf("  occluded (Niessner & Loop §6.2): %.2f%% (min %.2f%%, max %.2f%%), %.1f frames to a stable "
                     "visible set, %zu views unstable\n",
-                    100 * occluded_sum / n, 100 * (o.views ? occluded_min : 0.0), 100 * occluded_max, frames_sum / n,
-                    unstable);
-        std::printf("  back-patch (GPU, same views): tcone %.2f%%, ncone %.2f%%; false culls %zu\n", 100 * tcone_sum / n,
-                    100 * ncone_sum / n, false_culls);
+                    100 * r.occluded_sum / n, 100 * (o.views ? r.occluded_min : 0.0), 100 * r.occluded_max,
+                    r.frames_sum / n, r.unstable_views);
+        std::printf("  back-patch (GPU, same views): tcone %.2f%%, ncone %.2f%%; false culls %zu\n",
+                    100 * r.tcone_sum / n, 100 * r.ncone_sum / n, r.false_culls);
     }
     return 0;
 }

@@ -1,7 +1,8 @@
 // The library's layering, checked by the folders: each layer is a folder of sources (src/<layer>)
 // and of public headers (include/patchcull/<layer>), and its files include the public headers of
 // the layers below it only:
-//   core <- objects <- import <- eval;  core, objects <- gl;  tools -> public headers.
+//   core <- objects <- import <- eval;  core, objects <- gl;  eval, gl <- eval_gl (the
+//   evaluations of the GPU pipeline);  tools -> public headers.
 // The kernels and the object level include no OpenSubdiv, stb or GL.
 #include <gtest/gtest.h>
 
@@ -24,6 +25,7 @@ const std::map<std::string, std::set<std::string>> kAllowed = {
     {"import", {"core", "objects", "import"}},
     {"eval", {"core", "objects", "import", "eval"}},
     {"gl", {"core", "objects", "gl"}},
+    {"eval_gl", {"core", "objects", "import", "eval", "gl", "eval_gl"}},
 };
 
 struct Include {

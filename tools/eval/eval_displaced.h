@@ -1,5 +1,5 @@
-// `patchcull eval displaced` (tools/eval_displaced.cpp): Niessner & Loop's Table 1, registered by
-// tools/cmd_eval.cpp.
+// `patchcull eval displaced` (tools/eval/eval_displaced.cpp): Niessner & Loop's Table 1 (the run:
+// eval_gl/displaced_eval.h), registered by tools/cmd_eval.cpp.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +21,8 @@ struct DisplacedEvalOptions {
     bool json = false;
 };
 
+/// Parses the options, loads the model and its map, runs eval_gl::run_displaced_eval and prints its
+/// table or JSON; 1 when a bound or the pipeline culled a patch the unculled render shows.
 int run_displaced_eval(const DisplacedEvalOptions& options);
 
 }  // namespace patchcull::cli

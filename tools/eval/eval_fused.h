@@ -1,6 +1,6 @@
-// `patchcull eval fused` (tools/eval_fused.cpp): a comparison of the fused CPU cull
-// kernel's plans (fused_cull.h) and of its cost model (fused_cost_model.h) on a scene's camera
-// path, registered by tools/cmd_eval.cpp.
+// `patchcull eval fused` (tools/eval/eval_fused.cpp; the run: eval_gl/fused_eval.h): a
+// comparison of the fused CPU cull kernel's plans (fused_cull.h) and of its cost model
+// (fused_cost_model.h) on a scene's camera path, registered by tools/cmd_eval.cpp.
 #pragma once
 
 #include <string>
@@ -20,6 +20,8 @@ struct FusedEvalOptions {
     bool json = false;
 };
 
+/// Parses the options, loads and places the scene, runs eval_gl::run_fused_eval and prints its
+/// false culls (stderr, up to 10), table or JSON; 1 on any false cull.
 int run_fused_eval(const FusedEvalOptions& options);
 
 }  // namespace patchcull::cli

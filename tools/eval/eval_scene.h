@@ -1,7 +1,7 @@
-// `patchcull eval scene` (tools/eval_scene.cpp): the object-level occlusion methods
-// (hardware occlusion queries stop-and-wait and batched, CHC, CHC++, the occlusion horizon, cells
-// and portals) side by side with patchcull's per-patch Hi-Z culling on one scene's camera path,
-// registered by tools/cmd_eval.cpp.
+// `patchcull eval scene` (tools/eval/eval_scene.cpp; the run: eval_gl/scene_eval.h): the
+// object-level occlusion methods (hardware occlusion queries stop-and-wait and batched, CHC,
+// CHC++, the occlusion horizon, cells and portals) side by side with patchcull's per-patch Hi-Z
+// culling on one scene's camera path, registered by tools/cmd_eval.cpp.
 #pragma once
 
 #include <string>
@@ -25,6 +25,8 @@ struct SceneEvalOptions {
     bool json = false;
 };
 
+/// Parses the options, loads and places the scene, runs eval_gl::run_scene_eval and prints its
+/// table or JSON; 1 when a method culled what the unculled render shows.
 int run_scene_eval(const SceneEvalOptions& options);
 
 }  // namespace patchcull::cli

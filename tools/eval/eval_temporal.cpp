@@ -13,13 +13,11 @@
 // occluders: the ground quad of make_model_scene is left out, so every cull is the model hiding
 // itself (culling within one object, as Niessner & Loop §6.2 and Fig. 9).
 //
-// Per speed the pipeline starts from a first frame (reset_visibility: half the patches tagged
-// visible, Niessner & Loop §3); frame 0 primes the statuses, and occluded_fraction is the mean over
-// frames 1..N-1 of occlusion_culled / patches. converged_occluded_fraction is the mean over the
-// same views of the converged pipeline's fraction: a second CullPipeline runs each view from a
-// first frame until its visible set is stable (converge_frame, as `eval occlusion`; at most 8
-// frames), i.e. what the frame would cull without motion; the difference is the loss due to
-// motion. Views repeated across frames and speeds (the same eye) are converged once.
+// The run (eval_gl/temporal_eval.h): per speed the pipeline starts from a first frame; frame 0
+// primes the statuses, and occluded_fraction is the mean over frames 1..N-1 of occlusion_culled /
+// patches. converged_occluded_fraction is the mean over the same views of the converged
+// pipeline's fraction (converge_frame, as `eval occlusion`; at most 8 frames), i.e. what the frame
+// would cull without motion; the difference is the loss due to motion.
 // Every frame of the moving pipeline (frame 0 included) and every converged frame is compared with
 // the unculled render of its view (render_reference / compare_frames): a patch of the unculled
 // front set that was not drawn is a false cull; any false cull makes the exit status 1.
@@ -31,34 +29,18 @@
 // when the whole model stays in view).
 #include "eval_temporal.h"
 
-#include <algorithm>
-#include <array>
 #include <cstdio>
 #include <iostream>
-#include <map>
 
 #include <nlohmann/json.hpp>
 
 #include "cli_options.h"
 #include "commands.h"
-#include "patchcull/import/default_scene.h"
+#include "eval_progress.h"
 #include "patchcull/core/error.h"
-#include "patchcull/gl/gl_verification.h"
-#include "progress.h"
-#include "render_support.h"
+#include "patchcull/eval_gl/temporal_eval.h"
 
 namespace patchcull::cli {
-namespace {
-
-constexpr int kMaxConvergeFrames = 8;  // `eval occlusion`'s default --max-frames
-
-std::vector<bool> visible_set(const std::vector<std::uint32_t>& flags) {
-    std::vector<bool> visible(flags.size());
-    for (std::size_t p = 0; p < flags.size(); ++p) visible[p] = (flags[p] & gl::kStatusVisible) != 0;
-    return visible;
-}
-
-}  // namespace
 
 std::vector<double> parse_speeds(const std::string& flag, const std::string& text) {
     if (text.empty()) throw Error(flag + ": expected degrees per frame as a list such as 0,2,5,10, got ''");
@@ -77,128 +59,53 @@ std::vector<double> parse_speeds(const std::string& flag, const std::string& tex
     return speeds;
 }
 
-ConvergedFrame converge_frame(gl::CullPipeline& pipeline, const gl::PipelineParams& params, int max_frames) {
-    ConvergedFrame result;
-    pipeline.reset_visibility();
-    std::vector<bool> previous;
-    while (result.frames < max_frames && !result.stable) {
-        result.stats = pipeline.render_frame(params);
-        ++result.frames;
-        std::vector<bool> visible = visible_set(pipeline.renderer().read_cull_flags());
-        result.stable = visible == previous;
-        previous = std::move(visible);
-    }
-    return result;
-}
-
 int run_temporal_eval(const TemporalEvalOptions& o) {
-    int width = 0, height = 0;
-    parse_size("--size", o.size, width, height);
-    const std::vector<double> speeds = parse_speeds("--speeds", o.speeds);
+    eval_gl::TemporalEvalOptions run;
+    parse_size("--size", o.size, run.width, run.height);
+    run.speeds = parse_speeds("--speeds", o.speeds);
+    run.frames = o.frames;
+    run.tess = o.tess;
     Scheme scheme = Scheme::acc;
     if (!parse_scheme(o.scheme, scheme)) throw Error("--scheme: unknown scheme '" + o.scheme + "'");
     if (o.model == "default")
         throw Error("MODEL: eval temporal takes one model (an OBJ path or 'teapot'), not the default scene");
-    Scene scene = make_model_scene(load_model(o.model, scheme, 0));
-    const LoadedModel& model = scene.models.front();
+    LoadedModel model = load_model(o.model, scheme, 0);
     print_warnings(model.warnings);
-    const std::size_t patches = scene.patch_count();
-    const double per_patch = 1.0 / double(std::max<std::size_t>(patches, 1));
-
-    gl::GlContext context = gl::GlContext::create_headless();
-    gl::CullPipeline moving(context);     // runs frame after frame along the orbit
-    gl::CullPipeline converged(context);  // each view alone, until its visible set is stable
-    ScenePoser poser(scene);
-    const std::vector<BezierPatch>& rest = poser.pose(0);  // animate() at t = 0 is the rest pose
-    const gl::PatchAttributes attributes = pose_attributes(poser);
-    moving.set_patches(rest, attributes);
-    converged.set_patches(rest, attributes);
-
-    struct Converged {
-        double occluded = 0;
-    };
-    std::map<std::array<float, 3>, Converged> converged_views;  // by eye position (all else equal)
-    std::size_t unstable = 0;
-
-    nlohmann::json rows = nlohmann::json::array();
-    std::size_t total_false = 0;
-    struct Row {
-        double speed, occluded, converged, frustum;
-        std::size_t false_culls;
-    };
-    std::vector<Row> table;
-    Progress progress("eval temporal", "frames", std::uint64_t(speeds.size()) * std::uint64_t(o.frames),
-                      progress_wanted(o.json));
-    std::uint64_t frames_done = 0;
-    for (double speed : speeds) {
-        scene.camera.degrees_per_frame = static_cast<float>(speed);
-        const std::vector<Camera> cameras = scene.camera_path(o.frames, float(width) / float(height));
-        moving.reset_visibility();
-        double occluded_sum = 0, converged_sum = 0, frustum_sum = 0;
-        std::size_t false_culls = 0;
-        for (int f = 0; f < o.frames; ++f) {
-            const Camera& camera = cameras[static_cast<std::size_t>(f)];
-            gl::PipelineParams params;
-            params.frame.render = render_params(camera, width, height, o.tess, model.closed);
-            params.frame.cull = gl::CullMode::occlusion;
-            params.frame.timing = gl::TimingMethod::off;
-            const gl::FrameStats stats = moving.render_frame(params);
-            const gl::FrameCapture moving_frame = capture_culled_frame(moving.renderer());
-            const ReferenceFrame reference = render_reference(moving.renderer(), params.frame.render);
-            false_culls += gl::compare_frames(reference.capture, moving_frame).false_culled.size();
-            if (f == 0) {  // primes the statuses
-                progress.step(++frames_done);
-                continue;
-            }
-            occluded_sum += double(stats.occlusion_culled) * per_patch;
-            frustum_sum += double(stats.frustum_culled) * per_patch;
-
-            const std::array<float, 3> eye{camera.eye.x, camera.eye.y, camera.eye.z};
-            auto found = converged_views.find(eye);
-            if (found == converged_views.end()) {
-                const ConvergedFrame c = converge_frame(converged, params, kMaxConvergeFrames);
-                if (!c.stable) ++unstable;
-                false_culls += compare_with_reference(converged.renderer(), reference).false_culled.size();
-                found = converged_views.emplace(eye, Converged{double(c.stats.occlusion_culled) * per_patch}).first;
-            }
-            converged_sum += found->second.occluded;
-            progress.step(++frames_done);
-        }
-        const double n = std::max(o.frames - 1, 1);
-        table.push_back({speed, occluded_sum / n, converged_sum / n, frustum_sum / n, false_culls});
-        rows.push_back({{"degrees_per_frame", speed},
-                        {"occluded_fraction", occluded_sum / n},
-                        {"converged_occluded_fraction", converged_sum / n},
-                        {"frustum_fraction", frustum_sum / n},
-                        {"false_culls", false_culls}});
-        total_false += false_culls;
-    }
-    if (unstable > 0)
-        print_warnings({"eval temporal: " + std::to_string(unstable) + " views had no stable visible set after " +
-                        std::to_string(kMaxConvergeFrames) + " frames (their last frame counts as converged)"});
-    const std::string scheme_text = model.subdiv ? scheme_name(model.subdiv->scheme) : "bezier";
+    EvalProgress progress("eval temporal", "frames", o.json);
+    const eval_gl::TemporalEvalResult r = eval_gl::run_temporal_eval(std::move(model), run, progress.hooks());
+    if (r.unstable_views > 0)
+        print_warnings({"eval temporal: " + std::to_string(r.unstable_views) + " views had no stable visible set after " +
+                        std::to_string(eval_gl::kTemporalConvergeFrames) +
+                        " frames (their last frame counts as converged)"});
     if (o.json) {
+        nlohmann::json rows = nlohmann::json::array();
+        for (const eval_gl::TemporalSpeedRow& row : r.speeds)
+            rows.push_back({{"degrees_per_frame", row.degrees_per_frame},
+                            {"occluded_fraction", row.occluded_fraction},
+                            {"converged_occluded_fraction", row.converged_occluded_fraction},
+                            {"frustum_fraction", row.frustum_fraction},
+                            {"false_culls", row.false_culls}});
         nlohmann::json out;
-        out["model"] = model.name;
-        out["scheme"] = scheme_text;
-        out["patches"] = patches;
-        out["size"] = {width, height};
+        out["model"] = r.model;
+        out["scheme"] = r.scheme;
+        out["patches"] = r.patches;
+        out["size"] = {run.width, run.height};
         out["tess"] = o.tess;
         out["frames"] = o.frames;
         out["speeds"] = rows;
-        out["false_culls"] = total_false;
+        out["false_culls"] = r.false_culls;
         std::cout << out.dump() << "\n";
     } else {
         std::printf("%s (%s): %zu patches, %d frames per speed at %dx%d, level %d, cull occlusion\n",
-                    model.name.c_str(), scheme_text.c_str(), patches, o.frames, width, height, o.tess);
+                    r.model.c_str(), r.scheme.c_str(), r.patches, o.frames, run.width, run.height, o.tess);
         std::printf("  %9s  %9s  %9s  %9s  %6s  (mean over frames 1..%d)\n", "deg/frame", "occluded", "converged",
                     "frustum", "false", o.frames - 1);
-        for (const Row& r : table)
-            std::printf("  %9g  %8.2f%%  %8.2f%%  %8.2f%%  %6zu\n", r.speed, 100 * r.occluded, 100 * r.converged,
-                        100 * r.frustum, r.false_culls);
+        for (const eval_gl::TemporalSpeedRow& row : r.speeds)
+            std::printf("  %9g  %8.2f%%  %8.2f%%  %8.2f%%  %6zu\n", row.degrees_per_frame, 100 * row.occluded_fraction,
+                        100 * row.converged_occluded_fraction, 100 * row.frustum_fraction, row.false_culls);
     }
     // A false cull breaks the conservative promise: a failure, as in `render --verify`.
-    return total_false > 0 ? 1 : 0;
+    return r.false_culls > 0 ? 1 : 0;
 }
 
 }  // namespace patchcull::cli

@@ -1,12 +1,10 @@
-// `patchcull eval temporal` (tools/eval_temporal.cpp): Fig. 9 right of Niessner & Loop,
-// "Patch-Based Occlusion Culling for Hardware Tessellation", registered by
-// tools/cmd_eval.cpp; and the convergence loop it shares with `eval occlusion`.
+// `patchcull eval temporal` (tools/eval/eval_temporal.cpp): Fig. 9 right of Niessner & Loop,
+// "Patch-Based Occlusion Culling for Hardware Tessellation" (the run: eval_gl/temporal_eval.h),
+// registered by tools/cmd_eval.cpp.
 #pragma once
 
 #include <string>
 #include <vector>
-
-#include "patchcull/gl/gl_pipeline.h"
 
 namespace patchcull::cli {
 
@@ -28,19 +26,8 @@ inline constexpr std::size_t kMaxSpeeds = 16;
 /// (empty list or item, not a number, negative, over 180, too many).
 std::vector<double> parse_speeds(const std::string& flag, const std::string& text);
 
+/// Parses the options, runs eval_gl::run_temporal_eval and prints its table or JSON; 1 when a
+/// frame culled a patch the unculled render shows.
 int run_temporal_eval(const TemporalEvalOptions& options);
-
-/// A frame of the pipeline repeated from a first frame until its visible set is stable.
-struct ConvergedFrame {
-    gl::FrameStats stats;  ///< of the last frame run
-    int frames = 0;        ///< frames run
-    bool stable = false;   ///< the last two frames tagged the same patches visible
-};
-
-/// Niessner & Loop §3's pipeline on a static view as `eval occlusion` runs it: reset_visibility (the
-/// next frame is a first frame, half the patches tagged visible), then params' frame again and
-/// again until two consecutive frames tag the same patches visible (kStatusVisible), at most
-/// max_frames frames. The renderer's framebuffer then holds the last frame.
-ConvergedFrame converge_frame(gl::CullPipeline& pipeline, const gl::PipelineParams& params, int max_frames);
 
 }  // namespace patchcull::cli
