@@ -1,24 +1,56 @@
 # Build-time shader processing for src/gl (script mode: cmake -DMODE=... -P GlShaders.cmake).
 #
-# MODE=expand: INPUT (a shaders/*.glsl file) -> OUTPUT, every line `#include "NAME"` replaced by
-#   the text of INCLUDE_DIR/NAME (one level; the shared header shaders/shared.h is valid C++ and
-#   GLSL). The expanded file is what glslangValidator checks and what the driver compiles, so a
+# MODE=expand: INPUT (a shaders/*.glsl file, or a shipped header) -> OUTPUT, every line
+#   `#include "NAME"` replaced by the text of NAME found in INCLUDE_DIR (shaders/, then include/
+#   for patchcull/core/cull_flags.h; the shared headers are valid C++ and GLSL). The expanded file is what glslangValidator checks and what the driver compiles, so a
 #   validator error names a line of the expanded file in the build tree.
 # MODE=embed: OUTPUT (a .cpp) defining patchcull::gl::detail::kShaderSources from the expanded
 #   files in SHADERS (a |-separated list), so binaries never read the source tree at run time.
 cmake_minimum_required(VERSION 3.25)
 
 if(MODE STREQUAL "expand")
+  # INCLUDE_DIR: one folder, or several separated by |, searched in order. Included files may
+  # include others (up to 4 levels); each file is inlined once (later directives for it vanish).
+  string(REPLACE "|" ";" include_dirs "${INCLUDE_DIR}")
+  # Directives are lines that start with #include (a mention inside a comment is not one): the
+  # text gets a leading newline so that every directive is matched with the newline before it.
   file(READ "${INPUT}" text)
-  string(REGEX MATCHALL "#[ \t]*include[ \t]*\"[^\"\n]+\"" includes "${text}")
-  foreach(directive IN LISTS includes)
-    string(REGEX REPLACE ".*\"([^\"]+)\"" "\\1" name "${directive}")
-    if(NOT EXISTS "${INCLUDE_DIR}/${name}")
-      message(FATAL_ERROR "${INPUT}: #include \"${name}\": no such file in ${INCLUDE_DIR}")
+  set(text "\n${text}")
+  set(inlined)
+  foreach(level RANGE 4)
+    string(REGEX MATCHALL "\n[ \t]*#[ \t]*include[ \t]*\"[^\"\n]+\"" includes "${text}")
+    if(NOT includes)
+      break()
     endif()
-    file(READ "${INCLUDE_DIR}/${name}" body)
-    string(REPLACE "${directive}" "${body}" text "${text}")
+    if(level EQUAL 4)
+      message(FATAL_ERROR "${INPUT}: #include nested deeper than 4 levels")
+    endif()
+    foreach(directive IN LISTS includes)
+      string(REGEX REPLACE ".*\"([^\"]+)\"" "\\1" name "${directive}")
+      set(found)
+      foreach(dir IN LISTS include_dirs)
+        if(NOT found AND EXISTS "${dir}/${name}")
+          set(found "${dir}/${name}")
+        endif()
+      endforeach()
+      if(NOT found)
+        message(FATAL_ERROR "${INPUT}: #include \"${name}\": no such file in ${INCLUDE_DIR}")
+      endif()
+      if(name IN_LIST inlined)
+        set(body "")
+      else()
+        file(READ "${found}" body)
+        list(APPEND inlined "${name}")
+      endif()
+      string(FIND "${text}" "${directive}" at)
+      string(LENGTH "${directive}" directive_length)
+      string(SUBSTRING "${text}" 0 ${at} head)
+      math(EXPR rest_at "${at} + ${directive_length}")
+      string(SUBSTRING "${text}" ${rest_at} -1 tail)
+      set(text "${head}\n${body}${tail}")
+    endforeach()
   endforeach()
+  string(SUBSTRING "${text}" 1 -1 text)
   file(WRITE "${OUTPUT}.tmp" "${text}")
   file(RENAME "${OUTPUT}.tmp" "${OUTPUT}")
 elseif(MODE STREQUAL "embed")

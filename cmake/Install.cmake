@@ -44,11 +44,12 @@ if(PATCHCULL_WITH_GL)
   install(TARGETS patchcull_eval_gl EXPORT patchcullEvalGLTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
   install(EXPORT patchcullEvalGLTargets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
-  # The GLSL headers of gl_passes.h's shipped_glsl (shared.h: the constants of C++ and GLSL, those
-  # of the back-patch and displaced passes included (gl_backpatch.h, gl_displaced.h);
-  # patchcull_tcs.h: the TCS include, which uses shared.h's constants); patchcull::gl puts this
-  # folder on the include path, as the build puts shaders/.
-  install(FILES shaders/shared.h shaders/patchcull_tcs.h
+  # The GLSL headers of gl_passes.h's shipped_glsl, as the library embeds them: shared.h (the
+  # constants of C++ and GLSL, with core/cull_flags.h's flag word inlined by the shader build, so an
+  # engine's shader include system needs no second folder) and patchcull_tcs.h (the TCS include,
+  # which uses shared.h's constants); patchcull::gl puts this folder on the include path, as the
+  # build puts shaders/.
+  install(FILES ${PROJECT_BINARY_DIR}/src/gl/shaders/shipped/shared.h shaders/patchcull_tcs.h
     DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/patchcull/glsl)
 endif()
 if(TARGET patchcull_cli)

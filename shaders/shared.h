@@ -1,4 +1,5 @@
-// shaders/shared.h: constants shared by the C++ renderer (src/gl) and the GLSL shaders.
+// shaders/shared.h: constants shared by the C++ renderer (src/gl) and the GLSL shaders: the one
+// configuration header of the GPU passes (with the flag word of patchcull/core/cull_flags.h).
 //
 // Valid C++20 and GLSL 4.50 at once. Shaders pull it in with `#include "shared.h"`, which the
 // build replaces by this file's text (cmake/GlShaders.cmake) before validating the expanded
@@ -12,10 +13,19 @@
 #ifndef PATCHCULL_SHADERS_SHARED_H
 #define PATCHCULL_SHADERS_SHARED_H
 
+#include "patchcull/core/cull_flags.h"
+
 #ifdef __cplusplus
 #include <cstdint>
 namespace patchcull::gl::shared {
 using uint = std::uint32_t;
+using patchcull::kCullBackPatch;
+using patchcull::kCullFrustum;
+using patchcull::kCullObject;
+using patchcull::kCullOcclusion;
+using patchcull::kCullReasonMask;
+using patchcull::kStatusNewlyVisible;
+using patchcull::kStatusVisible;
 #define PATCHCULL_CONST inline constexpr
 #else
 #define PATCHCULL_CONST const
@@ -76,22 +86,13 @@ PATCHCULL_CONST uint kTextureUnitHiZ = 2u;           // R32F Hi-Z pyramid, level
 // Image units.
 PATCHCULL_CONST uint kImageUnitHiZOut = 0u;          // R32F Hi-Z level being written
 
-// Per-patch flag word (kBindingCullFlags). Bits 0-7: the cull reason of the latest frame (0 = not
-// culled): the test passes form a chain (flag_chain.h, gl_passes.h) in which the first test that
-// culls a patch sets its reason and the later ones skip it.
-PATCHCULL_CONST uint kCullFrustum = 1u;
-PATCHCULL_CONST uint kCullBackPatch = 2u;   // back-facing (a back-patch pass: tcone, ncone or ptp)
-PATCHCULL_CONST uint kCullOcclusion = 4u;   // behind the Hi-Z pyramid
-// Culled by the object level before any patch pass (object_culling.h: the object outside the
-// frustum, or a back-facing cluster of it): written by CullPipeline with a buffer clear, no pass.
-PATCHCULL_CONST uint kCullObject = 8u;
-PATCHCULL_CONST uint kCullReasonMask = 0xFFu;
-// Bits 8-9: temporal status of the two-pass pipeline (Niessner & Loop §3), written by cull_status (end):
-// kStatusVisible = passed the latest test (drawn in the next frame's first pass); with
-// kStatusNewlyVisible also set it was not tagged visible before that test (drawn in the second
-// pass). Neither bit = occluded (or culled by another test).
-PATCHCULL_CONST uint kStatusVisible = 0x100u;
-PATCHCULL_CONST uint kStatusNewlyVisible = 0x200u;
+// Per-patch flag word (kBindingCullFlags): the cull reasons kCullFrustum, kCullBackPatch,
+// kCullOcclusion, kCullObject (bits 0-7, kCullReasonMask) and the statuses kStatusVisible,
+// kStatusNewlyVisible (bits 8-9) are declared once, for C++ and GLSL, in
+// patchcull/core/cull_flags.h (included above). The test passes form a chain (flag_chain.h,
+// gl_passes.h) in which the first test that culls a patch sets its reason and the later ones skip
+// it; cull_status (end) turns reasons into statuses. kCullObject is written by CullPipeline with a
+// buffer clear for patches culled with their object (object_culling.h), before any pass.
 
 // cull_status.comp.glsl's modes (CullStatusParams::mode).
 PATCHCULL_CONST uint kStatusBegin = 0u;  // clear the reasons, keep the statuses

@@ -28,6 +28,7 @@
 #include "patchcull/gl/cull_auto_policy.h"
 #include "patchcull/gl/gl_verification.h"
 #include "render_support.h"
+#include "patchcull/gl/gl_backpatch_passes.h"
 
 namespace patchcull::cli {
 namespace {
@@ -98,9 +99,11 @@ int run_demo(const DemoOptions& options) {
                 height, options.tess, context.renderer().c_str(),
                 context.is_software() ? "software: wall-clock pass times" : "GPU timer queries");
 
-    // The rows: frustum, each back-patch method (gl::kBackpatchMethods), occlusion, all and auto.
+    // The rows: frustum, each back-patch method with a GPU pass (gl::gpu_backpatch_methods),
+    // occlusion, all and auto.
+    const std::vector<gl::BackpatchMethod> backpatch_methods = gl::gpu_backpatch_methods();
     std::vector<Method> methods = {{"frustum", gl::CullMode::frustum, gl::BackpatchMethod::tcone}};
-    for (gl::BackpatchMethod m : gl::kBackpatchMethods)
+    for (gl::BackpatchMethod m : backpatch_methods)
         methods.push_back({std::string("backpatch ") + gl::backpatch_method_name(m), gl::CullMode::backpatch, m});
     methods.push_back({"occlusion", gl::CullMode::occlusion, gl::BackpatchMethod::tcone});
     methods.push_back({"all (tcone)", gl::CullMode::all, gl::BackpatchMethod::tcone});
@@ -108,13 +111,13 @@ int run_demo(const DemoOptions& options) {
     // Frames rendered so far, on stderr when it is a terminal (progress.h): one warm-up frame per back-patch method,
     // the references and every method's frames. Cleared before each line printed on stdout.
     const std::uint64_t frames = static_cast<std::uint64_t>(options.frames);
-    Progress progress("demo", "frames", std::size(gl::kBackpatchMethods) + frames + methods.size() * frames,
+    Progress progress("demo", "frames", backpatch_methods.size() + frames + methods.size() * frames,
                       progress_wanted(false));
     progress.erase_when_done();
     std::uint64_t frames_done = 0;
     // Compiles every pass's program before anything is timed (llvmpipe takes seconds for ncone):
     // one untimed frame per back-patch method with every test.
-    for (gl::BackpatchMethod m : gl::kBackpatchMethods) {
+    for (gl::BackpatchMethod m : backpatch_methods) {
         gl::PipelineParams warm_up;
         warm_up.frame.render = params_of(0);
         warm_up.frame.cull = gl::CullMode::all;
@@ -151,7 +154,7 @@ int run_demo(const DemoOptions& options) {
     for (const Method& method : methods) {
         // Back-patch tests are conservative only on closed surfaces (README: "What contributes a
         // pixel"): on a --scene with an open model those rows are left out.
-        if (!one_sided && (static_cast<std::uint32_t>(method.cull) & gl::kFlagBackPatch)) {
+        if (!one_sided && (static_cast<std::uint32_t>(method.cull) & gl::kCullBackPatch)) {
             frames_done += frames;  // not rendered: counted as done
             progress.clear();
             std::printf("%-17s (left out: the scene has an open model, back-patch culling is not conservative on it)\n",

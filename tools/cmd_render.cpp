@@ -76,6 +76,9 @@
 #include "cull_mode_names.h"
 #include "frame_poser.h"
 #include "render_options.h"
+#include "cull_mode_names.h"
+#include "frame_poser.h"
+#include "render_options.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -165,7 +168,7 @@ Runner add_render_command(CLI::App& app) {
         if (!state->draw_bounds.empty() && state->out.empty())
             throw Error("--draw-bounds: needs --out FILE.png (the picture it draws)");
         if (!state->dump_hiz.empty()) {
-            if (!(static_cast<std::uint32_t>(cull) & gl::kFlagOcclusion))
+            if (!(static_cast<std::uint32_t>(cull) & gl::kCullOcclusion))
                 throw Error("--dump-hiz: the pyramid is built only with occlusion (--cull occlusion, all or auto)");
             prepare_output_dir("--dump-hiz", state->dump_hiz, {"hiz.json"});
         }
@@ -181,7 +184,7 @@ Runner add_render_command(CLI::App& app) {
         // for a scene with an open model; an explicit `backpatch` keeps it, with a warning, so
         // that --verify can show what it would remove.
         const gl::CullMode applied = applicable_cull_mode(scene, cull, "render");
-        const bool backpatch_applied = (static_cast<std::uint32_t>(applied) & gl::kFlagBackPatch) != 0;
+        const bool backpatch_applied = (static_cast<std::uint32_t>(applied) & gl::kCullBackPatch) != 0;
         const bool one_sided = scene_is_one_sided(scene);
         // Camera-relative frames (scene_model.h's rebase_scene): each frame is drawn and culled
         // in the float frame of the grid point nearest its eye, everything in it composed in

@@ -18,6 +18,8 @@
 #include "patchcull/import/scene_file.h"
 #include "cull_mode_names.h"
 #include "render_options.h"
+#include "cull_mode_names.h"
+#include "render_options.h"
 #include "render_support.h"
 #include "viewer/viewer_app.h"
 #include "viewer/viewer_script.h"

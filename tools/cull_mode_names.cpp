@@ -4,6 +4,7 @@
 #include <string>
 
 #include "patchcull/core/error.h"
+#include "patchcull/gl/gl_backpatch_passes.h"
 
 namespace patchcull::cli {
 
@@ -16,7 +17,7 @@ std::vector<std::string> cull_mode_choices() {
 
 std::vector<std::string> backpatch_method_choices() {
     std::vector<std::string> names;
-    for (gl::BackpatchMethod m : gl::kBackpatchMethods) names.emplace_back(gl::backpatch_method_name(m));
+    for (gl::BackpatchMethod m : gl::gpu_backpatch_methods()) names.emplace_back(gl::backpatch_method_name(m));
     return names;
 }
 

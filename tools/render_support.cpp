@@ -111,11 +111,11 @@ std::vector<SceneObject> scene_objects(const Scene& scene) {
 
 gl::CullMode applicable_cull_mode(const Scene& scene, gl::CullMode requested, const std::string& command) {
     const std::uint32_t bits = static_cast<std::uint32_t>(requested);
-    if ((bits & gl::kFlagBackPatch) == 0) return requested;
+    if ((bits & gl::kCullBackPatch) == 0) return requested;
     for (const LoadedModel& model : scene.models) {
         if (model.closed) continue;
         // Silently: `all` is the default, and the JSON says "backpatch": "off".
-        if (requested == gl::CullMode::all) return static_cast<gl::CullMode>(bits & ~gl::kFlagBackPatch);
+        if (requested == gl::CullMode::all) return static_cast<gl::CullMode>(bits & ~gl::kCullBackPatch);
         print_warnings({command + ": " + model.name +
                         " is not a closed solid: back-patch culling may remove patches seen through its openings"});
         return requested;

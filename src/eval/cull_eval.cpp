@@ -12,11 +12,13 @@
 #include <string>
 
 #include "patchcull/core/backpatch.h"
+#include "patchcull/core/backpatch_methods.h"
+#include "patchcull/core/cull_view.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/ground_truth.h"
 #include "patchcull/core/parallel.h"
-#include "patchcull/import/scene.h"
+#include "patchcull/import/model_loader.h"
 
 #include <tbb/enumerable_thread_specific.h>
 
@@ -24,14 +26,6 @@ namespace patchcull {
 namespace {
 
 constexpr std::size_t kGrain = 1024;
-
-/// Everything a kernel may need for one view.
-struct ViewContext {
-    Mat4 object_to_clip;
-    FrustumPlanes planes;
-    Vec3 eye;     ///< object space
-    float alpha;  ///< clip-space eye z (backpatch.h)
-};
 
 /// Seeded views of the DistanceViews distribution (cull_eval.h). Its own splitmix64 stream, so
 /// the contain and free distributions (camera.cpp) keep their sequences.
@@ -97,38 +91,34 @@ void check_distance_views(const DistanceViews& d) {
 enum class Truth { frustum, backface };
 
 struct Method {
-    const char* name;
+    std::string name;
     Truth truth;
-    std::function<void(const PatchBatchView&, const float*, const ViewContext&, std::uint8_t*)> kernel;
+    std::function<void(const PatchBatchView&, const float*, const CullView&, std::uint8_t*)> kernel;
 };
 
+/// The frustum kernels, then every registered back-patch method (backpatch_methods.h), then ptp
+/// with the Pcnt rule as "ptp-pcnt".
 const std::vector<Method>& methods() {
-    static const std::vector<Method> table = {
+    static std::vector<Method> table;
+    if (table.size() == 2 + backpatch_methods().size() + 1) return table;
+    table = {
         {"frustum", Truth::frustum,
-         [](const PatchBatchView& b, const float* d, const ViewContext& v, std::uint8_t* out) {
-             cull_frustum_simd(b, d, v.planes, out);
+         [](const PatchBatchView& b, const float* d, const CullView& v, std::uint8_t* out) {
+             cull_frustum(b, d, v, out);
          }},
         {"frustum-disp", Truth::frustum,
-         [](const PatchBatchView& b, const float* d, const ViewContext& v, std::uint8_t* out) {
-             cull_frustum_disp_simd(b, d, v.object_to_clip, ClipDepth::zero_to_one, out);
-         }},
-        {"tcone", Truth::backface,
-         [](const PatchBatchView& b, const float*, const ViewContext& v, std::uint8_t* out) {
-             cull_tcone_simd(b, v.eye, out);
-         }},
-        {"ncone", Truth::backface,
-         [](const PatchBatchView& b, const float*, const ViewContext& v, std::uint8_t* out) {
-             cull_ncone_simd(b, v.eye, out);
-         }},
-        {"ptp", Truth::backface,
-         [](const PatchBatchView& b, const float*, const ViewContext& v, std::uint8_t* out) {
-             cull_ptp_simd(b, v.object_to_clip, v.alpha, PtpRule::ncnt, out);
-         }},
-        {"ptp-pcnt", Truth::backface,
-         [](const PatchBatchView& b, const float*, const ViewContext& v, std::uint8_t* out) {
-             cull_ptp_simd(b, v.object_to_clip, v.alpha, PtpRule::pcnt, out);
+         [](const PatchBatchView& b, const float* d, const CullView& v, std::uint8_t* out) {
+             cull_frustum_disp(b, d, v, out);
          }},
     };
+    for (BackpatchMethod id : backpatch_method_ids())
+        table.push_back({backpatch_method_name(id), Truth::backface,
+                         [id](const PatchBatchView& b, const float*, const CullView& v, std::uint8_t* out) {
+                             cull_backpatch(id, b, v, BackpatchOptions{}, out);
+                         }});
+    table.push_back({"ptp-pcnt", Truth::backface, [](const PatchBatchView& b, const float*, const CullView& v, std::uint8_t* out) {
+                         cull_backpatch(BackpatchMethod::ptp, b, v, BackpatchOptions{PtpRule::pcnt}, out);
+                     }});
     return table;
 }
 
@@ -174,11 +164,11 @@ struct ChunkJudge {
     /// Runs every method of every view in block on patches [first, first + count) and judges
     /// each culled patch against its dense samples.
     void judge(const PatchFrame& frame, const PatchBatchView& batch, const float* disp,
-               const std::vector<const Method*>& methods, const std::vector<ViewContext>& block,
+               const std::vector<const Method*>& methods, const std::vector<CullView>& block,
                std::size_t first, std::size_t count) {
         window.clear();
         const PatchBatchView chunk = batch.subrange(first, count);
-        for (const ViewContext& ctx : block)
+        for (const CullView& ctx : block)
             for (std::size_t m = 0; m < methods.size(); ++m) {
                 methods[m]->kernel(chunk, disp ? disp + first : nullptr, ctx, decisions.data());
                 const bool backface = methods[m]->truth == Truth::backface;
@@ -225,6 +215,9 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
     const int grid = options.ground_truth_grid;
     if (grid < 1 || grid > 1024) throw Error("ground truth grid " + std::to_string(grid) + " is not in 1..1024");
     const std::size_t n = frame.patches.size();
+    if (frame.info.size() != n)
+        throw Error("evaluate_cull: the frame has " + std::to_string(n) + " patches but " +
+                    std::to_string(frame.info.size()) + " PatchInfo entries");
     const PatchBatch batch = make_batch(frame.patches);
     std::vector<float> max_disp(n);
     float largest = 0;
@@ -259,7 +252,7 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
         return ChunkJudge(grid, displacement, needs_frustum_truth, needs_backface_truth, method_count);
     });
     const int block_views = views_per_block(n, options.views);
-    std::vector<ViewContext> block;
+    std::vector<CullView> block;
     block.reserve(static_cast<std::size_t>(std::max(block_views, 0)));
     for (int done = 0; done < options.views;) {
         const int count = std::min(block_views, options.views - done);
@@ -270,11 +263,7 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
         for (int k = 0; k < count; ++k) {
             const Camera camera = distance_views ? distance_views->next() : views.next();
             eye_distance_sum += length(camera.eye - centre) / radius;
-            ViewContext ctx;
-            ctx.object_to_clip = camera.view_projection();
-            ctx.planes = make_frustum_planes(ctx.object_to_clip, ClipDepth::zero_to_one);
-            ctx.eye = camera.eye;
-            ctx.alpha = clip_space_eye_alpha(camera.projection());
+            const CullView ctx = make_cull_view(camera.view(), camera.projection(), ClipDepth::zero_to_one, camera.eye);
             block.push_back(ctx);
             for (std::size_t m = 0; m < method_count; ++m) {
                 const auto start = std::chrono::steady_clock::now();

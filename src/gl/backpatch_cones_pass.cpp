@@ -14,7 +14,8 @@ BackpatchConePass& BackpatchConePass::operator=(BackpatchConePass&&) noexcept = 
 BackpatchConePass::~BackpatchConePass() = default;
 
 void BackpatchConePass::run(const PatchBuffers& patches, BackpatchMethod method, Vec3 eye, std::uint32_t cone_values) {
-    if (method == BackpatchMethod::ptp) throw Error("GL: BackpatchConePass: ptp is BackpatchPtpPass's");
+    if (method != BackpatchMethod::tcone && method != BackpatchMethod::ncone)
+        throw Error(std::string("GL: BackpatchConePass runs tcone and ncone, not ") + backpatch_method_name(method));
     detail::begin_pass("BackpatchConePass");
     detail::check_patch_buffers("BackpatchConePass", patches);
     if (cone_values)

@@ -6,11 +6,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_backpatch.h"
+#include "patchcull/gl/gl_backpatch_passes.h"
 #include "patchcull/gl/gl_passes.h"
 #include "renderer_internal.h"
 #include "shader_sources.h"
@@ -19,8 +21,6 @@
 namespace patchcull::gl {
 
 namespace {
-
-static_assert(kFlagBackPatch == sh::kCullBackPatch);
 
 std::vector<float> read_floats(GLuint buffer, std::size_t n) {
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -36,6 +36,7 @@ struct BackpatchCuller::Impl {
     PassContext passes;
     BackpatchConePass cones{passes};
     BackpatchPtpPass ptp{passes};
+    std::map<BackpatchMethod, std::unique_ptr<BackpatchPass>> registered;  // other methods' passes
     GLuint own_points = 0, flags = 0, diagnostics = 0;
     GLuint points = 0;  // own_points or the caller's buffer
     std::size_t count = 0;
@@ -155,11 +156,23 @@ void BackpatchCuller::cull_ptp(const Mat4& object_to_clip, float alpha, PtpRule 
 
 void BackpatchCuller::cull(BackpatchMethod method, const Mat4& object_to_clip, Vec3 eye, float alpha, PtpRule rule,
                            std::vector<std::uint8_t>* culled) {
-    switch (method) {
-        case BackpatchMethod::tcone: cull_tcone(eye, culled); return;
-        case BackpatchMethod::ncone: cull_ncone(eye, culled); return;
-        case BackpatchMethod::ptp: cull_ptp(object_to_clip, alpha, rule, culled); return;
-    }
+    CullView view;
+    view.object_to_clip = object_to_clip;
+    view.eye = eye;
+    view.has_eye = true;
+    view.alpha = alpha;
+    view.orientation = ptp_orientation_sign(object_to_clip, alpha);
+    cull(method, view, BackpatchOptions{rule}, culled);
+}
+
+void BackpatchCuller::cull(BackpatchMethod method, const CullView& view, const BackpatchOptions& options,
+                           std::vector<std::uint8_t>* culled) {
+    Impl& m = *impl_;
+    std::unique_ptr<BackpatchPass>& pass = m.registered[method];
+    if (!pass) pass = make_backpatch_pass(m.passes, method);
+    m.clear_flags();
+    pass->run(m.buffers(), view, options);
+    if (culled) m.read_flags(*culled);
 }
 
 std::uint32_t BackpatchCuller::flag_buffer() const { return impl_->flags; }

@@ -23,8 +23,6 @@ namespace patchcull::gl {
 
 namespace {
 
-static_assert(kFlagFrustum == sh::kCullFrustum && kFlagOcclusion == sh::kCullOcclusion);
-
 using detail::check_gl;
 using detail::upload;
 
@@ -176,7 +174,7 @@ void DisplacedCuller::cull_frustum(DisplacedBoundKind bound, NormalConeKind cone
     if (!culled) return;
     const std::vector<std::uint32_t> words = impl_->read_words();
     culled->resize(words.size());
-    for (std::size_t p = 0; p < words.size(); ++p) (*culled)[p] = words[p] == kFlagFrustum ? 1 : 0;
+    for (std::size_t p = 0; p < words.size(); ++p) (*culled)[p] = words[p] == kCullFrustum ? 1 : 0;
 }
 
 void DisplacedCuller::cull_occlusion(DisplacedBoundKind bound, NormalConeKind cone, const DisplacedCullView& view,
@@ -186,8 +184,8 @@ void DisplacedCuller::cull_occlusion(DisplacedBoundKind bound, NormalConeKind co
     const std::vector<std::uint32_t> words = impl_->read_words();
     decisions->resize(words.size());
     for (std::size_t p = 0; p < words.size(); ++p)
-        (*decisions)[p] = words[p] == kFlagFrustum     ? kHiZFrustumCulled
-                          : words[p] == kFlagOcclusion ? kHiZOccluded
+        (*decisions)[p] = words[p] == kCullFrustum     ? kHiZFrustumCulled
+                          : words[p] == kCullOcclusion ? kHiZOccluded
                                                        : kHiZVisible;
 }
 

@@ -42,4 +42,8 @@ void FrustumDispPass::run(const PatchBuffers& patches, const Mat4& object_to_cli
     detail::finish_pass("FrustumDispPass");
 }
 
+void FrustumDispPass::run(const PatchBuffers& patches, const CullView& view, std::uint32_t plane_values) {
+    run(patches, view.object_to_clip, view.depth, plane_values);
+}
+
 }  // namespace patchcull::gl

@@ -30,4 +30,8 @@ void FrustumPass::run(const PatchBuffers& patches, const FrustumPlanes& planes, 
     detail::finish_pass("FrustumPass");
 }
 
+void FrustumPass::run(const PatchBuffers& patches, const CullView& view, std::uint32_t plane_values) {
+    run(patches, view.planes, plane_values);
+}
+
 }  // namespace patchcull::gl

@@ -21,8 +21,9 @@ void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const 
         throw Error("GL: FusedCullPass: tests must be kCullFrustum, kCullBackPatch and kCullOcclusion bits");
     const bool backpatch = (tests & shared::kCullBackPatch) != 0;
     const bool occlusion = (tests & shared::kCullOcclusion) != 0;
-    if (backpatch && method == BackpatchMethod::ptp)
-        throw Error("GL: FusedCullPass: ptp is not fused (BackpatchPtpPass)");
+    if (backpatch && method != BackpatchMethod::tcone && method != BackpatchMethod::ncone)
+        throw Error(std::string("GL: FusedCullPass: ") + backpatch_method_name(method) +
+                    " is not fused (its own pass runs it: gl_backpatch_passes.h)");
     if (occlusion && (!hiz || !glIsTexture(hiz->texture) || hiz->width < 1 || hiz->height < 1))
         throw Error("GL: FusedCullPass: the occlusion test needs a Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
     if (occlusion && hiz->reversed != is_reversed(depth))
@@ -48,6 +49,12 @@ void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const 
     if (occlusion) glBindTextureUnit(shared::kTextureUnitHiZ, hiz->texture);
     detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kCullGroupSize);
     detail::finish_pass("FusedCullPass");
+}
+
+void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const CullView& view, BackpatchMethod method,
+                        const HiZTexture* hiz) {
+    if (!view.has_eye) tests &= ~shared::kCullBackPatch;
+    run(patches, tests, view.object_to_clip, view.depth, method, view.eye, hiz);
 }
 
 }  // namespace patchcull::gl

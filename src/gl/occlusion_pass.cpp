@@ -39,4 +39,8 @@ void OcclusionPass::run(const PatchBuffers& patches, const Mat4& any_object_to_c
     detail::finish_pass("OcclusionPass");
 }
 
+void OcclusionPass::run(const PatchBuffers& patches, const CullView& view, const HiZTexture& hiz, bool with_frustum) {
+    run(patches, view.object_to_clip, view.depth, hiz, with_frustum);
+}
+
 }  // namespace patchcull::gl

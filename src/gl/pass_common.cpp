@@ -133,25 +133,6 @@ std::string_view shipped_glsl(std::string_view name) {
     return text ? std::string_view(text) : std::string_view();
 }
 
-const char* backpatch_method_name(BackpatchMethod method) {
-    switch (method) {
-        case BackpatchMethod::tcone: return "tcone";
-        case BackpatchMethod::ncone: return "ncone";
-        case BackpatchMethod::ptp: return "ptp";
-    }
-    return "?";
-}
-
-bool parse_backpatch_method(const char* text, BackpatchMethod& method) {
-    if (!text) return false;
-    for (BackpatchMethod m : kBackpatchMethods)
-        if (std::strcmp(text, backpatch_method_name(m)) == 0) {
-            method = m;
-            return true;
-        }
-    return false;
-}
-
 // ---- Hi-Z textures ------------------------------------------------------------------------
 
 namespace {

@@ -17,8 +17,8 @@
 
 namespace patchcull::gl {
 
-static_assert(kFlagFrustum == sh::kCullFrustum && kFlagBackPatch == sh::kCullBackPatch &&
-              kFlagOcclusion == sh::kCullOcclusion && kFlagReasonMask == sh::kCullReasonMask);
+static_assert(kCullFrustum == sh::kCullFrustum && kCullBackPatch == sh::kCullBackPatch &&
+              kCullOcclusion == sh::kCullOcclusion && kCullReasonMask == sh::kCullReasonMask);
 static_assert(kStatusVisible == sh::kStatusVisible && kStatusNewlyVisible == sh::kStatusNewlyVisible);
 static_assert(kIdOccluderBit == sh::kIdOccluderBit);
 

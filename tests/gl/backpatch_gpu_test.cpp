@@ -327,10 +327,10 @@ void check_cones(BackpatchMethod method) {
                 backpatch_method_name(method), all.total, all.cpu_culled, all.gpu_culled, all.gpu_only, all.cpu_only);
     // The comparison has teeth: a fair share is culled.
     EXPECT_GT(all.cpu_culled, all.total / 10);
-    // The flag buffer holds kFlagBackPatch / 0 (the cull_occlusion hook's layout).
+    // The flag buffer holds kCullBackPatch / 0 (the cull_occlusion hook's layout).
     const std::vector<std::uint32_t> words = c.read_flag_words();
     ASSERT_EQ(words.size(), patches.size());
-    for (std::uint32_t w : words) ASSERT_TRUE(w == 0 || w == kFlagBackPatch) << w;
+    for (std::uint32_t w : words) ASSERT_TRUE(w == 0 || w == kCullBackPatch) << w;
 }
 
 TEST(BackpatchGpu, TconeDecisionsEqualCpu) { check_cones(BackpatchMethod::tcone); }

@@ -13,8 +13,8 @@
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/camera.h"
 #include "patchcull/gl/gl_pipeline.h"
-#include "patchcull/import/model_loader.h"
 #include "patchcull/gl/gl_verification.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

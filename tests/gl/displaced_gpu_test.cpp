@@ -257,7 +257,7 @@ TEST(DisplacedGpu, DecisionsAndBoundsEqualTheCpu) {
                 compute_displaced_bounds(batch.view(), s.ranges.data(), b, c, tv.view, cpu_bounds.data());
                 gpu.cull_frustum(b, c, tv.view, &gpu_frustum);
                 gpu.cull_occlusion(b, c, tv.view, &gpu_occlusion, &gpu_bounds);
-                // The flag words of the last call are reason bits only: kFlagFrustum, kFlagOcclusion or 0.
+                // The flag words of the last call are reason bits only: kCullFrustum, kCullOcclusion or 0.
                 const std::vector<std::uint32_t> words = gpu.read_flag_words();
                 ASSERT_EQ(words.size(), n);
                 ASSERT_EQ(gpu_frustum.size(), n);
@@ -266,7 +266,7 @@ TEST(DisplacedGpu, DecisionsAndBoundsEqualTheCpu) {
                 std::size_t reported = 0;
                 for (std::size_t p = 0; p < n; ++p) {
                     ++t.decisions;
-                    EXPECT_TRUE(words[p] == 0 || words[p] == kFlagFrustum || words[p] == kFlagOcclusion)
+                    EXPECT_TRUE(words[p] == 0 || words[p] == kCullFrustum || words[p] == kCullOcclusion)
                         << where << " patch " << p << ": word " << words[p];
                     t.frustum_equal += cpu_frustum[p] == gpu_frustum[p];
                     t.occlusion_equal += cpu_occlusion[p] == gpu_occlusion[p];

@@ -44,7 +44,7 @@ Passes& passes() {
 }
 
 // One test setup: patches on the renderer, a camera, the pyramid of the drawn half.
-struct CullView {
+struct TestView {
     Mat4 m;               // the camera's matrix in `depth`'s convention
     ClipDepth depth = ClipDepth::zero_to_one;
     Vec3 eye;
@@ -53,18 +53,18 @@ struct CullView {
 
 // The chain the fused pass replaces, from `words` (reasons and statuses as given).
 std::vector<std::uint32_t> run_chain(PatchRenderer& r, const PatchBuffers& b, const std::vector<std::uint32_t>& words,
-                                     std::uint32_t tests, BackpatchMethod method, const CullView& s) {
+                                     std::uint32_t tests, BackpatchMethod method, const TestView& s) {
     r.set_flag_words(words);
     Passes& p = passes();
     const Mat4 m01 = to_zero_to_one(s.m, s.depth);
-    if (tests & kFlagFrustum) p.frustum.run(b, make_frustum_planes(m01, ClipDepth::zero_to_one));
-    if (tests & kFlagBackPatch) p.cones.run(b, method, s.eye);
-    if (tests & kFlagOcclusion) p.occlusion.run(b, s.m, s.depth, s.hiz, false);
+    if (tests & kCullFrustum) p.frustum.run(b, make_frustum_planes(m01, ClipDepth::zero_to_one));
+    if (tests & kCullBackPatch) p.cones.run(b, method, s.eye);
+    if (tests & kCullOcclusion) p.occlusion.run(b, s.m, s.depth, s.hiz, false);
     return r.read_cull_flags();
 }
 
 std::vector<std::uint32_t> run_fused(PatchRenderer& r, const PatchBuffers& b, const std::vector<std::uint32_t>& words,
-                                     std::uint32_t tests, BackpatchMethod method, const CullView& s) {
+                                     std::uint32_t tests, BackpatchMethod method, const TestView& s) {
     r.set_flag_words(words);
     passes().fused.run(b, tests, s.m, s.depth, method, s.eye, &s.hiz);
     return r.read_cull_flags();
@@ -146,7 +146,7 @@ TEST(FusedCullPass, FlagWordsEqualTheChainForEveryTestSubset) {
         params.height = h;
         params.tess_level = 5;
         r.render(params);
-        CullView s;
+        TestView s;
         s.eye = cam.eye;
         s.hiz = create_hiz_texture(w, h);
         passes().hiz_build.run(r.depth_texture(), s.hiz);
@@ -155,7 +155,7 @@ TEST(FusedCullPass, FlagWordsEqualTheChainForEveryTestSubset) {
         for (std::uint32_t& word : words) {
             const float x = u01(rng);
             word = x < 0.4f ? 0u : x < 0.8f ? kStatusVisible : kStatusVisible | kStatusNewlyVisible;
-            if (u01(rng) < 0.05f) word |= kFlagObject;
+            if (u01(rng) < 0.05f) word |= kCullObject;
         }
         const PatchBuffers b = r.patch_buffers();
         for (ClipDepth depth : {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one}) {
@@ -164,7 +164,7 @@ TEST(FusedCullPass, FlagWordsEqualTheChainForEveryTestSubset) {
             for (BackpatchMethod method : {BackpatchMethod::tcone, BackpatchMethod::ncone}) {
                 for (std::uint32_t tests = 1; tests <= 7; ++tests) {
                     // ncone's program is slow on llvmpipe: its own subsets only in the first convention.
-                    if (method == BackpatchMethod::ncone && (!(tests & kFlagBackPatch) || depth != ClipDepth::zero_to_one))
+                    if (method == BackpatchMethod::ncone && (!(tests & kCullBackPatch) || depth != ClipDepth::zero_to_one))
                         continue;
                     const std::string what = "round " + std::to_string(round) + " " +
                                              (depth == ClipDepth::zero_to_one ? "0..1" : "-1..1") + " " +
@@ -174,10 +174,10 @@ TEST(FusedCullPass, FlagWordsEqualTheChainForEveryTestSubset) {
                     EXPECT_EQ(count_differences(chain, fused, what), 0u) << what;
                     if (tests == 7) {
                         for (std::uint32_t word : fused) {
-                            const std::uint32_t reason = word & kFlagReasonMask;
-                            total.frustum += reason == kFlagFrustum;
-                            total.backpatch += reason == kFlagBackPatch;
-                            total.occlusion += reason == kFlagOcclusion;
+                            const std::uint32_t reason = word & kCullReasonMask;
+                            total.frustum += reason == kCullFrustum;
+                            total.backpatch += reason == kCullBackPatch;
+                            total.occlusion += reason == kCullOcclusion;
                             total.visible += reason == 0;
                         }
                     }
@@ -243,7 +243,7 @@ TEST(FusedCullPass, ReasonsEqualTheCpuKernels) {
         const std::vector<float> depth = r.read_depth_bottom_up();
         HiZPyramid cpu_hiz;
         cpu_hiz.build(depth.data(), w, h);
-        CullView s;
+        TestView s;
         s.m = cam.view_projection();
         s.eye = cam.eye;
         s.hiz = create_hiz_texture(w, h);
@@ -267,24 +267,24 @@ TEST(FusedCullPass, ReasonsEqualTheCpuKernels) {
             cull_fused_scalar(batch.view(), setup, FusedPlan{}, fused_cpu.data());
             for (std::size_t p = 0; p < patches.size(); ++p) {
                 const std::uint8_t d = fused_cpu[p];
-                const std::uint32_t cpu = d == kFusedFrustumCulled     ? kFlagFrustum
-                                          : d == kFusedBackPatchCulled ? kFlagBackPatch
-                                          : d == kFusedOccluded        ? kFlagOcclusion
+                const std::uint32_t cpu = d == kFusedFrustumCulled     ? kCullFrustum
+                                          : d == kFusedBackPatchCulled ? kCullBackPatch
+                                          : d == kFusedOccluded        ? kCullOcclusion
                                                                        : 0u;
-                if ((words[p] & kFlagReasonMask) != cpu && ++mismatched <= 5)
+                if ((words[p] & kCullReasonMask) != cpu && ++mismatched <= 5)
                     ADD_FAILURE() << "round " << round << " " << backpatch_method_name(method) << ": patch " << p
-                                  << " GPU " << (words[p] & kFlagReasonMask) << " cull_fused_scalar " << int(d);
+                                  << " GPU " << (words[p] & kCullReasonMask) << " cull_fused_scalar " << int(d);
             }
             for (std::size_t p = 0; p < patches.size(); ++p) {
-                const std::uint32_t cpu = hiz_out[p] == kHiZFrustumCulled ? kFlagFrustum
-                                          : cone_out[p]                   ? kFlagBackPatch
-                                          : hiz_out[p] == kHiZOccluded    ? kFlagOcclusion
+                const std::uint32_t cpu = hiz_out[p] == kHiZFrustumCulled ? kCullFrustum
+                                          : cone_out[p]                   ? kCullBackPatch
+                                          : hiz_out[p] == kHiZOccluded    ? kCullOcclusion
                                                                           : 0u;
-                const std::uint32_t gpu = words[p] & kFlagReasonMask;
+                const std::uint32_t gpu = words[p] & kCullReasonMask;
                 if (gpu != cpu && ++mismatched <= 5)
                     ADD_FAILURE() << "round " << round << " " << backpatch_method_name(method) << ": patch " << p
                                   << " GPU " << gpu << " CPU " << cpu;
-                decided[cpu == 0 ? 0 : cpu == kFlagFrustum ? 1 : cpu == kFlagBackPatch ? 2 : 3]++;
+                decided[cpu == 0 ? 0 : cpu == kCullFrustum ? 1 : cpu == kCullBackPatch ? 2 : 3]++;
             }
             EXPECT_EQ(mismatched, 0u) << "round " << round << " " << backpatch_method_name(method);
         }
@@ -298,14 +298,14 @@ TEST(FusedCullPass, RefusesPtpMissingPyramidsAndUnknownTests) {
     r.set_patches(test::split_teapot(0));
     const Mat4 m;  // identity
     FusedCullPass& fused = passes().fused;
-    EXPECT_THROW(fused.run(r.patch_buffers(), kFlagBackPatch, m, ClipDepth::zero_to_one, BackpatchMethod::ptp, {}, nullptr),
+    EXPECT_THROW(fused.run(r.patch_buffers(), kCullBackPatch, m, ClipDepth::zero_to_one, BackpatchMethod::ptp, {}, nullptr),
                  patchcull::Error);
-    EXPECT_THROW(fused.run(r.patch_buffers(), kFlagOcclusion, m, ClipDepth::zero_to_one, BackpatchMethod::tcone, {}, nullptr),
+    EXPECT_THROW(fused.run(r.patch_buffers(), kCullOcclusion, m, ClipDepth::zero_to_one, BackpatchMethod::tcone, {}, nullptr),
                  patchcull::Error);
-    EXPECT_THROW(fused.run(r.patch_buffers(), kFlagObject, m, ClipDepth::zero_to_one, BackpatchMethod::tcone, {}, nullptr),
+    EXPECT_THROW(fused.run(r.patch_buffers(), kCullObject, m, ClipDepth::zero_to_one, BackpatchMethod::tcone, {}, nullptr),
                  patchcull::Error);
     // ptp is fine when the back-patch test is not asked for; no pyramid is needed without occlusion.
-    EXPECT_NO_THROW(fused.run(r.patch_buffers(), kFlagFrustum, m, ClipDepth::zero_to_one, BackpatchMethod::ptp, {}, nullptr));
+    EXPECT_NO_THROW(fused.run(r.patch_buffers(), kCullFrustum, m, ClipDepth::zero_to_one, BackpatchMethod::ptp, {}, nullptr));
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 

@@ -63,7 +63,7 @@ std::size_t run_case(const Case& c, int frames) {
     ScenePoser poser(scene);
     bool one_sided = true;
     for (const LoadedModel& m : scene.models) one_sided = one_sided && m.closed;
-    const CullMode mode = one_sided ? CullMode::all : static_cast<CullMode>(kFlagFrustum | kFlagOcclusion);
+    const CullMode mode = one_sided ? CullMode::all : static_cast<CullMode>(kCullFrustum | kCullOcclusion);
     std::vector<TriangleSpan> one_sided_occluders;
     for (const EnvironmentObject& e : scene.environment)
         if (e.one_sided && e.triangle_count) one_sided_occluders.push_back({e.first_triangle, e.triangle_count});
@@ -171,7 +171,7 @@ TEST(FusedPipeline, PtpAndAabbKeepTheSeparatePasses) {
     EXPECT_TRUE(pl.render_frame(params).fused_pass);
     params.backpatch = BackpatchMethod::ptp;
     EXPECT_FALSE(pl.render_frame(params).fused_pass);
-    params.frame.cull = static_cast<CullMode>(kFlagFrustum | kFlagOcclusion);  // ptp unused: fused again
+    params.frame.cull = static_cast<CullMode>(kCullFrustum | kCullOcclusion);  // ptp unused: fused again
     EXPECT_TRUE(pl.render_frame(params).fused_pass);
     params.frustum = FrustumTest::aabb;
     EXPECT_FALSE(pl.render_frame(params).fused_pass);

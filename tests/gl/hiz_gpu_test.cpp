@@ -126,11 +126,11 @@ DecisionCounts compare_decisions(PatchRenderer& r, const std::vector<BezierPatch
     const std::vector<std::uint32_t> words = r.read_cull_flags();
     DecisionCounts n;
     for (std::size_t p = 0; p < patches.size(); ++p) {
-        const std::uint32_t reason = words[p] & kFlagReasonMask;
+        const std::uint32_t reason = words[p] & kCullReasonMask;
         std::uint8_t gpu = 0xFF;
         if (reason == 0) gpu = kHiZVisible;
-        if (reason == kFlagFrustum) gpu = kHiZFrustumCulled;
-        if (reason == kFlagOcclusion) gpu = kHiZOccluded;
+        if (reason == kCullFrustum) gpu = kHiZFrustumCulled;
+        if (reason == kCullOcclusion) gpu = kHiZOccluded;
         if (gpu != cpu[p]) {
             if (++n.mismatched <= 5)
                 ADD_FAILURE() << what << ": patch " << p << " GPU " << int(gpu) << " CPU " << int(cpu[p]);

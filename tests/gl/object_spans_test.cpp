@@ -1,6 +1,6 @@
 // The GPU side of the object level (gl_pipeline.h PipelineParams::object_culled and
 // culled_occluders, gl_renderer.h set_occluders' one-sided spans): spans culled before the passes
-// are never drawn, get kFlagObject, come back as newly visible; culled occluder triangles leave the
+// are never drawn, get kCullObject, come back as newly visible; culled occluder triangles leave the
 // frame but not the unculled reference; one-sided occluders show nothing from behind.
 #include <gtest/gtest.h>
 
@@ -60,7 +60,7 @@ TEST(ObjectSpans, CulledSpanIsNeverDrawnAndComesBackNewlyVisible) {
             const std::vector<std::uint32_t> flags = pipeline.renderer().read_cull_flags();
             for (std::size_t i = 10; i < 30; ++i) {
                 EXPECT_EQ(drawn[i], 0u) << i;
-                EXPECT_EQ(flags[i], kFlagObject) << i;
+                EXPECT_EQ(flags[i], kCullObject) << i;
             }
             EXPECT_FALSE(any_id_of_patches(pipeline.renderer().read_ids(), 10, 20));
             EXPECT_FALSE(any_id_of_patches(pipeline.renderer().read_ids(), 90, 5));

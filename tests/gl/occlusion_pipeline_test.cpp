@@ -35,7 +35,7 @@ constexpr int kSize = 256;
 // The teapot is an open surface drawn two-sided, on which back-patch culling is not conservative
 // (README, "What contributes a pixel"): its modes combine frustum and occlusion; the back-patch
 // test runs on the closed BigGuy, drawn one-sided.
-const CullMode kFrustumOcclusion = static_cast<CullMode>(kFlagFrustum | kFlagOcclusion);
+const CullMode kFrustumOcclusion = static_cast<CullMode>(kCullFrustum | kCullOcclusion);
 const CullMode kModes[] = {CullMode::none, CullMode::frustum, CullMode::occlusion, kFrustumOcclusion};
 
 // A pipeline frame with the default tests' choices (tcone, caf/acon, one object).
@@ -201,7 +201,7 @@ void expect_visible_patches_tagged(const std::vector<std::uint32_t>& ids, const 
     for (std::uint32_t id : test::ids_present(ids)) {
         if (id & kIdOccluderBit) continue;
         const std::uint32_t w = words[id - 1];
-        if (((w & kFlagReasonMask) != 0 || (w & kStatusVisible) == 0) && ++bad <= 3)
+        if (((w & kCullReasonMask) != 0 || (w & kStatusVisible) == 0) && ++bad <= 3)
             ADD_FAILURE() << what << ": patch " << id - 1 << " shows but its word is 0x" << std::hex << w;
     }
 }
@@ -210,16 +210,16 @@ void check_stats(const FrameStats& s, std::size_t patches, CullMode mode, bool f
     EXPECT_EQ(s.patches, patches) << what;
     EXPECT_EQ(s.frustum_culled + s.backpatch_culled + s.occlusion_culled + s.visible, patches) << what;
     const auto m = static_cast<std::uint32_t>(mode);
-    if (!(m & kFlagBackPatch)) {
+    if (!(m & kCullBackPatch)) {
         EXPECT_EQ(s.backpatch_culled, 0u) << what;
     }
-    if (!(m & kFlagFrustum)) {
+    if (!(m & kCullFrustum)) {
         EXPECT_EQ(s.frustum_culled, 0u) << what;
     }
-    if (!(m & kFlagOcclusion)) {
+    if (!(m & kCullOcclusion)) {
         EXPECT_EQ(s.occlusion_culled, 0u) << what;
     }
-    EXPECT_EQ(s.two_pass, (m & kFlagOcclusion) != 0) << what;
+    EXPECT_EQ(s.two_pass, (m & kCullOcclusion) != 0) << what;
     if (s.two_pass) {
         EXPECT_EQ(s.pass2_drawn, s.newly_visible) << what;
         if (first_frame) {
@@ -513,13 +513,13 @@ TEST(OcclusionPipeline, FlagChainKeepsTheFirstReasonAndSkipsCulledPatches) {
     FrustumPass frustum(test::passes());
     BackpatchConePass cones(test::passes());
     std::vector<std::uint32_t> words(patches.size(), kStatusVisible);
-    words[0] = kStatusVisible | kFlagOcclusion;  // stale from the last frame: begin clears it
+    words[0] = kStatusVisible | kCullOcclusion;  // stale from the last frame: begin clears it
     r.set_flag_words(words);
     status.begin(r.patch_buffers());
     std::vector<std::uint32_t> after_begin = r.read_cull_flags();
     for (std::uint32_t w : after_begin) ASSERT_EQ(w, kStatusVisible);
     words.assign(patches.size(), kStatusVisible);
-    words[1] = kStatusVisible | kFlagOcclusion;  // culled by an "earlier pass" of this frame
+    words[1] = kStatusVisible | kCullOcclusion;  // culled by an "earlier pass" of this frame
     r.set_flag_words(words);
     const FrustumPlanes planes = make_frustum_planes(m, ClipDepth::zero_to_one);
     frustum.run(r.patch_buffers(), planes);
@@ -529,23 +529,23 @@ TEST(OcclusionPipeline, FlagChainKeepsTheFirstReasonAndSkipsCulledPatches) {
     std::size_t frustum_culled = 0, back_culled = 0;
     for (std::size_t p = 0; p < patches.size(); ++p) {
         std::uint32_t reason = 0;
-        if (p == 1) reason = kFlagOcclusion;
-        else if (outside[p]) reason = kFlagFrustum;
-        else if (back[p] && margins[p] == 0.0f) reason = kFlagBackPatch;
-        ASSERT_EQ(got[p] & kFlagReasonMask, reason) << "patch " << p;
-        ASSERT_EQ(got[p] & ~kFlagReasonMask, kStatusVisible) << "patch " << p << ": statuses untouched";
-        frustum_culled += reason == kFlagFrustum;
-        back_culled += reason == kFlagBackPatch;
+        if (p == 1) reason = kCullOcclusion;
+        else if (outside[p]) reason = kCullFrustum;
+        else if (back[p] && margins[p] == 0.0f) reason = kCullBackPatch;
+        ASSERT_EQ(got[p] & kCullReasonMask, reason) << "patch " << p;
+        ASSERT_EQ(got[p] & ~kCullReasonMask, kStatusVisible) << "patch " << p << ": statuses untouched";
+        frustum_culled += reason == kCullFrustum;
+        back_culled += reason == kCullBackPatch;
     }
     EXPECT_GT(frustum_culled, 5u);
     EXPECT_GT(back_culled, 5u);
     if (!outside[displaced]) {
-        EXPECT_EQ(got[displaced] & kFlagReasonMask, 0u) << "the displaced patch " << displaced << " was back-patch tested";
+        EXPECT_EQ(got[displaced] & kCullReasonMask, 0u) << "the displaced patch " << displaced << " was back-patch tested";
     }
     status.end(r.patch_buffers(), 0);
     const std::vector<std::uint32_t> ended = r.read_cull_flags();
     for (std::size_t p = 0; p < patches.size(); ++p) {
-        const std::uint32_t reason = got[p] & kFlagReasonMask;
+        const std::uint32_t reason = got[p] & kCullReasonMask;
         ASSERT_EQ(ended[p], reason ? reason : kStatusVisible) << "patch " << p;
     }
 }
@@ -568,7 +568,7 @@ TEST(OcclusionPipeline, BackPatchModeCullsWhatTheGpuPassDecides) {
     const std::vector<std::uint32_t> words = pipeline.renderer().read_cull_flags();
     for (std::size_t p = 0; p < patches.size(); ++p) {
         expected += back[p];
-        ASSERT_EQ((words[p] & kFlagBackPatch) != 0, back[p] != 0) << "patch " << p;
+        ASSERT_EQ((words[p] & kCullBackPatch) != 0, back[p] != 0) << "patch " << p;
     }
     EXPECT_GT(expected, 10u);
     EXPECT_EQ(s.backpatch_culled, expected);

@@ -143,7 +143,7 @@ TEST(ViewerSettings, KeysAndSetsChangeTheSameState) {
     EXPECT_EQ(apply_setting(s, "cull.occlusion", "on"), "");
     EXPECT_TRUE(s.occlusion);
     EXPECT_EQ(apply_setting(s, "cull.frustum", "off"), "");
-    EXPECT_EQ(settings_cull_mode(s), static_cast<gl::CullMode>(gl::kFlagBackPatch | gl::kFlagOcclusion));
+    EXPECT_EQ(settings_cull_mode(s), static_cast<gl::CullMode>(gl::kCullBackPatch | gl::kCullOcclusion));
     apply_settings_key(s, ViewerKey::next_backpatch);
     EXPECT_EQ(s.backpatch_method, gl::BackpatchMethod::ncone);
     apply_settings_key(s, ViewerKey::next_view);

@@ -9,6 +9,7 @@
 #include <iterator>
 
 #include "patchcull/core/error.h"
+#include "patchcull/gl/gl_backpatch_passes.h"
 
 namespace patchcull::cli {
 namespace {
@@ -64,14 +65,15 @@ void culling_section(ViewerSettings& s, const PanelInfo& info) {
     if (s.backpatch && !info.one_sided)
         ImGui::TextColored(ImVec4(1, 0.5f, 0.3f, 1), "open surface: back-patch culling is not conservative here");
     ImGui::Checkbox("auto: cull only where it pays [4]", &s.cull_auto);
-    const char* methods[std::size(gl::kBackpatchMethods)];
+    const std::vector<gl::BackpatchMethod> ids = gl::gpu_backpatch_methods();
+    std::vector<const char*> methods;
     int method = 0;
-    for (std::size_t i = 0; i < std::size(gl::kBackpatchMethods); ++i) {
-        methods[i] = gl::backpatch_method_name(gl::kBackpatchMethods[i]);
-        if (gl::kBackpatchMethods[i] == s.backpatch_method) method = static_cast<int>(i);
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+        methods.push_back(gl::backpatch_method_name(ids[i]));
+        if (ids[i] == s.backpatch_method) method = static_cast<int>(i);
     }
-    if (combo("back-patch test [b]", method, methods, static_cast<int>(std::size(methods))))
-        s.backpatch_method = gl::kBackpatchMethods[method];
+    if (combo("back-patch test [b]", method, methods.data(), static_cast<int>(methods.size())))
+        s.backpatch_method = ids[static_cast<std::size_t>(method)];
     ImGui::Checkbox("aggressive: no second pass [g]", &s.aggressive);
     if (s.displace) {
         static const char* const bounds[] = {"oobb", "caf"};

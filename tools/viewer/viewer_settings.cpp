@@ -6,6 +6,7 @@
 #include <iterator>
 #include <utility>
 #include <vector>
+#include "patchcull/gl/gl_backpatch_passes.h"
 
 namespace patchcull::cli {
 namespace {
@@ -66,7 +67,7 @@ std::string apply_setting(ViewerSettings& settings, const std::string& name, con
     if (name == "panel") return set_switch(settings.panel, name, value);
     if (name == "backpatch") {
         std::vector<std::pair<const char*, gl::BackpatchMethod>> methods;
-        for (gl::BackpatchMethod m : gl::kBackpatchMethods) methods.emplace_back(gl::backpatch_method_name(m), m);
+        for (gl::BackpatchMethod m : gl::gpu_backpatch_methods()) methods.emplace_back(gl::backpatch_method_name(m), m);
         return set_choice(settings.backpatch_method, name, value, methods);
     }
     if (name == "bound")
@@ -130,11 +131,12 @@ bool apply_settings_key(ViewerSettings& s, ViewerKey key) {
     case ViewerKey::toggle_backpatch: s.backpatch = !s.backpatch; return true;
     case ViewerKey::toggle_occlusion: s.occlusion = !s.occlusion; return true;
     case ViewerKey::toggle_auto: s.cull_auto = !s.cull_auto; return true;
-    case ViewerKey::next_backpatch: {  // the next of gl::kBackpatchMethods, round
-        const std::size_t n = std::size(gl::kBackpatchMethods);
+    case ViewerKey::next_backpatch: {  // the next of gl::gpu_backpatch_methods, round
+        const std::vector<gl::BackpatchMethod> ids = gl::gpu_backpatch_methods();
+        const std::size_t n = ids.size();
         std::size_t at = 0;
-        while (at < n && gl::kBackpatchMethods[at] != s.backpatch_method) ++at;
-        s.backpatch_method = gl::kBackpatchMethods[(at + 1) % n];
+        while (at < n && ids[at] != s.backpatch_method) ++at;
+        s.backpatch_method = ids[(at + 1) % n];
         return true;
     }
     case ViewerKey::toggle_aggressive: s.aggressive = !s.aggressive; return true;
@@ -158,16 +160,16 @@ bool apply_settings_key(ViewerSettings& s, ViewerKey key) {
 }
 
 gl::CullMode settings_cull_mode(const ViewerSettings& s) {
-    const std::uint32_t bits = (s.frustum ? gl::kFlagFrustum : 0u) | (s.backpatch ? gl::kFlagBackPatch : 0u) |
-                               (s.occlusion ? gl::kFlagOcclusion : 0u);
+    const std::uint32_t bits = (s.frustum ? gl::kCullFrustum : 0u) | (s.backpatch ? gl::kCullBackPatch : 0u) |
+                               (s.occlusion ? gl::kCullOcclusion : 0u);
     return static_cast<gl::CullMode>(bits);
 }
 
 void set_cull_toggles(ViewerSettings& s, gl::CullMode mode) {
     const std::uint32_t bits = static_cast<std::uint32_t>(mode);
-    s.frustum = (bits & gl::kFlagFrustum) != 0;
-    s.backpatch = (bits & gl::kFlagBackPatch) != 0;
-    s.occlusion = (bits & gl::kFlagOcclusion) != 0;
+    s.frustum = (bits & gl::kCullFrustum) != 0;
+    s.backpatch = (bits & gl::kCullBackPatch) != 0;
+    s.occlusion = (bits & gl::kCullOcclusion) != 0;
 }
 
 const char* viewer_view_name(ViewerView view) {

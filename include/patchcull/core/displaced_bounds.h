@@ -168,6 +168,9 @@ struct DisplacedCullView {
 /// conventions; the pyramid must be built in the same direction). Throws Error when the
 /// projection contradicts depth (check_clip_depth).
 DisplacedCullView make_displaced_cull_view(const Mat4& object_to_view, const Mat4& projection, ClipDepth depth);
+struct CullView;  // cull_view.h
+/// The same from one view's CullView (view.view, view.projection, view.depth).
+DisplacedCullView make_displaced_cull_view(const CullView& view);
 
 /// Status of a computed bound.
 enum DisplacedBoundStatus : std::uint8_t {

@@ -113,6 +113,8 @@ struct FrustumVerdict {
 };
 
 /// frustum kernel, scalar reference.
+struct CullView;  // cull_view.h
+
 void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement,
                          const FrustumPlanes& planes, std::uint8_t* culled);
 /// frustum kernel, SIMD (Highway, best instruction set chosen once at run time).
@@ -146,5 +148,11 @@ inline void frustum_plane_values(const FrustumPlanes& planes, float X, float Y, 
 inline void add_frustum_margins(const FrustumPlanes& planes, float d, float W, float v[6]) {
     for (int q = 0; q < 6; ++q) v[q] = std::fma(d * planes.normal_length[q], W, v[q]);
 }
+
+/// The SIMD kernels on one view's CullView (view.planes; view.object_to_clip in view.depth).
+void cull_frustum(const PatchBatchView& patches, const float* max_displacement, const CullView& view,
+                  std::uint8_t* culled);
+void cull_frustum_disp(const PatchBatchView& patches, const float* max_displacement, const CullView& view,
+                       std::uint8_t* culled);
 
 }  // namespace patchcull

@@ -49,6 +49,7 @@
 
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/clip_space.h"
+#include "patchcull/core/cull_flags.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/math.h"
@@ -63,8 +64,10 @@ enum FusedDecision : std::uint8_t {
     kFusedBackPatchCulled = 3,  ///< the plan's back-patch cone culled it
 };
 
-enum class FusedStage : std::uint8_t { frustum, backpatch, occlusion };
-inline constexpr int kFusedStages = 3;
+/// A stage of a plan is one of the cull tests (cull_flags.h): FusedStage::frustum is
+/// CullTest::frustum, and a stage's flag bit is cull_test_flag(stage).
+using FusedStage = CullTest;
+inline constexpr int kFusedStages = kCullTestCount;
 
 /// Tests in the order they run; stages[0 .. count).
 struct FusedPlan {
@@ -96,6 +99,9 @@ struct FusedCullSetup {
 /// and the pyramid (null when no plan will have occlusion).
 FusedCullSetup make_fused_setup(const Mat4& object_to_clip, ClipDepth depth, Vec3 eye, BackPatchCone cone,
                                 const HiZPyramid* hiz);
+struct CullView;  // cull_view.h
+/// The same from one view's CullView (its planes and eye).
+FusedCullSetup make_fused_setup(const CullView& view, BackPatchCone cone, const HiZPyramid* hiz);
 
 /// Work counts of one or more kernel calls (added to, never reset by the kernel).
 struct FusedCullStats {

@@ -239,4 +239,8 @@ void cull_occlusion_scalar(const PatchBatchView& patches, const Mat4& object_to_
 void cull_occlusion_simd(const PatchBatchView& patches, const Mat4& object_to_clip, ClipDepth depth,
                          const HiZPyramid& hiz, std::uint8_t* decision);
 
+struct CullView;  // cull_view.h
+/// cull_occlusion_simd on one view's CullView (view.object_to_clip in view.depth).
+void cull_occlusion(const PatchBatchView& patches, const CullView& view, const HiZPyramid& hiz, std::uint8_t* decision);
+
 }  // namespace patchcull

@@ -75,7 +75,8 @@ struct CullEvalResult {
 };
 
 /// Runs options.methods over options.views views of frame (a static frame; displacement may be
-/// null). Throws patchcull::Error for an unknown method name or a grid outside 1..1024.
+/// null). Throws patchcull::Error for an unknown method name, a grid outside 1..1024, or a frame
+/// whose info does not hold one PatchInfo per patch.
 ///
 /// Memory does not grow with the patch count beyond the batch and a few bytes per patch (issue
 /// 14): the dense samples of the ground truth (12.7 KB per patch at grid 17) are never held for

@@ -16,7 +16,7 @@
 //   (patch.h order) at 16p + k, the renderer's layout. Either uploaded by set_patches or an
 //   existing buffer of that layout (use_patch_buffer, e.g. the renderer's).
 // - flags, kBindingCullFlags (1), flag_buffer(): uint flags[patch_count], cleared and written by
-//   every cull call: kFlagBackPatch (2, gl_renderer.h) = back-facing (culled), 0 = kept.
+//   every cull call: kCullBackPatch (2, gl_renderer.h) = back-facing (culled), 0 = kept.
 // - ptp diagnostics, shared.h's kBindingPtpPlanes (13): float [128 * patch_count], per
 //   patch the 64 clip-space control plane z values (at 128p + 8 jv + iu) and then their 64
 //   rounding-error margins thr (at 128p + 64 + 8 jv + iu), written only when cull_ptp is asked
@@ -69,6 +69,8 @@
 #include <vector>
 
 #include "patchcull/core/backpatch.h"
+#include "patchcull/core/backpatch_methods.h"
+#include "patchcull/core/cull_view.h"
 #include "patchcull/gl/gl_passes.h"
 #include "patchcull/gl/gl_renderer.h"
 #include "patchcull/core/math.h"
@@ -118,10 +120,14 @@ public:
     /// One of the above: tcone/ncone use eye, ptp uses object_to_clip, alpha and rule.
     void cull(BackpatchMethod method, const Mat4& object_to_clip, Vec3 eye, float alpha, PtpRule rule,
               std::vector<std::uint8_t>* culled = nullptr);
+    /// Any registered method with a GPU pass (gl_backpatch_passes.h) on view, e.g. a method an
+    /// engine registered; throws Error when the method has no pass.
+    void cull(BackpatchMethod method, const CullView& view, const BackpatchOptions& options,
+              std::vector<std::uint8_t>* culled = nullptr);
 
-    /// The flag SSBO (GL name): uint per patch, kFlagBackPatch = culled, written by each cull call.
+    /// The flag SSBO (GL name): uint per patch, kCullBackPatch = culled, written by each cull call.
     std::uint32_t flag_buffer() const;
-    /// Reads the flag buffer back as it is (kFlagBackPatch or 0 per patch).
+    /// Reads the flag buffer back as it is (kCullBackPatch or 0 per patch).
     std::vector<std::uint32_t> read_flag_words() const;
 
     /// True when pc_fma is computed in double precision (software rasterizer, or GLSL fma() of

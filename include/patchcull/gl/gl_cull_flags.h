@@ -3,7 +3,8 @@
 //
 // - Flag word: one uint per patch (PatchRenderer::flag_buffer(), gl_renderer.h), read by the TCS
 //   (shaders/patchcull_tcs.h). Bits 0-7 = cull reason of the latest frame, 0 = not culled:
-//   kFlagFrustum (1), kFlagBackPatch (2), kFlagOcclusion (4) (shaders/shared.h). Bits 8-9 =
+//   kCullFrustum (1), kCullBackPatch (2), kCullOcclusion (4), kCullObject (8)
+//   (core/cull_flags.h). Bits 8-9 =
 //   temporal status of the pipeline: kStatusVisible (passed the latest tests) and
 //   kStatusNewlyVisible (passed them, and was not tagged visible before); gl_passes.h's flag chain
 //   writes both. A culled patch gets tessellation levels 0 in the TCS and is discarded by the
@@ -15,17 +16,21 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "patchcull/core/cull_flags.h"
+
 namespace patchcull::gl {
 
-// Flag word bits and id encoding (equal to shaders/shared.h's; static_asserts in the renderer).
-inline constexpr std::uint32_t kFlagFrustum = 1u;        ///< culled by the view frustum
-inline constexpr std::uint32_t kFlagBackPatch = 2u;      ///< culled as back-facing (a back-patch pass)
-inline constexpr std::uint32_t kFlagOcclusion = 4u;      ///< culled behind the Hi-Z pyramid
-inline constexpr std::uint32_t kFlagObject = 8u;         ///< culled with its object (object_culling.h)
-inline constexpr std::uint32_t kFlagReasonMask = 0xFFu;  ///< bits of the cull reason
-inline constexpr std::uint32_t kStatusVisible = 0x100u;  ///< passed the latest test
-inline constexpr std::uint32_t kStatusNewlyVisible = 0x200u;  ///< ... and was not tagged visible
-inline constexpr std::uint32_t kIdOccluderBit = 0x80000000u;  ///< id of occluder triangle t: bit | t
+// The flag word's bits are core/cull_flags.h's (one vocabulary for C++ and GLSL); gl:: names them
+// too, for code written against this layer.
+using patchcull::kCullBackPatch;
+using patchcull::kCullFrustum;
+using patchcull::kCullObject;
+using patchcull::kCullOcclusion;
+using patchcull::kCullReasonMask;
+using patchcull::kStatusNewlyVisible;
+using patchcull::kStatusVisible;
+/// Id of occluder triangle t in the id buffer: kIdOccluderBit | t (shaders/shared.h's value).
+inline constexpr std::uint32_t kIdOccluderBit = 0x80000000u;
 
 /// Patches [first, first + count) of the set (object-level culling and draws restricted to spans).
 struct PatchSpan {
@@ -42,10 +47,10 @@ struct TriangleSpan {
 /// patch gets.
 enum class CullMode : std::uint32_t {
     none = 0,
-    frustum = kFlagFrustum,
-    backpatch = kFlagBackPatch,
-    occlusion = kFlagOcclusion,
-    all = kFlagFrustum | kFlagBackPatch | kFlagOcclusion,
+    frustum = kCullFrustum,
+    backpatch = kCullBackPatch,
+    occlusion = kCullOcclusion,
+    all = kCullFrustum | kCullBackPatch | kCullOcclusion,
 };
 /// Every cull mode, in the order the tools list them (render's and view's --cull).
 inline constexpr CullMode kCullModes[] = {CullMode::none, CullMode::frustum, CullMode::backpatch, CullMode::occlusion,

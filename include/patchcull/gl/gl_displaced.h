@@ -19,7 +19,7 @@
 // - displacement ranges, kBindingDisplacementRanges (8): vec2 (d_min, d_max) per patch, uploaded by
 //   set_ranges; without ranges every patch is undisplaced (the CPU kernels' ranges = null).
 // - flags, kBindingCullFlags (1), flag_buffer(): uint per patch, cleared and written by every
-//   cull call: kFlagFrustum (1) = outside the view volume, kFlagOcclusion (4) = behind the Hi-Z
+//   cull call: kCullFrustum (1) = outside the view volume, kCullOcclusion (4) = behind the Hi-Z
 //   pyramid (cull_occlusion only), 0 = kept; status bits 8-9 are 0 (the reason bits of the flag
 //   word, gl_renderer.h).
 // - Hi-Z pyramid: an R32F texture on kTextureUnitHiZ (2) of create_hiz_texture's layout (mip
@@ -93,13 +93,13 @@ public:
     /// (0, 0, W, H)). Replaces the previous one.
     void set_hiz(const HiZPyramid& hiz);
 
-    /// cull_displaced_frustum on the GPU: flag words kFlagFrustum / 0. culled (optional): the
+    /// cull_displaced_frustum on the GPU: flag words kCullFrustum / 0. culled (optional): the
     /// decisions read back (1 = culled, as the CPU's bytes). bounds (optional): each patch's bound
     /// (compute_displaced_bounds), read back. A view with valid == false culls nothing (as the CPU).
     void cull_frustum(DisplacedBoundKind bound, NormalConeKind cone, const DisplacedCullView& view,
                       std::vector<std::uint8_t>* culled = nullptr, std::vector<DisplacedBound>* bounds = nullptr);
     /// cull_displaced_occlusion on the GPU against the pyramid of set_hiz (throws without one):
-    /// flag words kFlagFrustum / kFlagOcclusion / 0. decisions (optional): HiZDecision bytes
+    /// flag words kCullFrustum / kCullOcclusion / 0. decisions (optional): HiZDecision bytes
     /// (kHiZVisible, kHiZFrustumCulled, kHiZOccluded) as the CPU writes them. bounds as above.
     void cull_occlusion(DisplacedBoundKind bound, NormalConeKind cone, const DisplacedCullView& view,
                         std::vector<std::uint8_t>* decisions = nullptr, std::vector<DisplacedBound>* bounds = nullptr);

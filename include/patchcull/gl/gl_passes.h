@@ -32,9 +32,9 @@
 // the Hi-Z pyramid, an R32F mipmapped texture made by create_hiz_texture, holding hiz.h's depth
 // keys (-depth for the reversed conventions). Texture row 0 is the bottom row, as in HiZPyramid.
 //
-// The flag word (shared.h): bits 0-7 the cull reason of this frame (kCullFrustum 1,
-// kCullBackPatch 2, kCullOcclusion 4; 0 = not culled), bits 8-9 the temporal status of Niessner &
-// Loop's two-pass pipeline (kStatusVisible, kStatusNewlyVisible). gl_renderer.h's kFlag* equal them.
+// The flag word (core/cull_flags.h, inlined into shared.h): bits 0-7 the cull reason of this frame
+// (kCullFrustum 1, kCullBackPatch 2, kCullOcclusion 4, kCullObject 8; 0 = not culled), bits 8-9
+// the temporal status of Niessner & Loop's two-pass pipeline (kStatusVisible, kStatusNewlyVisible).
 //
 // The flag chain: a frame's passes run in sequence on one flag buffer.
 //   CullStatusPass::begin   clears the reasons (keeps the statuses)
@@ -85,7 +85,9 @@
 #include <vector>
 
 #include "patchcull/core/backpatch.h"
+#include "patchcull/core/backpatch_methods.h"
 #include "patchcull/core/clip_space.h"
+#include "patchcull/core/cull_view.h"
 #include "patchcull/core/displaced_bounds.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/hiz.h"
@@ -93,17 +95,11 @@
 
 namespace patchcull::gl {
 
-/// Back-patch test of Loop, Niessner & Eisenacher: the tangent cone, the normal cone,
-/// or the parametric tangent plane.
-enum class BackpatchMethod { tcone, ncone, ptp };
-/// Every back-patch method, in the order the tools list them (render's and view's --backpatch, the
-/// viewer's key and panel, the demo's rows): the one list a new method joins.
-inline constexpr BackpatchMethod kBackpatchMethods[] = {BackpatchMethod::tcone, BackpatchMethod::ncone,
-                                                        BackpatchMethod::ptp};
-/// "tcone", "ncone", "ptp" (the `patchcull cull` method names).
-const char* backpatch_method_name(BackpatchMethod method);
-/// Parses backpatch_method_name's names; returns false (method unchanged) otherwise.
-bool parse_backpatch_method(const char* text, BackpatchMethod& method);
+/// Back-patch methods are registered in core/backpatch_methods.h (their GPU passes in
+/// gl_backpatch_passes.h); these names are the same entities, for code written against gl::.
+using patchcull::BackpatchMethod;
+using patchcull::backpatch_method_name;
+using patchcull::parse_backpatch_method;
 
 /// The text of a GLSL header shipped for an engine's own shaders, embedded in the library:
 /// "shared.h" (the constants shared by C++ and GLSL: bindings, flag bits, draw selections,
@@ -211,6 +207,8 @@ public:
     /// plane_values (optional, diagnostics): a buffer of >= 6 floats per patch of the buffers that
     /// receives, for each tested patch p, the six maxima the decision compares with 0 at 6p.
     void run(const PatchBuffers& patches, const FrustumPlanes& planes, std::uint32_t plane_values = 0);
+    /// The same on one view's CullView (view.planes).
+    void run(const PatchBuffers& patches, const CullView& view, std::uint32_t plane_values = 0);
 
 private:
     struct Impl;
@@ -238,6 +236,8 @@ public:
     /// buffers that receives, for each tested patch p, the six maxima over the corners (left,
     /// right, bottom, top, near, far) that the decision compares with 0, at 6p.
     void run(const PatchBuffers& patches, const Mat4& object_to_clip, ClipDepth depth, std::uint32_t plane_values = 0);
+    /// The same on one view's CullView (view.object_to_clip in view.depth).
+    void run(const PatchBuffers& patches, const CullView& view, std::uint32_t plane_values = 0);
 
 private:
     struct Impl;
@@ -260,6 +260,8 @@ public:
     /// GL_LOWER_LEFT origin. A matrix contradicting depth: Error (check_clip_depth).
     void run(const PatchBuffers& patches, const Mat4& object_to_clip, ClipDepth depth, const HiZTexture& hiz,
              bool with_frustum = true);
+    /// The same on one view's CullView (view.object_to_clip in view.depth).
+    void run(const PatchBuffers& patches, const CullView& view, const HiZTexture& hiz, bool with_frustum = true);
 
 private:
     struct Impl;
@@ -273,7 +275,7 @@ public:
     BackpatchConePass(BackpatchConePass&&) noexcept;
     BackpatchConePass& operator=(BackpatchConePass&&) noexcept;
     ~BackpatchConePass();
-    /// method: tcone or ncone (ptp: throws). cone_values (optional, diagnostics): >= 12 floats per
+    /// method: tcone or ncone (any other: throws). cone_values (optional, diagnostics): >= 12 floats per
     /// patch; a tested patch p gets (axis.xyz, cos, sin, valid 1/0, sphere centre.xyz, radius, 0,
     /// 0) at 12p.
     void run(const PatchBuffers& patches, BackpatchMethod method, Vec3 eye, std::uint32_t cone_values = 0);
@@ -342,14 +344,18 @@ public:
     FusedCullPass(FusedCullPass&&) noexcept;
     FusedCullPass& operator=(FusedCullPass&&) noexcept;
     ~FusedCullPass();
-    /// tests: a mask of kCullFrustum, kCullBackPatch, kCullOcclusion (shared.h; gl_renderer.h's
-    /// kFlag* are equal); 0 runs nothing. method: tcone or ncone, used with kCullBackPatch (ptp:
+    /// tests: a mask of kCullFrustum, kCullBackPatch, kCullOcclusion (core/cull_flags.h); 0 runs
+    /// nothing. method: tcone or ncone, used with kCullBackPatch (ptp:
     /// throws). eye: object space, for the cone test. hiz: the built pyramid, required with
     /// kCullOcclusion (see OcclusionPass for its conventions), else ignored (may be null). depth:
     /// the convention of object_to_clip. Throws patchcull::Error for other bits, ptp, or a
     /// missing pyramid.
     void run(const PatchBuffers& patches, std::uint32_t tests, const Mat4& object_to_clip, ClipDepth depth,
              BackpatchMethod method, Vec3 eye, const HiZTexture* hiz);
+    /// The same on one view's CullView (view.object_to_clip in view.depth, view.eye; a view
+    /// without an eye runs no back-patch test).
+    void run(const PatchBuffers& patches, std::uint32_t tests, const CullView& view, BackpatchMethod method,
+             const HiZTexture* hiz);
 
 private:
     struct Impl;

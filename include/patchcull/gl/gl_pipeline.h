@@ -121,7 +121,9 @@ public:
 /// Parameters of one pipeline frame: the frame and the choice of each test.
 struct PipelineParams {
     FrameParams frame;
-    BackpatchMethod backpatch = BackpatchMethod::tcone;  ///< the back-patch test (Loop, Niessner & Eisenacher)
+    /// The back-patch test: any method with a GPU pass (gl_backpatch_passes.h; the built-in ones
+    /// are Loop, Niessner & Eisenacher's). A method without one: render_frame throws Error.
+    BackpatchMethod backpatch = BackpatchMethod::tcone;
     PtpRule ptp_rule = PtpRule::ncnt;                    ///< rule of ptp (ignored by the cones)
     /// Bound and cone of displaced patches (Niessner & Loop §4.2; used when the set has
     /// displacement_ranges and a displacement map is set).
@@ -133,7 +135,8 @@ struct PipelineParams {
     /// Hi-Z tests in one dispatch per object in place of FrustumPass, BackpatchConePass and
     /// OcclusionPass, with the same decisions, so the frame (flag words, statuses, counts, image)
     /// is the same. Used where the choices allow it: frustum hull and back-patch tcone or ncone (or
-    /// a mode without the back-patch test); with ptp or frustum aabb the separate passes run
+    /// a mode without the back-patch test: BackpatchMethodInfo::fusable); with ptp, a method that
+    /// is not fusable, or frustum aabb the separate passes run
     /// (FrameStats::fused_pass says which). Displaced patches keep their separate pass
     /// (DisplacedPass, after the fused one; the fused pass gives them the frustum test with their
     /// margin, as FrustumPass does). Its time is in FrameStats::cull_ms; backpatch_ms is 0.
@@ -144,7 +147,7 @@ struct PipelineParams {
     std::vector<ObjectRange> objects;
     /// Patches culled by the object level (object_culling.h: an object outside the frustum, a
     /// back-facing cluster) before the passes: no pass tests them and no draw issues them (no
-    /// patch work on the GPU); their flag words become kFlagObject with the status cleared, so a
+    /// patch work on the GPU); their flag words become kCullObject with the status cleared, so a
     /// span that comes back next frame is tested and drawn as newly visible. Disjoint, any order,
     /// within the set (else render_frame throws). The caller answers for them being invisible.
     std::vector<PatchSpan> object_culled;
@@ -228,8 +231,9 @@ public:
     const PatchRenderer& renderer() const;
     PassContext& passes();
 
+    struct Impl;  ///< the library's internals (src/gl/cull_pipeline_impl.h)
+
 private:
-    struct Impl;
     std::unique_ptr<Impl> impl_;
 };
 

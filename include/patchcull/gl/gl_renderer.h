@@ -22,7 +22,7 @@
 // - Patch id buffer: 0 = background, patch index p (its position in the uploaded set) writes p + 1.
 //   Triangle t of the occluder mesh (set_occluders) writes kIdOccluderBit | t.
 // - Flag word: one uint per patch (flag_buffer()), read by the TCS: bits 0-7 the cull reason
-//   (kFlagFrustum, kFlagBackPatch, kFlagOcclusion), bits 8-9 the temporal status (kStatusVisible,
+//   (kCullFrustum, kCullBackPatch, kCullOcclusion), bits 8-9 the temporal status (kStatusVisible,
 //   kStatusNewlyVisible), as gl_cull_flags.h states. A culled patch is not tessellated.
 // - Tessellation: uniform integer level L (equal_spacing) on every edge and the interior, L in
 //   [1, 64], scaled by 2^(D - depth) per patch for sets of mixed refinement depth
@@ -195,7 +195,7 @@ public:
     // ---- cull flags --------------------------------------------------------------------------
     /// Sets every flag word to 0 (draw every patch; no status).
     void clear_cull_flags();
-    /// Uploads flags from a CPU kernel: culled[p] nonzero sets the word of patch p to kFlagFrustum
+    /// Uploads flags from a CPU kernel: culled[p] nonzero sets the word of patch p to kCullFrustum
     /// (1), zero sets 0; culled holds patch_count() bytes.
     void set_cull_flags(const std::uint8_t* culled);
     /// Reads the flag words back (patch_count() values; bits 0-7 = cull reason, 0 = drawn by

@@ -1,0 +1,132 @@
+// Internals of CullPipeline (patchcull/gl/gl_pipeline.h) shared by its sources: the passes and
+// buffers a pipeline owns (cull_pipeline.cpp) and the clock that times a frame's parts, used by
+// the flag chain's runner (frame_chain.cpp). Not a public header.
+#pragma once
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "patchcull/gl/gl_backpatch_passes.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "renderer_internal.h"
+
+namespace patchcull::gl {
+
+struct SpanPlan;
+struct FrameTests;
+
+// Marks pass boundaries: GL_TIMESTAMP queries, or steady_clock after glFinish().
+class PassClock {
+public:
+    static constexpr int kMaxMarks = 8;
+    PassClock(TimingMethod method, GLuint* queries) : method_(method), queries_(queries) {
+        if (method_ == TimingMethod::timer_query && !queries_[0]) glCreateQueries(GL_TIMESTAMP, kMaxMarks, queries_);
+    }
+    void mark() {
+        if (method_ == TimingMethod::wall_clock) {
+            glFinish();
+            wall_[marks_] = std::chrono::steady_clock::now();
+        } else if (method_ == TimingMethod::timer_query) {
+            glQueryCounter(queries_[marks_], GL_TIMESTAMP);
+        }
+        ++marks_;
+    }
+    // Milliseconds between mark i and mark i + 1 (waits for query results); 0 when not timed.
+    std::vector<double> intervals() {
+        std::vector<double> ms(static_cast<std::size_t>(std::max(marks_ - 1, 0)), 0.0);
+        if (method_ == TimingMethod::wall_clock) {
+            for (int i = 0; i + 1 < marks_; ++i)
+                ms[static_cast<std::size_t>(i)] = std::chrono::duration<double, std::milli>(wall_[i + 1] - wall_[i]).count();
+        } else if (method_ == TimingMethod::timer_query) {
+            GLuint64 t[kMaxMarks] = {};
+            for (int i = 0; i < marks_; ++i) glGetQueryObjectui64v(queries_[i], GL_QUERY_RESULT, &t[i]);
+            for (int i = 0; i + 1 < marks_; ++i) ms[static_cast<std::size_t>(i)] = static_cast<double>(t[i + 1] - t[i]) * 1e-6;
+        }
+        return ms;
+    }
+
+private:
+    TimingMethod method_;
+    GLuint* queries_;
+    std::chrono::steady_clock::time_point wall_[kMaxMarks];
+    int marks_ = 0;
+};
+
+
+struct CullPipeline::Impl {
+    explicit Impl(const GlContext& ctx)
+        : renderer(ctx), frustum(passes), frustum_disp(passes), hiz_build(passes), occlusion(passes), displaced(passes),
+          status(passes), fused(passes) {
+        glCreateBuffers(1, &counters);
+        GLint alignment = 16;
+        glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &alignment);
+        const std::size_t bytes = sh::kCounterCount * sizeof(std::uint32_t);
+        const std::size_t a = static_cast<std::size_t>(std::max(alignment, 1));
+        counter_stride = (bytes + a - 1) / a * a;
+        check_gl("CullPipeline setup");
+    }
+    ~Impl() {
+        glDeleteBuffers(1, &counters);
+        glDeleteTextures(1, &hiz.texture);
+        if (timer_queries[0]) glDeleteQueries(PassClock::kMaxMarks, timer_queries);
+    }
+    PatchRenderer renderer;  // first: makes the context current before the passes bind to it
+    PassContext passes;
+    FrustumPass frustum;
+    FrustumDispPass frustum_disp;
+    HiZBuildPass hiz_build;
+    OcclusionPass occlusion;
+    DisplacedPass displaced;
+    CullStatusPass status;
+    FusedCullPass fused;
+    std::map<BackpatchMethod, std::unique_ptr<BackpatchPass>> backpatch_passes;  // made on first use
+    HiZTexture hiz;  // of the framebuffer's size; recreated when it changes
+    GLuint counters = 0;             // kCounterCount uints per object (+ one slot for the rest)
+    std::size_t counter_stride = 0;  // bytes between slots (the SSBO offset alignment)
+    std::size_t counter_slots = 0;   // slots allocated
+    GLuint timer_queries[PassClock::kMaxMarks] = {};
+    // The renderer's flag_generation when the statuses were primed; another value (the flags were
+    // replaced, or reset_visibility) makes the next frame a first frame.
+    std::uint64_t primed_generation = ~std::uint64_t{0};
+
+    // Tags the even-indexed patches visible, the others not (Niessner & Loop §3's first frame).
+    void prime_statuses() {
+        std::vector<std::uint32_t> words(renderer.patch_count());
+        for (std::size_t p = 0; p < words.size(); p += 2) words[p] = sh::kStatusVisible;
+        renderer.set_flag_words(words);
+        primed_generation = renderer.flag_generation();
+    }
+
+    void ensure_counter_slots(std::size_t slots) {
+        if (slots > counter_slots) {
+            glNamedBufferData(counters, static_cast<GLsizeiptr>(slots * counter_stride), nullptr, GL_DYNAMIC_READ);
+            counter_slots = slots;
+        }
+        glClearNamedBufferData(counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    }
+
+    BackpatchPass& backpatch_pass(BackpatchMethod method) {
+        std::unique_ptr<BackpatchPass>& pass = backpatch_passes[method];
+        if (!pass) pass = make_backpatch_pass(passes, method);
+        return *pass;
+    }
+
+    /// Reads the frame's counters back (waits) into stats: per object and in all, and the
+    /// clock's intervals as the pass times.
+    void read_stats(const SpanPlan& plan, const FrameTests& frame, bool two_pass, bool aggressive, PassClock& clock,
+                    FrameStats& stats);
+
+    void ensure_hiz() {
+        if (hiz.texture && hiz.width == renderer.width() && hiz.height == renderer.height()) return;
+        glDeleteTextures(1, &hiz.texture);
+        hiz = create_hiz_texture(renderer.width(), renderer.height());
+    }
+};
+
+
+}  // namespace patchcull::gl
