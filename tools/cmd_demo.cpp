@@ -21,14 +21,16 @@
 #include "cli_options.h"
 #include "commands.h"
 #include "demo_city.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
-#include "progress.h"
-#include "patchcull/import/scene_file.h"
+#include "patchcull/eval_gl/reference_frame.h"
+#include "patchcull/eval_gl/scene_setup.h"
 #include "patchcull/gl/cull_auto_policy.h"
-#include "patchcull/gl/gl_verification.h"
-#include "render_support.h"
 #include "patchcull/gl/gl_backpatch_passes.h"
+#include "patchcull/gl/gl_verification.h"
+#include "patchcull/import/scene_file.h"
+#include "patchcull/import/scene_poser.h"
+#include "progress.h"
+#include "render_support.h"
 
 namespace patchcull::cli {
 namespace {
@@ -76,22 +78,23 @@ int run_demo(const DemoOptions& options) {
     std::vector<gl::PatchAttributes> attributes;  // ACC tangent patches for shading
     for (int f = 0; f < options.frames; ++f) {
         poses.push_back(poser.pose(f * kSecondsPerFrame));
-        attributes.push_back(pose_attributes(poser));
+        attributes.push_back(eval_gl::pose_attributes(poser));
     }
     const std::vector<Camera> cameras = scene.camera_path(options.frames, float(width) / float(height));
-    const bool one_sided = scene_is_one_sided(scene);
+    const bool one_sided = eval_gl::scene_is_one_sided(scene);
     auto params_of = [&](int f) {
-        return render_params(cameras[static_cast<std::size_t>(f)], width, height, options.tess, one_sided);
+        return eval_gl::render_params(cameras[static_cast<std::size_t>(f)], width, height, options.tess, one_sided);
     };
     const std::size_t patches = scene.patch_count();
 
     pipeline.set_patches(poses[0], attributes[0]);
-    upload_scene_occluders(renderer, scene);
+    eval_gl::upload_scene_occluders(renderer, scene);
     renderer.set_displacement_map(scene.displacement);  // the frogs are displaced (Niessner & Loop §6)
     if (options.scene == "default")
-        std::printf("patchcull default scene: 3 BigGuy + 3 displaced MonsterFrog (ACC, animated), %zu patches, %zu "
-                    "occluder triangles;\n",
-                    patches, renderer.occluder_triangle_count());
+        std::printf(
+            "patchcull default scene: 3 BigGuy + 3 displaced MonsterFrog (ACC, animated), %zu patches, %zu "
+            "occluder triangles;\n",
+            patches, renderer.occluder_triangle_count());
     else
         std::printf("patchcull scene %s: %zu objects, %zu patches, %zu occluder triangles;\n", scene.name.c_str(),
                     scene.instances.size(), patches, renderer.occluder_triangle_count());
@@ -126,11 +129,11 @@ int run_demo(const DemoOptions& options) {
         pipeline.render_frame(warm_up);
         progress.step(++frames_done);
     }
-    std::vector<ReferenceFrame> references;
+    std::vector<eval_gl::ReferenceFrame> references;
     double reference_ms = 0;
     for (int f = 0; f < options.frames; ++f) {
         pipeline.update_patches(poses[static_cast<std::size_t>(f)], attributes[static_cast<std::size_t>(f)]);
-        references.push_back(render_reference(renderer, params_of(f)));
+        references.push_back(eval_gl::render_reference(renderer, params_of(f)));
         if (f > 0 || options.frames == 1) reference_ms += references.back().ms;
         progress.step(++frames_done);
     }
@@ -138,12 +141,13 @@ int run_demo(const DemoOptions& options) {
     reference_ms /= timed_frames;
 
     std::vector<gl::ObjectRange> ranges;
-    for (const SceneObject& o : scene_objects(scene)) ranges.push_back(o.range);
+    for (const eval_gl::SceneObject& o : eval_gl::scene_objects(scene)) ranges.push_back(o.range);
     progress.clear();
-    std::printf("\nPer method, averaged over frames 1..%d (frame 0 starts with half the patches tagged visible, "
-                "Niessner & Loop §3);\ncull rates are fractions of the %zu patches; times in ms; 'x ref' = total / "
-                "unculled render.\n\n",
-                options.frames - 1, patches);
+    std::printf(
+        "\nPer method, averaged over frames 1..%d (frame 0 starts with half the patches tagged visible, "
+        "Niessner & Loop §3);\ncull rates are fractions of the %zu patches; times in ms; 'x ref' = total / "
+        "unculled render.\n\n",
+        options.frames - 1, patches);
     std::printf("%-17s %7s %7s %7s %7s %7s %7s %7s %7s %7s %8s %6s %6s\n", "method", "culled", "frustum", "back",
                 "occl", "drawn", "pass1", "hiz", "cull", "pass2", "total", "x ref", "false");
     std::printf("%-17s %7s %7s %7s %7s %6.1f%% %7s %7s %7s %7s %8.1f %6.2f %6s\n", "none (reference)", "0.0%", "-", "-",
@@ -165,7 +169,8 @@ int run_demo(const DemoOptions& options) {
         Sums sums;
         gl::CullAutoPolicy policy(ranges, patches);
         for (int f = 0; f < options.frames; ++f) {
-            if (f > 0) pipeline.update_patches(poses[static_cast<std::size_t>(f)], attributes[static_cast<std::size_t>(f)]);
+            if (f > 0)
+                pipeline.update_patches(poses[static_cast<std::size_t>(f)], attributes[static_cast<std::size_t>(f)]);
             gl::PipelineParams params;
             params.frame.render = params_of(f);
             params.frame.cull = method.cull;
@@ -177,7 +182,8 @@ int run_demo(const DemoOptions& options) {
             }
             const gl::FrameStats s = pipeline.render_frame(params);
             if (method.automatic) policy.observe(s);
-            const gl::FrameComparison cmp = compare_with_reference(renderer, references[static_cast<std::size_t>(f)]);
+            const gl::FrameComparison cmp =
+                eval_gl::compare_with_reference(renderer, references[static_cast<std::size_t>(f)]);
             sums.false_culls += cmp.false_culled.size();
             progress.step(++frames_done);
             if (f == 0 && options.frames > 1) continue;
@@ -201,8 +207,10 @@ int run_demo(const DemoOptions& options) {
                     sums.cull / n, sums.pass2 / n, sums.total / n, sums.total / n / reference_ms, sums.false_culls);
         total_false += sums.false_culls;
         if (method.automatic)
-            std::printf("%-17s (objects culled per frame: %.1f of %zu, where the measured costs and cull rates say "
-                        "it pays)\n", "", sums.objects_culled / n, ranges.size());
+            std::printf(
+                "%-17s (objects culled per frame: %.1f of %zu, where the measured costs and cull rates say "
+                "it pays)\n",
+                "", sums.objects_culled / n, ranges.size());
         if (method.cull == gl::CullMode::all && !method.automatic) {
             wrote_images = true;
             renderer.write_color_png((out_dir / "frame.png").string());
@@ -213,7 +221,8 @@ int run_demo(const DemoOptions& options) {
             overview.eye = overview.target + Vec3{-d.z, 0, d.x} * 1.4f + Vec3{0, 1.8f, 0};
             overview.fovy_radians = 1.0471976f;
             overview.z_far *= 2;
-            renderer.write_status_png((out_dir / "cull.png").string(), render_params(overview, width, height, options.tess, one_sided));
+            renderer.write_status_png((out_dir / "cull.png").string(),
+                                      eval_gl::render_params(overview, width, height, options.tess, one_sided));
         }
     }
     progress.finish();
@@ -227,12 +236,15 @@ int run_demo(const DemoOptions& options) {
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (wrote_images)
-        std::printf("\nWrote %s (colour, cull mode all) and %s (statuses, seen from the side and above: green "
-                    "visible,\nyellow newly visible, blue frustum-culled, magenta back-patch-culled, red "
-                    "occlusion-culled, grey occluders).\n",
-                    (out_dir / "frame.png").string().c_str(), (out_dir / "cull.png").string().c_str());
-    std::printf("False culls (patches and objects in the unculled image but culled) in total: %zu (must be 0); "
-                "%.1f s.\n", total_false, seconds);
+        std::printf(
+            "\nWrote %s (colour, cull mode all) and %s (statuses, seen from the side and above: green "
+            "visible,\nyellow newly visible, blue frustum-culled, magenta back-patch-culled, red "
+            "occlusion-culled, grey occluders).\n",
+            (out_dir / "frame.png").string().c_str(), (out_dir / "cull.png").string().c_str());
+    std::printf(
+        "False culls (patches and objects in the unculled image but culled) in total: %zu (must be 0); "
+        "%.1f s.\n",
+        total_false, seconds);
     return total_false == 0 ? 0 : 1;
 }
 
@@ -240,12 +252,13 @@ int run_demo(const DemoOptions& options) {
 
 Runner add_demo_command(CLI::App& app) {
     auto options = std::make_shared<DemoOptions>();
-    CLI::App* command =
-        app.add_subcommand("demo", "Render the built-in default scene and the city's object level (the main job; the default command)");
+    CLI::App* command = app.add_subcommand(
+        "demo", "Render the built-in default scene and the city's object level (the main job; the default command)");
     add_size_option(*command, "--size", options->size, "framebuffer size");
     add_int_option(*command, "--frames", options->frames, 2, 100, "frames along the camera path");
     add_int_option(*command, "--tess", options->tess, 1, 64, "uniform tessellation level");
-    add_text_option(*command, "--out-dir", options->out_dir, "directory of frame.png and cull.png (created if missing)");
+    add_text_option(*command, "--out-dir", options->out_dir,
+                    "directory of frame.png and cull.png (created if missing)");
     add_text_option(*command, "--scene", options->scene,
                     "the scene of the method table: 'default', 'city', 'building', a scene file (.json) or a model");
     add_int_option(*command, "--city-frames", options->city_frames, 0, 100,

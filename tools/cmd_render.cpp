@@ -26,7 +26,7 @@
 // chain, hull (Niessner & Loop: the control points, the default) or aabb (Sathe: the control
 // points' box grown by max |D|, which also bounds the displaced patches against the frustum).
 // --cull auto (cull_auto_policy.h: Niessner & Loop §6.3's per-object switch): each object of the scene
-// (render_support.h scene_objects: one per instance) is culled with the tests of `all` (back-patch
+// (eval_gl/scene_setup.h scene_objects: one per instance) is culled with the tests of `all` (back-patch
 // only where applicable_cull_mode allows) or drawn whole, decided per frame from the measured pass
 // costs, its recent cull rate and its tessellation factor; "cull" is "auto" and every frame gains
 //   "auto_objects":[{"name","patches","culling":"on"|"off","break_even","cull_rate"}]
@@ -66,18 +66,17 @@
 
 #include "cli_options.h"
 #include "commands.h"
+#include "cull_mode_names.h"
+#include "frame_poser.h"
 #include "object_level_options.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
-#include "render_dumps.h"
-#include "patchcull/import/scene_file.h"
+#include "patchcull/eval_gl/reference_frame.h"
+#include "patchcull/eval_gl/scene_setup.h"
 #include "patchcull/gl/cull_auto_policy.h"
 #include "patchcull/gl/gl_verification.h"
-#include "cull_mode_names.h"
-#include "frame_poser.h"
-#include "render_options.h"
-#include "cull_mode_names.h"
-#include "frame_poser.h"
+#include "patchcull/import/scene_file.h"
+#include "patchcull/import/scene_poser.h"
+#include "render_dumps.h"
 #include "render_options.h"
 #include "render_support.h"
 
@@ -87,7 +86,7 @@ namespace {
 // A number of the objects array: null when not known (NaN) or infinite.
 nlohmann::json number_or_null(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
-nlohmann::json auto_objects_json(const std::vector<SceneObject>& objects,
+nlohmann::json auto_objects_json(const std::vector<eval_gl::SceneObject>& objects,
                                  const std::vector<gl::CullAutoPolicy::Decision>& decisions) {
     nlohmann::json out = nlohmann::json::array();
     for (std::size_t i = 0; i < objects.size(); ++i)
@@ -127,7 +126,9 @@ Runner add_render_command(CLI::App& app) {
     };
     auto state = std::make_shared<State>();
     CLI::App* command = app.add_subcommand("render", "Render an animated camera path with the GPU cull pipeline");
-    add_text_option(*command, "MODEL", state->model, "OBJ control mesh, 'teapot', a built-in scene ('default', 'city', 'building') or a scene file (.json)");
+    add_text_option(
+        *command, "MODEL", state->model,
+        "OBJ control mesh, 'teapot', a built-in scene ('default', 'city', 'building') or a scene file (.json)");
     add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 1, 1000, "number of frames");
@@ -152,9 +153,10 @@ Runner add_render_command(CLI::App& app) {
     command->add_flag("--verify", state->verify,
                       "render the unculled reference of every frame and count false culls (exit status 1 if any)");
     add_output_file_option(*command, "--out", state->out, "write the colour image of the last frame as a PNG");
-    add_text_option(*command, "--dump-hiz", state->dump_hiz,
-                    "write the last frame's Hi-Z levels into DIR (created): hiz_level_NN.png (grey: white = depth 1, "
-                    "else black..grey 254 = the level's min..max depth below 1), raw .f32 levels, depth, ids, hiz.json");
+    add_text_option(
+        *command, "--dump-hiz", state->dump_hiz,
+        "write the last frame's Hi-Z levels into DIR (created): hiz_level_NN.png (grey: white = depth 1, "
+        "else black..grey 254 = the level's min..max depth below 1), raw .f32 levels, depth, ids, hiz.json");
     add_text_option(*command, "--draw-bounds", state->draw_bounds,
                     "P[,P...]: draw these patches' CAF (green) and OOBB (red) screen rectangles, as the occlusion "
                     "test uses them, over the last frame into --out (Niessner & Loop, Fig. 6)");
@@ -175,9 +177,9 @@ Runner add_render_command(CLI::App& app) {
         Scene scene = load_scene(state->model, state->scheme, state->split);
         check_scene_motion(scene, state->model, state->frames, kSecondsPerFrame);  // before any GL work
         apply_displace_options(state->displace, scene);
-        const std::vector<std::size_t> bounds_patches =
-            state->draw_bounds.empty() ? std::vector<std::size_t>{}
-                                       : parse_patch_list(state->draw_bounds, scene.patch_count());
+        const std::vector<std::size_t> bounds_patches = state->draw_bounds.empty()
+                                                            ? std::vector<std::size_t>{}
+                                                            : parse_patch_list(state->draw_bounds, scene.patch_count());
         const TessMode tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         // Back-patch culling is conservative only on closed surfaces (both sides are drawn, and
         // through an opening the inside of a patch that faces away shows): `all` leaves it out
@@ -185,7 +187,7 @@ Runner add_render_command(CLI::App& app) {
         // that --verify can show what it would remove.
         const gl::CullMode applied = applicable_cull_mode(scene, cull, "render");
         const bool backpatch_applied = (static_cast<std::uint32_t>(applied) & gl::kCullBackPatch) != 0;
-        const bool one_sided = scene_is_one_sided(scene);
+        const bool one_sided = eval_gl::scene_is_one_sided(scene);
         // Camera-relative frames (scene_model.h's rebase_scene): each frame is drawn and culled
         // in the float frame of the grid point nearest its eye, everything in it composed in
         // double and rounded once. A scene whose eyes stay within 1024 of the origin never leaves
@@ -201,7 +203,8 @@ Runner add_render_command(CLI::App& app) {
         }
         Scene world;  // the placements in world coordinates (without the models), when frames move
         if (rebases) world = rebase_scene_in_place(scene, frame_origins[0]);
-        auto object_level = std::make_unique<ObjectLevelRun>(state->objects, scene, one_sided);  // before the occluders go up
+        auto object_level =
+            std::make_unique<ObjectLevelRun>(state->objects, scene, one_sided);  // before the occluders go up
         if (automatic && object_level->sets_objects())
             throw Error("--object-occlusion: a query method decides per object itself; not with --cull auto");
 
@@ -215,20 +218,21 @@ Runner add_render_command(CLI::App& app) {
         // The CPU readers of posed patches (object level, --cull auto, --draw-bounds) keep a CPU
         // pose under --pose gpu: their bounds stay the CPU's, exactly.
         const bool cpu_patches = object_level->enabled() || automatic || !bounds_patches.empty();
-        FramePoser frame_poser(context, poser, pipeline.renderer(), parse_pose_where("--pose", state->pose), cpu_patches);
+        FramePoser frame_poser(context, poser, pipeline.renderer(), parse_pose_where("--pose", state->pose),
+                               cpu_patches);
         const std::vector<BezierPatch>* pose = frame_poser.pose(0);  // a CPU pose (frame 0 uploads the attributes)
         pipeline.renderer().set_displacement_map(scene.displacement);
-        upload_scene_occluders(pipeline.renderer(), scene);
+        eval_gl::upload_scene_occluders(pipeline.renderer(), scene);
         std::vector<Camera> cameras = scene.camera_path(state->frames, aspect);
         if (rebases)
             for (std::size_t f = 0; f < cameras.size(); ++f) cameras[f] = world_cameras[f].local(frame_origins[f]);
         const ClipDepth clip_depth = parse_clip_depth_option(state->clip_depth);
         for (Camera& c : cameras) c.depth = clip_depth;  // drawn, culled and verified in it
-        const std::vector<SceneObject> objects = scene_objects(scene);
+        const std::vector<eval_gl::SceneObject> objects = eval_gl::scene_objects(scene);
         std::vector<gl::ObjectRange> ranges;
-        for (const SceneObject& o : objects) ranges.push_back(o.range);
+        for (const eval_gl::SceneObject& o : objects) ranges.push_back(o.range);
         std::vector<std::string> names;
-        for (const SceneObject& o : objects) names.push_back(o.name);
+        for (const eval_gl::SceneObject& o : objects) names.push_back(o.name);
         gl::CullAutoPolicy policy(ranges, scene.patch_count());
 
         nlohmann::json frames = nlohmann::json::array();
@@ -241,7 +245,7 @@ Runner add_render_command(CLI::App& app) {
                 rebase_scene(world, frame_origins[static_cast<std::size_t>(f)], scene);
                 object_level->release_gl();
                 object_level = std::make_unique<ObjectLevelRun>(state->objects, scene, one_sided);
-                upload_scene_occluders(pipeline.renderer(), scene);
+                eval_gl::upload_scene_occluders(pipeline.renderer(), scene);
             }
             // gpu without a CPU reader: no CPU pose; `pose` keeps frame 0's, which nothing reads.
             if (f > 0)
@@ -249,7 +253,7 @@ Runner add_render_command(CLI::App& app) {
             const PoseCost& pose_cost = frame_poser.last();
             gl::PipelineParams params;
             params.frame.render =
-                render_params(cameras[static_cast<std::size_t>(f)], width, height, state->tess, one_sided);
+                eval_gl::render_params(cameras[static_cast<std::size_t>(f)], width, height, state->tess, one_sided);
             apply_tess_mode(tess_mode, params.frame.render);
             params.frame.cull = applied;
             params.frame.aggressive = state->aggressive;
@@ -258,7 +262,8 @@ Runner add_render_command(CLI::App& app) {
             params.cone = displace_cone(state->displace);
             params.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
             params.fused_pass = state->fused_pass;
-            object_level->apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height, params, width);
+            object_level->apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height,
+                                params, width);
             if (automatic) {
                 policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
                 params.objects = policy.objects();
@@ -278,15 +283,20 @@ Runner add_render_command(CLI::App& app) {
                     PatchBounds b;
                     b.patch = p;
                     if (!ranges.empty() && !scene.displacement.empty()) b.range = ranges[p];  // else drawn undisplaced
-                    b.caf = screen_bound((*pose)[p], b.range, DisplacedBoundKind::caf, params.cone, params.frame.render);
-                    b.oobb = screen_bound((*pose)[p], b.range, DisplacedBoundKind::oobb, params.cone, params.frame.render);
+                    b.caf =
+                        screen_bound((*pose)[p], b.range, DisplacedBoundKind::caf, params.cone, params.frame.render);
+                    b.oobb =
+                        screen_bound((*pose)[p], b.range, DisplacedBoundKind::oobb, params.cone, params.frame.render);
                     drawn_bounds.push_back(patch_bounds_json(b, ids));
                     bounds.push_back(b);
                 }
                 write_bounds_png(state->out, pipeline.renderer().read_color(), ids, width, height, bounds);
             }
-            nlohmann::json ms = {{"pass1", stats.pass1_ms}, {"hiz", stats.hiz_ms}, {"cull", stats.cull_ms},
-                                 {"pass2", stats.pass2_ms}, {"total", stats.total_ms}};
+            nlohmann::json ms = {{"pass1", stats.pass1_ms},
+                                 {"hiz", stats.hiz_ms},
+                                 {"cull", stats.cull_ms},
+                                 {"pass2", stats.pass2_ms},
+                                 {"total", stats.total_ms}};
             if (object_level->enabled()) {
                 ms["object_level"] = object_level->object_level_ms();  // CPU, before the GPU frame
                 ms["cpu_frustum_after_objects"] = object_level->cpu_frustum_ms();
@@ -295,8 +305,9 @@ Runner add_render_command(CLI::App& app) {
             std::vector<std::uint32_t> false_culled;  // patch indices, ascending
             ObjectVerification object_check;
             if (state->verify) {
-                const gl::FrameCapture culled = capture_culled_frame(pipeline.renderer());
-                const ReferenceFrame reference = render_reference(pipeline.renderer(), params.frame.render);
+                const gl::FrameCapture culled = eval_gl::capture_culled_frame(pipeline.renderer());
+                const eval_gl::ReferenceFrame reference =
+                    eval_gl::render_reference(pipeline.renderer(), params.frame.render);
                 const gl::FrameComparison cmp = gl::compare_frames(reference.capture, culled);
                 // Patches culled by detail culling are not false culls (it is not conservative):
                 // they are reported as pixels changed.
@@ -317,12 +328,13 @@ Runner add_render_command(CLI::App& app) {
                               {"visible", stats.visible},
                               {"newly_visible", stats.newly_visible},
                               {"ms", ms},
-                              {"pose", {{"where", pose_where_name(pose_cost.where)},
-                                        {"cpu_patches", pose_cost.cpu_patches},
-                                        {"cpu_ms", pose_cost.cpu_ms},
-                                        {"done_ms", pose_cost.done_ms},
-                                        {"meshes_ms", pose_cost.meshes_ms},
-                                        {"bytes_uploaded", pose_cost.bytes_uploaded}}},
+                              {"pose",
+                               {{"where", pose_where_name(pose_cost.where)},
+                                {"cpu_patches", pose_cost.cpu_patches},
+                                {"cpu_ms", pose_cost.cpu_ms},
+                                {"done_ms", pose_cost.done_ms},
+                                {"meshes_ms", pose_cost.meshes_ms},
+                                {"bytes_uploaded", pose_cost.bytes_uploaded}}},
                               {"false_culls", false_culls},
                               {"depth_ties", depth_ties},
                               {"fused_pass", stats.fused_pass}});
@@ -338,20 +350,22 @@ Runner add_render_command(CLI::App& app) {
                 }
             }
             if (!state->json) {
-                std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
-                            "(displaced %zu); ms pass1 %.1f hiz %.1f cull %.1f pass2 %.1f",
-                            f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
-                            stats.backpatch_culled, stats.occlusion_culled, stats.displaced_occlusion_culled,
-                            stats.pass1_ms, stats.hiz_ms, stats.cull_ms, stats.pass2_ms);
+                std::printf(
+                    "frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
+                    "(displaced %zu); ms pass1 %.1f hiz %.1f cull %.1f pass2 %.1f",
+                    f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
+                    stats.backpatch_culled, stats.occlusion_culled, stats.displaced_occlusion_culled, stats.pass1_ms,
+                    stats.hiz_ms, stats.cull_ms, stats.pass2_ms);
                 if (state->verify) std::printf("; false culls %zu", false_culls);
                 std::printf("\n");
                 if (object_level->enabled()) {
                     const ObjectCullStats& o = object_level->result().stats;
-                    std::printf("  objects (%s): %zu of %zu culled (frustum %zu, back-face %zu, detail %zu); %zu patches "
-                                "and %zu triangles skipped; %u plane tests, %u BVH nodes, %u cluster tests\n",
-                                object_level->method_name(), o.frustum_culled + o.backface_culled + o.detail_culled,
-                                o.total, o.frustum_culled, o.backface_culled, o.detail_culled, o.patches_culled,
-                                o.triangles_culled, o.plane_tests, o.bvh_nodes_visited, o.cluster_tests);
+                    std::printf(
+                        "  objects (%s): %zu of %zu culled (frustum %zu, back-face %zu, detail %zu); %zu patches "
+                        "and %zu triangles skipped; %u plane tests, %u BVH nodes, %u cluster tests\n",
+                        object_level->method_name(), o.frustum_culled + o.backface_culled + o.detail_culled, o.total,
+                        o.frustum_culled, o.backface_culled, o.detail_culled, o.patches_culled, o.triangles_culled,
+                        o.plane_tests, o.bvh_nodes_visited, o.cluster_tests);
                 }
                 if (automatic) std::printf("%s\n", auto_summary_line(names, policy.decisions()).c_str());
             }

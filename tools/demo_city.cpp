@@ -7,10 +7,12 @@
 #include <vector>
 
 #include "object_level_options.h"
-#include "patchcull/import/builtin_scenes.h"
-#include "patchcull/import/scene_poser.h"
+#include "patchcull/eval_gl/reference_frame.h"
+#include "patchcull/eval_gl/scene_setup.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_verification.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 #include "progress.h"
 #include "render_support.h"
 
@@ -31,7 +33,7 @@ CityParams demo_city_params() {
 
 std::size_t run_demo_city(const gl::GlContext& context, const DemoCityOptions& options) {
     Scene scene = make_city_scene(Scheme::acc, demo_city_params());
-    const bool one_sided = scene_is_one_sided(scene);
+    const bool one_sided = eval_gl::scene_is_one_sided(scene);
     gl::CullPipeline pipeline(context);
     gl::PatchRenderer& renderer = pipeline.renderer();
     ScenePoser poser(scene);
@@ -39,7 +41,7 @@ std::size_t run_demo_city(const gl::GlContext& context, const DemoCityOptions& o
     std::vector<gl::PatchAttributes> attributes;
     for (int f = 0; f < options.frames; ++f) {
         poses.push_back(poser.pose(f * kSecondsPerFrame));
-        attributes.push_back(pose_attributes(poser));
+        attributes.push_back(eval_gl::pose_attributes(poser));
     }
     const std::vector<Camera> cameras = scene.camera_path(options.frames, float(options.width) / float(options.height));
     // One object level per method, built before the occluders go up (clusters reorder them; the
@@ -52,15 +54,15 @@ std::size_t run_demo_city(const gl::GlContext& context, const DemoCityOptions& o
         levels.push_back(std::make_unique<ObjectLevelRun>(o, scene, one_sided));
     }
     pipeline.set_patches(poses[0], attributes[0]);
-    upload_scene_occluders(renderer, scene);
+    eval_gl::upload_scene_occluders(renderer, scene);
     renderer.set_displacement_map(scene.displacement);
-    std::printf("\npatchcull city: %zu characters (BigGuy, MonsterFrog; ACC, animated, some rigid and walking, some "
-                "displaced), %zu patches,\n%zu buildings + ground (%zu triangles); %d frames of the street walk, %dx%d, "
-                "tessellation level %d, cull mode all.\nObject level before the patch passes (per frame, frames 1..%d): "
-                "objects culled whole, patches skipped, plane tests, BVH nodes, cluster tests.\n\n",
-                scene.instances.size(), scene.patch_count(), scene.environment.size() - 1,
-                renderer.occluder_triangle_count(), options.frames, options.width, options.height, options.tess,
-                options.frames - 1);
+    std::printf(
+        "\npatchcull city: %zu characters (BigGuy, MonsterFrog; ACC, animated, some rigid and walking, some "
+        "displaced), %zu patches,\n%zu buildings + ground (%zu triangles); %d frames of the street walk, %dx%d, "
+        "tessellation level %d, cull mode all.\nObject level before the patch passes (per frame, frames 1..%d): "
+        "objects culled whole, patches skipped, plane tests, BVH nodes, cluster tests.\n\n",
+        scene.instances.size(), scene.patch_count(), scene.environment.size() - 1, renderer.occluder_triangle_count(),
+        options.frames, options.width, options.height, options.tess, options.frames - 1);
     std::printf("%-13s %8s %8s %8s %8s %8s %8s %8s %8s %8s %6s %6s\n", "objects", "culled", "skipped", "tris", "planes",
                 "nodes", "clusters", "patch-cl", "drawn", "ms", "x none", "false");
     std::size_t total_false = 0;
@@ -73,19 +75,21 @@ std::size_t run_demo_city(const gl::GlContext& context, const DemoCityOptions& o
     for (std::size_t k = 0; k < levels.size(); ++k) {
         ObjectLevelRun& level = *levels[k];
         pipeline.set_patches(poses[0], attributes[0]);
-        double objects = 0, skipped = 0, tris = 0, planes = 0, nodes = 0, clusters = 0, patch_culled = 0, drawn = 0, ms = 0;
+        double objects = 0, skipped = 0, tris = 0, planes = 0, nodes = 0, clusters = 0, patch_culled = 0, drawn = 0,
+               ms = 0;
         std::size_t false_culls = 0;
         int timed = 0;
         for (int f = 0; f < options.frames; ++f) {
             const std::size_t i = static_cast<std::size_t>(f);
             if (f > 0) pipeline.update_patches(poses[i], attributes[i]);
             gl::PipelineParams params;
-            params.frame.render = render_params(cameras[i], options.width, options.height, options.tess, one_sided);
+            params.frame.render =
+                eval_gl::render_params(cameras[i], options.width, options.height, options.tess, one_sided);
             params.frame.cull = gl::CullMode::all;
             level.apply(poser, poses[i], f * kSecondsPerFrame, cameras[i], options.height, params);
             const gl::FrameStats s = pipeline.render_frame(params);
-            const gl::FrameCapture culled = capture_culled_frame(renderer);
-            const ReferenceFrame reference = render_reference(renderer, params.frame.render);
+            const gl::FrameCapture culled = eval_gl::capture_culled_frame(renderer);
+            const eval_gl::ReferenceFrame reference = eval_gl::render_reference(renderer, params.frame.render);
             const gl::FrameComparison cmp = gl::compare_frames(reference.capture, culled);
             const ObjectVerification v = level.verify(reference.capture.ids, cmp.false_culled);
             false_culls += v.patch_false_culls.size() + v.false_culled_triangles;
@@ -111,10 +115,11 @@ std::size_t run_demo_city(const gl::GlContext& context, const DemoCityOptions& o
                     ms / n / none_ms, false_culls);
         total_false += false_culls;
     }
-    std::printf("(culled: objects culled whole of %zu; skipped: patches no pass touched; tris: occluder triangles "
-                "culled;\npatch-cl: patches culled by the patch passes; ms: the pipeline frame; false: against the "
-                "unculled render, must be 0)\n",
-                scene.instances.size() + scene.environment.size());
+    std::printf(
+        "(culled: objects culled whole of %zu; skipped: patches no pass touched; tris: occluder triangles "
+        "culled;\npatch-cl: patches culled by the patch passes; ms: the pipeline frame; false: against the "
+        "unculled render, must be 0)\n",
+        scene.instances.size() + scene.environment.size());
     return total_false;
 }
 

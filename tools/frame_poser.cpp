@@ -5,7 +5,7 @@
 #include <chrono>
 
 #include "patchcull/core/error.h"
-#include "render_support.h"
+#include "patchcull/eval_gl/scene_setup.h"
 
 namespace patchcull::cli {
 
@@ -64,10 +64,10 @@ const std::vector<BezierPatch>* FramePoser::pose(float time_seconds) {
         cost_.cpu_patches = true;
     }
     if (first_) {
-        renderer_->set_patches(*patches, pose_attributes(*poser_));
+        renderer_->set_patches(*patches, eval_gl::pose_attributes(*poser_));
         cost_.bytes_uploaded += renderer_->last_upload_bytes();
     } else if (where_ == PoseWhere::cpu) {
-        renderer_->update_patches(*patches, pose_attributes(*poser_));
+        renderer_->update_patches(*patches, eval_gl::pose_attributes(*poser_));
         cost_.bytes_uploaded += renderer_->last_upload_bytes();
     }
     if (where_ == PoseWhere::gpu) {
@@ -91,9 +91,8 @@ const std::vector<BezierPatch>* FramePoser::pose(float time_seconds) {
 
 std::size_t displaced_patch_count(const ScenePoser& poser) {
     const std::vector<DisplacementRange>& ranges = poser.displacement_ranges();
-    return static_cast<std::size_t>(std::count_if(ranges.begin(), ranges.end(), [](const DisplacementRange& r) {
-        return r.d_min != 0 || r.d_max != 0;
-    }));
+    return static_cast<std::size_t>(std::count_if(
+        ranges.begin(), ranges.end(), [](const DisplacementRange& r) { return r.d_min != 0 || r.d_max != 0; }));
 }
 
 }  // namespace patchcull::cli

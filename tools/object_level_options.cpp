@@ -8,8 +8,8 @@
 #include <cmath>
 
 #include "cli_options.h"
-#include "render_support.h"
 #include "patchcull/core/error.h"
+#include "patchcull/eval_gl/scene_setup.h"
 
 namespace patchcull::cli {
 
@@ -20,33 +20,43 @@ void add_object_level_options(CLI::App& command, ObjectLevelOptions& options) {
     add_float_option(command, "--detail-cull", options.detail_pixels, 0, 1e6,
                      "detail culling: cull objects whose bounding sphere covers fewer pixels (not conservative; "
                      "0 = off; needs --objects)");
-    options.given["--plane-masking"] = add_choice_option(command, "--plane-masking", options.plane_masking, {"on", "off"},
-                      "bvh: children test only the planes their parent straddles");
-    options.given["--plane-coherence"] = add_choice_option(command, "--plane-coherence", options.plane_coherence, {"on", "off"},
-                      "the plane that rejected a volume last frame is tried first");
-    options.given["--meta-bv"] = add_choice_option(command, "--meta-bv", options.meta_bv, {"on", "off"},
-                      "test object boxes against the frustum's bounding sphere and box too");
-    options.given["--object-volume"] = add_choice_option(command, "--object-volume", options.volume, {"aabb", "sphere", "obb"},
-                      "after the AABB test (flat or BVH), also test each object's sphere or PCA OBB");
-    options.given["--backface-triangles"] = add_choice_option(command, "--backface-triangles", options.backface_triangles, {"clusters", "masks", "triangles"},
-                      "bvh+backface on one-sided environment objects: cluster hierarchy, normal masks, or per triangle");
-    options.given["--mask-sectors"] = add_int_option(command, "--mask-sectors", options.mask_sectors, 1, 8,
-                   "normal masks: screen sectors per side (an object inside one uses that sector's mask)");
-    options.given["--cluster-cost"] = add_float_option(command, "--cluster-cost", options.cluster_cost, 0, 1e6,
-                     "tC/r of the triangle cluster hierarchy: a cluster test's cost in triangles drawn");
+    options.given["--plane-masking"] =
+        add_choice_option(command, "--plane-masking", options.plane_masking, {"on", "off"},
+                          "bvh: children test only the planes their parent straddles");
+    options.given["--plane-coherence"] =
+        add_choice_option(command, "--plane-coherence", options.plane_coherence, {"on", "off"},
+                          "the plane that rejected a volume last frame is tried first");
+    options.given["--meta-bv"] =
+        add_choice_option(command, "--meta-bv", options.meta_bv, {"on", "off"},
+                          "test object boxes against the frustum's bounding sphere and box too");
+    options.given["--object-volume"] =
+        add_choice_option(command, "--object-volume", options.volume, {"aabb", "sphere", "obb"},
+                          "after the AABB test (flat or BVH), also test each object's sphere or PCA OBB");
+    options.given["--backface-triangles"] = add_choice_option(
+        command, "--backface-triangles", options.backface_triangles, {"clusters", "masks", "triangles"},
+        "bvh+backface on one-sided environment objects: cluster hierarchy, normal masks, or per triangle");
+    options.given["--mask-sectors"] =
+        add_int_option(command, "--mask-sectors", options.mask_sectors, 1, 8,
+                       "normal masks: screen sectors per side (an object inside one uses that sector's mask)");
+    options.given["--cluster-cost"] =
+        add_float_option(command, "--cluster-cost", options.cluster_cost, 0, 1e6,
+                         "tC/r of the triangle cluster hierarchy: a cluster test's cost in triangles drawn");
     add_choice_option(command, "--object-occlusion", options.occlusion,
                       {"none", "stop-and-wait", "batched", "chc", "chc++", "horizon", "portals"},
                       "object-level occlusion after --objects: hardware occlusion queries (stop-and-wait, batched, "
                       "CHC, CHC++), the occlusion horizon (box occluders) or cells and portals (scenes with cells)");
     options.given["--query-batch"] = add_int_option(command, "--query-batch", options.query_batch, 1, 1024,
-                   "batched and chc++: queries issued b at a time (CHC++'s I-queue)");
-    options.given["--query-threshold"] = add_int_option(command, "--query-threshold", options.query_threshold, 0, 1 << 24,
-                   "aggressive approximate culling: an object is drawn only when its query passes more samples "
-                   "(not conservative; --verify reports the pixels it changes)");
-    options.given["--tight-sigma"] = add_float_option(command, "--tight-sigma", options.tight_sigma, 1, 16,
-                     "chc++ tight bounding volumes: refine while the boxes' area stays below sigma times the parent's");
-    options.given["--patch-cluster-cost"] = add_float_option(command, "--patch-cluster-cost", options.patch_cluster_cost, 0, 1e6,
-                     "tC/r of the patch cluster hierarchy: a cluster test's cost in patches drawn");
+                                                    "batched and chc++: queries issued b at a time (CHC++'s I-queue)");
+    options.given["--query-threshold"] =
+        add_int_option(command, "--query-threshold", options.query_threshold, 0, 1 << 24,
+                       "aggressive approximate culling: an object is drawn only when its query passes more samples "
+                       "(not conservative; --verify reports the pixels it changes)");
+    options.given["--tight-sigma"] = add_float_option(
+        command, "--tight-sigma", options.tight_sigma, 1, 16,
+        "chc++ tight bounding volumes: refine while the boxes' area stays below sigma times the parent's");
+    options.given["--patch-cluster-cost"] =
+        add_float_option(command, "--patch-cluster-cost", options.patch_cluster_cost, 0, 1e6,
+                         "tC/r of the patch cluster hierarchy: a cluster test's cost in patches drawn");
 }
 
 ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, bool patches_one_sided) {
@@ -89,12 +99,14 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
         else
             throw Error("--object-occlusion: unknown method '" + options.occlusion + "'");
         if (method_ == ObjectCullMethod::none)
-            throw Error("--object-occlusion: needs --objects frustum, bvh or bvh+backface (the objects' boxes come from "
-                        "the object level)");
+            throw Error(
+                "--object-occlusion: needs --objects frustum, bvh or bvh+backface (the objects' boxes come from "
+                "the object level)");
     }
     if (given("--query-threshold") && !query_method_)
         throw Error("--query-threshold: needs --object-occlusion stop-and-wait, batched, chc or chc++");
-    if (given("--query-batch") && !(query_method_ == gl::QueryMethod::batched || query_method_ == gl::QueryMethod::chcpp))
+    if (given("--query-batch") &&
+        !(query_method_ == gl::QueryMethod::batched || query_method_ == gl::QueryMethod::chcpp))
         throw Error("--query-batch: needs --object-occlusion batched or chc++");
     if (given("--tight-sigma") && query_method_ != gl::QueryMethod::chcpp)
         throw Error("--tight-sigma: needs --object-occlusion chc++");
@@ -118,7 +130,7 @@ ObjectLevelRun::ObjectLevelRun(const ObjectLevelOptions& options, Scene& scene, 
             throw Error(std::string("--object-occlusion: ") + e.what());
         }
     }
-    for (const SceneObject& o : scene_objects(scene)) {
+    for (const eval_gl::SceneObject& o : eval_gl::scene_objects(scene)) {
         instance_ranges_.push_back(o.range);
         instance_patches_.push_back(static_cast<std::uint32_t>(o.range.count));
     }
@@ -137,7 +149,8 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
     if (!enabled()) return;
     const auto start = std::chrono::steady_clock::now();
     result_ = &level_->cull(pose, poser.displacement_ranges(), time_seconds, camera, viewport_height, options_);
-    if (viewport_width <= 0) viewport_width = std::max(1, static_cast<int>(std::lround(camera.aspect * float(viewport_height))));
+    if (viewport_width <= 0)
+        viewport_width = std::max(1, static_cast<int>(std::lround(camera.aspect * float(viewport_height))));
     if (scene_occlusion_) result_ = &scene_occlusion_->cull(*result_, camera, viewport_width, viewport_height);
     // One pipeline object per instance: an instance culled whole is then never dispatched (with
     // the whole set as one object, a span culled inside it still costs its dispatch).
@@ -171,9 +184,9 @@ void ObjectLevelRun::apply(const ScenePoser& poser, const std::vector<BezierPatc
     for (std::size_t i = 0; i < cpu_margins_.size(); ++i)
         cpu_margins_[i] = std::max(std::fabs(ranges[i].d_min), std::fabs(ranges[i].d_max));
     cpu_culled_.assign(pose.size(), 0);
-    cpu_patch_tests_ = cull_frustum_after_objects(
-        *result_, batch.view(), cpu_margins_.empty() ? nullptr : cpu_margins_.data(),
-        make_frustum_planes(camera.view_projection(), camera.depth), cpu_culled_.data());
+    cpu_patch_tests_ =
+        cull_frustum_after_objects(*result_, batch.view(), cpu_margins_.empty() ? nullptr : cpu_margins_.data(),
+                                   make_frustum_planes(camera.view_projection(), camera.depth), cpu_culled_.data());
     cpu_frustum_culled_ = 0;
     for (std::uint8_t c : cpu_culled_) cpu_frustum_culled_ += c;
     cpu_frustum_culled_ -= result_->stats.patches_culled;
@@ -195,7 +208,8 @@ ObjectVerification ObjectLevelRun::verify(const std::vector<std::uint32_t>& refe
         (culler.object(i).triangles ? triangle_objects : patch_objects).push_back({culler.object(i).span.first, i});
     std::sort(patch_objects.begin(), patch_objects.end());
     std::sort(triangle_objects.begin(), triangle_objects.end());
-    auto object_of = [&](const std::vector<std::pair<std::size_t, std::size_t>>& table, std::size_t index) -> std::size_t {
+    auto object_of = [&](const std::vector<std::pair<std::size_t, std::size_t>>& table,
+                         std::size_t index) -> std::size_t {
         auto it = std::upper_bound(table.begin(), table.end(), std::make_pair(index, ~std::size_t{0}));
         if (it == table.begin()) return ~std::size_t{0};
         const std::size_t object = std::prev(it)->second;
@@ -270,10 +284,17 @@ nlohmann::json ObjectLevelRun::frame_json() const {
 nlohmann::json ObjectLevelRun::occlusion_json() const {
     if (queries_ && query_method_) {
         const gl::QueryStats& q = queries_->stats();
-        return {{"method", occlusion_name()},      {"objects", q.objects},           {"frustum_culled", q.frustum_culled},
-                {"occlusion_culled", q.occlusion_culled}, {"drawn", q.drawn},     {"queries", q.queries},
-                {"multiqueries", q.multiqueries},  {"multiqueries_passed", q.multiquery_passed},
-                {"proxy_boxes", q.proxy_boxes},    {"waits", q.waits},             {"unqueryable", q.unqueryable},
+        return {{"method", occlusion_name()},
+                {"objects", q.objects},
+                {"frustum_culled", q.frustum_culled},
+                {"occlusion_culled", q.occlusion_culled},
+                {"drawn", q.drawn},
+                {"queries", q.queries},
+                {"multiqueries", q.multiqueries},
+                {"multiqueries_passed", q.multiquery_passed},
+                {"proxy_boxes", q.proxy_boxes},
+                {"waits", q.waits},
+                {"unqueryable", q.unqueryable},
                 {"aggressive", query_options_.pixel_threshold > 0}};
     }
     if (scene_occlusion_) {

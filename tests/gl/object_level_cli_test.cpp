@@ -30,18 +30,17 @@ using namespace patchcull::cli_test;
 namespace {
 
 std::string scene_file(const char* name) { return std::string(PATCHCULL_SOURCE_DIR) + "/data/scenes/" + name; }
-std::string test_scene(const char* name) {
-    return std::string(PATCHCULL_SOURCE_DIR) + "/tests/data/scenes/" + name;
-}
+std::string test_scene(const char* name) { return std::string(PATCHCULL_SOURCE_DIR) + "/tests/data/scenes/" + name; }
 
 // Object counts of one frame must be numbers, and consistent; objects: the scene's count (0: not
 // checked exactly).
 void check_objects_json(const nlohmann::json& frame, std::size_t objects, const std::string& what) {
     ASSERT_TRUE(frame.contains("objects")) << what << ": " << frame.dump();
     const nlohmann::json& o = frame["objects"];
-    for (const char* key : {"total", "frustum_culled", "backface_culled", "detail_culled", "plane_tests",
-                            "bvh_nodes_visited", "cluster_tests", "patches_culled", "triangles_culled",
-                            "backface_patches_culled", "false_culled_objects", "false_culled_triangles", "detail_pixels"})
+    for (const char* key :
+         {"total", "frustum_culled", "backface_culled", "detail_culled", "plane_tests", "bvh_nodes_visited",
+          "cluster_tests", "patches_culled", "triangles_culled", "backface_patches_culled", "false_culled_objects",
+          "false_culled_triangles", "detail_pixels"})
         ASSERT_TRUE(o.contains(key) && o[key].is_number_unsigned()) << what << ": " << key << " in " << o.dump();
     if (objects > 0) {
         EXPECT_EQ(o["total"].get<std::size_t>(), objects) << what;
@@ -119,8 +118,8 @@ TEST(ObjectLevelCli, CitySmallEveryMethodHasNoFalseCulls) {
     for (const auto& frame : j["frames"]) {
         ASSERT_TRUE(frame.contains("objects")) << frame.dump();
         const nlohmann::json& o = frame["objects"];
-        for (const char* key : {"total", "frustum_culled", "backface_culled", "detail_culled", "plane_tests",
-                                "bvh_nodes_visited"})
+        for (const char* key :
+             {"total", "frustum_culled", "backface_culled", "detail_culled", "plane_tests", "bvh_nodes_visited"})
             ASSERT_TRUE(o.contains(key) && o[key].is_number_unsigned()) << key << " in " << o.dump();
         EXPECT_EQ(o["total"], kCitySmallObjects);
         EXPECT_EQ(o["frustum_culled"], 0);
@@ -173,9 +172,8 @@ TEST(ObjectLevelCli, BuildingAndDefaultSceneHaveNoFalseCulls) {
         verified_render("render building --objects bvh+backface --size 64x36 --tess 1 --frames 1", 0, 1);
     EXPECT_GT(built_in.frustum, 0u);
     EXPECT_GT(built_in.backface_patches, 0u) << "the rigid characters' patch clusters";
-    const Summary b = verified_render("render " + scene_file("building.json") +
-                                          " --objects bvh+backface --size 96x54 --tess 2 --frames 3",
-                                      0, 3);
+    const Summary b = verified_render(
+        "render " + scene_file("building.json") + " --objects bvh+backface --size 96x54 --tess 2 --frames 3", 0, 3);
     EXPECT_GT(b.triangles, 0u);
     for (const char* scheme : {"acc", "osd"}) {
         const Summary d = verified_render(std::string("render default --scheme ") + scheme +
@@ -201,8 +199,10 @@ TEST(ObjectLevelCli, BadObjectFlagsAreOneLineErrors) {
     expect_one_line_error(run(r + "--mask-sectors 2 --json"), "--mask-sectors: needs --objects bvh+backface");
     expect_one_line_error(run(r + "--objects bvh+backface --mask-sectors 2 --json"),
                           "--mask-sectors: needs --backface-triangles masks");
-    expect_one_line_error(run(r + "--objects frustum --plane-masking off --json"), "--plane-masking: needs --objects bvh");
-    expect_one_line_error(run(r + "--objects bvh --cluster-cost 2 --json"), "--cluster-cost: needs --objects bvh+backface");
+    expect_one_line_error(run(r + "--objects frustum --plane-masking off --json"),
+                          "--plane-masking: needs --objects bvh");
+    expect_one_line_error(run(r + "--objects bvh --cluster-cost 2 --json"),
+                          "--cluster-cost: needs --objects bvh+backface");
     expect_one_line_error(run(r + "--meta-bv on --json"), "--meta-bv: needs --objects");
 }
 
@@ -238,9 +238,10 @@ TEST(ObjectLevelCli, FarSceneFilesVerify) {
 namespace patchcull::gl {
 namespace {
 
-// What --verify compares (tools/render_support.cpp): the culled frame's ids, depth and drawn
+// What --verify compares (eval_gl/reference_frame.cpp): the culled frame's ids, depth and drawn
 // patches against the unculled render's ids, depth and front patches.
-FrameComparison verify_frame(CullPipeline& pipeline, const RenderParams& rp, std::vector<std::uint32_t>& reference_ids) {
+FrameComparison verify_frame(CullPipeline& pipeline, const RenderParams& rp,
+                             std::vector<std::uint32_t>& reference_ids) {
     PatchRenderer& r = pipeline.renderer();
     const FrameCapture culled{r.read_ids(), r.read_depth(), r.read_drawn_patches()};
     RenderParams unculled = rp;
@@ -264,7 +265,8 @@ TEST(ObjectLevelGpu, VerifyCatchesAFalseObjectCull) {
     std::vector<std::uint32_t> idx;
     const Vec3 lo{2.2f, -0.5f, 0.0f}, hi{3.2f, 0.5f, 1.0f};
     for (int i = 0; i < 8; ++i) v.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-    const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                       {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
     for (const auto& q : quads)
         for (int k : {0, 1, 2, 0, 2, 3}) idx.push_back(q[k]);
     pipeline.renderer().set_occluders(v, idx, {{0, 12}});

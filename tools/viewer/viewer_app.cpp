@@ -13,7 +13,9 @@
 
 #include "commands.h"
 #include "patchcull/core/error.h"
+#include "patchcull/eval_gl/reference_frame.h"
 #include "patchcull/gl/cull_auto_policy.h"
+#include "render_support.h"
 #include "viewer_camera.h"
 #include "viewer_controls.h"
 #include "viewer_panel.h"
@@ -31,22 +33,56 @@ struct InputQueue {
 
 bool key_of(int glfw_key, ViewerKey& key) {
     switch (glfw_key) {
-    case GLFW_KEY_1: key = ViewerKey::toggle_frustum; return true;
-    case GLFW_KEY_2: key = ViewerKey::toggle_backpatch; return true;
-    case GLFW_KEY_3: key = ViewerKey::toggle_occlusion; return true;
-    case GLFW_KEY_4: key = ViewerKey::toggle_auto; return true;
-    case GLFW_KEY_B: key = ViewerKey::next_backpatch; return true;
-    case GLFW_KEY_G: key = ViewerKey::toggle_aggressive; return true;
-    case GLFW_KEY_V: key = ViewerKey::next_view; return true;
-    case GLFW_KEY_C: key = ViewerKey::next_camera; return true;
-    case GLFW_KEY_R: key = ViewerKey::reset_camera; return true;
-    case GLFW_KEY_H: key = ViewerKey::toggle_panel; return true;
-    case GLFW_KEY_X: key = ViewerKey::toggle_displace; return true;
-    case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: key = ViewerKey::tess_up; return true;
-    case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: key = ViewerKey::tess_down; return true;
-    case GLFW_KEY_SPACE: key = ViewerKey::pause; return true;
-    case GLFW_KEY_P: case GLFW_KEY_F12: key = ViewerKey::screenshot; return true;
-    default: return false;  // movement keys are polled (held), Escape closes the window (GlContext)
+        case GLFW_KEY_1:
+            key = ViewerKey::toggle_frustum;
+            return true;
+        case GLFW_KEY_2:
+            key = ViewerKey::toggle_backpatch;
+            return true;
+        case GLFW_KEY_3:
+            key = ViewerKey::toggle_occlusion;
+            return true;
+        case GLFW_KEY_4:
+            key = ViewerKey::toggle_auto;
+            return true;
+        case GLFW_KEY_B:
+            key = ViewerKey::next_backpatch;
+            return true;
+        case GLFW_KEY_G:
+            key = ViewerKey::toggle_aggressive;
+            return true;
+        case GLFW_KEY_V:
+            key = ViewerKey::next_view;
+            return true;
+        case GLFW_KEY_C:
+            key = ViewerKey::next_camera;
+            return true;
+        case GLFW_KEY_R:
+            key = ViewerKey::reset_camera;
+            return true;
+        case GLFW_KEY_H:
+            key = ViewerKey::toggle_panel;
+            return true;
+        case GLFW_KEY_X:
+            key = ViewerKey::toggle_displace;
+            return true;
+        case GLFW_KEY_EQUAL:
+        case GLFW_KEY_KP_ADD:
+            key = ViewerKey::tess_up;
+            return true;
+        case GLFW_KEY_MINUS:
+        case GLFW_KEY_KP_SUBTRACT:
+            key = ViewerKey::tess_down;
+            return true;
+        case GLFW_KEY_SPACE:
+            key = ViewerKey::pause;
+            return true;
+        case GLFW_KEY_P:
+        case GLFW_KEY_F12:
+            key = ViewerKey::screenshot;
+            return true;
+        default:
+            return false;  // movement keys are polled (held), Escape closes the window (GlContext)
     }
 }
 
@@ -112,7 +148,7 @@ int run_viewer(ViewerConfig& config) {
     // A model's scene is named by its path: the panel's title shows the file name.
     const std::string scene_name = std::filesystem::path(config.scene.name).filename().string();
     ViewerWorld world(std::move(config.scene), config.objects);
-    int anim_frame = 0;  // frames the animation (and the path camera) advanced: time = anim_frame / 12 s
+    int anim_frame = 0;        // frames the animation (and the path camera) advanced: time = anim_frame / 12 s
     world.build(settings, 0);  // before the window: a bad object-level flag is an error without one
     gl::GlContext context = gl::GlContext::create_window(width, height, "patchcull view: " + scene_name);
     gl::CullPipeline pipeline(context);
@@ -157,20 +193,31 @@ int run_viewer(ViewerConfig& config) {
         // Input: the script's events of this frame, then the user's (both through Controls).
         std::vector<std::string> script_shots;
         bool script_quit = false;
-        while (scripted && next_event < config.script->events.size() &&
-               config.script->events[next_event].frame == f) {
+        while (scripted && next_event < config.script->events.size() && config.script->events[next_event].frame == f) {
             const ScriptEvent& e = config.script->events[next_event++];
             switch (e.kind) {
-            case ScriptEvent::Kind::orbit: controls.drag(true, e.x, e.y, path_camera); break;
-            case ScriptEvent::Kind::look: controls.drag(false, e.x, e.y, path_camera); break;
-            case ScriptEvent::Kind::zoom: controls.wheel(e.x, path_camera); break;
-            case ScriptEvent::Kind::key: controls.key(e.key, path_camera); break;
-            case ScriptEvent::Kind::set:
-                apply_setting(settings, e.name, e.value);  // checked by the parser
-                controls.sync(path_camera);
-                break;
-            case ScriptEvent::Kind::screenshot: script_shots.push_back(e.value); break;
-            case ScriptEvent::Kind::quit: script_quit = true; break;
+                case ScriptEvent::Kind::orbit:
+                    controls.drag(true, e.x, e.y, path_camera);
+                    break;
+                case ScriptEvent::Kind::look:
+                    controls.drag(false, e.x, e.y, path_camera);
+                    break;
+                case ScriptEvent::Kind::zoom:
+                    controls.wheel(e.x, path_camera);
+                    break;
+                case ScriptEvent::Kind::key:
+                    controls.key(e.key, path_camera);
+                    break;
+                case ScriptEvent::Kind::set:
+                    apply_setting(settings, e.name, e.value);  // checked by the parser
+                    controls.sync(path_camera);
+                    break;
+                case ScriptEvent::Kind::screenshot:
+                    script_shots.push_back(e.value);
+                    break;
+                case ScriptEvent::Kind::quit:
+                    script_quit = true;
+                    break;
             }
         }
         if (panel) {
@@ -188,9 +235,9 @@ int run_viewer(ViewerConfig& config) {
             queue.wheel = 0;
             if (!panel->wants_keyboard()) {
                 for (ViewerKey k : queue.pressed) controls.key(k, path_camera);
-                const std::pair<int, ViewerKey> held[] = {{GLFW_KEY_W, ViewerKey::forward}, {GLFW_KEY_S, ViewerKey::back},
-                                                          {GLFW_KEY_A, ViewerKey::left},    {GLFW_KEY_D, ViewerKey::right},
-                                                          {GLFW_KEY_E, ViewerKey::up},      {GLFW_KEY_Q, ViewerKey::down}};
+                const std::pair<int, ViewerKey> held[] = {
+                    {GLFW_KEY_W, ViewerKey::forward}, {GLFW_KEY_S, ViewerKey::back}, {GLFW_KEY_A, ViewerKey::left},
+                    {GLFW_KEY_D, ViewerKey::right},   {GLFW_KEY_E, ViewerKey::up},   {GLFW_KEY_Q, ViewerKey::down}};
                 for (const auto& [glfw_key, k] : held)
                     if (glfwGetKey(window, glfw_key) == GLFW_PRESS) controls.hold(k);
             }
@@ -207,12 +254,13 @@ int run_viewer(ViewerConfig& config) {
             ++anim_frame;
             world.pose(anim_frame * kSecondsPerFrame, pipeline);
         }
-        Camera view_camera = settings.camera == ViewerCameraMode::path ? cameras[static_cast<std::size_t>(anim_frame % lap)]
-                                                                       : camera.camera();
+        Camera view_camera = settings.camera == ViewerCameraMode::path
+                                 ? cameras[static_cast<std::size_t>(anim_frame % lap)]
+                                 : camera.camera();
         view_camera.depth = config.clip_depth;
 
         gl::PipelineParams params;
-        params.frame.render = render_params(view_camera, width, height, settings.tess, world.one_sided());
+        params.frame.render = eval_gl::render_params(view_camera, width, height, settings.tess, world.one_sided());
         TessMode tess_mode = config.tess_mode;
         tess_mode.adaptive = settings.adaptive_tess;
         apply_tess_mode(tess_mode, params.frame.render);
@@ -225,8 +273,9 @@ int run_viewer(ViewerConfig& config) {
         if (settings.backpatch && !world.one_sided() && config.interactive && !warned_open_backpatch) {
             // As `render --cull backpatch` on an open surface: kept, with one warning.
             warned_open_backpatch = true;
-            print_warnings({"view: the scene has an open surface: back-patch culling may remove patches seen "
-                            "through its openings"});
+            print_warnings(
+                {"view: the scene has an open surface: back-patch culling may remove patches seen "
+                 "through its openings"});
         }
         world.object_level().apply(world.poser(), world.current_pose(), anim_frame * kSecondsPerFrame, view_camera,
                                    height, params);
@@ -244,7 +293,8 @@ int run_viewer(ViewerConfig& config) {
         } else {
             gl::RenderParams seen = params.frame.render;
             if (settings.view == ViewerView::status_second) {
-                seen = render_params(second_status_camera(view_camera), width, height, settings.tess, world.one_sided());
+                seen = eval_gl::render_params(second_status_camera(view_camera), width, height, settings.tess,
+                                              world.one_sided());
                 apply_tess_mode(tess_mode, seen);
             }
             status_display.show(pipeline.renderer().render_status_image(seen), width, height);
@@ -290,12 +340,13 @@ int run_viewer(ViewerConfig& config) {
         if (last && !config.final_screenshot.empty()) context.write_window_png(config.final_screenshot);
         context.swap_buffers();
         if (print_frames) {
-            std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
-                        "(displaced %zu); %.1f ms\n",
-                        f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
-                        stats.backpatch_culled, stats.occlusion_culled, stats.displaced_occlusion_culled,
-                        stats.total_ms);
-            if (settings.cull_auto) std::printf("%s\n", gl::auto_summary_line(world.names(), policy.decisions()).c_str());
+            std::printf(
+                "frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
+                "(displaced %zu); %.1f ms\n",
+                f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled, stats.backpatch_culled,
+                stats.occlusion_culled, stats.displaced_occlusion_culled, stats.total_ms);
+            if (settings.cull_auto)
+                std::printf("%s\n", gl::auto_summary_line(world.names(), policy.decisions()).c_str());
             if (world.object_level().enabled())
                 std::printf("  objects (%s): %zu frustum-culled, %zu back-face-culled of %zu; %zu patches skipped\n",
                             world.object_level().method_name(), world.object_level().result().stats.frustum_culled,

@@ -9,7 +9,6 @@
 #include "object_level_options.h"
 #include "patchcull/import/scene_model.h"
 #include "render_options.h"
-#include "render_support.h"
 #include "viewer_script.h"
 #include "viewer_settings.h"
 
@@ -24,14 +23,14 @@ struct ViewerConfig {
     /// false: `view --frames N` non-interactively: render's camera path (one lap of N frames), no
     /// panel, a line per frame; the window then shows exactly `render --out`'s images.
     bool interactive = true;
-    ViewerSettings settings;      ///< the starting settings (from the flags)
-    bool backpatch_requested = false;  ///< --cull backpatch given: kept on an open scene, with a warning
-    TessMode tess_mode;           ///< reference distance of adaptive tessellation
+    ViewerSettings settings;                          ///< the starting settings (from the flags)
+    bool backpatch_requested = false;                 ///< --cull backpatch given: kept on an open scene, with a warning
+    TessMode tess_mode;                               ///< reference distance of adaptive tessellation
     gl::FrustumTest frustum = gl::FrustumTest::hull;  ///< --frustum: the chain's frustum test
     ClipDepth clip_depth = ClipDepth::zero_to_one;    ///< --clip-depth: drawn and culled in it
-    std::string final_screenshot;  ///< --screenshot: after the last of --frames
-    std::string screenshot_dir = "out";  ///< the screenshot key's numbered PNGs
-    const ViewerScript* script = nullptr;  ///< events by frame; with one, time steps are fixed
+    std::string final_screenshot;                     ///< --screenshot: after the last of --frames
+    std::string screenshot_dir = "out";               ///< the screenshot key's numbered PNGs
+    const ViewerScript* script = nullptr;             ///< events by frame; with one, time steps are fixed
 };
 
 /// Opens the window and runs the viewer; returns the exit status (0). Throws patchcull::Error

@@ -1,7 +1,7 @@
 // The viewer's scene, rebuilt when displacement or the object level change (viewer_world.h).
 #include "viewer_world.h"
 
-#include "render_support.h"
+#include "patchcull/eval_gl/scene_setup.h"
 
 namespace patchcull::cli {
 
@@ -29,7 +29,7 @@ void ViewerWorld::build(const ViewerSettings& s, float time_seconds) {
         scene->displacement_name = "procedural";
         for (SceneInstance& instance : scene->instances) instance.displaced = true;
     }
-    one_sided_ = scene_is_one_sided(*scene);
+    one_sided_ = eval_gl::scene_is_one_sided(*scene);
     ObjectLevelOptions options = options_;
     if (built_) {
         // The command's flags were checked by the first build; later ones change the method only.
@@ -43,7 +43,8 @@ void ViewerWorld::build(const ViewerSettings& s, float time_seconds) {
     pose_ = &poser_->pose(time_seconds);  // before pose_attributes reads it
     ranges_.clear();
     names_.clear();
-    for (const SceneObject& o : scene_objects(*scene_)) ranges_.push_back(o.range), names_.push_back(o.name);
+    for (const eval_gl::SceneObject& o : eval_gl::scene_objects(*scene_))
+        ranges_.push_back(o.range), names_.push_back(o.name);
     built_ = true;
     built_displace_ = s.displace;
     built_scale_ = s.displace_scale;
@@ -51,14 +52,14 @@ void ViewerWorld::build(const ViewerSettings& s, float time_seconds) {
 }
 
 void ViewerWorld::upload(gl::CullPipeline& pipeline) {
-    pipeline.set_patches(*pose_, pose_attributes(*poser_));
+    pipeline.set_patches(*pose_, eval_gl::pose_attributes(*poser_));
     pipeline.renderer().set_displacement_map(scene_->displacement);
-    upload_scene_occluders(pipeline.renderer(), *scene_);
+    eval_gl::upload_scene_occluders(pipeline.renderer(), *scene_);
 }
 
 void ViewerWorld::pose(float time_seconds, gl::CullPipeline& pipeline) {
     pose_ = &poser_->pose(time_seconds);
-    pipeline.update_patches(*pose_, pose_attributes(*poser_));
+    pipeline.update_patches(*pose_, eval_gl::pose_attributes(*poser_));
 }
 
 }  // namespace patchcull::cli
