@@ -1,4 +1,6 @@
-// Scene files (patchcull/import/scene_file.h; the format: docs/SCENE_FORMAT.md).
+// Scene files (patchcull/import/scene_file.h; the format: docs/SCENE_FORMAT.md): the reader.
+// What a scene reaches over a run (check_scene_motion, place_scene_at_first_camera):
+// scene_placement.cpp.
 //
 // The reader walks the parsed JSON with the JSON path of every value at hand, so each check can
 // name it. Objects are checked key by key against the keys their kind allows (unknown keys are
@@ -22,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "input_file.h"
+#include "number_text.h"
 #include "patchcull/core/error.h"
 #include "patchcull/import/image.h"
 #include "patchcull/import/obj.h"
@@ -33,12 +36,6 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 using namespace detail;
-
-std::string number_text(double v) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g", v);
-    return text;
-}
 
 // A range bound: as number_text, the scene coordinate limit in full (536870912, not 5.36871e+08).
 std::string bound_text(double v) {
@@ -155,7 +152,8 @@ struct Reader {
     DVec3 position(const json& j, const std::string& path) const {
         if (!j.is_array() || j.size() != 3) fail(path, "expected 3 numbers");
         double v[3];
-        for (std::size_t k = 0; k < 3; ++k) v[k] = real(j[k], index(path, k), -kMaxSceneCoordinate, kMaxSceneCoordinate);
+        for (std::size_t k = 0; k < 3; ++k)
+            v[k] = real(j[k], index(path, k), -kMaxSceneCoordinate, kMaxSceneCoordinate);
         return {v[0], v[1], v[2]};
     }
 
@@ -224,11 +222,14 @@ Placement read_transform(const Reader& r, const json& j, const std::string& path
         if (!(std::fabs(det) > 0) || !std::isfinite(det)) r.fail(path, "the matrix is singular (a zero scale)");
         // M * translation(origin): the translation summed in double.
         for (int row = 0; row < 3; ++row)
-            t[row] += double(m.at(row, 0)) * origin.x + double(m.at(row, 1)) * origin.y + double(m.at(row, 2)) * origin.z;
+            t[row] +=
+                double(m.at(row, 0)) * origin.x + double(m.at(row, 1)) * origin.y + double(m.at(row, 2)) * origin.z;
         return split_translation(m, {t[0], t[1], t[2]});
     }
-    if (model) r.object(j, path, {"position", "yaw_degrees", "scale", "height"});
-    else r.object(j, path, {"position", "yaw_degrees", "scale"});
+    if (model)
+        r.object(j, path, {"position", "yaw_degrees", "scale", "height"});
+    else
+        r.object(j, path, {"position", "yaw_degrees", "scale"});
     const json* p = r.find(j, "position");
     const DVec3 position = p ? r.position(*p, join(path, "position")) : DVec3{};
     const float yaw = r.number_or(j, path, "yaw_degrees", 0, -1e6, 1e6);
@@ -250,7 +251,8 @@ Placement read_transform(const Reader& r, const json& j, const std::string& path
         const double so[3] = {double(s) * origin.x, double(s) * origin.y, double(s) * origin.z};
         double* out = &shift.x;
         for (int row = 0; row < 3; ++row)
-            out[row] = double(turn.at(row, 0)) * so[0] + double(turn.at(row, 1)) * so[1] + double(turn.at(row, 2)) * so[2];
+            out[row] =
+                double(turn.at(row, 0)) * so[0] + double(turn.at(row, 1)) * so[1] + double(turn.at(row, 2)) * so[2];
     }
     // translation(rest) * rotation_y(yaw) * local in float, the rest of the position after its
     // grid origin (all of it near the world's origin) added in float as the built-in scenes do.
@@ -280,8 +282,9 @@ void check_placed(const Reader& r, const std::string& path, const std::vector<DV
     for (int a = 0; a < 3; ++a) diagonal += (hi[a] - lo[a]) * (hi[a] - lo[a]);
     diagonal = std::sqrt(diagonal);
     if (!(diagonal >= kMinMeshDiagonal))
-        r.fail(path, std::string("the placed ") + what + " is " + number_text(diagonal) +
-                         " units across; patchcull takes meshes of at least 1e-06 units across (the kernels work in float)");
+        r.fail(path,
+               std::string("the placed ") + what + " is " + number_text(diagonal) +
+                   " units across; patchcull takes meshes of at least 1e-06 units across (the kernels work in float)");
 }
 
 Scheme read_scheme(const Reader& r, const json& obj, const std::string& path) {
@@ -289,7 +292,8 @@ Scheme read_scheme(const Reader& r, const json& obj, const std::string& path) {
     if (!j) return Scheme::acc;
     const std::string text = r.string(*j, join(path, "scheme"));
     Scheme scheme = Scheme::acc;
-    if (!parse_scheme(text, scheme)) r.fail(join(path, "scheme"), "unknown scheme " + quote_input(text) + " (acc or osd)");
+    if (!parse_scheme(text, scheme))
+        r.fail(join(path, "scheme"), "unknown scheme " + quote_input(text) + " (acc or osd)");
     return scheme;
 }
 
@@ -311,29 +315,30 @@ json parse_strict(const Reader& r, const std::string& text) {
     };
     const json::parser_callback_t callback = [&](int, json::parse_event_t event, json& parsed) {
         switch (event) {
-        case json::parse_event_t::object_start:
-        case json::parse_event_t::array_start: {
-            // The format nests 6 deep; a deeper file is refused before its paths grow (each
-            // frame keeps its path: quadratic in the depth).
-            if (frames.size() >= kMaxDepth) r.fail("", "JSON nested deeper than " + std::to_string(kMaxDepth) + " levels");
-            std::string path = child_path();
-            frames.push_back({event == json::parse_event_t::array_start, 0, std::move(path), {}, {}});
-            break;
-        }
-        case json::parse_event_t::object_end:
-        case json::parse_event_t::array_end:
-            if (!frames.empty()) frames.pop_back();
-            break;
-        case json::parse_event_t::key:
-            if (!frames.empty()) {
-                Frame& f = frames.back();
-                f.key = parsed.is_string() ? parsed.get<std::string>() : std::string();
-                if (!f.keys.insert(f.key).second) r.fail(f.path, "duplicate key " + quote_input(f.key));
+            case json::parse_event_t::object_start:
+            case json::parse_event_t::array_start: {
+                // The format nests 6 deep; a deeper file is refused before its paths grow (each
+                // frame keeps its path: quadratic in the depth).
+                if (frames.size() >= kMaxDepth)
+                    r.fail("", "JSON nested deeper than " + std::to_string(kMaxDepth) + " levels");
+                std::string path = child_path();
+                frames.push_back({event == json::parse_event_t::array_start, 0, std::move(path), {}, {}});
+                break;
             }
-            break;
-        case json::parse_event_t::value:
-            if (!frames.empty() && frames.back().array) ++frames.back().next;
-            break;
+            case json::parse_event_t::object_end:
+            case json::parse_event_t::array_end:
+                if (!frames.empty()) frames.pop_back();
+                break;
+            case json::parse_event_t::key:
+                if (!frames.empty()) {
+                    Frame& f = frames.back();
+                    f.key = parsed.is_string() ? parsed.get<std::string>() : std::string();
+                    if (!f.keys.insert(f.key).second) r.fail(f.path, "duplicate key " + quote_input(f.key));
+                }
+                break;
+            case json::parse_event_t::value:
+                if (!frames.empty() && frames.back().array) ++frames.back().next;
+                break;
         }
         return true;
     };
@@ -344,13 +349,17 @@ json parse_strict(const Reader& r, const std::string& text) {
         const std::size_t end = std::min<std::size_t>(e.byte == 0 ? 0 : e.byte - 1, text.size());
         std::size_t line = 1, column = 1;
         for (std::size_t i = 0; i < end; ++i) {
-            if (text[i] == '\n') ++line, column = 1;
-            else ++column;
+            if (text[i] == '\n')
+                ++line, column = 1;
+            else
+                ++column;
         }
         std::string what = e.what();
         const std::size_t colon = what.find(": ", what.find("column"));
-        what = colon != std::string::npos ? what.substr(colon + 2) : what.substr(std::min(what.size(), what.find(']') + 1));
-        throw Error(printable_line(r.file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + what, 300));
+        what = colon != std::string::npos ? what.substr(colon + 2)
+                                          : what.substr(std::min(what.size(), what.find(']') + 1));
+        throw Error(
+            printable_line(r.file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " + what, 300));
     } catch (const json::exception& e) {
         // E.g. out_of_range.406, a number beyond a double (nlohmann-json gives no position).
         std::string what = e.what();
@@ -453,7 +462,8 @@ std::map<ModelKey, std::string> default_name_stems(const Reader& r, const json& 
         const std::string spec = m->get<std::string>();
         const ModelKey key = model_key(r, spec, scheme);
         auto& group = by_stem[fs::path(model_file(r, spec)).stem().string()];
-        if (std::none_of(group.begin(), group.end(), [&](const auto& g) { return !(g.first < key) && !(key < g.first); }))
+        if (std::none_of(group.begin(), group.end(),
+                         [&](const auto& g) { return !(g.first < key) && !(key < g.first); }))
             group.emplace_back(key, spec);
     }
     for (const auto& [stem, group] : by_stem) {
@@ -463,7 +473,8 @@ std::map<ModelKey, std::string> default_name_stems(const Reader& r, const json& 
             schemes_differ = schemes_differ || g.first.scheme != group.front().first.scheme;
         }
         for (const auto& [key, spec] : group)
-            default_keys[key] = (files_differ ? spec : stem) + (schemes_differ ? std::string(":") + scheme_name(key.scheme) : "");
+            default_keys[key] =
+                (files_differ ? spec : stem) + (schemes_differ ? std::string(":") + scheme_name(key.scheme) : "");
     }
     return default_keys;
 }
@@ -475,7 +486,8 @@ void read_object_animation(const Reader& r, const json& a, const std::string& ap
     instance.time_offset = r.number_or(a, ap, "time_offset", 0, -1e6, 1e6);
     if (const json* v = r.find(a, "velocity")) {
         instance.velocity = r.vec3(*v, join(ap, "velocity"));
-        if (length(instance.velocity) > 1e6f) r.fail(join(ap, "velocity"), "expected a speed of at most 1e6 units per second");
+        if (length(instance.velocity) > 1e6f)
+            r.fail(join(ap, "velocity"), "expected a speed of at most 1e6 units per second");
     }
 }
 
@@ -520,10 +532,12 @@ NameIndex read_objects(const Reader& r, const json& root, Scene& scene) {
         std::vector<DVec3> points;
         points.reserve(model.rest.patches.size() * kPatchPoints);
         for (const BezierPatch& patch : model.rest.patches)
-            for (const Vec4& c : patch.cp) points.push_back(to_double(cartesian(instance.object_to_world * c)) + instance.origin);
+            for (const Vec4& c : patch.cp)
+                points.push_back(to_double(cartesian(instance.object_to_world * c)) + instance.origin);
         check_placed(r, join(p, "transform"), points, "model");
         const json* n = r.find(o, "name");
-        instance.name = n ? r.string(*n, join(p, "name")) : default_keys.at(key) + "#" + std::to_string(copies[instance.model]);
+        instance.name =
+            n ? r.string(*n, join(p, "name")) : default_keys.at(key) + "#" + std::to_string(copies[instance.model]);
         ++copies[instance.model];
         if (!instance_names.emplace(instance.name, i).second)
             r.fail(join(p, "name"), "duplicate object name " + quote_input(instance.name) + " (also objects[" +
@@ -597,7 +611,8 @@ EnvironmentShape read_obj_shape(const Reader& r, const json& obj, const std::str
 }
 
 // One entry of "environment": its shape placed in world space and added to the scene.
-void read_environment_object(const Reader& r, const json& e, std::size_t i, Scene& scene, NameIndex& environment_names) {
+void read_environment_object(const Reader& r, const json& e, std::size_t i, Scene& scene,
+                             NameIndex& environment_names) {
     const std::string p = index("environment", i);
     r.object(e, p, {"name", "box", "quad", "obj", "transform", "one_sided"});
     const int kinds = (r.find(e, "box") ? 1 : 0) + (r.find(e, "quad") ? 1 : 0) + (r.find(e, "obj") ? 1 : 0);
@@ -619,7 +634,8 @@ void read_environment_object(const Reader& r, const json& e, std::size_t i, Scen
         const double x = v.x + shape.origin.x, y = v.y + shape.origin.y, z = v.z + shape.origin.z;
         double w[3];
         for (int row = 0; row < 3; ++row)
-            w[row] = double(m.at(row, 0)) * x + double(m.at(row, 1)) * y + double(m.at(row, 2)) * z + double(m.at(row, 3));
+            w[row] =
+                double(m.at(row, 0)) * x + double(m.at(row, 1)) * y + double(m.at(row, 2)) * z + double(m.at(row, 3));
         world.push_back(DVec3{w[0], w[1], w[2]} + placed.origin);
     }
     check_placed(r, t ? join(p, "transform") : p, world, "environment object");
@@ -646,7 +662,8 @@ NameIndex read_environment(const Reader& r, const json& root, Scene& scene) {
     NameIndex environment_names;
     if (const json* env = r.find(root, "environment")) {
         r.array(*env, "environment", false);
-        for (std::size_t i = 0; i < env->size(); ++i) read_environment_object(r, (*env)[i], i, scene, environment_names);
+        for (std::size_t i = 0; i < env->size(); ++i)
+            read_environment_object(r, (*env)[i], i, scene, environment_names);
     }
     return environment_names;
 }
@@ -658,7 +675,8 @@ void read_orbit(const Reader& r, const json& orbit, CameraPath& cam) {
     const DVec3 t = target ? r.position(*target, "camera.orbit.target") : DVec3{};
     cam.origin = scene_frame_near(t);
     cam.target = to_float(t - cam.origin);
-    cam.distance = r.number(r.require(orbit, "camera.orbit", "distance"), "camera.orbit.distance", 0, kMaxMeshExtent, true);
+    cam.distance =
+        r.number(r.require(orbit, "camera.orbit", "distance"), "camera.orbit.distance", 0, kMaxMeshExtent, true);
     cam.height = r.number_or(orbit, "camera.orbit", "height", 0, -kMaxMeshExtent, kMaxMeshExtent);
     cam.start_degrees = r.number_or(orbit, "camera.orbit", "start_degrees", 0, -1e6, 1e6);
     cam.degrees_per_frame = r.number_or(orbit, "camera.orbit", "degrees_per_frame", 5, -360, 360);
@@ -683,12 +701,15 @@ void read_walk(const Reader& r, const json& walk, CameraPath& cam) {
 
 // "camera": exactly one of orbit or walk, and the projection.
 void read_camera(const Reader& r, const json& root, CameraPath& cam) {
-    const json& c = r.object(r.require(root, "", "camera"), "camera", {"orbit", "walk", "fovy_degrees", "z_near", "z_far"});
+    const json& c =
+        r.object(r.require(root, "", "camera"), "camera", {"orbit", "walk", "fovy_degrees", "z_near", "z_far"});
     const json* orbit = r.find(c, "orbit");
     const json* walk = r.find(c, "walk");
     if ((orbit ? 1 : 0) + (walk ? 1 : 0) != 1) r.fail("camera", "expected exactly one of 'orbit' or 'walk'");
-    if (orbit) read_orbit(r, *orbit, cam);
-    else read_walk(r, *walk, cam);
+    if (orbit)
+        read_orbit(r, *orbit, cam);
+    else
+        read_walk(r, *walk, cam);
     const float fovy = r.number_or(c, "camera", "fovy_degrees", 60, 0, 179, true);
     cam.fovy_radians = fovy * kPi / 180.0f;
     cam.z_near = r.number_or(c, "camera", "z_near", 0.05f, 0, kMaxMeshExtent, true);
@@ -777,7 +798,8 @@ void read_portals(const Reader& r, const json& root, const NameIndex& cell_names
     if (!portals) return;
     r.array(*portals, "portals", false);
     if (!portals->empty() && scene.cells.empty()) r.fail("portals", "portals need cells (\"cells\")");
-    for (std::size_t i = 0; i < portals->size(); ++i) read_portal(r, (*portals)[i], index("portals", i), cell_names, scene);
+    for (std::size_t i = 0; i < portals->size(); ++i)
+        read_portal(r, (*portals)[i], index("portals", i), cell_names, scene);
 }
 
 }  // namespace
@@ -797,156 +819,6 @@ Scene load_scene_file(const std::string& path) {
     const NameIndex cell_names = read_cells(r, root, instance_names, environment_names, scene);
     read_portals(r, root, cell_names, scene);
     return scene;
-}
-
-namespace {
-
-// The first coordinate of the points in [lo, hi] (a box) moved by d that lies beyond the limit
-// (axis in 0..2, value), or axis -1.
-struct Reach {
-    int axis = -1;
-    double value = 0;
-};
-Reach beyond_limit(const double lo[3], const double hi[3], const double d[3], double limit, DVec3 centre) {
-    const double o[3] = {centre.x, centre.y, centre.z};
-    for (int a = 0; a < 3; ++a)
-        for (double c : {lo[a] + d[a], hi[a] + d[a]})
-            if (!(std::fabs(c - o[a]) <= limit)) return {a, c};
-    return {};
-}
-
-static_assert(kMaxSceneCoordinate == 536870912.0, "the messages name the limit as 536870912 (2^29)");
-
-// A limit as written in the docs: 536870912 (2^29), 8192.
-std::string limit_text(double limit) {
-    char text[48];
-    std::snprintf(text, sizeof text, "%.0f", limit);
-    return text + std::string(limit == kMaxSceneCoordinate ? " (2^29)" : "");
-}
-
-[[noreturn]] void motion_fail(const std::string& source, const std::string& path, const std::string& what, Reach r,
-                              int frame, double seconds, const std::string& advice) {
-    static const char* const axes[3] = {"x", "y", "z"};
-    throw Error(printable_line(source + ": " + path + ": " + what + " reaches " + axes[r.axis] + " = " +
-                               number_text(r.value) + " at frame " + std::to_string(frame) + " (time " +
-                               number_text(seconds) + " s); " + advice));
-}
-
-}  // namespace
-
-void check_scene_motion(const Scene& scene, const std::string& source, int frames, double seconds_per_frame,
-                        double limit, DVec3 centre) {
-    if (frames <= 0) return;
-    const int last = frames - 1;
-    const bool at_origin = centre.x == 0 && centre.y == 0 && centre.z == 0;
-    const std::string advice =
-        limit >= kMaxSceneCoordinate && at_origin
-            ? "scenes take world coordinates up to " + limit_text(limit)
-            : "this command draws a scene in one float frame, at its first camera's grid point (" +
-                  number_text(centre.x) + ", " + number_text(centre.y) + ", " + number_text(centre.z) +
-                  "), and takes what lies within " + limit_text(limit) + " of it";
-    auto beyond = [&](const double lo[3], const double hi[3], const double d[3]) {
-        return beyond_limit(lo, hi, d, limit, centre);
-    };
-    auto seconds = [&](int f) { return double(f) * seconds_per_frame; };
-    const DVec3 world = scene.frame_origin;
-    // Objects: the placed rest control points' box (in double), moved by velocity x time.
-    for (std::size_t i = 0; i < scene.instances.size(); ++i) {
-        const SceneInstance& instance = scene.instances[i];
-        const Vec3 v = instance.velocity;
-        const bool moves = v.x != 0 || v.y != 0 || v.z != 0;
-        const Mat4& m = instance.object_to_world;
-        double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-        const double o[3] = {instance.origin.x, instance.origin.y, instance.origin.z};
-        for (const BezierPatch& patch : scene.models.at(instance.model).rest.patches)
-            for (const Vec4& c : patch.cp) {
-                const double h[4] = {c.x, c.y, c.z, c.w};
-                double w = 0;
-                for (int k = 0; k < 4; ++k) w += double(m.at(3, k)) * h[k];
-                for (int a = 0; a < 3; ++a) {
-                    double x = 0;
-                    for (int k = 0; k < 4; ++k) x += double(m.at(a, k)) * h[k];
-                    x = x / w + o[a];
-                    lo[a] = std::min(lo[a], x);
-                    hi[a] = std::max(hi[a], x);
-                }
-            }
-        auto moved = [&](int f) {
-            const double t = moves ? seconds(f) + double(instance.time_offset) : 0.0;
-            const double d[3] = {double(v.x) * t, double(v.y) * t, double(v.z) * t};
-            return beyond(lo, hi, d);
-        };
-        // The motion is linear: within the limit at the first and the last frame, within it at
-        // every frame between.
-        if (moved(0).axis < 0 && moved(last).axis < 0) continue;
-        for (int f = 0; f <= last; ++f)
-            if (const Reach r = moved(f); r.axis >= 0) {
-                const std::string path = "objects[" + std::to_string(i) + "]" +
-                                         (!moves                                  ? ".transform"
-                                          : f == 0 && instance.time_offset != 0 ? ".animation.time_offset"
-                                                                                 : ".animation.velocity");
-                motion_fail(source, path, std::string(moves ? "the moving" : "the placed") + " model (" +
-                                              quote_input(instance.name) + ")",
-                            r, f, seconds(f), advice);
-            }
-    }
-    // The environment, the cells and the portals do not move.
-    const double zero[3] = {0, 0, 0};
-    for (std::size_t e = 0; e < scene.environment.size(); ++e) {
-        const EnvironmentObject& object = scene.environment[e];
-        for (std::size_t k = 3 * std::size_t{object.first_triangle};
-             k < 3 * (std::size_t{object.first_triangle} + object.triangle_count); ++k) {
-            const std::uint32_t index = scene.occluder_indices[k];
-            const DVec3 p = scene.occluder_world.empty() ? to_double(scene.occluder_vertices[index]) + world
-                                                         : scene.occluder_world[index];
-            const double c[3] = {p.x, p.y, p.z};
-            if (const Reach r = beyond(c, c, zero); r.axis >= 0)
-                motion_fail(source, "environment[" + std::to_string(e) + "]",
-                            "the environment object (" + quote_input(object.name) + ")", r, 0, 0, advice);
-        }
-    }
-    for (std::size_t i = 0; i < scene.cells.size(); ++i) {
-        const Bounds& b = scene.cells[i].box;
-        const DVec3 l = scene.cell_world.empty() ? to_double(b.min) + world : scene.cell_world[i][0];
-        const DVec3 h = scene.cell_world.empty() ? to_double(b.max) + world : scene.cell_world[i][1];
-        const double lo[3] = {l.x, l.y, l.z}, hi[3] = {h.x, h.y, h.z};
-        if (const Reach r = beyond(lo, hi, zero); r.axis >= 0)
-            motion_fail(source, "cells[" + std::to_string(i) + "]", "the cell", r, 0, 0, advice);
-    }
-    for (std::size_t i = 0; i < scene.portals.size(); ++i)
-        for (std::size_t k = 0; k < 4; ++k) {
-            const DVec3 p = scene.portal_world.empty() ? to_double(scene.portals[i].corners[k]) + world
-                                                       : scene.portal_world[i][k];
-            const double c[3] = {p.x, p.y, p.z};
-            if (const Reach r = beyond(c, c, zero); r.axis >= 0)
-                motion_fail(source, "portals[" + std::to_string(i) + "].corners[" + std::to_string(k) + "]", "the portal",
-                            r, 0, 0, advice);
-        }
-    // The camera: its eye and target at every frame (the path is not linear for an orbit).
-    const CameraPath& c = scene.camera;
-    const std::vector<WorldCamera> cameras = scene.world_camera_path(frames, 1.0f);
-    for (int f = 0; f <= last; ++f) {
-        const WorldCamera& cam = cameras[static_cast<std::size_t>(f)];
-        const double eye[3] = {cam.eye.x, cam.eye.y, cam.eye.z};
-        const double target[3] = {cam.target.x, cam.target.y, cam.target.z};
-        if (const Reach r = beyond(eye, eye, zero); r.axis >= 0)
-            motion_fail(source,
-                        c.walk ? (f == 0 ? "camera.walk.start" : "camera.walk.step")
-                        : r.axis == 1 ? "camera.orbit.height"
-                                      : "camera.orbit.distance",
-                        "the camera's eye", r, f, seconds(f), advice);
-        if (const Reach r = beyond(target, target, zero); r.axis >= 0)
-            motion_fail(source, c.walk ? "camera.walk.direction" : "camera.orbit.target", "the camera's target", r, f,
-                        seconds(f), advice);
-    }
-}
-
-void place_scene_at_first_camera(Scene& scene, const std::string& source, int frames, double seconds_per_frame) {
-    check_scene_motion(scene, source, frames, seconds_per_frame);
-    const DVec3 origin = scene_frame_near(scene.world_camera_path(1, 1.0f).front().eye);
-    const DVec3 now = scene.frame_origin;
-    if (origin.x != now.x || origin.y != now.y || origin.z != now.z) rebase_scene_in_place(scene, origin);
-    check_scene_motion(scene, source, frames, seconds_per_frame, kMaxSingleFrameReach, origin);
 }
 
 }  // namespace patchcull
