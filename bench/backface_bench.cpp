@@ -34,11 +34,11 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/objects/backface.h"
-#include "patchcull/objects/backface_clusters.h"
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/frustum.h"  // simd_target_name
 #include "patchcull/import/model_loader.h"
+#include "patchcull/objects/backface.h"
+#include "patchcull/objects/backface_clusters.h"
 
 using namespace patchcull;
 
@@ -56,7 +56,8 @@ TriMesh uv_sphere(int stacks, int slices) {
     for (int i = 0; i <= stacks; ++i)
         for (int j = 0; j <= slices; ++j) {
             const double th = pi * i / stacks, ph = 2 * pi * j / slices;
-            m.vertices.push_back({float(std::sin(th) * std::cos(ph)), float(std::sin(th) * std::sin(ph)), float(std::cos(th))});
+            m.vertices.push_back(
+                {float(std::sin(th) * std::cos(ph)), float(std::sin(th) * std::sin(ph)), float(std::cos(th))});
         }
     for (int i = 0; i < stacks; ++i)
         for (int j = 0; j < slices; ++j) {
@@ -131,9 +132,12 @@ Scene& scene(const std::string& name) {
     if (slot) return *slot;
     slot = std::make_unique<Scene>();
     Scene& s = *slot;
-    if (name == "sphere") s.mesh = uv_sphere(256, 256);
-    else if (name == "box") s.mesh = tessellated_box(90);
-    else s.mesh = bigguy_tessellated(8);
+    if (name == "sphere")
+        s.mesh = uv_sphere(256, 256);
+    else if (name == "box")
+        s.mesh = tessellated_box(90);
+    else
+        s.mesh = bigguy_tessellated(8);
     const Bounds b = compute_bounds(s.mesh.vertices);
     s.centre = b.center();
     s.radius = b.radius();
@@ -143,7 +147,8 @@ Scene& scene(const std::string& name) {
         Vec3 d{u(rng), u(rng), u(rng)};
         const Vec3 eye = s.centre + normalize(d) * (s.radius * (2.0f + 2.0f * (k % 2)));
         s.eyes.push_back(eye);
-        s.world_to_clip.push_back(perspective(0.9f, 1.0f, 0.05f * s.radius, 20 * s.radius) * look_at(eye, s.centre, {0, 1, 0}));
+        s.world_to_clip.push_back(perspective(0.9f, 1.0f, 0.05f * s.radius, 20 * s.radius) *
+                                  look_at(eye, s.centre, {0, 1, 0}));
     }
     const NormalMaskGrid grid(16);
     s.classes.resize(s.mesh.triangles());
@@ -171,12 +176,14 @@ void BM_Mask(benchmark::State& state, bool simd) {
     Scene& s = scene("sphere");
     const NormalMaskGrid grid(16);
     std::vector<BackMask> masks(s.eyes.size());
-    for (std::size_t k = 0; k < masks.size(); ++k) make_back_mask(grid, s.world_to_clip[k], ClipDepth::zero_to_one, 0, 0, 1, masks[k]);
+    for (std::size_t k = 0; k < masks.size(); ++k)
+        make_back_mask(grid, s.world_to_clip[k], ClipDepth::zero_to_one, 0, 0, 1, masks[k]);
     std::vector<std::uint8_t> culled(s.mesh.triangles());
     std::size_t frame = 0, total = 0;
     for (auto _ : state) {
         const BackMask& m = masks[frame++ % masks.size()];
-        (simd ? cull_by_normal_mask_simd : cull_by_normal_mask_scalar)(s.classes.data(), s.classes.size(), m, culled.data());
+        (simd ? cull_by_normal_mask_simd : cull_by_normal_mask_scalar)(s.classes.data(), s.classes.size(), m,
+                                                                       culled.data());
         benchmark::DoNotOptimize(culled.data());
         for (std::uint8_t c : culled) total += c;
     }
@@ -225,11 +232,12 @@ HierarchyCase& hierarchy_case(const std::string& mesh, double tcr) {
         std::uniform_real_distribution<float> u(-1, 1);
         const PatchBatch batch = make_batch(patches);
         for (int k = 0; k < 32; ++k) {
-            const Vec3 eye = b.center() + normalize(Vec3{u(rng), u(rng), u(rng)}) * (b.radius() * (2.0f + 2.0f * (k % 2)));
+            const Vec3 eye =
+                b.center() + normalize(Vec3{u(rng), u(rng), u(rng)}) * (b.radius() * (2.0f + 2.0f * (k % 2)));
             const Mat4 proj = perspective(0.9f, 1.0f, 0.05f * b.radius(), 20 * b.radius());
             std::vector<std::uint8_t> out(patches.size());
-            cull_ptp_simd(batch.view(), proj * look_at(eye, b.center(), {0, 1, 0}), clip_space_eye_alpha(proj), PtpRule::pcnt,
-                          out.data());
+            cull_ptp_simd(batch.view(), proj * look_at(eye, b.center(), {0, 1, 0}), clip_space_eye_alpha(proj),
+                          PtpRule::pcnt, out.data());
             c.eyes.push_back(eye);
             c.per_primitive.push_back(std::move(out));
         }
@@ -240,7 +248,8 @@ HierarchyCase& hierarchy_case(const std::string& mesh, double tcr) {
     c.members = s.mesh.triangles();
     for (std::size_t k = 0; k < 32; ++k) {
         std::vector<std::uint8_t> out(s.mesh.triangles());
-        cull_backfacing_triangles_simd(s.mesh.vertices.data(), s.mesh.indices.data(), s.mesh.triangles(), s.eyes[k], out.data());
+        cull_backfacing_triangles_simd(s.mesh.vertices.data(), s.mesh.indices.data(), s.mesh.triangles(), s.eyes[k],
+                                       out.data());
         c.eyes.push_back(s.eyes[k]);
         c.per_primitive.push_back(std::move(out));
     }
@@ -294,7 +303,8 @@ void BM_PtpFrame(benchmark::State& state, int splits) {
     std::vector<std::uint8_t> out(batch.size());
     std::size_t frame = 0;
     for (auto _ : state) {
-        cull_ptp_simd(batch.view(), views[frame++ % views.size()], clip_space_eye_alpha(proj), PtpRule::pcnt, out.data());
+        cull_ptp_simd(batch.view(), views[frame++ % views.size()], clip_space_eye_alpha(proj), PtpRule::pcnt,
+                      out.data());
         benchmark::DoNotOptimize(out.data());
     }
     state.SetItemsProcessed(state.iterations());
@@ -321,20 +331,27 @@ const bool registered = [] {
     benchmark::RegisterBenchmark("backface/dot_simd", BM_Dot, true)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark("backface/mask_scalar", BM_Mask, false)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark("backface/mask_simd", BM_Mask, true)->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark("backface/make_mask", BM_MakeMask)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark("backface/make_mask", BM_MakeMask)
+        ->Arg(1)
+        ->Arg(2)
+        ->Arg(4)
+        ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark("backface/cluster_test", BM_ClusterTest)->Unit(benchmark::kMicrosecond);
     for (const char* mesh : {"sphere", "box", "bigguy_tess"})
         for (double tcr : {1.0, 4.0, 16.0})
-            benchmark::RegisterBenchmark(("backface/hierarchy/" + std::string(mesh) + "/" + std::to_string(int(tcr))).c_str(),
-                                         BM_Hierarchy, std::string(mesh), tcr)
+            benchmark::RegisterBenchmark(
+                ("backface/hierarchy/" + std::string(mesh) + "/" + std::to_string(int(tcr))).c_str(), BM_Hierarchy,
+                std::string(mesh), tcr)
                 ->Unit(benchmark::kMicrosecond);
     for (const char* mesh : {"bigguy_acc_s0", "bigguy_acc_s1", "bigguy_acc_s2"})
         for (double tcr : {0.01, 0.1, 1.0})
-            benchmark::RegisterBenchmark(("backface/hierarchy/" + std::string(mesh) + "/" + std::to_string(tcr)).c_str(),
-                                         BM_Hierarchy, std::string(mesh), tcr)
+            benchmark::RegisterBenchmark(
+                ("backface/hierarchy/" + std::string(mesh) + "/" + std::to_string(tcr)).c_str(), BM_Hierarchy,
+                std::string(mesh), tcr)
                 ->Unit(benchmark::kMicrosecond);
     for (int splits : {0, 1, 2})
-        benchmark::RegisterBenchmark(("backface/ptp_frame/bigguy_acc_s" + std::to_string(splits)).c_str(), BM_PtpFrame, splits)
+        benchmark::RegisterBenchmark(("backface/ptp_frame/bigguy_acc_s" + std::to_string(splits)).c_str(), BM_PtpFrame,
+                                     splits)
             ->Unit(benchmark::kMicrosecond);
     return true;
 }();

@@ -18,16 +18,15 @@
 #include <string>
 #include <vector>
 
+#include "cull_bench_loop.h"
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/frustum.h"  // simd_target_name
 #include "patchcull/core/parallel.h"
 #include "patchcull/core/patch.h"
-#include "cull_bench_loop.h"
 
 using namespace patchcull;
 
 namespace {
-
 
 struct ConeWorkload {
     PatchBatch batch;

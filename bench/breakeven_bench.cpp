@@ -96,7 +96,8 @@ void BM_break_even(benchmark::State& state) {
     BreakEvenScene& s = scene();
     const int level = static_cast<int>(state.range(0));
     const auto cone = static_cast<NormalConeKind>(state.range(1));
-    const DisplacedCullView view = make_displaced_cull_view(s.camera.view(), s.camera.projection(), ClipDepth::zero_to_one);
+    const DisplacedCullView view =
+        make_displaced_cull_view(s.camera.view(), s.camera.projection(), ClipDepth::zero_to_one);
     // Every patch culled (RT0: the draw issues every patch and the TCS discards each).
     const std::vector<std::uint8_t> all_culled(s.renderer->patch_count(), 1);
     // Warm-up outside the timing: shader compilation (seconds for con on llvmpipe) and first use.
@@ -120,8 +121,9 @@ void BM_break_even(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_break_even)
-    ->ArgsProduct({{2, 4, 8, 16}, {static_cast<int>(NormalConeKind::full), static_cast<int>(NormalConeKind::acon),
-                                   static_cast<int>(NormalConeKind::con)}})
+    ->ArgsProduct({{2, 4, 8, 16},
+                   {static_cast<int>(NormalConeKind::full), static_cast<int>(NormalConeKind::acon),
+                    static_cast<int>(NormalConeKind::con)}})
     ->ArgNames({"tess", "cone"})
     ->Iterations(3)
     ->Unit(benchmark::kMillisecond);

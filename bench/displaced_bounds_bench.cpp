@@ -97,7 +97,8 @@ void bm_displaced(benchmark::State& state, DisplacedBoundKind bound, NormalConeK
     DisplacedWorkload& w = displaced_workload(n);
     for (auto _ : state) {
         if (occlusion) {
-            cull_displaced_occlusion(w.batch.view(), w.ranges.data(), bound, cone, w.cull_view, w.hiz, w.decision.data());
+            cull_displaced_occlusion(w.batch.view(), w.ranges.data(), bound, cone, w.cull_view, w.hiz,
+                                     w.decision.data());
         } else {
             cull_displaced_frustum(w.batch.view(), w.ranges.data(), bound, cone, w.cull_view, w.decision.data());
         }
@@ -132,7 +133,8 @@ int register_displaced() {
             for (NormalConeKind cone : {NormalConeKind::full, NormalConeKind::acon, NormalConeKind::con}) {
                 const std::string name = std::string(occlusion ? "displaced_occlusion/" : "displaced_frustum/") +
                                          displaced_bound_name(bound) + "_" + normal_cone_name(cone);
-                benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& s) { bm_displaced(s, bound, cone, occlusion); })
+                benchmark::RegisterBenchmark(name.c_str(),
+                                             [=](benchmark::State& s) { bm_displaced(s, bound, cone, occlusion); })
                     ->Arg(5168)
                     ->UseRealTime()
                     ->Unit(benchmark::kMicrosecond);

@@ -23,10 +23,10 @@
 #include <type_traits>
 #include <vector>
 
+#include "cull_bench_loop.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/parallel.h"
 #include "patchcull/core/patch.h"
-#include "cull_bench_loop.h"
 
 using namespace patchcull;
 
@@ -68,8 +68,8 @@ Workload& workload(std::size_t n, bool rational) {
         w.disp[p] = 0.1f * unit(rng);
     }
     w.batch = make_batch(patches);
-    w.object_to_clip = perspective(60.0f * 3.14159265f / 180, 16.0f / 9.0f, 0.1f, 200.0f) *
-                       look_at({0, 3, 15}, {0, 0, 0}, {0, 1, 0});
+    w.object_to_clip =
+        perspective(60.0f * 3.14159265f / 180, 16.0f / 9.0f, 0.1f, 200.0f) * look_at({0, 3, 15}, {0, 0, 0}, {0, 1, 0});
     w.planes = make_frustum_planes(w.object_to_clip, ClipDepth::zero_to_one);
     w.culled.assign(n, 0);
     return w;
@@ -85,7 +85,8 @@ void run_range(const Workload& w, Kernel k, Impl impl, std::size_t first, std::s
     if (k == Kernel::kFrustum) {
         (impl == Impl::kSimd ? cull_frustum_simd : cull_frustum_scalar)(v, d, w.planes, out);
     } else {
-        (impl == Impl::kSimd ? cull_frustum_disp_simd : cull_frustum_disp_scalar)(v, d, w.object_to_clip, ClipDepth::zero_to_one, out);
+        (impl == Impl::kSimd ? cull_frustum_disp_simd : cull_frustum_disp_scalar)(v, d, w.object_to_clip,
+                                                                                  ClipDepth::zero_to_one, out);
     }
 }
 
@@ -211,19 +212,25 @@ __attribute__((target("avx2,fma,avx512f"))) void fma_chains(std::int64_t iters, 
     std::conditional_t<kLanes == 16, __m512, __m256> a[12];
 #pragma GCC diagnostic pop
     for (int i = 0; i < 12; ++i) {
-        if constexpr (kLanes == 16) a[i] = _mm512_set1_ps(1.0f + i * 1e-3f);
-        else a[i] = _mm256_set1_ps(1.0f + i * 1e-3f);
+        if constexpr (kLanes == 16)
+            a[i] = _mm512_set1_ps(1.0f + i * 1e-3f);
+        else
+            a[i] = _mm256_set1_ps(1.0f + i * 1e-3f);
     }
     for (std::int64_t k = 0; k < iters; ++k) {
 #pragma GCC unroll 12
         for (int i = 0; i < 12; ++i) {
-            if constexpr (kLanes == 16) a[i] = _mm512_fmadd_ps(a[i], _mm512_set1_ps(0.999999f), _mm512_set1_ps(1e-7f));
-            else a[i] = _mm256_fmadd_ps(a[i], _mm256_set1_ps(0.999999f), _mm256_set1_ps(1e-7f));
+            if constexpr (kLanes == 16)
+                a[i] = _mm512_fmadd_ps(a[i], _mm512_set1_ps(0.999999f), _mm512_set1_ps(1e-7f));
+            else
+                a[i] = _mm256_fmadd_ps(a[i], _mm256_set1_ps(0.999999f), _mm256_set1_ps(1e-7f));
         }
     }
     for (int i = 0; i < 12; ++i) {  // every chain is live: sink holds 12 * 16 floats
-        if constexpr (kLanes == 16) _mm512_storeu_ps(sink + 16 * i, a[i]);
-        else _mm256_storeu_ps(sink + 16 * i, a[i]);
+        if constexpr (kLanes == 16)
+            _mm512_storeu_ps(sink + 16 * i, a[i]);
+        else
+            _mm256_storeu_ps(sink + 16 * i, a[i]);
     }
 }
 
@@ -245,7 +252,7 @@ void bm_fma_peak(benchmark::State& state) {
 }
 
 const std::vector<std::int64_t> kSizes = {1450, 5168, 65536};
-constexpr std::int64_t kL1Size = 128;     // 32 KiB of control points: fits the 48 KiB L1
+constexpr std::int64_t kL1Size = 128;        // 32 KiB of control points: fits the 48 KiB L1
 constexpr std::int64_t kDramSize = 1 << 20;  // 256 MiB of control points: far beyond the caches
 
 int register_all() {
@@ -255,7 +262,8 @@ int register_all() {
             for (bool mt : {false, true}) {
                 const std::string name =
                     kname + "/" + (impl == Impl::kSimd ? "simd" : "scalar") + "/" + (mt ? "all_threads" : "1_thread");
-                auto* b = benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& s) { bm_cull(s, k, impl, mt, false); });
+                auto* b = benchmark::RegisterBenchmark(name.c_str(),
+                                                       [=](benchmark::State& s) { bm_cull(s, k, impl, mt, false); });
                 for (std::int64_t n : kSizes) b->Arg(n);
                 if (impl == Impl::kSimd) b->Arg(kL1Size)->Arg(kDramSize);
                 b->UseRealTime()->Unit(benchmark::kMicrosecond);

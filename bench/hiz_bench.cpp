@@ -94,8 +94,8 @@ OcclusionWorkload& occlusion_workload(std::size_t n) {
             }
     }
     w.batch = make_batch(patches);
-    w.object_to_clip = perspective(60.0f * 3.14159265f / 180, 16.0f / 9.0f, 0.1f, 200.0f) *
-                       look_at({0, 3, 15}, {0, 0, 0}, {0, 1, 0});
+    w.object_to_clip =
+        perspective(60.0f * 3.14159265f / 180, 16.0f / 9.0f, 0.1f, 200.0f) * look_at({0, 3, 15}, {0, 0, 0}, {0, 1, 0});
     const int W = 1920, H = 1080;
     const std::vector<float> depth = synthetic_depth(W, H, 7);
     w.hiz.build(depth.data(), W, H);
@@ -138,7 +138,9 @@ int register_hiz() {
         benchmark::RegisterBenchmark("hiz_build", bm_build)->Args({W, H})->Unit(benchmark::kMicrosecond);
     for (std::int64_t n : {5168, 65536}) {
         benchmark::RegisterBenchmark("hiz_occlusion_scalar", bm_occlusion, false, false, false)->Arg(n);
-        benchmark::RegisterBenchmark("hiz_occlusion_scalar_mt", bm_occlusion, false, true, false)->Arg(n)->UseRealTime();
+        benchmark::RegisterBenchmark("hiz_occlusion_scalar_mt", bm_occlusion, false, true, false)
+            ->Arg(n)
+            ->UseRealTime();
         benchmark::RegisterBenchmark("hiz_occlusion_simd", bm_occlusion, true, false, false)->Arg(n);
         benchmark::RegisterBenchmark("hiz_occlusion_simd_mt", bm_occlusion, true, true, false)->Arg(n)->UseRealTime();
         benchmark::RegisterBenchmark("hiz_occlusion_simd_2x2screen", bm_occlusion, true, false, true)->Arg(n);

@@ -31,13 +31,13 @@
 #include <string>
 #include <vector>
 
+#include "cull_bench_loop.h"
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/fused_cull.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/parallel.h"
 #include "patchcull/core/patch.h"
-#include "cull_bench_loop.h"
 
 using namespace patchcull;
 
@@ -149,7 +149,8 @@ HiZPyramid make_pyramid() {
         const int w = 1 + static_cast<int>(unit(rng) * W * 0.3f), h = 1 + static_cast<int>(unit(rng) * H * 0.3f);
         const float z = (zf / (zf - zn)) * (1 - zn / (8 + 12 * unit(rng)));
         for (int y = y0; y < std::min(H, y0 + h); ++y)
-            for (int x = x0; x < std::min(W, x0 + w); ++x) depth[static_cast<std::size_t>(y) * W + x] = std::min(depth[static_cast<std::size_t>(y) * W + x], z);
+            for (int x = x0; x < std::min(W, x0 + w); ++x)
+                depth[static_cast<std::size_t>(y) * W + x] = std::min(depth[static_cast<std::size_t>(y) * W + x], z);
     }
     HiZPyramid hiz;
     hiz.build(depth.data(), W, H);
@@ -195,21 +196,32 @@ enum class Layout { kPlain, kPlainPrefetch, kBlocked, kBlockedPrefetch };
 
 const char* kernel_name(Kernel k) {
     switch (k) {
-        case Kernel::kFrustum: return "frustum";
-        case Kernel::kFrustumDisp: return "frustum_disp";
-        case Kernel::kTcone: return "tcone";
-        case Kernel::kNcone: return "ncone";
-        case Kernel::kPtp: return "ptp";
-        case Kernel::kOcclusion: return "occlusion";
-        default: return "fused";
+        case Kernel::kFrustum:
+            return "frustum";
+        case Kernel::kFrustumDisp:
+            return "frustum_disp";
+        case Kernel::kTcone:
+            return "tcone";
+        case Kernel::kNcone:
+            return "ncone";
+        case Kernel::kPtp:
+            return "ptp";
+        case Kernel::kOcclusion:
+            return "occlusion";
+        default:
+            return "fused";
     }
 }
 const char* layout_name(Layout l) {
     switch (l) {
-        case Layout::kPlain: return "plain";
-        case Layout::kPlainPrefetch: return "plain_prefetch";
-        case Layout::kBlocked: return "blocked";
-        default: return "blocked_prefetch";
+        case Layout::kPlain:
+            return "plain";
+        case Layout::kPlainPrefetch:
+            return "plain_prefetch";
+        case Layout::kBlocked:
+            return "blocked";
+        default:
+            return "blocked_prefetch";
     }
 }
 
@@ -218,15 +230,27 @@ void run_kernel(const Workload& w, Kernel k, const PatchBatchView& all, std::siz
     const PatchBatchView v = all.subrange(first, last - first);
     std::uint8_t* out = culled + first;
     switch (k) {
-        case Kernel::kFrustum: cull_frustum_simd(v, w.disp.data() + first, w.planes, out); break;
+        case Kernel::kFrustum:
+            cull_frustum_simd(v, w.disp.data() + first, w.planes, out);
+            break;
         case Kernel::kFrustumDisp:
             cull_frustum_disp_simd(v, w.disp.data() + first, w.object_to_clip, ClipDepth::zero_to_one, out);
             break;
-        case Kernel::kTcone: cull_tcone_simd(v, w.eye, out); break;
-        case Kernel::kNcone: cull_ncone_simd(v, w.eye, out); break;
-        case Kernel::kPtp: cull_ptp_simd(v, w.object_to_clip, w.alpha, PtpRule::ncnt, out); break;
-        case Kernel::kOcclusion: cull_occlusion_simd(v, w.object_to_clip, ClipDepth::zero_to_one, w.hiz, out); break;
-        case Kernel::kFused: cull_fused_simd(v, w.fused, FusedPlan{}, out); break;
+        case Kernel::kTcone:
+            cull_tcone_simd(v, w.eye, out);
+            break;
+        case Kernel::kNcone:
+            cull_ncone_simd(v, w.eye, out);
+            break;
+        case Kernel::kPtp:
+            cull_ptp_simd(v, w.object_to_clip, w.alpha, PtpRule::ncnt, out);
+            break;
+        case Kernel::kOcclusion:
+            cull_occlusion_simd(v, w.object_to_clip, ClipDepth::zero_to_one, w.hiz, out);
+            break;
+        case Kernel::kFused:
+            cull_fused_simd(v, w.fused, FusedPlan{}, out);
+            break;
     }
 }
 
@@ -267,7 +291,8 @@ void bm_scaling(benchmark::State& state, Kernel k, bool all_threads) {
     const std::size_t grain = std::max<std::size_t>(16, (n + 16 * threads - 1) / (16 * threads) * 16);
     for (auto _ : state) {
         if (all_threads) {
-            parallel_for_ranges(n, grain, [&](std::size_t a, std::size_t b) { run_kernel(w, k, w.plain.view(), a, b, culled); });
+            parallel_for_ranges(n, grain,
+                                [&](std::size_t a, std::size_t b) { run_kernel(w, k, w.plain.view(), a, b, culled); });
         } else {
             run_kernel(w, k, w.plain.view(), 0, n, culled);
         }
@@ -288,8 +313,7 @@ void bm_prefetch(benchmark::State& state, Kernel k, bool blocked) {
     std::uint8_t* culled = w.culled.data();
     const PatchBatchView all = blocked ? w.blocked.view() : w.plain.view();
     bench::run_cull_benchmark(
-        state, n, culled, false, 0,
-        [&](std::size_t a, std::size_t b) { run_kernel(w, k, all, a, b, culled); },
+        state, n, culled, false, 0, [&](std::size_t a, std::size_t b) { run_kernel(w, k, all, a, b, culled); },
         [&] { return simd_target_name(); });
     state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * n * kBytesPerPatch));
 }
@@ -307,24 +331,23 @@ int register_all() {
             for (bool mt : {false, true}) {
                 const std::string name = std::string("layout/") + kernel_name(k) + "/" + layout_name(l) + "/" +
                                          (mt ? "all_threads" : "1_thread");
-                auto* b = benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& s) {
-                    bm_layout(s, k, l, mt);
-                });
+                auto* b =
+                    benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& s) { bm_layout(s, k, l, mt); });
                 for (std::int64_t n : kSizes) b->Arg(n);
                 b->UseRealTime()->Unit(benchmark::kMicrosecond);
             }
     for (Kernel k : {Kernel::kFrustum, Kernel::kFrustumDisp, Kernel::kTcone, Kernel::kNcone, Kernel::kPtp,
                      Kernel::kOcclusion, Kernel::kFused})
         for (bool mt : {false, true}) {
-            const std::string name =
-                std::string("scaling/") + kernel_name(k) + "/" + (mt ? "all_threads" : "1_thread");
+            const std::string name = std::string("scaling/") + kernel_name(k) + "/" + (mt ? "all_threads" : "1_thread");
             auto* b = benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& s) { bm_scaling(s, k, mt); });
             for (std::int64_t n = 256; n <= 65536; n *= 2) b->Arg(n);
             b->UseRealTime()->Unit(benchmark::kMicrosecond);
         }
     for (bool blocked : {false, true}) {
-        auto* b = benchmark::RegisterBenchmark(blocked ? "layout_prefetch/frustum/blocked" : "layout_prefetch/frustum/plain",
-                                               [=](benchmark::State& s) { bm_prefetch(s, Kernel::kFrustum, blocked); });
+        auto* b =
+            benchmark::RegisterBenchmark(blocked ? "layout_prefetch/frustum/blocked" : "layout_prefetch/frustum/plain",
+                                         [=](benchmark::State& s) { bm_prefetch(s, Kernel::kFrustum, blocked); });
         for (std::int64_t n : {std::int64_t{5168}, std::int64_t{65536}, std::int64_t{1} << 20})
             for (std::int64_t d : {0, 16, 32, 64, 128, 256, 512}) b->Args({n, d});
         b->UseRealTime()->Unit(benchmark::kMicrosecond);

@@ -20,8 +20,8 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/objects/bounding_volumes.h"
 #include "patchcull/core/frustum.h"
+#include "patchcull/objects/bounding_volumes.h"
 #include "patchcull/objects/object_bvh.h"
 
 using namespace patchcull;
@@ -47,9 +47,9 @@ const VolumeWorkload& volume_workload() {
         const std::size_t n = 4096;
         std::mt19937 rng(42);
         std::uniform_real_distribution<float> u(-1, 1), unit(0, 1);
-        v.planes = make_frustum_planes(perspective(1.0472f, 16.0f / 9.0f, 0.1f, 150.0f) *
-                                           look_at({0, 2, 0}, {0, 2, -10}, {0, 1, 0}),
-                                       ClipDepth::zero_to_one);
+        v.planes = make_frustum_planes(
+            perspective(1.0472f, 16.0f / 9.0f, 0.1f, 150.0f) * look_at({0, 2, 0}, {0, 2, -10}, {0, 1, 0}),
+            ClipDepth::zero_to_one);
         for (std::size_t i = 0; i < n; ++i) {
             const Vec3 c{160 * u(rng), 10 * u(rng), 160 * u(rng) - 60};
             const float s = 0.5f + 7.5f * unit(rng) * unit(rng);
@@ -89,17 +89,26 @@ void object_tests(benchmark::State& state, Vol vol, Impl impl) {
             for (std::size_t i = 0; i < n; ++i) {
                 PlaneCullState st;
                 switch (vol) {
-                    case Vol::kSphere: w.out[i] = classify_sphere(w.planes, w.spheres[i], st, tests); break;
-                    case Vol::kAabb: w.out[i] = classify_aabb(w.planes, w.boxes[i], st, tests); break;
-                    case Vol::kAabbCorners: w.out[i] = classify_aabb_corners(w.planes, w.boxes[i], tests); break;
-                    case Vol::kObb: w.out[i] = classify_obb(w.planes, w.obbs[i], st, tests); break;
+                    case Vol::kSphere:
+                        w.out[i] = classify_sphere(w.planes, w.spheres[i], st, tests);
+                        break;
+                    case Vol::kAabb:
+                        w.out[i] = classify_aabb(w.planes, w.boxes[i], st, tests);
+                        break;
+                    case Vol::kAabbCorners:
+                        w.out[i] = classify_aabb_corners(w.planes, w.boxes[i], tests);
+                        break;
+                    case Vol::kObb:
+                        w.out[i] = classify_obb(w.planes, w.obbs[i], st, tests);
+                        break;
                 }
             }
         } else {
             const bool simd = impl == Impl::kSimd;
             switch (vol) {
                 case Vol::kSphere:
-                    (simd ? classify_spheres_simd : classify_spheres_scalar)(w.planes, w.spheres.data(), n, w.out.data());
+                    (simd ? classify_spheres_simd : classify_spheres_scalar)(w.planes, w.spheres.data(), n,
+                                                                             w.out.data());
                     break;
                 case Vol::kAabb:
                     (simd ? classify_aabbs_simd : classify_aabbs_scalar)(w.planes, w.boxes.data(), n, w.out.data());
@@ -107,14 +116,16 @@ void object_tests(benchmark::State& state, Vol vol, Impl impl) {
                 case Vol::kObb:
                     (simd ? classify_obbs_simd : classify_obbs_scalar)(w.planes, w.obbs.data(), n, w.out.data());
                     break;
-                case Vol::kAabbCorners: break;
+                case Vol::kAabbCorners:
+                    break;
             }
         }
         benchmark::DoNotOptimize(w.out.data());
         benchmark::ClobberMemory();
     }
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));
-    if (impl == Impl::kSingle) state.counters["plane_tests_per_volume"] = double(tests) / (double(state.iterations()) * n);
+    if (impl == Impl::kSingle)
+        state.counters["plane_tests_per_volume"] = double(tests) / (double(state.iterations()) * n);
     report_mix(state, w.out);
 }
 
@@ -163,9 +174,9 @@ const CityScene& city(std::size_t n) {
         const Vec3 eye{street_x, 1.7f, 2.0f - 0.5f * f};
         const float yaw = 0.3f * std::sin(0.1f * f);
         const Vec3 target = eye + Vec3{std::sin(yaw), 0, -std::cos(yaw)};
-        s.frames.push_back(make_frustum_planes(perspective(1.0472f, 16.0f / 9.0f, 0.1f, 120.0f) *
-                                                   look_at(eye, target, {0, 1, 0}),
-                                               ClipDepth::zero_to_one));
+        s.frames.push_back(
+            make_frustum_planes(perspective(1.0472f, 16.0f / 9.0f, 0.1f, 120.0f) * look_at(eye, target, {0, 1, 0}),
+                                ClipDepth::zero_to_one));
     }
     return s;
 }

@@ -31,9 +31,9 @@
 
 #include "patchcull/core/camera.h"
 #include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_object_level.h"
 #include "patchcull/import/scene_poser.h"
 #include "patchcull/objects/object_culling.h"
-#include "patchcull/import/scene_object_level.h"
 
 using namespace patchcull;
 
@@ -54,7 +54,7 @@ struct CityCase {
     std::unique_ptr<ScenePoser> poser;
     std::vector<std::vector<BezierPatch>> poses;  // frames 1..kFrames
     std::vector<DisplacementRange> ranges;
-    std::vector<Camera> cameras;                  // frames 0..kFrames
+    std::vector<Camera> cameras;  // frames 0..kFrames
     std::unique_ptr<SceneObjectLevel> level;
     // Per timed frame: the boxes of SceneObjectLevel::cull and the world -> object maps of the
     // instances (for the cull/* benchmarks, which call ObjectCuller::cull directly).

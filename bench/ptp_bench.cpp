@@ -20,16 +20,15 @@
 #include <string>
 #include <vector>
 
+#include "cull_bench_loop.h"
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/parallel.h"
 #include "patchcull/core/patch.h"
-#include "cull_bench_loop.h"
 
 using namespace patchcull;
 
 namespace {
-
 
 struct PtpWorkload {
     PatchBatch batch;
@@ -95,8 +94,9 @@ int register_ptp() {
             for (std::int64_t n : sizes) b->Arg(n);
             b->UseRealTime()->Unit(benchmark::kMicrosecond);
         }
-    benchmark::RegisterBenchmark("ptp/simd_avx2/1_thread",
-                                 [](benchmark::State& s) { bm_ptp(s, PtpImpl::kSimd, false, PtpRule::ncnt, false, HWY_AVX2); })
+    benchmark::RegisterBenchmark(
+        "ptp/simd_avx2/1_thread",
+        [](benchmark::State& s) { bm_ptp(s, PtpImpl::kSimd, false, PtpRule::ncnt, false, HWY_AVX2); })
         ->Arg(11532)
         ->UseRealTime()
         ->Unit(benchmark::kMicrosecond);

@@ -110,7 +110,8 @@ int run(int width, int height, bool misdeclare) {
         const char* name;
         pc::Vec3 at;
     };
-    const Instance instances[] = {{"in front", {0, -0.3f, -3}}, {"hidden", {0, -0.3f, -10}}, {"beside", {6, -0.3f, -10}}};
+    const Instance instances[] = {
+        {"in front", {0, -0.3f, -3}}, {"hidden", {0, -0.3f, -10}}, {"beside", {6, -0.3f, -10}}};
     int failures = 0;
     auto fail = [&](const char* what, const char* message) {
         std::printf("FAILED (%s teapot): %s\n", what, message);
@@ -145,7 +146,8 @@ int run(int width, int height, bool misdeclare) {
         const bool front = instance.at.z > -5, hidden = instance.at.x == 0 && !front;
         if (front && occluded > 0) fail(instance.name, "a patch in front of the occluder was culled");
         // (A very narrow screen puts some hidden patches outside the frustum: culled too.)
-        if (hidden && occluded + outside != batch.size()) fail(instance.name, "a patch hidden behind the occluder was kept");
+        if (hidden && occluded + outside != batch.size())
+            fail(instance.name, "a patch hidden behind the occluder was kept");
     }
     std::printf(failures ? "FAILED\n" : "ok\n");
     return failures ? 1 : 0;
@@ -164,7 +166,8 @@ int main(int argc, char** argv) {
                 continue;
             }
             if (arg != "--size")
-                throw pc::Error("unknown argument " + pc::quote_input(arg) + " (usage: [--size WxH] [--misdeclare-depth])");
+                throw pc::Error("unknown argument " + pc::quote_input(arg) +
+                                " (usage: [--size WxH] [--misdeclare-depth])");
             const std::string value = i + 1 < argc ? argv[++i] : "";
             if (!parse_size(value, width, height))
                 throw pc::Error("--size: expected WIDTHxHEIGHT, each in 64..4096, got " + pc::quote_input(value));

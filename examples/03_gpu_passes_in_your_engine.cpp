@@ -80,11 +80,11 @@
 #include "patchcull/core/displacement.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
-#include "patchcull/gl/gl_passes.h"
 #include "patchcull/core/math.h"
 #include "patchcull/core/patch.h"
-#include "patchcull/import/model_loader.h"
 #include "patchcull/core/teapot.h"
+#include "patchcull/gl/gl_passes.h"
+#include "patchcull/import/model_loader.h"
 #include "shared.h"  // shaders/shared.h: C++ and GLSL at once
 
 namespace pc = patchcull;
@@ -151,10 +151,14 @@ Options parse_options(int argc, char** argv) {
                 !parse_int(value.substr(x + 1), 1, 8192, o.height))
                 setup_error("--size: expected WIDTHxHEIGHT, each in 1..8192, got " + pc::quote_input(value));
         } else if (flag == "--backpatch") {
-            if (value == "tcone") o.backpatch = pc::gl::BackpatchMethod::tcone;
-            else if (value == "ncone") o.backpatch = pc::gl::BackpatchMethod::ncone;
-            else if (value == "ptp") o.backpatch = pc::gl::BackpatchMethod::ptp;
-            else setup_error("--backpatch: expected tcone, ncone or ptp, got " + pc::quote_input(value));
+            if (value == "tcone")
+                o.backpatch = pc::gl::BackpatchMethod::tcone;
+            else if (value == "ncone")
+                o.backpatch = pc::gl::BackpatchMethod::ncone;
+            else if (value == "ptp")
+                o.backpatch = pc::gl::BackpatchMethod::ptp;
+            else
+                setup_error("--backpatch: expected tcone, ncone or ptp, got " + pc::quote_input(value));
         } else if (flag == "--bound") {
             if (!pc::parse_displaced_bound(value.c_str(), o.bound))
                 setup_error("--bound: expected caf or oobb, got " + pc::quote_input(value));
@@ -204,7 +208,8 @@ std::string expand_includes(const std::string& source) {
         const std::string directive = "#include \"";
         if (line.rfind(directive, 0) == 0 && line.size() > directive.size() + 1 && line.back() == '"') {
             const std::string name = line.substr(directive.size(), line.size() - directive.size() - 1);
-            const std::string_view text = name == "example_patch_eval.glsl" ? kPatchEvalGlsl : pc::gl::shipped_glsl(name);
+            const std::string_view text =
+                name == "example_patch_eval.glsl" ? kPatchEvalGlsl : pc::gl::shipped_glsl(name);
             if (text.empty()) setup_error("GLSL header " + name + " is not shipped by patchcull");
             out += std::string(text) + "\n";
         } else {
@@ -464,15 +469,15 @@ View camera(int frame, int frames_per_position, float aspect) {
         float azimuth, elevation, distance;
         pc::Vec3 target;
     };
-    const Position positions[] = {{15, 12, 13, {-1.5f, -1.2f, 1.3f}},
-                                  {-10, 10, 3.5f, {0.2f, 0, 1.5f}},
-                                  {-120, 55, 12, {-1.5f, -2.0f, 1.0f}}};
+    const Position positions[] = {
+        {15, 12, 13, {-1.5f, -1.2f, 1.3f}}, {-10, 10, 3.5f, {0.2f, 0, 1.5f}}, {-120, 55, 12, {-1.5f, -2.0f, 1.0f}}};
     const Position& p = positions[frame / frames_per_position];
     const float deg = 3.14159265f / 180;
     const float azimuth = (p.azimuth + 4.0f * static_cast<float>(frame % frames_per_position)) * deg;
     const float elevation = p.elevation * deg;
     const pc::Vec3 eye = p.target + pc::Vec3{std::cos(elevation) * std::cos(azimuth),
-                                             std::cos(elevation) * std::sin(azimuth), std::sin(elevation)} * p.distance;
+                                             std::cos(elevation) * std::sin(azimuth), std::sin(elevation)} *
+                                        p.distance;
     // patchcull's perspective() is a zero-to-one depth projection (clip_space.h), matching
     // glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) below.
     return {pc::look_at(eye, p.target, {0, 0, 1}), pc::perspective(0.9f, aspect, 0.1f, 60.0f), eye};
@@ -525,15 +530,16 @@ struct Renderer {
         glUniform1f(loc_scale, displacement_scale);
         glUniform1f(loc_midlevel, displacement_midlevel);
         glBindVertexArray(vao);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullFlags, flag_buffer);  // read by the TCS
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, patch_buffer);  // fragment shader
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingMaxDisplacement, margin_buffer);  // TES
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullFlags, flag_buffer);           // read by the TCS
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, patch_buffer);      // fragment shader
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingMaxDisplacement, margin_buffer);   // TES
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchTexcoords, texcoord_buffer);  // TES
         glBindTextureUnit(sh::kTextureUnitDisplacement, height_texture);
         glPatchParameteri(GL_PATCH_VERTICES, 16);
         // llvmpipe garbles a 4096-vertex chunk that yields more than 65536 tessellated vertices
         // (gl_renderer.h): sub-draws of at most 65536 / (level + 1)^2 patches avoid it.
-        const std::size_t per_draw = std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((level + 1) * (level + 1)));
+        const std::size_t per_draw =
+            std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((level + 1) * (level + 1)));
         for (std::size_t first = 0; first < patch_count; first += per_draw)
             glDrawArrays(GL_PATCHES, static_cast<GLint>(16 * first),
                          static_cast<GLsizei>(16 * std::min(per_draw, patch_count - first)));
@@ -599,8 +605,10 @@ Comparison compare(const std::vector<std::uint32_t>& ids, const std::vector<floa
             const bool pass2 = !aggressive && (words_after[p] & sh::kDrawMaskSecondPass) == sh::kDrawValueSecondPass;
             tie = pass1 || pass2;
         }
-        if (tie) ++c.ties;
-        else ++c.differing;
+        if (tie)
+            ++c.ties;
+        else
+            ++c.differing;
     }
     return c;
 }
@@ -630,7 +638,8 @@ int run(const Options& options) {
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
-    GLFWwindow* window = glfwCreateWindow(options.width, options.height, "patchcull passes in your engine", nullptr, nullptr);
+    GLFWwindow* window =
+        glfwCreateWindow(options.width, options.height, "patchcull passes in your engine", nullptr, nullptr);
     if (!window) setup_error("GLFW: no OpenGL 4.5 core context: " + g_glfw_error);
     glfwMakeContextCurrent(window);
     glfwSwapInterval(0);
@@ -736,11 +745,12 @@ int run(const Options& options) {
     char bound_name[32];
     std::snprintf(bound_name, sizeof bound_name, "%s/%s", pc::displaced_bound_name(options.bound),
                   pc::normal_cone_name(options.cone));
-    std::printf("%s, %zu patches (teapot %zu two-sided, bigguy %zu one-sided, frog %zu displaced), %dx%d, "
-                "tessellation level %g, back-patch %s, displaced bound %s, %d frames at 3 camera positions\n",
-                reinterpret_cast<const char*>(glGetString(GL_RENDERER)), n, scene.teapot.count, scene.bigguy.count,
-                scene.frog.count, r.width, r.height, static_cast<double>(r.level), backpatch_name, bound_name,
-                3 * options.frames);
+    std::printf(
+        "%s, %zu patches (teapot %zu two-sided, bigguy %zu one-sided, frog %zu displaced), %dx%d, "
+        "tessellation level %g, back-patch %s, displaced bound %s, %d frames at 3 camera positions\n",
+        reinterpret_cast<const char*>(glGetString(GL_RENDERER)), n, scene.teapot.count, scene.bigguy.count,
+        scene.frog.count, r.width, r.height, static_cast<double>(r.level), backpatch_name, bound_name,
+        3 * options.frames);
     const float aspect = static_cast<float>(r.width) / static_cast<float>(r.height);
     int mismatched = 0;
     std::size_t total_frustum = 0, total_backpatch = 0, total_occlusion = 0, total_displaced = 0;
@@ -827,14 +837,15 @@ int run(const Options& options) {
         total_displaced += displaced_hiz;
         std::string verdict = ok ? "ids match" : "IDS DIFFER in " + std::to_string(cmp.differing) + " pixels";
         if (cmp.ties) verdict += " (" + std::to_string(cmp.ties) + " exact depth-tie pixels, both patches drawn)";
-        std::printf("frame %d (camera %d): culled frustum %u (teapot %u, bigguy %u, frog %u), back-patch %u "
-                    "(bigguy %u), occlusion %u (teapot %u, bigguy %u), displaced occlusion %u (frog); "
-                    "drawn pass 1 %u, pass 2 %u%s; %s\n",
-                    f, f / options.frames, c.total(sh::kCounterFrustum), c.slot[0][sh::kCounterFrustum],
-                    c.slot[1][sh::kCounterFrustum], c.slot[2][sh::kCounterFrustum], c.total(sh::kCounterBackPatch),
-                    c.slot[1][sh::kCounterBackPatch], occlusion_hiz, c.slot[0][sh::kCounterOcclusion], c.slot[1][sh::kCounterOcclusion], displaced_hiz,
-                    c.total(sh::kCounterWasVisible), c.total(sh::kCounterNewlyVisible),
-                    options.aggressive ? " (skipped: --aggressive)" : "", verdict.c_str());
+        std::printf(
+            "frame %d (camera %d): culled frustum %u (teapot %u, bigguy %u, frog %u), back-patch %u "
+            "(bigguy %u), occlusion %u (teapot %u, bigguy %u), displaced occlusion %u (frog); "
+            "drawn pass 1 %u, pass 2 %u%s; %s\n",
+            f, f / options.frames, c.total(sh::kCounterFrustum), c.slot[0][sh::kCounterFrustum],
+            c.slot[1][sh::kCounterFrustum], c.slot[2][sh::kCounterFrustum], c.total(sh::kCounterBackPatch),
+            c.slot[1][sh::kCounterBackPatch], occlusion_hiz, c.slot[0][sh::kCounterOcclusion],
+            c.slot[1][sh::kCounterOcclusion], displaced_hiz, c.total(sh::kCounterWasVisible),
+            c.total(sh::kCounterNewlyVisible), options.aggressive ? " (skipped: --aggressive)" : "", verdict.c_str());
         std::fflush(stdout);
         glfwSwapBuffers(window);
         glfwPollEvents();
@@ -866,9 +877,10 @@ int run(const Options& options) {
                         pass.pass.c_str());
             return 1;
         }
-    std::printf("all %d frames match the unculled draw (patch-frames culled: %zu frustum, %zu back-patch %s, "
-                "%zu occlusion, %zu displaced occlusion %s)\n",
-                frames, total_frustum, total_backpatch, backpatch_name, total_occlusion, total_displaced, bound_name);
+    std::printf(
+        "all %d frames match the unculled draw (patch-frames culled: %zu frustum, %zu back-patch %s, "
+        "%zu occlusion, %zu displaced occlusion %s)\n",
+        frames, total_frustum, total_backpatch, backpatch_name, total_occlusion, total_displaced, bound_name);
     return 0;
 }
 

@@ -24,14 +24,14 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/import/builtin_scenes.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/ground_truth.h"
-#include "patchcull/objects/object_culling.h"
+#include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/scene_file.h"
 #include "patchcull/import/scene_object_level.h"
+#include "patchcull/import/scene_poser.h"
+#include "patchcull/objects/object_culling.h"
 
 namespace pc = patchcull;
 
@@ -75,8 +75,8 @@ int run(const Options& options) {
                                                  : pc::load_scene_file(options.scene_file);
     // Patch clusters may cull only when patches are drawn one-sided: every model a closed solid.
     pc::ObjectLevelSetup setup;
-    setup.patches_one_sided = std::all_of(scene.models.begin(), scene.models.end(),
-                                          [](const pc::LoadedModel& m) { return m.closed; });
+    setup.patches_one_sided =
+        std::all_of(scene.models.begin(), scene.models.end(), [](const pc::LoadedModel& m) { return m.closed; });
     pc::SceneObjectLevel level(scene, setup);  // reorders occluder triangles: build before drawing them
     pc::ScenePoser poser(scene);
     pc::ObjectCullOptions object_options;
@@ -105,8 +105,8 @@ int run(const Options& options) {
         const pc::Camera& camera = cameras[f];
         const pc::ObjectCullResult& objects = level.cull(pose, ranges, t, camera, kViewHeight, object_options);
         const pc::FrustumPlanes frustum = pc::make_frustum_planes(camera.view_projection(), pc::ClipDepth::zero_to_one);
-        const std::size_t tested = pc::cull_frustum_after_objects(objects, batch.view(), margins.data(), frustum,
-                                                                  culled.data());
+        const std::size_t tested =
+            pc::cull_frustum_after_objects(objects, batch.view(), margins.data(), frustum, culled.data());
 
         // Ground truth for every culled patch (object spans and kernel alike).
         std::size_t culled_now = 0, wrong = 0;
@@ -129,10 +129,11 @@ int run(const Options& options) {
                 }
         }
         const pc::ObjectCullStats& s = objects.stats;
-        std::printf("frame %d: objects culled %zu (frustum) + %zu (back-facing) + %zu (detail) of %zu; patches skipped %zu "
-                    "(%zu in back-facing clusters), tested %zu, culled in all %zu of %zu; %zu false culls\n",
-                    f, s.frustum_culled, s.backface_culled, s.detail_culled, s.total, s.patches_culled, s.backface_patches_culled,
-                    tested, culled_now, n, wrong);
+        std::printf(
+            "frame %d: objects culled %zu (frustum) + %zu (back-facing) + %zu (detail) of %zu; patches skipped %zu "
+            "(%zu in back-facing clusters), tested %zu, culled in all %zu of %zu; %zu false culls\n",
+            f, s.frustum_culled, s.backface_culled, s.detail_culled, s.total, s.patches_culled,
+            s.backface_patches_culled, tested, culled_now, n, wrong);
         total_culled += s.patches_culled;
         false_culls += wrong;
     }

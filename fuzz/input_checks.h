@@ -17,8 +17,8 @@
 #include <string>
 
 #include "patchcull/core/error.h"
-#include "patchcull/import/image.h"
 #include "patchcull/core/mesh.h"
+#include "patchcull/import/image.h"
 #include "patchcull/import/obj.h"
 
 namespace patchcull::fuzz {

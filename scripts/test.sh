@@ -3,25 +3,40 @@
 # tests with AddressSanitizer + UndefinedBehaviorSanitizer and runs them, runs a short fuzz
 # campaign over the input loaders (scripts/fuzz.sh, clang), then builds everything in Release with
 # warnings as errors (PATCHCULL_WERROR) and runs the whole suite, two tests at a time (ctest's
-# summary line comes last). The sanitizer build compiles the SIMD kernels for the wide targets only
-# (AVX2, AVX-512 and the portable one; the Release build has all five): their tails are where a
-# stray load would be.
+# summary line comes before the phases' times).
+# The sanitizer tree is the kernels' (the core suite, no GL: the CLI and GL suites run in Release)
+# and compiles the SIMD kernels for the wide targets and the portable one only (AVX2, AVX-512,
+# EMU128; the Release build has all five): their group tails are where a stray load would be.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS="$(nproc)"
+phases=""
+phase_start=$SECONDS
+end_phase() {
+  phases+="  $1: $((SECONDS - phase_start)) s"$'\n'
+  phase_start=$SECONDS
+}
 
 ./scripts/install-deps.sh
 
 echo "== core tests under ASan + UBSan =="
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DPATCHCULL_SANITIZE=ON -DPATCHCULL_BUILD_BENCHMARKS=OFF \
-  "-DCMAKE_CXX_FLAGS=-DHWY_DISABLED_TARGETS=(HWY_SSSE3|HWY_SSE4)" >/dev/null
-cmake --build build-asan -j"$JOBS" --target patchcull_core_tests patchcull_cli patchcull_cli_tests
-ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j"$JOBS" -L "core|cli" --output-on-failure
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DPATCHCULL_SANITIZE=ON -DPATCHCULL_WITH_GL=OFF \
+  -DPATCHCULL_BUILD_BENCHMARKS=OFF -DPATCHCULL_BUILD_EXAMPLES=OFF -DPATCHCULL_BUILD_TOOLS=OFF \
+  -DPATCHCULL_WIDE_SIMD_TARGETS_ONLY=ON >/dev/null
+cmake --build build-asan -j"$JOBS" --target patchcull_core_tests
+ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j"$JOBS" -L core --output-on-failure
+end_phase "sanitizer build and core suite"
 
 echo "== fuzz campaign (libFuzzer, clang: OBJ reader and PNG loader, 20 s each) =="
 ./scripts/fuzz.sh 20
+end_phase "fuzz campaign"
 
 echo "== full suite (Release) =="
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPATCHCULL_WERROR=ON >/dev/null
 cmake --build build -j"$JOBS"
-ctest --test-dir build -j"$JOBS" --output-on-failure
+end_phase "Release build"
+status=0
+ctest --test-dir build -j"$JOBS" --output-on-failure || status=$?
+end_phase "Release suite"
+printf 'test.sh phases (wall clock, %s cores):\n%s' "$JOBS" "$phases"
+exit "$status"

@@ -65,7 +65,8 @@ double parse_real(const std::string& flag, const std::string& text, double min, 
 CLI::Option* add_int_option(CLI::App& command, const std::string& flag, int& target, int min, int max,
                             const std::string& description) {
     CLI::Option* option = command.add_option_function<std::string>(
-        flag, [&target, flag, min, max](const std::string& text) {
+        flag,
+        [&target, flag, min, max](const std::string& text) {
             target = static_cast<int>(parse_integer(flag, text, min, max));
         },
         description);
@@ -77,8 +78,7 @@ CLI::Option* add_int_option(CLI::App& command, const std::string& flag, int& tar
 CLI::Option* add_uint64_option(CLI::App& command, const std::string& flag, std::uint64_t& target, std::uint64_t max,
                                const std::string& description) {
     CLI::Option* option = command.add_option_function<std::string>(
-        flag, [&target, flag, max](const std::string& text) { target = parse_unsigned(flag, text, max); },
-        description);
+        flag, [&target, flag, max](const std::string& text) { target = parse_unsigned(flag, text, max); }, description);
     option->type_name("UINT 0.." + std::to_string(max));
     option->default_str(std::to_string(target));
     return option;
@@ -87,7 +87,8 @@ CLI::Option* add_uint64_option(CLI::App& command, const std::string& flag, std::
 CLI::Option* add_float_option(CLI::App& command, const std::string& flag, float& target, double min, double max,
                               const std::string& description) {
     CLI::Option* option = command.add_option_function<std::string>(
-        flag, [&target, flag, min, max](const std::string& text) {
+        flag,
+        [&target, flag, min, max](const std::string& text) {
             target = static_cast<float>(parse_real(flag, text, min, max));
         },
         description);
@@ -100,7 +101,8 @@ CLI::Option* add_float_option(CLI::App& command, const std::string& flag, float&
 CLI::Option* add_text_option(CLI::App& command, const std::string& flag, std::string& target,
                              const std::string& description) {
     CLI::Option* option = command.add_option_function<std::string>(
-        flag, [&target, flag](const std::string& text) {
+        flag,
+        [&target, flag](const std::string& text) {
             if (text.empty()) throw Error(flag + ": must not be empty");
             target = text;
         },
@@ -114,7 +116,8 @@ CLI::Option* add_choice_option(CLI::App& command, const std::string& flag, std::
     std::string names;
     for (const std::string& c : choices) names += (names.empty() ? "" : "|") + c;
     CLI::Option* option = command.add_option_function<std::string>(
-        flag, [&target, flag, choices, names](const std::string& text) {
+        flag,
+        [&target, flag, choices, names](const std::string& text) {
             for (const std::string& c : choices)
                 if (text == c) {
                     target = text;
@@ -145,7 +148,8 @@ ClipDepth parse_clip_depth_option(const std::string& text) {
 CLI::Option* add_size_option(CLI::App& command, const std::string& flag, std::string& target,
                              const std::string& description) {
     CLI::Option* option = command.add_option_function<std::string>(
-        flag, [&target, flag](const std::string& text) {
+        flag,
+        [&target, flag](const std::string& text) {
             // parse_size quotes the text as it is: only digits and 'x' reach it.
             if (text.find_first_not_of("0123456789x") != std::string::npos)
                 throw Error(flag + ": expected WIDTHxHEIGHT with each in 1..8192, got " + quote_input(text));
@@ -187,7 +191,8 @@ void check_output_file(const std::string& flag, const std::string& path) {
 CLI::Option* add_output_file_option(CLI::App& command, const std::string& flag, std::string& target,
                                     const std::string& description) {
     return command.add_option_function<std::string>(
-        flag, [&target, flag](const std::string& text) {
+        flag,
+        [&target, flag](const std::string& text) {
             check_output_file(flag, text);
             target = text;
         },

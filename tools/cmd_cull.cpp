@@ -11,9 +11,9 @@
 
 #include "cli_options.h"
 #include "commands.h"
-#include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
+#include "patchcull/eval/cull_eval.h"
 #include "progress.h"
 
 namespace patchcull::cli {
@@ -42,12 +42,12 @@ std::vector<std::string> split_methods(const std::string& list) {
 DistanceViews parse_distance_range(const std::string& text) {
     const std::size_t comma = text.find(',');
     if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos)
-        throw Error("--distance-range: expected A,B (two multiples of the containing distance), got " + quote_input(text));
+        throw Error("--distance-range: expected A,B (two multiples of the containing distance), got " +
+                    quote_input(text));
     DistanceViews d;
     d.min = float(parse_real("--distance-range", text.substr(0, comma), 1.0, 1000.0));
     d.max = float(parse_real("--distance-range", text.substr(comma + 1), 1.0, 1000.0));
-    if (d.max < d.min)
-        throw Error("--distance-range: A must not exceed B, got " + quote_input(text));
+    if (d.max < d.min) throw Error("--distance-range: A must not exceed B, got " + quote_input(text));
     return d;
 }
 
@@ -81,10 +81,12 @@ Runner add_cull_command(CLI::App& app) {
         options.views = state->views;
         options.seed = state->seed;
         if (state->view_mode == "distance") {
-            options.distance = state->distance_range.empty() ? DistanceViews{} : parse_distance_range(state->distance_range);
+            options.distance =
+                state->distance_range.empty() ? DistanceViews{} : parse_distance_range(state->distance_range);
         } else {
             if (!state->distance_range.empty())
-                throw Error("--distance-range: only with --view-mode distance (the view mode is " + state->view_mode + ")");
+                throw Error("--distance-range: only with --view-mode distance (the view mode is " + state->view_mode +
+                            ")");
             parse_view_mode(state->view_mode.c_str(), options.mode);
         }
         options.methods = split_methods(state->methods);
@@ -92,17 +94,19 @@ Runner add_cull_command(CLI::App& app) {
         print_warnings(model.warnings);
         // The back-patch truth is one-sided (sampled tangent planes facing the eye): it is the
         // renderer's visibility only for closed solids (README, "What contributes a pixel").
-        const bool backpatch_requested = std::any_of(options.methods.begin(), options.methods.end(), [](const std::string& m) {
-            return m != "frustum" && m != "frustum-disp";
-        });
+        const bool backpatch_requested =
+            std::any_of(options.methods.begin(), options.methods.end(),
+                        [](const std::string& m) { return m != "frustum" && m != "frustum-disp"; });
         const DisplacementMap displacement = displacement_from_options(state->model, model);
         // Views done on stderr when it is a terminal (progress.h); nothing with --json or a pipe.
         Progress progress("cull", "views", std::uint64_t(options.views), progress_wanted(state->json));
         options.on_view_done = [&progress](int done) { progress.step(std::uint64_t(done)); };
-        const CullEvalResult result = evaluate_cull(model.rest, displacement.empty() ? nullptr : &displacement, options);
+        const CullEvalResult result =
+            evaluate_cull(model.rest, displacement.empty() ? nullptr : &displacement, options);
         progress.finish();
         if (backpatch_requested && !model.closed)  // after the run: an error stays the only line
-            print_warnings({"cull: " + model.name + " is not a closed solid: it is drawn two-sided, and the back-patch "
+            print_warnings({"cull: " + model.name +
+                            " is not a closed solid: it is drawn two-sided, and the back-patch "
                             "methods' false culls here count only front-facing samples"});
         nlohmann::json out;
         out["model"] = model.name;
@@ -116,24 +120,25 @@ Runner add_cull_command(CLI::App& app) {
                                         {"fovy_degrees", DistanceViews::fovy_degrees},
                                         {"target", "centre"}};
         else if (options.mode == ViewMode::contain)
-            out["view_distribution"] = {{"distance_range", {1.05, 2.55}}, {"fovy_degrees", {30, 70}},
+            out["view_distribution"] = {{"distance_range", {1.05, 2.55}},
+                                        {"fovy_degrees", {30, 70}},
                                         {"target", "off centre, object kept in view"}};
         else
             out["view_distribution"] = {{"eye", "inside the object's box or the box enlarged 3x"},
-                                        {"fovy_degrees", {20, 90}}, {"target", "random direction"}};
+                                        {"fovy_degrees", {20, 90}},
+                                        {"target", "random direction"}};
         out["mean_eye_distance_radii"] = result.mean_eye_distance_radii;
         out["seed"] = state->seed;
         out["simd"] = simd_target_name();
         out["methods"] = nlohmann::json::object();
         for (const CullMethodResult& r : result.methods)
-            out["methods"][r.name] = {{"cull_rate", r.cull_rate}, {"false_culls", r.false_culls},
-                                      {"ns_per_patch", r.ns_per_patch}};
+            out["methods"][r.name] = {
+                {"cull_rate", r.cull_rate}, {"false_culls", r.false_culls}, {"ns_per_patch", r.ns_per_patch}};
         if (state->json) {
             std::cout << out.dump() << "\n";
         } else {
-            std::cout << model.name << ": " << result.patches << " patches, " << result.views << " "
-                      << state->view_mode << " views, eye " << result.mean_eye_distance_radii
-                      << " radii away on average\n";
+            std::cout << model.name << ": " << result.patches << " patches, " << result.views << " " << state->view_mode
+                      << " views, eye " << result.mean_eye_distance_radii << " radii away on average\n";
             for (const CullMethodResult& r : result.methods)
                 std::cout << "  " << r.name << ": cull rate " << 100.0 * r.cull_rate << "%, false culls "
                           << r.false_culls << ", " << r.ns_per_patch << " ns/patch\n";

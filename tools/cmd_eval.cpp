@@ -84,10 +84,11 @@ int run_occlusion(const OcclusionOptions& o) {
     } else {
         std::printf("%s: %zu patches, %d whole-object views at %dx%d, level %d\n", model.name.c_str(), patches, o.views,
                     width, height, o.tess);
-        std::printf("  occluded (Niessner & Loop §6.2): %.2f%% (min %.2f%%, max %.2f%%), %.1f frames to a stable "
-                    "visible set, %zu views unstable\n",
-                    100 * r.occluded_sum / n, 100 * (o.views ? r.occluded_min : 0.0), 100 * r.occluded_max,
-                    r.frames_sum / n, r.unstable_views);
+        std::printf(
+            "  occluded (Niessner & Loop §6.2): %.2f%% (min %.2f%%, max %.2f%%), %.1f frames to a stable "
+            "visible set, %zu views unstable\n",
+            100 * r.occluded_sum / n, 100 * (o.views ? r.occluded_min : 0.0), 100 * r.occluded_max, r.frames_sum / n,
+            r.unstable_views);
         std::printf("  back-patch (GPU, same views): tcone %.2f%%, ncone %.2f%%; false culls %zu\n",
                     100 * r.tcone_sum / n, 100 * r.ncone_sum / n, r.false_culls);
     }
@@ -97,7 +98,9 @@ int run_occlusion(const OcclusionOptions& o) {
 }  // namespace
 
 Runner add_eval_command(CLI::App& app) {
-    CLI::App* eval = app.add_subcommand("eval", "Reproduce the papers' evaluations (eval occlusion, eval displaced, eval temporal, eval scene, eval fused)");
+    CLI::App* eval = app.add_subcommand(
+        "eval",
+        "Reproduce the papers' evaluations (eval occlusion, eval displaced, eval temporal, eval scene, eval fused)");
     // At most one; none is reported by the runner ("eval: expected a subcommand ..."), which names
     // the command, unlike CLI11's own message.
     eval->require_subcommand(0, 1);
@@ -157,8 +160,12 @@ Runner add_eval_command(CLI::App& app) {
 
     auto scene = std::make_shared<SceneEvalOptions>();
     CLI::App* scene_command = eval->add_subcommand(
-        "scene", "Object-level occlusion (queries, CHC, CHC++, horizon, portals) beside per-patch Hi-Z on a scene's path");
-    add_text_option(*scene_command, "SCENE", scene->scene, "a built-in scene (city, building, default), a scene file (.json), or a model (OBJ or teapot) as render takes it")->required();
+        "scene",
+        "Object-level occlusion (queries, CHC, CHC++, horizon, portals) beside per-patch Hi-Z on a scene's path");
+    add_text_option(*scene_command, "SCENE", scene->scene,
+                    "a built-in scene (city, building, default), a scene file (.json), or a model (OBJ or teapot) as "
+                    "render takes it")
+        ->required();
     add_choice_option(*scene_command, "--scheme", scene->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*scene_command, "--frames", scene->frames, 1, 10000, "frames of the scene's camera path");
     add_size_option(*scene_command, "--size", scene->size, "framebuffer size");
@@ -176,12 +183,17 @@ Runner add_eval_command(CLI::App& app) {
     auto fused = std::make_shared<FusedEvalOptions>();
     CLI::App* fused_command = eval->add_subcommand(
         "fused", "The fused CPU cull kernel's fixed plans against its cost model on a scene's path");
-    add_text_option(*fused_command, "SCENE", fused->scene, "a built-in scene (city, building, default), a scene file (.json), or a model (OBJ or teapot) as render takes it")->required();
+    add_text_option(*fused_command, "SCENE", fused->scene,
+                    "a built-in scene (city, building, default), a scene file (.json), or a model (OBJ or teapot) as "
+                    "render takes it")
+        ->required();
     add_choice_option(*fused_command, "--scheme", fused->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*fused_command, "--frames", fused->frames, 1, 10000, "frames of the scene's camera path");
     add_size_option(*fused_command, "--size", fused->size, "framebuffer size (the depth that feeds the Hi-Z pyramid)");
-    add_int_option(*fused_command, "--tess", fused->tess, 1, 64, "uniform tessellation level of the unculled render (the check)");
-    add_int_option(*fused_command, "--repeats", fused->repeats, 1, 1000, "timed runs per object, plan and frame (minimum kept)");
+    add_int_option(*fused_command, "--tess", fused->tess, 1, 64,
+                   "uniform tessellation level of the unculled render (the check)");
+    add_int_option(*fused_command, "--repeats", fused->repeats, 1, 1000,
+                   "timed runs per object, plan and frame (minimum kept)");
     add_int_option(*fused_command, "--profile-interval", fused->profile_interval, 1, 10000,
                    "frames between an object's profiling runs (cost model)");
     add_choice_option(*fused_command, "--cone", fused->cone, {"tcone", "ncone"}, "the back-patch cone test");
@@ -194,8 +206,9 @@ Runner add_eval_command(CLI::App& app) {
         if (temporal_command->parsed()) return run_temporal_eval(*temporal);
         if (scene_command->parsed()) return run_scene_eval(*scene);
         if (fused_command->parsed()) return run_fused_eval(*fused);
-        throw Error("eval: expected a subcommand: occlusion, displaced, temporal, scene or fused (e.g. patchcull eval "
-                    "occlusion MODEL --json)");
+        throw Error(
+            "eval: expected a subcommand: occlusion, displaced, temporal, scene or fused (e.g. patchcull eval "
+            "occlusion MODEL --json)");
     };
 }
 

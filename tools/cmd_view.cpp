@@ -1,8 +1,8 @@
 // `patchcull view [MODEL|default] ...`: the `render` pipeline (Niessner & Loop §3, with Loop,
-// Niessner & Eisenacher's GPU back-patch pass) in a window (viewer/viewer_app.h). Interactive (no --frames, or with --script): an
-// orbit/fly camera, a Dear ImGui panel with every cull test, method, bound and cone, the
-// tessellation, the displacement and the status colouring of cull.png live, keys for the main
-// toggles and a screenshot key; --script FILE drives it by frame number (viewer/viewer_script.h).
+// Niessner & Eisenacher's GPU back-patch pass) in a window (viewer/viewer_app.h). Interactive (no --frames, or with
+// --script): an orbit/fly camera, a Dear ImGui panel with every cull test, method, bound and cone, the tessellation,
+// the displacement and the status colouring of cull.png live, keys for the main toggles and a screenshot key; --script
+// FILE drives it by frame number (viewer/viewer_script.h).
 // --frames N without a script plays render's camera path for N frames with no panel (the window
 // shows `render --out`'s images; --screenshot writes the last one), a line per frame.
 // --tess-mode / --tess-distance, --displace, --cull auto and the object-level flags as `render`.
@@ -12,13 +12,11 @@
 
 #include "cli_options.h"
 #include "commands.h"
+#include "cull_mode_names.h"
 #include "object_level_options.h"
-#include "patchcull/import/scene_model.h"
 #include "patchcull/core/error.h"
 #include "patchcull/import/scene_file.h"
-#include "cull_mode_names.h"
-#include "render_options.h"
-#include "cull_mode_names.h"
+#include "patchcull/import/scene_model.h"
 #include "render_options.h"
 #include "render_support.h"
 #include "viewer/viewer_app.h"
@@ -63,7 +61,9 @@ Runner add_view_command(CLI::App& app) {
     };
     auto state = std::make_shared<State>();
     CLI::App* command = app.add_subcommand("view", "Show the GPU cull pipeline in a window (GLFW, Dear ImGui panel)");
-    add_text_option(*command, "MODEL", state->model, "OBJ control mesh, 'teapot', a built-in scene ('default', 'city', 'building') or a scene file (.json)");
+    add_text_option(
+        *command, "MODEL", state->model,
+        "OBJ control mesh, 'teapot', a built-in scene ('default', 'city', 'building') or a scene file (.json)");
     add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 0, 1000000,
@@ -81,13 +81,15 @@ Runner add_view_command(CLI::App& app) {
     add_displace_options(*command, state->displace);
     add_object_level_options(*command, state->objects);
     add_size_option(*command, "--size", state->size, "window size");
-    command->add_flag("--aggressive", state->aggressive, "skip the second pass (Niessner & Loop §3.1; not conservative)");
+    command->add_flag("--aggressive", state->aggressive,
+                      "skip the second pass (Niessner & Loop §3.1; not conservative)");
     add_output_file_option(*command, "--screenshot", state->screenshot,
                            "after the last of --frames, write the window's content as a PNG");
     add_text_option(*command, "--screenshot-dir", state->screenshot_dir,
                     "directory of the screenshot key's view_NNNN.png (created when first needed)");
-    add_text_option(*command, "--script", state->script,
-                    "timed input events by frame number (orbit, look, zoom, key, set, screenshot, quit; docs/VIEWER.md)");
+    add_text_option(
+        *command, "--script", state->script,
+        "timed input events by frame number (orbit, look, zoom, key, set, screenshot, quit; docs/VIEWER.md)");
     return [state]() {
         // The script first: a malformed line is reported before anything is loaded or opened.
         std::unique_ptr<ViewerScript> script;

@@ -36,8 +36,8 @@ struct ModelOptions {
     std::string model;
     std::string scheme = "acc";
     int split = 0;
-    std::string displace;        ///< "", "procedural" or a PNG path
-    float displace_scale = -1;   ///< object units; -1 (no flag gives < 0) means 2% of the bounding-box diagonal
+    std::string displace;       ///< "", "procedural" or a PNG path
+    float displace_scale = -1;  ///< object units; -1 (no flag gives < 0) means 2% of the bounding-box diagonal
 };
 
 /// The largest --displace-scale accepted (object units): large enough for any model, small

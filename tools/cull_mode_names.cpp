@@ -33,7 +33,8 @@ std::string names_text(const std::vector<std::string>& names) {
 gl::BackpatchMethod parse_backpatch_method(const std::string& flag, const std::string& text) {
     gl::BackpatchMethod method = gl::BackpatchMethod::tcone;
     if (!gl::parse_backpatch_method(text.c_str(), method))
-        throw Error(flag + ": unknown back-patch method '" + text + "' (" + names_text(backpatch_method_choices()) + ")");
+        throw Error(flag + ": unknown back-patch method '" + text + "' (" + names_text(backpatch_method_choices()) +
+                    ")");
     return method;
 }
 

@@ -14,14 +14,14 @@
 
 #include "patchcull/gl/gl_object_queries.h"
 #include "patchcull/gl/gl_pipeline.h"
-#include "patchcull/import/scene_occlusion.h"
 #include "patchcull/import/scene_object_level.h"
+#include "patchcull/import/scene_occlusion.h"
 #include "patchcull/import/scene_poser.h"
 
 namespace CLI {
 class App;
 class Option;
-}
+}  // namespace CLI
 
 namespace patchcull::cli {
 
@@ -35,7 +35,7 @@ struct ObjectLevelOptions {
     std::string volume = "aabb";
     std::string backface_triangles = "clusters";
     int mask_sectors = 1;
-    float cluster_cost = 1;          ///< tC/r of triangle clusters
+    float cluster_cost = 1;            ///< tC/r of triangle clusters
     float patch_cluster_cost = 0.05f;  ///< tC/r of patch clusters
     /// --object-occlusion: none, a query method (gl_object_queries.h) or horizon / portals
     /// (scene_occlusion.h), after the object level.
@@ -75,8 +75,8 @@ public:
     /// a query method sets params.objects (the instances) and params.object_pass (its queries
     /// then run inside render_frame, on the GL context current at the first apply).
     /// viewport_width 0: the camera's aspect times viewport_height.
-    void apply(const ScenePoser& poser, const std::vector<BezierPatch>& pose, float time_seconds,
-               const Camera& camera, int viewport_height, gl::PipelineParams& params, int viewport_width = 0);
+    void apply(const ScenePoser& poser, const std::vector<BezierPatch>& pose, float time_seconds, const Camera& camera,
+               int viewport_height, gl::PipelineParams& params, int viewport_width = 0);
     /// The --object-occlusion method's name ("none" without one).
     std::string occlusion_name() const;
     /// Deletes the query method's GL objects (made on the context current at the first apply);

@@ -38,8 +38,8 @@ void write_stderr(const std::string& bytes) {
 
 bool progress_wanted(bool json) { return !json && isatty(fileno(stderr)) == 1; }
 
-std::string format_progress(const std::string& label, const std::string& unit, std::uint64_t done,
-                            std::uint64_t total, double elapsed_seconds, bool final_line) {
+std::string format_progress(const std::string& label, const std::string& unit, std::uint64_t done, std::uint64_t total,
+                            double elapsed_seconds, bool final_line) {
     done = std::min(done, total);
     const bool known = done > 0 && elapsed_seconds > 0;
     const double rate = known ? double(done) / elapsed_seconds : 0;

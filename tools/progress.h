@@ -22,8 +22,8 @@ bool progress_wanted(bool json);
 /// exponent), and "--" (ETA "--" too) while nothing is
 /// done or no time has passed. T is "42s" below a minute, "3m05s" below an hour, "2h05m" above.
 /// done above total is shown as total.
-std::string format_progress(const std::string& label, const std::string& unit, std::uint64_t done,
-                            std::uint64_t total, double elapsed_seconds, bool final_line = false);
+std::string format_progress(const std::string& label, const std::string& unit, std::uint64_t done, std::uint64_t total,
+                            double elapsed_seconds, bool final_line = false);
 
 /// One progress line. Construct it before the loop with the loop's total; call step(done) after
 /// each unit of work. Not thread-safe: call it from the thread that runs the loop.

@@ -40,10 +40,14 @@ std::string level_name(int level, const char* extension) {
 
 const char* status_name(std::uint8_t status) {
     switch (status) {
-        case kDisplacedBoundProjected: return "projected";
-        case kDisplacedBoundOutsidePlane: return "outside-plane";
-        case kDisplacedBoundUnprojectable: return "unprojectable";
-        default: return "invalid";
+        case kDisplacedBoundProjected:
+            return "projected";
+        case kDisplacedBoundOutsidePlane:
+            return "outside-plane";
+        case kDisplacedBoundUnprojectable:
+            return "unprojectable";
+        default:
+            return "invalid";
     }
 }
 
@@ -98,25 +102,31 @@ nlohmann::json dump_hiz(const gl::CullPipeline& pipeline, const std::string& dir
             for (int x = 0; x < level.width; ++x) {
                 const float d = values[static_cast<std::size_t>(y) * level.width + x];
                 const double t = hi > lo ? (double(d) - lo) / (double(hi) - lo) : 0.0;
-                const std::uint8_t g = d >= 1 ? 255 : static_cast<std::uint8_t>(std::lround(254 * std::clamp(t, 0.0, 1.0)));
+                const std::uint8_t g =
+                    d >= 1 ? 255 : static_cast<std::uint8_t>(std::lround(254 * std::clamp(t, 0.0, 1.0)));
                 grey[static_cast<std::size_t>(level.height - 1 - y) * level.width + x] = g;  // PNG: top row first
             }
         const std::string png = level_name(l, "png"), raw = level_name(l, "f32");
         write_png_checked((base / png).string(), level.width, level.height, 1, grey);
         write_raw((base / raw).string(), values);
-        levels.push_back({{"level", l}, {"width", level.width}, {"height", level.height}, {"png", png},
-                          {"raw", raw}, {"lo", lo}, {"hi", hi}});
+        levels.push_back({{"level", l},
+                          {"width", level.width},
+                          {"height", level.height},
+                          {"png", png},
+                          {"raw", raw},
+                          {"lo", lo},
+                          {"hi", hi}});
     }
     // The renderer's read-backs are top row first; the dumps are row 0 = bottom, as the pyramid.
     write_raw((base / "depth.f32").string(), bottom_first(renderer.read_depth(), width, height));
     write_raw((base / "ids.u32").string(), bottom_first(renderer.read_ids(), width, height));
-    nlohmann::json out = {
-        {"size", {width, height}},
-        {"levels", levels},
-        {"depth", "depth.f32"},
-        {"ids", "ids.u32"},
-        {"mapping", "grey = 255 where depth is 1 (far), else round(254 (d - lo) / (hi - lo)), lo/hi the level's "
-                    "smallest depth and largest depth below 1"}};
+    nlohmann::json out = {{"size", {width, height}},
+                          {"levels", levels},
+                          {"depth", "depth.f32"},
+                          {"ids", "ids.u32"},
+                          {"mapping",
+                           "grey = 255 where depth is 1 (far), else round(254 (d - lo) / (hi - lo)), lo/hi the level's "
+                           "smallest depth and largest depth below 1"}};
     const std::string json_path = (base / "hiz.json").string();
     const std::string text = out.dump(1) + "\n";
     write_raw(json_path, std::vector<char>(text.begin(), text.end()));
@@ -164,8 +174,8 @@ ScreenBound screen_bound(const BezierPatch& patch, DisplacementRange range, Disp
 }
 
 nlohmann::json patch_bounds_json(const PatchBounds& b, const std::vector<std::uint32_t>& ids) {
-    const std::size_t pixels = static_cast<std::size_t>(
-        std::count(ids.begin(), ids.end(), static_cast<std::uint32_t>(b.patch + 1)));
+    const std::size_t pixels =
+        static_cast<std::size_t>(std::count(ids.begin(), ids.end(), static_cast<std::uint32_t>(b.patch + 1)));
     return {{"patch", b.patch},
             {"range", {b.range.d_min, b.range.d_max}},
             {"pixels", pixels},
@@ -179,12 +189,12 @@ void write_bounds_png(const std::string& path, std::vector<std::uint8_t> rgba, c
     auto pixel = [&](int x, int y) { return &rgba[(static_cast<std::size_t>(height - 1 - y) * width + x) * 4]; };
     for (const PatchBounds& b : bounds)
         for (std::size_t i = 0; i < ids.size(); ++i)
-                if (ids[i] == b.patch + 1) {
-                    std::uint8_t* p = &rgba[i * 4];  // half-way to yellow
-                    p[0] = static_cast<std::uint8_t>((p[0] + 255) / 2);
-                    p[1] = static_cast<std::uint8_t>((p[1] + 230) / 2);
-                    p[2] = static_cast<std::uint8_t>(p[2] / 2);
-                }
+            if (ids[i] == b.patch + 1) {
+                std::uint8_t* p = &rgba[i * 4];  // half-way to yellow
+                p[0] = static_cast<std::uint8_t>((p[0] + 255) / 2);
+                p[1] = static_cast<std::uint8_t>((p[1] + 230) / 2);
+                p[2] = static_cast<std::uint8_t>(p[2] / 2);
+            }
     auto outline = [&](const ScreenBound& s, std::uint8_t r, std::uint8_t g, std::uint8_t bl) {
         if (!s.projected) return;
         const PixelRect& q = s.rect;

@@ -28,9 +28,9 @@
 #include <nlohmann/json.hpp>
 
 #include "patchcull/core/displaced_bounds.h"
-#include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/patch.h"
+#include "patchcull/gl/gl_pipeline.h"
 
 namespace patchcull::cli {
 
@@ -68,8 +68,8 @@ struct PatchBounds {
 nlohmann::json patch_bounds_json(const PatchBounds& bounds, const std::vector<std::uint32_t>& ids);
 
 /// The frame's colour (RGBA8, top row first, width x height: PatchRenderer::read_color) with each
-/// patch's pixels (ids, top row first: read_ids; == patch + 1) tinted yellow, its OOBB rectangle outlined in red and its CAF rectangle in green
-/// (drawn last: where the two coincide the CAF shows), written to path as a PNG. Throws
+/// patch's pixels (ids, top row first: read_ids; == patch + 1) tinted yellow, its OOBB rectangle outlined in red and
+/// its CAF rectangle in green (drawn last: where the two coincide the CAF shows), written to path as a PNG. Throws
 /// patchcull::Error naming path when it cannot be written.
 void write_bounds_png(const std::string& path, std::vector<std::uint8_t> rgba, const std::vector<std::uint32_t>& ids,
                       int width, int height, const std::vector<PatchBounds>& bounds);

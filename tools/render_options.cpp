@@ -54,7 +54,7 @@ void apply_displace_options(const DisplaceOptions& options, Scene& scene) {
     const float scale = options.scale >= 0 ? options.scale : 0.02f;
     if (!(scale > 0)) throw Error("--displace-scale: must be > 0 with --displace " + quote_input(options.displace));
     scene.displacement = options.displace == "procedural" ? make_procedural_displacement(512, scale)
-                                                         : load_displacement_png(options.displace, scale);
+                                                          : load_displacement_png(options.displace, scale);
     scene.displacement_name = options.displace;
     for (SceneInstance& instance : scene.instances) instance.displaced = true;
 }

@@ -45,8 +45,8 @@ float camera_path_eye_distance(const CameraPath& path);
 /// displaced patches tested against the frustum and the running pipeline's Hi-Z with the chosen
 /// bound (gl_passes.h's DisplacedPass inside CullPipeline::render_frame).
 struct DisplaceOptions {
-    std::string displace;      ///< "" (the scene's own), "none", "procedural" or a PNG path
-    float scale = -1;          ///< world units (a character is 1 high); < 0: not given (0.02)
+    std::string displace;  ///< "" (the scene's own), "none", "procedural" or a PNG path
+    float scale = -1;      ///< world units (a character is 1 high); < 0: not given (0.02)
     std::string bound = "caf";
     std::string cone = "acon";
 };

@@ -23,8 +23,7 @@ namespace {
 
 PATCHCULL_CONES_INLINE BezierPatch load_patch(const PatchBatchView& v, std::size_t p) {
     BezierPatch patch;
-    for (int k = 0; k < kPatchPoints; ++k)
-        patch.cp[k] = {v.at(p, k, 0), v.at(p, k, 1), v.at(p, k, 2), v.at(p, k, 3)};
+    for (int k = 0; k < kPatchPoints; ++k) patch.cp[k] = {v.at(p, k, 0), v.at(p, k, 1), v.at(p, k, 2), v.at(p, k, 3)};
     return patch;
 }
 

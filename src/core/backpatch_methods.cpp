@@ -10,19 +10,33 @@
 namespace patchcull {
 namespace {
 
-void no_cull(const PatchBatchView& patches, std::uint8_t* culled) { std::fill_n(culled, patches.count, std::uint8_t{0}); }
+void no_cull(const PatchBatchView& patches, std::uint8_t* culled) {
+    std::fill_n(culled, patches.count, std::uint8_t{0});
+}
 
 void tcone_scalar(const PatchBatchView& p, const CullView& v, const BackpatchOptions&, std::uint8_t* culled) {
-    if (v.has_eye) cull_tcone_scalar(p, v.eye, culled); else no_cull(p, culled);
+    if (v.has_eye)
+        cull_tcone_scalar(p, v.eye, culled);
+    else
+        no_cull(p, culled);
 }
 void tcone_simd(const PatchBatchView& p, const CullView& v, const BackpatchOptions&, std::uint8_t* culled) {
-    if (v.has_eye) cull_tcone_simd(p, v.eye, culled); else no_cull(p, culled);
+    if (v.has_eye)
+        cull_tcone_simd(p, v.eye, culled);
+    else
+        no_cull(p, culled);
 }
 void ncone_scalar(const PatchBatchView& p, const CullView& v, const BackpatchOptions&, std::uint8_t* culled) {
-    if (v.has_eye) cull_ncone_scalar(p, v.eye, culled); else no_cull(p, culled);
+    if (v.has_eye)
+        cull_ncone_scalar(p, v.eye, culled);
+    else
+        no_cull(p, culled);
 }
 void ncone_simd(const PatchBatchView& p, const CullView& v, const BackpatchOptions&, std::uint8_t* culled) {
-    if (v.has_eye) cull_ncone_simd(p, v.eye, culled); else no_cull(p, culled);
+    if (v.has_eye)
+        cull_ncone_simd(p, v.eye, culled);
+    else
+        no_cull(p, culled);
 }
 void ptp_scalar(const PatchBatchView& p, const CullView& v, const BackpatchOptions& o, std::uint8_t* culled) {
     cull_ptp_scalar(p, v.object_to_clip, v.alpha, o.ptp_rule, culled);

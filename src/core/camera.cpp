@@ -12,9 +12,12 @@ namespace patchcull {
 const char* view_mode_name(ViewMode mode) { return mode == ViewMode::contain ? "contain" : "free"; }
 
 bool parse_view_mode(const char* text, ViewMode& mode) {
-    if (std::strcmp(text, "contain") == 0) mode = ViewMode::contain;
-    else if (std::strcmp(text, "free") == 0) mode = ViewMode::free;
-    else return false;
+    if (std::strcmp(text, "contain") == 0)
+        mode = ViewMode::contain;
+    else if (std::strcmp(text, "free") == 0)
+        mode = ViewMode::free;
+    else
+        return false;
     return true;
 }
 

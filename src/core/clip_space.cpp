@@ -10,17 +10,21 @@ namespace patchcull {
 
 const char* clip_depth_name(ClipDepth depth) {
     switch (depth) {
-        case ClipDepth::zero_to_one: return "zero-to-one";
-        case ClipDepth::minus_one_to_one: return "minus-one-to-one";
-        case ClipDepth::reversed: return "reversed";
-        case ClipDepth::reversed_infinite: return "reversed-infinite";
+        case ClipDepth::zero_to_one:
+            return "zero-to-one";
+        case ClipDepth::minus_one_to_one:
+            return "minus-one-to-one";
+        case ClipDepth::reversed:
+            return "reversed";
+        case ClipDepth::reversed_infinite:
+            return "reversed-infinite";
     }
     return "unknown";
 }
 
 bool parse_clip_depth(std::string_view text, ClipDepth& out) {
-    for (ClipDepth d : {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed,
-                        ClipDepth::reversed_infinite}) {
+    for (ClipDepth d :
+         {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed, ClipDepth::reversed_infinite}) {
         if (text == clip_depth_name(d)) {
             out = d;
             return true;
@@ -57,10 +61,11 @@ void check_clip_depth(const Mat4& object_to_clip, ClipDepth depth, const char* w
     if (!(std::fabs(eye_w) > 1e-6 * scale)) return;  // orthographic (eye at infinity): cannot tell
     const bool reversed_matrix = eye_w > 0;
     if (reversed_matrix == is_reversed(depth)) return;
-    throw Error(std::string(what) + ": the matrix maps the near plane to depth " + (reversed_matrix ? "1" : "0 or -1") +
-                " (a " + (reversed_matrix ? "reversed" : "forward") + " projection) but was declared " +
-                clip_depth_name(depth) + (reversed_matrix ? "; declare reversed or reversed-infinite"
-                                                          : "; declare zero-to-one or minus-one-to-one"));
+    throw Error(
+        std::string(what) + ": the matrix maps the near plane to depth " + (reversed_matrix ? "1" : "0 or -1") +
+        " (a " + (reversed_matrix ? "reversed" : "forward") + " projection) but was declared " +
+        clip_depth_name(depth) +
+        (reversed_matrix ? "; declare reversed or reversed-infinite" : "; declare zero-to-one or minus-one-to-one"));
 }
 
 Mat4 perspective(float fovy_radians, float aspect, float z_near, float z_far, ClipDepth depth) {

@@ -94,8 +94,8 @@
 //   sin b moves sin(alpha + beta) by at most that error); the test requires
 //   a . d <= -|d| (sin(alpha + beta) + kFacingSlack), kFacingSlack = 1e-5. NaN anywhere -> no cull
 //   (every comparison is written to fail on NaN).
-#include "core/cones_internal.h"
 #include "patchcull/core/cones.h"
+#include "core/cones_internal.h"
 
 namespace patchcull {
 

@@ -61,8 +61,9 @@ PATCHCULL_CONES_INLINE bool is_polynomial(const BezierPatch& p) {
 /// vectors, cos of the half-angle = min over them of axis . v/|v| (minus widen[k] * inv|v_k| when
 /// widen is given, the NCONE rounding bound), minus kCosSlack. Unused vectors get h = NaN, which
 /// min_like_simd(h, lo) / max_like_simd(h, hi) skip (h first: `NaN < lo` is false, so lo is kept;
-/// Highway's Min/Max on every x86 target and its scalar fallbacks keep the non-NaN second operand too). widen == null: zero vectors are skipped; else a zero
-/// vector is skipped only when widen[k] == 0 (exactly zero), otherwise the cone is invalid.
+/// Highway's Min/Max on every x86 target and its scalar fallbacks keep the non-NaN second operand too). widen == null:
+/// zero vectors are skipped; else a zero vector is skipped only when widen[k] == 0 (exactly zero), otherwise the cone
+/// is invalid.
 template <int n>
 PATCHCULL_CONES_INLINE NormalCone cone_of_vectors(const Vec3* v, const float* widen) {
     Vec3 h[n];

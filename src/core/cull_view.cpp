@@ -45,7 +45,8 @@ void cull_frustum_disp(const PatchBatchView& patches, const float* max_displacem
                        std::uint8_t* culled) {
     cull_frustum_disp_simd(patches, max_displacement, view.object_to_clip, view.depth, culled);
 }
-void cull_occlusion(const PatchBatchView& patches, const CullView& view, const HiZPyramid& hiz, std::uint8_t* decision) {
+void cull_occlusion(const PatchBatchView& patches, const CullView& view, const HiZPyramid& hiz,
+                    std::uint8_t* decision) {
     cull_occlusion_simd(patches, view.object_to_clip, view.depth, hiz, decision);
 }
 FusedCullSetup make_fused_setup(const CullView& view, BackPatchCone cone, const HiZPyramid* hiz) {

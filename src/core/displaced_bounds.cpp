@@ -26,8 +26,8 @@
 #include "patchcull/core/displaced_bounds.h"
 
 #include <cmath>
-#include <limits>
 #include <cstring>
+#include <limits>
 
 #include "core/cones_internal.h"
 
@@ -64,7 +64,8 @@ struct AxisExtension {
     float plus = 0, minus = 0;
 };
 
-PATCHCULL_DISPLACED_INLINE AxisExtension extension_along(Vec3 r, float length, const NormalCone& cone, float d_min, float d_max, float radius) {
+PATCHCULL_DISPLACED_INLINE AxisExtension extension_along(Vec3 r, float length, const NormalCone& cone, float d_min,
+                                                         float d_max, float radius) {
     const float scale = length * kDisplacedExtScale;
     if (!cone.valid) return {radius * scale, radius * scale};
     const float c = dot3(r, cone.axis);
@@ -90,14 +91,15 @@ PATCHCULL_DISPLACED_INLINE ViewPoint to_view(const Mat4& v, const float abs_row_
     q.x = std::fma(v.at(0, 2), p.z, std::fma(v.at(0, 1), p.y, v.at(0, 0) * p.x)) + v.at(0, 3);
     q.y = std::fma(v.at(1, 2), p.z, std::fma(v.at(1, 1), p.y, v.at(1, 0) * p.x)) + v.at(1, 3);
     q.t = -(std::fma(v.at(2, 2), p.z, std::fma(v.at(2, 1), p.y, v.at(2, 0) * p.x)) + v.at(2, 3));
-    q.t_terms = std::fma(abs_row_z[2], std::fabs(p.z), std::fma(abs_row_z[1], std::fabs(p.y), abs_row_z[0] * std::fabs(p.x))) +
-                abs_row_z[3];
+    q.t_terms =
+        std::fma(abs_row_z[2], std::fabs(p.z), std::fma(abs_row_z[1], std::fabs(p.y), abs_row_z[0] * std::fabs(p.x))) +
+        abs_row_z[3];
     return q;
 }
 
 /// Step 5 of the header: NDC rectangle and depths from x/t, y/t ranges and the view depth range.
-PATCHCULL_DISPLACED_INLINE DisplacedBound to_screen(const DisplacedCullView& view, float x_min, float x_max, float y_min, float y_max,
-                         float t_front, float t_back) {
+PATCHCULL_DISPLACED_INLINE DisplacedBound to_screen(const DisplacedCullView& view, float x_min, float x_max,
+                                                    float y_min, float y_max, float t_front, float t_back) {
     const Mat4& p = view.projection;
     const float ax = std::fma(p.at(0, 0), x_min, -p.at(0, 2)), bx = std::fma(p.at(0, 0), x_max, -p.at(0, 2));
     const float ay = std::fma(p.at(1, 1), y_min, -p.at(1, 2)), by = std::fma(p.at(1, 1), y_max, -p.at(1, 2));
@@ -129,8 +131,8 @@ PATCHCULL_DISPLACED_INLINE DisplacedBound invalid_bound() { return DisplacedBoun
 
 // ---- caf ------------------------------------------------------------------------------------------
 
-PATCHCULL_DISPLACED_INLINE DisplacedBound caf_bound(const Vec3 p[kPatchPoints], const NormalCone& cone, float d_min, float d_max, float radius,
-                         const DisplacedCullView& view) {
+PATCHCULL_DISPLACED_INLINE DisplacedBound caf_bound(const Vec3 p[kPatchPoints], const NormalCone& cone, float d_min,
+                                                    float d_max, float radius, const DisplacedCullView& view) {
     // Step 2: extensions along the view axes (rows of L).
     AxisExtension ext[3];
     for (int i = 0; i < 3; ++i)
@@ -204,8 +206,8 @@ PATCHCULL_DISPLACED_INLINE void oobb_frame(const Vec3 p[kPatchPoints], Vec3 e[3]
     e[2] = n;
 }
 
-PATCHCULL_DISPLACED_INLINE DisplacedBound oobb_bound(const Vec3 p[kPatchPoints], const NormalCone& cone, float d_min, float d_max, float radius,
-                          const DisplacedCullView& view) {
+PATCHCULL_DISPLACED_INLINE DisplacedBound oobb_bound(const Vec3 p[kPatchPoints], const NormalCone& cone, float d_min,
+                                                     float d_max, float radius, const DisplacedCullView& view) {
     Vec3 e[3];
     oobb_frame(p, e);
     const Vec3 origin = p[0];
@@ -275,7 +277,6 @@ PATCHCULL_DISPLACED_INLINE BezierPatch gather(const PatchBatchView& v, std::size
     return patch;
 }
 
-
 PATCHCULL_DISPLACED_INLINE NormalCone cone_of(const BezierPatch& patch, NormalConeKind kind) {
     // cones.h's entry points without the call: rational patches get no cone (full), as there.
     if (kind == NormalConeKind::full || !cones_detail::is_polynomial(patch)) return NormalCone{};
@@ -337,25 +338,35 @@ const char* displaced_bound_name(DisplacedBoundKind kind) { return kind == Displ
 
 const char* normal_cone_name(NormalConeKind kind) {
     switch (kind) {
-        case NormalConeKind::full: return "full";
-        case NormalConeKind::acon: return "acon";
-        case NormalConeKind::con: return "con";
+        case NormalConeKind::full:
+            return "full";
+        case NormalConeKind::acon:
+            return "acon";
+        case NormalConeKind::con:
+            return "con";
     }
     return "?";
 }
 
 bool parse_displaced_bound(const char* text, DisplacedBoundKind& kind) {
-    if (std::strcmp(text, "oobb") == 0) kind = DisplacedBoundKind::oobb;
-    else if (std::strcmp(text, "caf") == 0) kind = DisplacedBoundKind::caf;
-    else return false;
+    if (std::strcmp(text, "oobb") == 0)
+        kind = DisplacedBoundKind::oobb;
+    else if (std::strcmp(text, "caf") == 0)
+        kind = DisplacedBoundKind::caf;
+    else
+        return false;
     return true;
 }
 
 bool parse_normal_cone(const char* text, NormalConeKind& kind) {
-    if (std::strcmp(text, "full") == 0) kind = NormalConeKind::full;
-    else if (std::strcmp(text, "acon") == 0) kind = NormalConeKind::acon;
-    else if (std::strcmp(text, "con") == 0) kind = NormalConeKind::con;
-    else return false;
+    if (std::strcmp(text, "full") == 0)
+        kind = NormalConeKind::full;
+    else if (std::strcmp(text, "acon") == 0)
+        kind = NormalConeKind::acon;
+    else if (std::strcmp(text, "con") == 0)
+        kind = NormalConeKind::con;
+    else
+        return false;
     return true;
 }
 
@@ -421,7 +432,8 @@ PATCHCULL_DISPLACED_CLONES
 void cull_displaced_frustum(const PatchBatchView& patches, const DisplacementRange* ranges, DisplacedBoundKind kind,
                             NormalConeKind cone, const DisplacedCullView& view, std::uint8_t* culled) {
     for (std::size_t i = 0; i < patches.count; ++i) {
-        const DisplacedBound b = bound_of(gather(patches, i), ranges ? ranges[i] : DisplacementRange{}, kind, cone, view);
+        const DisplacedBound b =
+            bound_of(gather(patches, i), ranges ? ranges[i] : DisplacementRange{}, kind, cone, view);
         culled[i] = outside_frustum(b) ? 1 : 0;
     }
 }
@@ -432,7 +444,8 @@ void cull_displaced_occlusion(const PatchBatchView& patches, const DisplacementR
                               std::uint8_t* decision) {
     check_hiz_convention(hiz, view.depth, "cull_displaced_occlusion");
     for (std::size_t i = 0; i < patches.count; ++i) {
-        const DisplacedBound b = bound_of(gather(patches, i), ranges ? ranges[i] : DisplacementRange{}, kind, cone, view);
+        const DisplacedBound b =
+            bound_of(gather(patches, i), ranges ? ranges[i] : DisplacementRange{}, kind, cone, view);
         decision[i] = hiz_decision(b, hiz);
     }
 }

@@ -76,8 +76,10 @@ void corner_box(const Vec2 uv[4], float& s_min, float& s_max, float& t_min, floa
     s_min = s_max = uv[0].x;
     t_min = t_max = uv[0].y;
     for (int k = 1; k < 4; ++k) {
-        s_min = std::min(s_min, uv[k].x); s_max = std::max(s_max, uv[k].x);
-        t_min = std::min(t_min, uv[k].y); t_max = std::max(t_max, uv[k].y);
+        s_min = std::min(s_min, uv[k].x);
+        s_max = std::max(s_max, uv[k].x);
+        t_min = std::min(t_min, uv[k].y);
+        t_max = std::max(t_max, uv[k].y);
     }
     // std::min/max drop a NaN in some argument orders: make a NaN corner poison the box.
     for (int k = 0; k < 4; ++k)
@@ -172,8 +174,8 @@ void RangePyramidCache::reset() {
 
 const RangePyramid& RangePyramidCache::get(const float* texels, std::size_t count, int width, int height) const {
     const std::lock_guard<std::mutex> lock(mutex_);
-    if (!pyramid_ || pyramid_->key_texels != texels || pyramid_->key_count != count ||
-        pyramid_->key_width != width || pyramid_->key_height != height) {
+    if (!pyramid_ || pyramid_->key_texels != texels || pyramid_->key_count != count || pyramid_->key_width != width ||
+        pyramid_->key_height != height) {
         auto p = std::make_unique<RangePyramid>();
         p->build(texels, width, height);
         p->key_texels = texels;
@@ -240,10 +242,14 @@ DisplacementMap make_procedural_displacement(int size, float scale, std::uint32_
     // A few periodic ridges and bumps (integer frequencies, so the map tiles under wrap-around).
     std::uint32_t state = seed * 2654435761u + 1;
     auto next = [&state]() {
-        state ^= state << 13; state ^= state >> 17; state ^= state << 5;
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
         return (state & 0xffffff) / float(0x1000000);
     };
-    struct Wave { float fx, fy, phase, amp; };
+    struct Wave {
+        float fx, fy, phase, amp;
+    };
     Wave waves[6];
     for (Wave& w : waves)
         w = {float(1 + int(next() * 12)), float(1 + int(next() * 12)), next() * 6.2831853f, 0.5f + next()};

@@ -17,10 +17,14 @@ std::size_t decode_utf8(std::string_view s, std::size_t i, std::uint32_t& cp) {
     }
     std::size_t length = 0;
     std::uint32_t min = 0;
-    if ((b0 & 0xE0) == 0xC0) length = 2, cp = b0 & 0x1F, min = 0x80;
-    else if ((b0 & 0xF0) == 0xE0) length = 3, cp = b0 & 0x0F, min = 0x800;
-    else if ((b0 & 0xF8) == 0xF0) length = 4, cp = b0 & 0x07, min = 0x10000;
-    else return 0;
+    if ((b0 & 0xE0) == 0xC0)
+        length = 2, cp = b0 & 0x1F, min = 0x80;
+    else if ((b0 & 0xF0) == 0xE0)
+        length = 3, cp = b0 & 0x0F, min = 0x800;
+    else if ((b0 & 0xF8) == 0xF0)
+        length = 4, cp = b0 & 0x07, min = 0x10000;
+    else
+        return 0;
     if (i + length > s.size()) return 0;
     for (std::size_t k = 1; k < length; ++k) {
         if ((byte(i + k) & 0xC0) != 0x80) return 0;
@@ -35,8 +39,8 @@ std::size_t decode_utf8(std::string_view s, std::size_t i, std::uint32_t& cp) {
 // isolates (which reorder the rest of the line, so a message could be made to read differently),
 // and the invisible zero-width characters and byte-order mark (a quoted 'v' that is not "v").
 bool is_unprintable(std::uint32_t cp) {
-    return cp < 0x20 || (cp >= 0x7F && cp < 0xA0) || (cp >= 0x200B && cp <= 0x200F) || cp == 0x2028 ||
-           cp == 0x2029 || (cp >= 0x202A && cp <= 0x202E) || (cp >= 0x2066 && cp <= 0x2069) || cp == 0xFEFF;
+    return cp < 0x20 || (cp >= 0x7F && cp < 0xA0) || (cp >= 0x200B && cp <= 0x200F) || cp == 0x2028 || cp == 0x2029 ||
+           (cp >= 0x202A && cp <= 0x202E) || (cp >= 0x2066 && cp <= 0x2069) || cp == 0xFEFF;
 }
 
 const char kHex[] = "0123456789ABCDEF";

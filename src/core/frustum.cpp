@@ -28,7 +28,6 @@ namespace {
 inline float min_like_simd(float a, float b) { return a < b ? a : b; }
 inline float max_like_simd(float a, float b) { return a > b ? a : b; }
 
-
 }  // namespace
 
 FrustumPlanes make_frustum_planes(const Mat4& any_object_to_clip, ClipDepth depth) {
@@ -43,13 +42,13 @@ FrustumPlanes make_frustum_planes(const Mat4& any_object_to_clip, ClipDepth dept
     planes.near_w = is_reversed(depth) ? 1.0f : 0.0f;
     planes.far_w = is_reversed(depth) ? 0.0f : 1.0f;
     planes.far_limit = has_far_plane(depth) ? 0.0f : -std::numeric_limits<float>::infinity();
-    planes.rows[0] = w + x;  // left:   w + x >= 0
-    planes.rows[1] = w - x;  // right:  w - x >= 0
-    planes.rows[2] = w + y;  // bottom: w + y >= 0
-    planes.rows[3] = w - y;  // top:    w - y >= 0
-    planes.rows[4] = is_reversed(depth) ? k + w : k;  // near: z >= 0, or w - z >= 0 (reversed)
+    planes.rows[0] = w + x;                                              // left:   w + x >= 0
+    planes.rows[1] = w - x;                                              // right:  w - x >= 0
+    planes.rows[2] = w + y;                                              // bottom: w + y >= 0
+    planes.rows[3] = w - y;                                              // top:    w - y >= 0
+    planes.rows[4] = is_reversed(depth) ? k + w : k;                     // near: z >= 0, or w - z >= 0 (reversed)
     planes.rows[5] = is_reversed(depth) ? Vec4{0, 0, 0, 0} - k : w - k;  // far: w - z >= 0, or z >= 0
-    if (!has_far_plane(depth)) planes.rows[5] = Vec4{0, 0, 0, 1};  // at infinity: every point passes
+    if (!has_far_plane(depth)) planes.rows[5] = Vec4{0, 0, 0, 1};        // at infinity: every point passes
     planes.clip_rows[0] = x;
     planes.clip_rows[1] = y;
     planes.clip_rows[2] = k;
@@ -66,8 +65,8 @@ FrustumPlanes make_frustum_planes(const Mat4& any_object_to_clip, ClipDepth dept
 // (frustum_plane_values, frustum.h: clip coordinates once, then w +- x, w +- y, z, w - z; with
 // margins, add_frustum_margins). The SIMD kernel does exactly these operations.
 PATCHCULL_SCALAR_CLONES
-void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement,
-                         const FrustumPlanes& planes, std::uint8_t* culled) {
+void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement, const FrustumPlanes& planes,
+                         std::uint8_t* culled) {
     for (std::size_t p = 0; p < patches.count; ++p) {
         FrustumVerdict verdict;
         float v[6];
@@ -88,8 +87,8 @@ void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displac
 // and the patch is culled when all 8 corners fail the same clip-plane inequality (plane values as
 // frustum_plane_values forms them) and its probe over the raw coordinates X, Y, Z, W is still 0.
 PATCHCULL_SCALAR_CLONES
-void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement,
-                              const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled) {
+void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement, const Mat4& object_to_clip,
+                              ClipDepth depth, std::uint8_t* culled) {
     const FrustumPlanes planes = make_frustum_planes(object_to_clip, depth);
     Mat4 m;
     for (int r = 0; r < 4; ++r) {

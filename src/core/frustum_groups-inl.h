@@ -19,6 +19,7 @@
 
 #include <hwy/highway.h>
 
+#include "core/simd_groups-inl.h"
 #include "patchcull/core/frustum.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -49,7 +50,8 @@ struct ClipRows {
 
 // Clip coordinates c[0..3] = (x, y, z, w) of control point (X, Y, Z, W): hiz.h's step-2 order.
 HWY_INLINE void ClipPoint(DF d, const ClipRows& rows, VF X, VF Y, VF Z, VF W, VF c[4]) {
-    for (int r = 0; r < 4; ++r) c[r] = Fma(d, rows.m[r][3], W, Fma(d, rows.m[r][2], Z, Fma(d, rows.m[r][1], Y, hn::Mul(rows.m[r][0], X))));
+    for (int r = 0; r < 4; ++r)
+        c[r] = Fma(d, rows.m[r][3], W, Fma(d, rows.m[r][2], Z, Fma(d, rows.m[r][1], Y, hn::Mul(rows.m[r][0], X))));
 }
 
 // Running per-plane maxima of w + x, w - x, w + y, w - y, k + near_w w, far_w w - k, with the
@@ -62,9 +64,12 @@ struct PlaneMaxima {
     }
     template <bool kMargins>
     HWY_INLINE void add(DF d, const ClipRows& rows, const VF c[4], VF W, const VF margin[6]) {
-        VF v[6] = {hn::Add(c[3], c[0]), hn::Sub(c[3], c[0]),
-                   hn::Add(c[3], c[1]), hn::Sub(c[3], c[1]),
-                   hn::Add(c[2], hn::Mul(rows.near_w, c[3])), hn::Sub(hn::Mul(rows.far_w, c[3]), c[2])};
+        VF v[6] = {hn::Add(c[3], c[0]),
+                   hn::Sub(c[3], c[0]),
+                   hn::Add(c[3], c[1]),
+                   hn::Sub(c[3], c[1]),
+                   hn::Add(c[2], hn::Mul(rows.near_w, c[3])),
+                   hn::Sub(hn::Mul(rows.far_w, c[3]), c[2])};
         for (int q = 0; q < 6; ++q) {
             if constexpr (kMargins) v[q] = Fma(d, margin[q], W, v[q]);
             mx[q] = hn::Max(mx[q], v[q]);

@@ -21,8 +21,8 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
-#include "core/simd_groups-inl.h"
 #include "core/frustum_groups-inl.h"
+#include "core/simd_groups-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace patchcull {
@@ -134,8 +134,8 @@ HWY_INLINE VF GroupDisplacement(DF d, const float* max_displacement, std::size_t
     return max_displacement ? LoadPadded(d, max_displacement + first, valid) : hn::Zero(d);
 }
 
-void CullFrustum(const PatchBatchView& patches, const float* max_displacement,
-                 const FrustumPlanes& planes, std::uint8_t* culled) {
+void CullFrustum(const PatchBatchView& patches, const float* max_displacement, const FrustumPlanes& planes,
+                 std::uint8_t* culled) {
     if (max_displacement == nullptr) {
         ForEachGroup(patches, culled, [&](DF d, const Group& g, std::size_t, std::size_t) {
             return FrustumGroup<false>(d, g, hn::Zero(d), planes);
@@ -147,8 +147,8 @@ void CullFrustum(const PatchBatchView& patches, const float* max_displacement,
     });
 }
 
-void CullFrustumDisp(const PatchBatchView& patches, const float* max_displacement,
-                     const FrustumPlanes& planes, std::uint8_t* culled) {
+void CullFrustumDisp(const PatchBatchView& patches, const float* max_displacement, const FrustumPlanes& planes,
+                     std::uint8_t* culled) {
     ClipMatrix cm;
     for (int r = 0; r < 4; ++r) {
         const Vec4 row = planes.clip_rows[r];
@@ -178,14 +178,14 @@ HWY_EXPORT(CullFrustum);
 HWY_EXPORT(CullFrustumDisp);
 HWY_EXPORT(TargetName);
 
-void cull_frustum_simd(const PatchBatchView& patches, const float* max_displacement,
-                       const FrustumPlanes& planes, std::uint8_t* culled) {
+void cull_frustum_simd(const PatchBatchView& patches, const float* max_displacement, const FrustumPlanes& planes,
+                       std::uint8_t* culled) {
     if (patches.count == 0) return;
     HWY_DYNAMIC_DISPATCH(CullFrustum)(patches, max_displacement, planes, culled);
 }
 
-void cull_frustum_disp_simd(const PatchBatchView& patches, const float* max_displacement,
-                            const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled) {
+void cull_frustum_disp_simd(const PatchBatchView& patches, const float* max_displacement, const Mat4& object_to_clip,
+                            ClipDepth depth, std::uint8_t* culled) {
     const FrustumPlanes planes = make_frustum_planes(object_to_clip, depth);  // may throw: before the loop
     if (patches.count == 0) return;
     HWY_DYNAMIC_DISPATCH(CullFrustumDisp)(patches, max_displacement, planes, culled);

@@ -27,7 +27,8 @@ bool FusedCostModel::should_profile(std::size_t object, unsigned available) cons
     return frame_ - o.last_profile >= interval && (frame_ + static_cast<long long>(object)) % interval == 0;
 }
 
-double FusedCostModel::expected_seconds(std::size_t object, const FusedPlan& plan, double groups, double patches) const {
+double FusedCostModel::expected_seconds(std::size_t object, const FusedPlan& plan, double groups,
+                                        double patches) const {
     const ObjectState& o = objects_[object];
     double per_group = 0;
     unsigned prefix = 0;
@@ -80,7 +81,8 @@ void FusedCostModel::observe(std::size_t object, const FusedPlan& plan, const Fu
     unsigned prefix = 0;
     for (int i = 0; i + 1 < plan.count; ++i) {
         prefix |= stage_bit(plan.stages[i]);
-        const double decided = 1.0 - static_cast<double>(stats.groups_entered[i + 1]) / static_cast<double>(stats.groups);
+        const double decided =
+            1.0 - static_cast<double>(stats.groups_entered[i + 1]) / static_cast<double>(stats.groups);
         o.decided[prefix] = blend(o.decided[prefix], decided, config_.rate_weight);
     }
 }
@@ -93,7 +95,8 @@ void FusedCostModel::observe_profile(std::size_t object, unsigned available, con
         for (unsigned s = 1; s < (1u << kFusedStages); ++s) {
             if ((s & ~available) != 0) continue;
             const double decided = static_cast<double>(profile.decided[s]) / static_cast<double>(profile.groups);
-            const double culled = patches ? static_cast<double>(profile.patches_culled_by[s]) / static_cast<double>(patches) : 0.0;
+            const double culled =
+                patches ? static_cast<double>(profile.patches_culled_by[s]) / static_cast<double>(patches) : 0.0;
             o.decided[s] = first ? decided : blend(o.decided[s], decided, config_.rate_weight);
             o.culled[s] = first ? culled : blend(o.culled[s], culled, config_.rate_weight);
         }

@@ -27,7 +27,8 @@ bool valid_fused_plan(const FusedPlan& plan) {
 }
 
 int fused_plans_of(unsigned stages, FusedPlan out[6]) {
-    static constexpr FusedStage kAll[kFusedStages] = {FusedStage::frustum, FusedStage::backpatch, FusedStage::occlusion};
+    static constexpr FusedStage kAll[kFusedStages] = {FusedStage::frustum, FusedStage::backpatch,
+                                                      FusedStage::occlusion};
     FusedStage chosen[kFusedStages];
     int n = 0;
     for (FusedStage s : kAll)

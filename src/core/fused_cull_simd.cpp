@@ -39,8 +39,8 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
-#include "core/simd_groups-inl.h"
 #include "core/frustum_groups-inl.h"
+#include "core/simd_groups-inl.h"
 
 #ifndef PATCHCULL_FUSED_TICKS_DEFINED
 #define PATCHCULL_FUSED_TICKS_DEFINED

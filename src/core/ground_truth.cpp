@@ -130,7 +130,8 @@ bool any_tessellation_triangle_faces_eye(const PointD* pts, int grid, Vec3 eye) 
     auto faces = [&](const PointD& a, const PointD& b, const PointD& c) {
         const double e1[3] = {b.x - a.x, b.y - a.y, b.z - a.z};
         const double e2[3] = {c.x - a.x, c.y - a.y, c.z - a.z};
-        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                             e1[0] * e2[1] - e1[1] * e2[0]};
         const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         const double l1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
         const double l2 = std::sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]);
@@ -194,7 +195,8 @@ bool sphere_outside_clip_volume(const Mat4& m, const SampleSphere& sphere) {
         const double len = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
         const double value = p[0] * c[0] + p[1] * c[1] + p[2] * c[2] + p[3];
         // Outside when even the sphere's nearest point has a negative plane value.
-        if (value + len * sphere.radius < -1e-9 * (std::abs(p[3]) + len * (std::abs(c[0]) + std::abs(c[1]) + std::abs(c[2]))))
+        if (value + len * sphere.radius <
+            -1e-9 * (std::abs(p[3]) + len * (std::abs(c[0]) + std::abs(c[1]) + std::abs(c[2]))))
             return true;
     }
     return false;

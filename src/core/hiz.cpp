@@ -181,8 +181,8 @@ float hiz_rect_max(const HiZPyramid& hiz, const PixelRect& rect) {
 namespace {
 
 struct ClipRows {
-    float m[4][4];      // m[r][c] = M(r, c)
-    float abs_w[4];     // |M(3, c)|
+    float m[4][4];   // m[r][c] = M(r, c)
+    float abs_w[4];  // |M(3, c)|
     float half_w, half_h;
 };
 
@@ -270,7 +270,7 @@ void cull_occlusion_scalar(const PatchBatchView& patches, const Mat4& any_object
         for (std::size_t i = first; i < first + n; ++i) {
             if (decision[i] != kHiZVisible) continue;
             PatchScreenBounds b;
-            if (!patch_bounds(patches, i, cr, width, height, b)) continue;  // not projectable: visible
+            if (!patch_bounds(patches, i, cr, width, height, b)) continue;       // not projectable: visible
             if (hiz_rect_max(hiz, b.rect) < b.zmin) decision[i] = kHiZOccluded;  // step 9
         }
     }

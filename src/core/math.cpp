@@ -23,9 +23,18 @@ Mat4 look_at(Vec3 eye, Vec3 target, Vec3 up) {
     if (length(s) == 0) s = normalize(cross(f, Vec3{0, 0, 1}));
     const Vec3 u = cross(s, f);
     Mat4 v;
-    v.at(0, 0) = s.x; v.at(0, 1) = s.y; v.at(0, 2) = s.z; v.at(0, 3) = -dot(s, eye);
-    v.at(1, 0) = u.x; v.at(1, 1) = u.y; v.at(1, 2) = u.z; v.at(1, 3) = -dot(u, eye);
-    v.at(2, 0) = -f.x; v.at(2, 1) = -f.y; v.at(2, 2) = -f.z; v.at(2, 3) = dot(f, eye);
+    v.at(0, 0) = s.x;
+    v.at(0, 1) = s.y;
+    v.at(0, 2) = s.z;
+    v.at(0, 3) = -dot(s, eye);
+    v.at(1, 0) = u.x;
+    v.at(1, 1) = u.y;
+    v.at(1, 2) = u.z;
+    v.at(1, 3) = -dot(u, eye);
+    v.at(2, 0) = -f.x;
+    v.at(2, 1) = -f.y;
+    v.at(2, 2) = -f.z;
+    v.at(2, 3) = dot(f, eye);
     return v;
 }
 

@@ -63,7 +63,8 @@ double ControlMesh::signed_volume() const {
 
 void ControlMesh::reverse_faces() {
     for (std::size_t f = 0; f < face_count(); ++f) {
-        const auto begin = static_cast<std::ptrdiff_t>(face_offsets[f]), end = static_cast<std::ptrdiff_t>(face_offsets[f + 1]);
+        const auto begin = static_cast<std::ptrdiff_t>(face_offsets[f]),
+                   end = static_cast<std::ptrdiff_t>(face_offsets[f + 1]);
         std::reverse(face_vertices.begin() + begin, face_vertices.begin() + end);
         if (has_texcoords()) std::reverse(face_texcoords.begin() + begin, face_texcoords.begin() + end);
     }
@@ -77,8 +78,8 @@ struct Shell {
     std::vector<std::uint32_t> samples;  // up to kShellSamples of its vertices, spread over it
     double volume = 0;                   // signed, relative to its own first vertex
     double area = 0;
-    std::array<double, 3> lo{}, hi{};    // bounds of its vertices
-    std::size_t triangles = 0;           // fan triangles
+    std::array<double, 3> lo{}, hi{};  // bounds of its vertices
+    std::size_t triangles = 0;         // fan triangles
     bool flat = false;
 };
 
@@ -109,7 +110,8 @@ std::vector<Shell> find_shells(const ControlMesh& mesh) {
         for (std::size_t f = 0; f < faces; ++f) {
             const std::uint32_t first = mesh.face_offsets[f], n = mesh.face_size(f);
             for (std::uint32_t i = 0; i < n; ++i)
-                out[fill[mesh.face_vertices[first + i]]++] = {mesh.face_vertices[first + (i + 1) % n], static_cast<std::uint32_t>(f)};
+                out[fill[mesh.face_vertices[first + i]]++] = {mesh.face_vertices[first + (i + 1) % n],
+                                                              static_cast<std::uint32_t>(f)};
         }
     }
     std::vector<std::uint32_t> parent(faces);
@@ -120,7 +122,8 @@ std::vector<Shell> find_shells(const ControlMesh& mesh) {
             const std::uint32_t from = mesh.face_vertices[first + i], to = mesh.face_vertices[first + (i + 1) % n];
             for (std::uint32_t e = first_out[to]; e < first_out[to + 1]; ++e) {
                 if (out[e].first != from) continue;
-                const std::size_t a = find_root(parent, static_cast<std::uint32_t>(f)), b = find_root(parent, out[e].second);
+                const std::size_t a = find_root(parent, static_cast<std::uint32_t>(f)),
+                                  b = find_root(parent, out[e].second);
                 if (a != b) parent[std::max(a, b)] = static_cast<std::uint32_t>(std::min(a, b));
                 break;
             }
@@ -159,8 +162,10 @@ std::vector<Shell> find_shells(const ControlMesh& mesh) {
                 const auto b = rel(mesh.face_vertices[first + i]), c = rel(mesh.face_vertices[first + i + 1]);
                 six_volume += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
                               a[2] * (b[0] * c[1] - b[1] * c[0]);
-                const std::array<double, 3> u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-                const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2], cz = u[0] * w[1] - u[1] * w[0];
+                const std::array<double, 3> u{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                    w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+                const double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2],
+                             cz = u[0] * w[1] - u[1] * w[0];
                 shell.area += 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
                 ++shell.triangles;
             }
@@ -175,7 +180,8 @@ std::vector<Shell> find_shells(const ControlMesh& mesh) {
         for (const std::uint32_t v : vertices) {
             const Vec3 p = mesh.positions[v];
             const double c[3] = {p.x, p.y, p.z};
-            for (int k = 0; k < 3; ++k) shell.lo[k] = std::min(shell.lo[k], c[k]), shell.hi[k] = std::max(shell.hi[k], c[k]);
+            for (int k = 0; k < 3; ++k)
+                shell.lo[k] = std::min(shell.lo[k], c[k]), shell.hi[k] = std::max(shell.hi[k], c[k]);
         }
         const std::size_t count = std::min(kShellSamples, vertices.size());
         for (std::size_t i = 0; i < count; ++i) shell.samples.push_back(vertices[i * vertices.size() / count]);
@@ -221,7 +227,8 @@ int ray_parity(const ControlMesh& mesh, const Shell& shell, const std::array<dou
         const std::uint32_t first = mesh.face_offsets[f], n = mesh.face_size(f);
         const Vec3 a = mesh.positions[mesh.face_vertices[first]];
         for (std::uint32_t i = 1; i + 1 < n; ++i) {
-            const Vec3 b = mesh.positions[mesh.face_vertices[first + i]], c = mesh.positions[mesh.face_vertices[first + i + 1]];
+            const Vec3 b = mesh.positions[mesh.face_vertices[first + i]],
+                       c = mesh.positions[mesh.face_vertices[first + i + 1]];
             if (std::max({a.x, b.x, c.x}) < p[0] || std::min({a.x, b.x, c.x}) > p[0] ||
                 std::max({a.y, b.y, c.y}) < p[1] || std::min({a.y, b.y, c.y}) > p[1])
                 continue;
@@ -342,7 +349,8 @@ private:
             const std::uint32_t middle = begin + (end - begin) / 2;
             std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
                              [&](std::uint32_t x, std::uint32_t y) {
-                                 return shells_[x].lo[axis] + shells_[x].hi[axis] < shells_[y].lo[axis] + shells_[y].hi[axis];
+                                 return shells_[x].lo[axis] + shells_[x].hi[axis] <
+                                        shells_[y].lo[axis] + shells_[y].hi[axis];
                              });
             const std::uint32_t left = build(begin, middle), right = build(middle, end);
             nodes_[index].left = left, nodes_[index].right = right;
@@ -405,7 +413,8 @@ OrientationAnalysis analyse_orientation(const ControlMesh& mesh) {
 }
 
 void reverse_face(ControlMesh& mesh, std::size_t f) {
-    const auto begin = static_cast<std::ptrdiff_t>(mesh.face_offsets[f]), end = static_cast<std::ptrdiff_t>(mesh.face_offsets[f + 1]);
+    const auto begin = static_cast<std::ptrdiff_t>(mesh.face_offsets[f]),
+               end = static_cast<std::ptrdiff_t>(mesh.face_offsets[f + 1]);
     std::reverse(mesh.face_vertices.begin() + begin, mesh.face_vertices.begin() + end);
     if (mesh.has_texcoords()) std::reverse(mesh.face_texcoords.begin() + begin, mesh.face_texcoords.begin() + end);
 }
@@ -423,10 +432,12 @@ SurfaceOrientation orient_outward(ControlMesh& mesh) {
                 if (a.reverse[s])
                     for (const std::uint32_t f : a.shells[s].faces) reverse_face(mesh, f);
             if (a.reversed == shells && shells == 1) {
-                mesh.warnings.push_back(mesh.name + ": closed surface oriented inward (negative signed volume): "
+                mesh.warnings.push_back(mesh.name +
+                                        ": closed surface oriented inward (negative signed volume): "
                                         "faces reversed, so that its outside faces out");
             } else {
-                mesh.warnings.push_back(mesh.name + ": " + std::to_string(a.reversed) + " of " + std::to_string(shells) +
+                mesh.warnings.push_back(mesh.name + ": " + std::to_string(a.reversed) + " of " +
+                                        std::to_string(shells) +
                                         " closed shells oriented inward (facing into the solid; a shell inside an odd "
                                         "number of others bounds a cavity): their faces reversed, so that every shell "
                                         "faces out of the solid");

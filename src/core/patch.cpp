@@ -143,8 +143,7 @@ void split_tangents(const TangentPatches& t, TangentPatches out[4]) {
 
 void PatchBatch::resize(std::size_t count) {
     count_ = count;
-    stride_ = std::max<std::size_t>(kBatchAlignment,
-                                    (count + kBatchAlignment - 1) / kBatchAlignment * kBatchAlignment);
+    stride_ = std::max<std::size_t>(kBatchAlignment, (count + kBatchAlignment - 1) / kBatchAlignment * kBatchAlignment);
     data_.assign(stride_ * 4 * kPatchPoints, 0.0f);
 }
 
@@ -154,8 +153,9 @@ void check_patch_weights(const BezierPatch& patch, std::size_t index) {
         char weight[32];
         std::snprintf(weight, sizeof weight, "%g", static_cast<double>(patch.cp[k].w));
         throw Error("patch " + std::to_string(index) + ": control point " + std::to_string(k) + " has weight " +
-                    weight + "; weights must be positive (negate every coordinate of a patch whose weights "
-                             "are all negative: the same surface)");
+                    weight +
+                    "; weights must be positive (negate every coordinate of a patch whose weights "
+                    "are all negative: the same surface)");
     }
 }
 
@@ -172,8 +172,7 @@ void PatchBatch::set(std::size_t index, const BezierPatch& patch) {
 BezierPatch PatchBatch::get(std::size_t index) const {
     BezierPatch p;
     for (int k = 0; k < kPatchPoints; ++k)
-        p.cp[k] = {component(k, 0)[index], component(k, 1)[index], component(k, 2)[index],
-                   component(k, 3)[index]};
+        p.cp[k] = {component(k, 0)[index], component(k, 1)[index], component(k, 2)[index], component(k, 3)[index]};
     return p;
 }
 
@@ -233,7 +232,7 @@ constexpr std::size_t kHugeFrom = std::size_t{4} << 20;
 }  // namespace
 
 void* allocate_batch_storage(std::size_t bytes) {
-    if (bytes < kHugeFrom) return ::operator new(bytes, std::align_val_t{64});
+    if (bytes < kHugeFrom) return ::operator new (bytes, std::align_val_t{64});
     const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
     void* p = std::aligned_alloc(kHugePage, rounded);
     if (!p) throw std::bad_alloc();
@@ -244,8 +243,10 @@ void* allocate_batch_storage(std::size_t bytes) {
 }
 
 void free_batch_storage(void* p, std::size_t bytes) {
-    if (bytes < kHugeFrom) ::operator delete(p, std::align_val_t{64});
-    else std::free(p);
+    if (bytes < kHugeFrom)
+        ::operator delete (p, std::align_val_t{64});
+    else
+        std::free(p);
 }
 }  // namespace detail
 
@@ -258,7 +259,9 @@ std::atomic<std::size_t> g_blocked_prefetch{kDefaultBlockedPrefetch};
 
 void set_plain_prefetch_distance(std::size_t patches) { g_plain_prefetch.store(patches, std::memory_order_relaxed); }
 std::size_t plain_prefetch_distance() { return g_plain_prefetch.load(std::memory_order_relaxed); }
-void set_blocked_prefetch_distance(std::size_t patches) { g_blocked_prefetch.store(patches, std::memory_order_relaxed); }
+void set_blocked_prefetch_distance(std::size_t patches) {
+    g_blocked_prefetch.store(patches, std::memory_order_relaxed);
+}
 std::size_t blocked_prefetch_distance() { return g_blocked_prefetch.load(std::memory_order_relaxed); }
 
 }  // namespace patchcull

@@ -55,11 +55,11 @@ static_assert(kTermCount == 516, "Loop, Niessner & Eisenacher: 516 weighted cros
 struct Pair {
     std::uint8_t a, b;  // a < b
 };
-struct Step {           // acc += weight * cross4Z(p[pairs[pair].a], p[pairs[pair].b], p[third])
+struct Step {  // acc += weight * cross4Z(p[pairs[pair].a], p[pairs[pair].b], p[third])
     std::uint8_t pair, third;
-    float weight;       // table weight with the permutation sign folded in
+    float weight;  // table weight with the permutation sign folded in
 };
-struct Corner {         // t[dest] = weight * det[p_a, p_b - p_a, p_c - p_a]
+struct Corner {  // t[dest] = weight * det[p_a, p_b - p_a, p_c - p_a]
     std::uint8_t dest, a, b, c;
     float weight;
 };
@@ -67,10 +67,10 @@ struct Corner {         // t[dest] = weight * det[p_a, p_b - p_a, p_c - p_a]
 struct Schedule {
     int num_pairs = 0;
     std::array<Pair, 120> pairs{};
-    std::array<Step, kTermCount> steps{};             // grouped by destination, table order within
-    std::array<std::uint16_t, 65> dest_first{};       // steps of dest d: [dest_first[d], dest_first[d+1])
+    std::array<Step, kTermCount> steps{};        // grouped by destination, table order within
+    std::array<std::uint16_t, 65> dest_first{};  // steps of dest d: [dest_first[d], dest_first[d+1])
     std::array<Corner, 4> corners{};
-    std::array<std::int8_t, 64> corner_of_dest{};      // index into corners, or -1
+    std::array<std::int8_t, 64> corner_of_dest{};  // index into corners, or -1
 };
 
 namespace schedule_build {
@@ -175,12 +175,13 @@ constexpr Schedule make() {
                 // Anchor: the corner point of the destination's corner (shared by both edges).
                 const int corner = (d % 8 == 0 ? 0 : 3) + 4 * (d / 8 == 0 ? 0 : 3);
                 const int other[2] = {r.j == corner ? r.k : r.j, r.l == corner ? r.k : r.l};
-                if (!(r.j == corner || r.k == corner || r.l == corner)) throw "ptp schedule: corner term without its corner";
+                if (!(r.j == corner || r.k == corner || r.l == corner))
+                    throw "ptp schedule: corner term without its corner";
                 const int sign = perm_sign(r.j, r.k, r.l, corner, other[0], other[1]);
                 s.corner_of_dest[d] = static_cast<std::int8_t>(c);
-                s.corners[c++] = Corner{static_cast<std::uint8_t>(d), static_cast<std::uint8_t>(corner),
-                                        static_cast<std::uint8_t>(other[0]), static_cast<std::uint8_t>(other[1]),
-                                        sign > 0 ? w : -w};
+                s.corners[c++] =
+                    Corner{static_cast<std::uint8_t>(d), static_cast<std::uint8_t>(corner),
+                           static_cast<std::uint8_t>(other[0]), static_cast<std::uint8_t>(other[1]), sign > 0 ? w : -w};
                 continue;
             }
             const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
@@ -239,9 +240,9 @@ inline constexpr int kStepCount = kTermCount - 4;
 // 1 = u1 (3, 7, 11, 15; iu = 7), 2 = v1 (12-15; jv = 7), 3 = u0 (0, 4, 8, 12; iu = 0).
 // The bound is about 100 times the largest error observed (tests/core/ptp_test.cpp: worst-case
 // roundings against ones that partly cancel); its cost in culls is in docs/RESULTS.md.
-inline constexpr float kMarginC1 = 0x1p-17f;   // 128 u
-inline constexpr float kMarginC2 = 0x1p-21f;   // 8 u
-inline constexpr float kMarginC3 = 0x1p-38f;   // >= 384 u^2
+inline constexpr float kMarginC1 = 0x1p-17f;  // 128 u
+inline constexpr float kMarginC2 = 0x1p-21f;  // 8 u
+inline constexpr float kMarginC3 = 0x1p-38f;  // >= 384 u^2
 inline constexpr float kMarginUnderflow = 0x1p-100f;
 inline constexpr int kEdgePoints[4][4] = {{0, 1, 2, 3}, {3, 7, 11, 15}, {12, 13, 14, 15}, {0, 4, 8, 12}};
 

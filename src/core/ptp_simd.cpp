@@ -38,6 +38,8 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 namespace ptp {
 
+using ptp_detail::kPairCount;
+using ptp_detail::kSchedule;
 using simd_groups::DF;
 using simd_groups::Fma;
 using simd_groups::FmaSub;
@@ -46,8 +48,6 @@ using simd_groups::Group;
 using simd_groups::MF;
 using simd_groups::NegFma;
 using simd_groups::VF;
-using ptp_detail::kPairCount;
-using ptp_detail::kSchedule;
 
 // a*b - c*e as fma(a, b, -(c*e)), like minor2 in ptp.cpp. (A plain Sub(Mul, Mul) would not do:
 // GCC contracts it into an fma on FMA targets, but not on the others.)
@@ -181,8 +181,7 @@ HWY_INLINE MF PtpGroup(DF d, const Group& g, const ptp_detail::PtpClipRows& rows
 }
 
 template <bool kPcnt>
-HWY_NOINLINE void CullGroups(const PatchBatchView& patches, const ptp_detail::PtpClipRows& rows,
-                             std::uint8_t* culled) {
+HWY_NOINLINE void CullGroups(const PatchBatchView& patches, const ptp_detail::PtpClipRows& rows, std::uint8_t* culled) {
     // Compute-bound: software prefetching costs more than it saves (simd_groups-inl.h).
     ForEachGroup<false>(patches, culled, [&rows](DF d, const Group& g, std::size_t, std::size_t) {
         return PtpGroup<kPcnt>(d, g, rows);

@@ -115,10 +115,12 @@ bool reduce_8_to_7(const Get& c8, const Put& put) {
 
 Rational make_rational(std::int64_t num, std::int64_t den) { return normalized(num, den); }
 Rational operator+(Rational a, Rational b) {
-    return normalized(static_cast<i128>(a.num) * b.den + static_cast<i128>(b.num) * a.den, static_cast<i128>(a.den) * b.den);
+    return normalized(static_cast<i128>(a.num) * b.den + static_cast<i128>(b.num) * a.den,
+                      static_cast<i128>(a.den) * b.den);
 }
 Rational operator-(Rational a, Rational b) {
-    return normalized(static_cast<i128>(a.num) * b.den - static_cast<i128>(b.num) * a.den, static_cast<i128>(a.den) * b.den);
+    return normalized(static_cast<i128>(a.num) * b.den - static_cast<i128>(b.num) * a.den,
+                      static_cast<i128>(a.den) * b.den);
 }
 Rational operator*(Rational a, Rational b) {
     return normalized(static_cast<i128>(a.num) * b.num, static_cast<i128>(a.den) * b.den);
@@ -160,21 +162,22 @@ Expansion expand_ptp() {
                 for (const auto& row : p)
                     for (const Rational& c : row) {
                         nonzero = nonzero || !is_zero(c);
-                        out.max_abs_numerator = std::max<int>(out.max_abs_numerator, static_cast<int>(c.num < 0 ? -c.num : c.num));
+                        out.max_abs_numerator =
+                            std::max<int>(out.max_abs_numerator, static_cast<int>(c.num < 0 ? -c.num : c.num));
                     }
                 if (!nonzero) continue;
                 ++out.triples_considered;
                 // Reduce in u for each rv (9 columns), then in v for each iu (8 rows).
                 std::array<std::array<Rational, 9>, 8> pu{};  // pu[iu][rv]
                 for (int rv = 0; rv <= 8; ++rv) {
-                    const bool ok = reduce_8_to_7([&](int r) { return p[r][rv]; },
-                                                  [&](int r, Rational c) { pu[r][rv] = c; });
+                    const bool ok =
+                        reduce_8_to_7([&](int r) { return p[r][rv]; }, [&](int r, Rational c) { pu[r][rv] = c; });
                     out.reduced_exactly = out.reduced_exactly && ok;
                 }
                 std::array<std::array<Rational, 8>, 8> p7{};  // p7[iu][jv]
                 for (int iu = 0; iu < 8; ++iu) {
-                    const bool ok = reduce_8_to_7([&](int r) { return pu[iu][r]; },
-                                                  [&](int r, Rational c) { p7[iu][r] = c; });
+                    const bool ok =
+                        reduce_8_to_7([&](int r) { return pu[iu][r]; }, [&](int r, Rational c) { p7[iu][r] = c; });
                     out.reduced_exactly = out.reduced_exactly && ok;
                 }
                 if (!out.reduced_exactly) throw std::logic_error("ptp_gen: T does not reduce to bidegree 7");

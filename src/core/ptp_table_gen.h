@@ -33,16 +33,16 @@ inline bool operator==(Rational a, Rational b) { return a.num == b.num && a.den 
 inline bool is_zero(Rational a) { return a.num == 0; }
 
 struct Term {
-    int dest = 0;     ///< control plane index 8*jv + iu
+    int dest = 0;             ///< control plane index 8*jv + iu
     int j = 0, k = 0, l = 0;  ///< control point indices, j < k < l
     Rational weight;
 };
 
 struct Expansion {
-    std::vector<Term> terms;        ///< canonical order: by dest, then (j, k, l)
-    int triples_considered = 0;     ///< sorted triples whose coefficient polynomial is non-zero
-    bool reduced_exactly = false;   ///< every bidegree-8 coefficient polynomial degree-reduced exactly to 7
-    int max_abs_numerator = 0;      ///< of the degree-8 coefficients, for the record
+    std::vector<Term> terms;       ///< canonical order: by dest, then (j, k, l)
+    int triples_considered = 0;    ///< sorted triples whose coefficient polynomial is non-zero
+    bool reduced_exactly = false;  ///< every bidegree-8 coefficient polynomial degree-reduced exactly to 7
+    int max_abs_numerator = 0;     ///< of the degree-8 coefficients, for the record
 };
 
 /// Expands cross4(B, B_u, B_v) as described above. Throws std::logic_error when a coefficient

@@ -131,7 +131,8 @@ HWY_INLINE Group CopyPartialGroup(DF d, const PatchBatchView& patches, std::size
                                   float* buf) {
     const std::size_t N = hn::Lanes(d);
     for (int a = 0; a < kComponents; ++a)
-        for (std::size_t j = 0; j < N; ++j) buf[a * N + j] = patches.at(first + (j < valid ? j : valid - 1), a / 4, a % 4);
+        for (std::size_t j = 0; j < N; ++j)
+            buf[a * N + j] = patches.at(first + (j < valid ? j : valid - 1), a / 4, a % 4);
     return Group{buf, N};
 }
 

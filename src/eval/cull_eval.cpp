@@ -32,7 +32,10 @@ constexpr std::size_t kGrain = 1024;
 class DistanceViewGenerator {
 public:
     DistanceViewGenerator(const Bounds& object, const DistanceViews& range, std::uint64_t seed, float aspect)
-        : object_(object), range_(range), state_(seed * 0x9E3779B97F4A7C15ull + 0xD1B54A32D192ED03ull), aspect_(aspect) {}
+        : object_(object),
+          range_(range),
+          state_(seed * 0x9E3779B97F4A7C15ull + 0xD1B54A32D192ED03ull),
+          aspect_(aspect) {}
 
     Camera next() {
         Camera cam;
@@ -81,7 +84,8 @@ private:
 void check_distance_views(const DistanceViews& d) {
     // Written so NaN fails every test.
     if (!(d.min >= 1.0f && d.min <= 1000.0f))
-        throw Error("distance range: min " + std::to_string(d.min) + " is not in 1..1000 (below 1 the object leaves the view)");
+        throw Error("distance range: min " + std::to_string(d.min) +
+                    " is not in 1..1000 (below 1 the object leaves the view)");
     if (!(d.max >= d.min && d.max <= 1000.0f))
         throw Error("distance range: max " + std::to_string(d.max) + " is not in min..1000");
 }
@@ -116,9 +120,10 @@ const std::vector<Method>& methods() {
                          [id](const PatchBatchView& b, const float*, const CullView& v, std::uint8_t* out) {
                              cull_backpatch(id, b, v, BackpatchOptions{}, out);
                          }});
-    table.push_back({"ptp-pcnt", Truth::backface, [](const PatchBatchView& b, const float*, const CullView& v, std::uint8_t* out) {
-                         cull_backpatch(BackpatchMethod::ptp, b, v, BackpatchOptions{PtpRule::pcnt}, out);
-                     }});
+    table.push_back(
+        {"ptp-pcnt", Truth::backface, [](const PatchBatchView& b, const float*, const CullView& v, std::uint8_t* out) {
+             cull_backpatch(BackpatchMethod::ptp, b, v, BackpatchOptions{PtpRule::pcnt}, out);
+         }});
     return table;
 }
 
@@ -139,8 +144,8 @@ constexpr std::size_t kChunk = 64;
 int views_per_block(std::size_t patches, int views) {
     const std::size_t target = std::size_t{1} << 22;
     const std::size_t by_work = patches > 0 ? target / patches : 256;
-    return static_cast<int>(std::min<std::size_t>(std::clamp<std::size_t>(by_work, 16, 256),
-                                                   static_cast<std::size_t>(std::max(views, 1))));
+    return static_cast<int>(
+        std::min<std::size_t>(std::clamp<std::size_t>(by_work, 16, 256), static_cast<std::size_t>(std::max(views, 1))));
 }
 
 /// One thread's scratch for judging chunks: the window of dense samples, the chunk's decisions
@@ -164,8 +169,8 @@ struct ChunkJudge {
     /// Runs every method of every view in block on patches [first, first + count) and judges
     /// each culled patch against its dense samples.
     void judge(const PatchFrame& frame, const PatchBatchView& batch, const float* disp,
-               const std::vector<const Method*>& methods, const std::vector<CullView>& block,
-               std::size_t first, std::size_t count) {
+               const std::vector<const Method*>& methods, const std::vector<CullView>& block, std::size_t first,
+               std::size_t count) {
         window.clear();
         const PatchBatchView chunk = batch.subrange(first, count);
         for (const CullView& ctx : block)
@@ -209,8 +214,9 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
         (m->truth == Truth::frustum ? needs_frustum_truth : needs_backface_truth) = true;
     }
     if (needs_backface_truth && displacement && !displacement->empty())
-        throw Error("--displace: back-patch methods (tcone, ncone, ptp) do not bound displaced patches "
-                    "(Loop, Niessner & Eisenacher §8)");
+        throw Error(
+            "--displace: back-patch methods (tcone, ncone, ptp) do not bound displaced patches "
+            "(Loop, Niessner & Eisenacher §8)");
     if (options.distance) check_distance_views(*options.distance);
     const int grid = options.ground_truth_grid;
     if (grid < 1 || grid > 1024) throw Error("ground truth grid " + std::to_string(grid) + " is not in 1..1024");
@@ -248,9 +254,8 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
     std::vector<double> seconds(method_count, 0.0);
     std::vector<std::uint64_t> timed_culled(method_count), judged_culled(method_count), judged_false(method_count);
     std::vector<std::uint8_t> culled(n);
-    tbb::enumerable_thread_specific<ChunkJudge> judges([&] {
-        return ChunkJudge(grid, displacement, needs_frustum_truth, needs_backface_truth, method_count);
-    });
+    tbb::enumerable_thread_specific<ChunkJudge> judges(
+        [&] { return ChunkJudge(grid, displacement, needs_frustum_truth, needs_backface_truth, method_count); });
     const int block_views = views_per_block(n, options.views);
     std::vector<CullView> block;
     block.reserve(static_cast<std::size_t>(std::max(block_views, 0)));
@@ -268,11 +273,12 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
             for (std::size_t m = 0; m < method_count; ++m) {
                 const auto start = std::chrono::steady_clock::now();
                 parallel_for_ranges(n, kGrain, [&](std::size_t first, std::size_t last) {
-                    selected[m]->kernel(batch.view().subrange(first, last - first), disp_ptr ? disp_ptr + first : nullptr,
-                                        ctx, culled.data() + first);
+                    selected[m]->kernel(batch.view().subrange(first, last - first),
+                                        disp_ptr ? disp_ptr + first : nullptr, ctx, culled.data() + first);
                 });
                 seconds[m] += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-                timed_culled[m] += static_cast<std::uint64_t>(std::count_if(culled.begin(), culled.end(), [](std::uint8_t c) { return c != 0; }));
+                timed_culled[m] += static_cast<std::uint64_t>(
+                    std::count_if(culled.begin(), culled.end(), [](std::uint8_t c) { return c != 0; }));
             }
         }
         // The judgement, chunk by chunk on all cores: a chunk's dense samples are made when one of
@@ -297,7 +303,8 @@ CullEvalResult evaluate_cull(const PatchFrame& frame, const DisplacementMap* dis
             if (judged_culled[m] != timed_culled[m])
                 throw Error(std::string("cull evaluation: ") + selected[m]->name + " culled " +
                             std::to_string(timed_culled[m]) + " patch-views in the timed pass but " +
-                            std::to_string(judged_culled[m]) + " when judged chunk by chunk (a kernel whose "
+                            std::to_string(judged_culled[m]) +
+                            " when judged chunk by chunk (a kernel whose "
                             "decisions depend on the range it runs in)");
             result.methods[m].culled += judged_culled[m];
             result.methods[m].false_culls += judged_false[m];

@@ -65,7 +65,7 @@ DisplacedEvalResult run_displaced_eval(const LoadedModel& model, const Displacem
     std::uint64_t done = 0;
     for (int v = 0; v < o.views; ++v) {
         Camera camera = views.next();
-        camera.depth = o.clip_depth;  // drawn and culled in it
+        camera.depth = o.clip_depth;                                                    // drawn and culled in it
         gl::RenderParams params = render_params(camera, width, height, o.tess, false);  // displaced: two-sided
         params.use_cull_flags = false;
         renderer.render(params);

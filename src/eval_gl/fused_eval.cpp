@@ -108,8 +108,8 @@ FusedEvalResult run_fused_eval(Scene scene, const FusedEvalOptions& o, const Run
             if (id != 0 && (id & gl::kIdOccluderBit) == 0 && id <= pose.size()) shown[id - 1] = true;
 
         const PatchBatch batch = make_batch(pose);
-        const FusedCullSetup setup = make_fused_setup(params.projection * params.view, camera.depth,
-                                                      camera.eye, cone, &hiz);
+        const FusedCullSetup setup =
+            make_fused_setup(params.projection * params.view, camera.depth, camera.eye, cone, &hiz);
         for (std::size_t i = 0; i < fused.size(); ++i) {
             const PatchBatchView view = batch.view().subrange(fused[i].first, fused[i].count);
             decision.resize(view.count);
@@ -167,7 +167,8 @@ FusedEvalResult run_fused_eval(Scene scene, const FusedEvalOptions& o, const Run
             }
             r.model_seconds += t;
             for (int p = 0; p < fixed_count; ++p)
-                if (fused_plan_name(fixed[p]) == fused_plan_name(plan) && times[static_cast<std::size_t>(p)] <= best * 1.03)
+                if (fused_plan_name(fixed[p]) == fused_plan_name(plan) &&
+                    times[static_cast<std::size_t>(p)] <= best * 1.03)
                     ++r.agreements;
             ++r.object_frames;
             // The separate kernels.

@@ -12,7 +12,8 @@ namespace {
 
 double fraction_culled(const std::vector<std::uint8_t>& culled) {
     if (culled.empty()) return 0;
-    return double(std::count_if(culled.begin(), culled.end(), [](std::uint8_t c) { return c != 0; })) / double(culled.size());
+    return double(std::count_if(culled.begin(), culled.end(), [](std::uint8_t c) { return c != 0; })) /
+           double(culled.size());
 }
 
 }  // namespace

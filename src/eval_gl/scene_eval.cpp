@@ -29,7 +29,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point start) { return std::chrono::duration<double, std::milli>(Clock::now() - start).count(); }
+double ms_since(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
 
 struct Method {
     std::string name;  // the row's name: the object method's, + "+hiz" when followed by the patch passes
@@ -47,7 +49,8 @@ std::vector<Method> all_methods(bool has_boxes, bool has_cells) {
         m.patch_hiz = true;
         out.push_back(m);
     };
-    for (gl::QueryMethod q : {gl::QueryMethod::stop_and_wait, gl::QueryMethod::batched, gl::QueryMethod::chc, gl::QueryMethod::chcpp})
+    for (gl::QueryMethod q :
+         {gl::QueryMethod::stop_and_wait, gl::QueryMethod::batched, gl::QueryMethod::chc, gl::QueryMethod::chcpp})
         both({gl::query_method_name(q), q, {}, false});
     if (has_boxes) both({"horizon", {}, SceneOcclusionMethod::horizon, false});
     if (has_cells) both({"portals", {}, SceneOcclusionMethod::portals, false});
@@ -63,7 +66,8 @@ std::vector<Method> chosen_methods(const std::vector<std::string>& names, const 
         if (it == available.end()) {
             std::string list;
             for (const Method& m : available) list += (list.empty() ? "" : ", ") + m.name;
-            throw Error("--methods: " + quote_input(item) + " is not a method for scene '" + scene.name + "' (" + list + ")");
+            throw Error("--methods: " + quote_input(item) + " is not a method for scene '" + scene.name + "' (" + list +
+                        ")");
         }
         if (std::none_of(out.begin(), out.end(), [&](const Method& m) { return m.name == item; })) out.push_back(*it);
     }
@@ -77,14 +81,16 @@ std::vector<Method> chosen_methods(const std::vector<std::string>& names, const 
 }
 
 struct Totals {
-    double objects_culled = 0, objects_hidden = 0, patches_hidden = 0, patches_culled = 0, patches_object = 0, patches_frustum = 0, patches_occlusion = 0;
+    double objects_culled = 0, objects_hidden = 0, patches_hidden = 0, patches_culled = 0, patches_object = 0,
+           patches_frustum = 0, patches_occlusion = 0;
     double queries = 0, multiqueries = 0, multiqueries_passed = 0, proxy_boxes = 0, waits = 0;
     double object_cpu = 0, pass1 = 0, hiz = 0, cull = 0, pass2 = 0, frame = 0;
     std::size_t wait_frames = 0, false_culls = 0;
 };
 
 // Culled occluder triangles that the unculled reference shows.
-std::size_t false_culled_triangles(const std::vector<std::uint32_t>& reference_ids, const std::vector<IndexSpan>& culled) {
+std::size_t false_culled_triangles(const std::vector<std::uint32_t>& reference_ids,
+                                   const std::vector<IndexSpan>& culled) {
     if (culled.empty()) return 0;
     std::vector<std::uint32_t> seen;
     for (std::uint32_t id : reference_ids)
@@ -217,7 +223,8 @@ SceneEvalResult run_scene_eval(Scene scene, const SceneEvalOptions& o, const Run
                 if (method.scene_method) {
                     const ObjectCullResult& culled = scene_method->cull(culled_objects, camera, width, height);
                     for (const IndexSpan& s : culled.culled_patches) params.object_culled.push_back({s.first, s.count});
-                    for (const IndexSpan& s : culled.culled_triangles) params.culled_occluders.push_back({s.first, s.count});
+                    for (const IndexSpan& s : culled.culled_triangles)
+                        params.culled_occluders.push_back({s.first, s.count});
                     params.objects = ranges;  // an instance culled whole is then not dispatched at all
                     t.objects_culled += double(culled.stats.frustum_culled + scene_method->stats().objects_culled);
                     t.objects_hidden += double(scene_method->stats().objects_culled);
@@ -232,7 +239,8 @@ SceneEvalResult run_scene_eval(Scene scene, const SceneEvalOptions& o, const Run
                     objects.count = instances;
                     objects.patches = object_patches.data();
                     if (q.method == gl::QueryMethod::chcpp && q.tight_bounds) {
-                        tight.update(pose, poser.displacement_ranges(), o.sigma, static_cast<std::size_t>(o.max_tight_boxes));
+                        tight.update(pose, poser.displacement_ranges(), o.sigma,
+                                     static_cast<std::size_t>(o.max_tight_boxes));
                         objects.tight = tight.boxes().data();
                         objects.tight_first = tight.first().data();
                     }
@@ -245,8 +253,8 @@ SceneEvalResult run_scene_eval(Scene scene, const SceneEvalOptions& o, const Run
             const gl::FrameStats stats = pipeline.render_frame(params);
             if (method.queries) {
                 // The objects the queries hid (not drawn, inside the frustum: the pass's own box test).
-                const FrustumPlanes planes =
-                    make_frustum_planes(params.frame.render.projection * params.frame.render.view, ClipDepth::zero_to_one);
+                const FrustumPlanes planes = make_frustum_planes(
+                    params.frame.render.projection * params.frame.render.view, ClipDepth::zero_to_one);
                 for (std::size_t i = 0; i < instances; ++i) {
                     if (queries.drawn()[i]) continue;
                     PlaneCullState state;

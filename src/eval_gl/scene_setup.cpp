@@ -37,8 +37,9 @@ std::vector<SceneObject> scene_objects(const Scene& scene) {
         const LoadedModel& model = scene.models.at(instance.model);
         SceneObject o;
         const std::size_t copy = copies[instance.model]++;
-        o.name = !instance.name.empty() ? instance.name
-                                        : std::filesystem::path(model.name).stem().string() + "#" + std::to_string(copy);
+        o.name = !instance.name.empty()
+                     ? instance.name
+                     : std::filesystem::path(model.name).stem().string() + "#" + std::to_string(copy);
         o.range.first = first;
         o.range.count = model.rest.patches.size();
         o.range.cull = true;

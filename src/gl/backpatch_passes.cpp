@@ -36,10 +36,15 @@ private:
 std::map<BackpatchMethod, BackpatchPassFactory>& factories() {
     static std::map<BackpatchMethod, BackpatchPassFactory> passes = {
         {BackpatchMethod::tcone,
-         [](PassContext& c) -> std::unique_ptr<BackpatchPass> { return std::make_unique<ConeMethodPass>(c, BackpatchMethod::tcone); }},
+         [](PassContext& c) -> std::unique_ptr<BackpatchPass> {
+             return std::make_unique<ConeMethodPass>(c, BackpatchMethod::tcone);
+         }},
         {BackpatchMethod::ncone,
-         [](PassContext& c) -> std::unique_ptr<BackpatchPass> { return std::make_unique<ConeMethodPass>(c, BackpatchMethod::ncone); }},
-        {BackpatchMethod::ptp, [](PassContext& c) -> std::unique_ptr<BackpatchPass> { return std::make_unique<PtpMethodPass>(c); }},
+         [](PassContext& c) -> std::unique_ptr<BackpatchPass> {
+             return std::make_unique<ConeMethodPass>(c, BackpatchMethod::ncone);
+         }},
+        {BackpatchMethod::ptp,
+         [](PassContext& c) -> std::unique_ptr<BackpatchPass> { return std::make_unique<PtpMethodPass>(c); }},
     };
     return passes;
 }

@@ -75,8 +75,8 @@ void require_library(const char* const* names, const char* what) {
 struct Candidate {
     EGLenum platform;
     void* native;
-    std::string name;  // "device", "surfaceless", "software-device"
-    std::string label; // for messages
+    std::string name;   // "device", "surfaceless", "software-device"
+    std::string label;  // for messages
 };
 
 // Tries to make a GL 4.5 core context on candidate c; returns an empty string on success (and
@@ -86,8 +86,7 @@ std::string try_candidate(const Candidate& c, PFNEGLGETPLATFORMDISPLAYEXTPROC ge
     EGLDisplay display = get_platform_display(c.platform, c.native, nullptr);
     if (display == EGL_NO_DISPLAY) return c.label + ": eglGetPlatformDisplayEXT failed (" + hex(eglGetError()) + ")";
     EGLint major = 0, minor = 0;
-    if (!eglInitialize(display, &major, &minor))
-        return c.label + ": eglInitialize failed (" + hex(eglGetError()) + ")";
+    if (!eglInitialize(display, &major, &minor)) return c.label + ": eglInitialize failed (" + hex(eglGetError()) + ")";
     acquire_display(display);
     auto fail = [&](const std::string& why) {
         release_display(display);
@@ -102,8 +101,9 @@ std::string try_candidate(const Candidate& c, PFNEGLGETPLATFORMDISPLAYEXTPROC ge
         EGLint n = 0;
         if (!eglChooseConfig(display, attribs, &config, 1, &n) || n < 1) return fail("no OpenGL EGLConfig");
     }
-    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    const EGLint ctx_attribs[] = {
+        EGL_CONTEXT_MAJOR_VERSION,           4,       EGL_CONTEXT_MINOR_VERSION, 5, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     EGLContext context = eglCreateContext(display, config, EGL_NO_CONTEXT, ctx_attribs);
     if (context == EGL_NO_CONTEXT) return fail("no OpenGL 4.5 core context");
     if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, context)) {
@@ -160,8 +160,8 @@ GlContext GlContext::create_headless() {
     require_library(gl_names, "the OpenGL library");
 
     const char* client_exts = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
-    auto get_platform_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
-        eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    auto get_platform_display =
+        reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
     if (!client_exts || !get_platform_display || !has_extension(client_exts, "EGL_EXT_platform_base"))
         throw Error("EGL: no display: EGL_EXT_platform_base is missing (no EGL vendor library installed?)");
 

@@ -129,7 +129,8 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
         for (std::size_t i = 0; i < objects_.size(); ++i) {
             if (!decisions_[i].cull) continue;
             const double n = static_cast<double>(objects_[i].range.count);
-            saving += n * (objects_[i].rate * tess_cost_ms(decisions_[i].tess_factor) - costs_.issue_ms - costs_.cull_ms);
+            saving +=
+                n * (objects_[i].rate * tess_cost_ms(decisions_[i].tess_factor) - costs_.issue_ms - costs_.cull_ms);
             culled_patches += objects_[i].range.count;
         }
         const double fixed = costs_.hiz_ms + static_cast<double>(patch_count_ - culled_patches) * costs_.issue_ms;
@@ -137,7 +138,8 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
             for (Decision& d : decisions_) {
                 if (!d.cull) continue;
                 d.cull = false;
-                d.reason += format("; the frame would save %.2f ms <= %.2f ms (Hi-Z build, pass-2 issue)", saving, fixed);
+                d.reason +=
+                    format("; the frame would save %.2f ms <= %.2f ms (Hi-Z build, pass-2 issue)", saving, fixed);
             }
         }
     }
@@ -157,12 +159,11 @@ std::vector<ObjectRange> CullAutoPolicy::objects() const {
 }
 
 std::size_t CullAutoPolicy::culled_objects() const {
-    return static_cast<std::size_t>(std::count_if(decisions_.begin(), decisions_.end(), [](const Decision& d) { return d.cull; }));
+    return static_cast<std::size_t>(
+        std::count_if(decisions_.begin(), decisions_.end(), [](const Decision& d) { return d.cull; }));
 }
 
-CullMode CullAutoPolicy::frame_cull_mode(CullMode tests) const {
-    return culled_objects() > 0 ? tests : CullMode::none;
-}
+CullMode CullAutoPolicy::frame_cull_mode(CullMode tests) const { return culled_objects() > 0 ? tests : CullMode::none; }
 
 void CullAutoPolicy::observe(const FrameStats& stats) {
     if (!pending_) throw std::logic_error("CullAutoPolicy::observe: no decision to observe");
@@ -181,8 +182,8 @@ void CullAutoPolicy::observe(const FrameStats& stats) {
         weights += static_cast<double>(s.visible);
         if (!decisions_[i].cull || s.patches == 0) continue;
         culled_patches += s.patches;
-        const double rate =
-            static_cast<double>(s.frustum_culled + s.backpatch_culled + s.occlusion_culled) / static_cast<double>(s.patches);
+        const double rate = static_cast<double>(s.frustum_culled + s.backpatch_culled + s.occlusion_culled) /
+                            static_cast<double>(s.patches);
         const bool retest = decisions_[i].probe && !std::isnan(o.rate);  // not its first measurement
         o.rate = decisions_[i].probe ? rate : average(o.rate, rate, config_.rate_weight);
         o.last_culled = frame_;
@@ -225,7 +226,8 @@ void CullAutoPolicy::observe(const FrameStats& stats) {
             costs_.issue_ms = average(costs_.issue_ms, issue, cw);
         }
         if (culled_patches > 0) {
-            const double cull = std::max(0.0, stats.cull_ms - costs_.status_ms * n) / static_cast<double>(culled_patches);
+            const double cull =
+                std::max(0.0, stats.cull_ms - costs_.status_ms * n) / static_cast<double>(culled_patches);
             costs_.cull_ms = average(costs_.cull_ms, cull, cw);
         }
         ++cost_samples_;
@@ -245,8 +247,8 @@ std::string auto_summary_line(const std::vector<std::string>& names,
     std::string line = "auto: culling " + std::to_string(on) + " of " + std::to_string(decisions.size()) + " objects";
     for (std::size_t i = 0; i < decisions.size(); ++i) {
         line += i == 0 ? ": " : "; ";
-        line += (i < names.size() ? names[i] : "object " + std::to_string(i)) + (decisions[i].cull ? " on (" : " off (") +
-                decisions[i].reason + ")";
+        line += (i < names.size() ? names[i] : "object " + std::to_string(i)) +
+                (decisions[i].cull ? " on (" : " off (") + decisions[i].reason + ")";
     }
     return line;
 }

@@ -15,7 +15,6 @@
 
 namespace patchcull::gl {
 
-
 CullPipeline::CullPipeline(const GlContext& ctx) : impl_((ctx.make_current(), std::make_unique<Impl>(ctx))) {}
 CullPipeline::CullPipeline(CullPipeline&&) noexcept = default;
 CullPipeline& CullPipeline::operator=(CullPipeline&&) noexcept = default;
@@ -49,7 +48,8 @@ struct Drawer final : ObjectDrawer {
     PatchRenderer* target = nullptr;
     std::vector<std::uint8_t> done;
     void draw(std::size_t object) override {
-        if (object >= done.size()) throw Error("ObjectDrawer::draw: object " + std::to_string(object) + " out of range");
+        if (object >= done.size())
+            throw Error("ObjectDrawer::draw: object " + std::to_string(object) + " out of range");
         if (done[object]) return;
         done[object] = 1;
         draw_object(object);
@@ -90,7 +90,8 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     const FrameTests f = frame_tests(params, r);
     const bool two_pass = f.two_pass;
     TimingMethod method = frame.timing;
-    if (method == TimingMethod::automatic) method = m.passes.is_software() ? TimingMethod::wall_clock : TimingMethod::timer_query;
+    if (method == TimingMethod::automatic)
+        method = m.passes.is_software() ? TimingMethod::wall_clock : TimingMethod::timer_query;
 
     FrameStats stats;
     stats.patches = r.patch_count();
@@ -160,7 +161,8 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         r.begin_frame(rp);
         run_object_pass(true);
         for (std::size_t i = 0; i < plan.objects.size(); ++i)
-            if (plan.object_spans[i].empty()) chain.mark_culled(plan.objects[i].first, plan.objects[i].first + plan.objects[i].count);
+            if (plan.object_spans[i].empty())
+                chain.mark_culled(plan.objects[i].first, plan.objects[i].first + plan.objects[i].count);
         chain.begin_gaps();
         chain.end_gaps();
         r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.gaps_drawn);

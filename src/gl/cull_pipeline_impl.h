@@ -41,11 +41,13 @@ public:
         std::vector<double> ms(static_cast<std::size_t>(std::max(marks_ - 1, 0)), 0.0);
         if (method_ == TimingMethod::wall_clock) {
             for (int i = 0; i + 1 < marks_; ++i)
-                ms[static_cast<std::size_t>(i)] = std::chrono::duration<double, std::milli>(wall_[i + 1] - wall_[i]).count();
+                ms[static_cast<std::size_t>(i)] =
+                    std::chrono::duration<double, std::milli>(wall_[i + 1] - wall_[i]).count();
         } else if (method_ == TimingMethod::timer_query) {
             GLuint64 t[kMaxMarks] = {};
             for (int i = 0; i < marks_; ++i) glGetQueryObjectui64v(queries_[i], GL_QUERY_RESULT, &t[i]);
-            for (int i = 0; i + 1 < marks_; ++i) ms[static_cast<std::size_t>(i)] = static_cast<double>(t[i + 1] - t[i]) * 1e-6;
+            for (int i = 0; i + 1 < marks_; ++i)
+                ms[static_cast<std::size_t>(i)] = static_cast<double>(t[i + 1] - t[i]) * 1e-6;
         }
         return ms;
     }
@@ -57,11 +59,16 @@ private:
     int marks_ = 0;
 };
 
-
 struct CullPipeline::Impl {
     explicit Impl(const GlContext& ctx)
-        : renderer(ctx), frustum(passes), frustum_disp(passes), hiz_build(passes), occlusion(passes), displaced(passes),
-          status(passes), fused(passes) {
+        : renderer(ctx),
+          frustum(passes),
+          frustum_disp(passes),
+          hiz_build(passes),
+          occlusion(passes),
+          displaced(passes),
+          status(passes),
+          fused(passes) {
         glCreateBuffers(1, &counters);
         GLint alignment = 16;
         glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &alignment);
@@ -85,7 +92,7 @@ struct CullPipeline::Impl {
     CullStatusPass status;
     FusedCullPass fused;
     std::map<BackpatchMethod, std::unique_ptr<BackpatchPass>> backpatch_passes;  // made on first use
-    HiZTexture hiz;  // of the framebuffer's size; recreated when it changes
+    HiZTexture hiz;                  // of the framebuffer's size; recreated when it changes
     GLuint counters = 0;             // kCounterCount uints per object (+ one slot for the rest)
     std::size_t counter_stride = 0;  // bytes between slots (the SSBO offset alignment)
     std::size_t counter_slots = 0;   // slots allocated
@@ -127,6 +134,5 @@ struct CullPipeline::Impl {
         hiz = create_hiz_texture(renderer.width(), renderer.height());
     }
 };
-
 
 }  // namespace patchcull::gl

@@ -26,7 +26,6 @@ namespace {
 using detail::check_gl;
 using detail::upload;
 
-
 }  // namespace
 
 struct DisplacedCuller::Impl {
@@ -66,7 +65,8 @@ struct DisplacedCuller::Impl {
 
     void run(DisplacedBoundKind bound, NormalConeKind cone, const DisplacedCullView& view, bool occlusion,
              std::vector<DisplacedBound>* bound_out) {
-        if (occlusion && !hiz.texture) throw Error("GL: DisplacedCuller::cull_occlusion: no Hi-Z pyramid (call set_hiz)");
+        if (occlusion && !hiz.texture)
+            throw Error("GL: DisplacedCuller::cull_occlusion: no Hi-Z pyramid (call set_hiz)");
         glClearNamedBufferData(flags, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
         if (bound_out) upload(bounds, count * shared::kDisplacedBoundValues * sizeof(float), nullptr);
         pass.run({points, flags, 0, 0, count}, has_ranges ? ranges : 0, bound, cone, view, occlusion ? &hiz : nullptr,
@@ -112,7 +112,8 @@ DisplacedCuller::DisplacedCuller(DisplacedCuller&&) noexcept = default;
 DisplacedCuller& DisplacedCuller::operator=(DisplacedCuller&&) noexcept = default;
 DisplacedCuller::~DisplacedCuller() = default;
 
-void DisplacedCuller::set_patches(const std::vector<BezierPatch>& patches, const std::vector<DisplacementRange>& ranges) {
+void DisplacedCuller::set_patches(const std::vector<BezierPatch>& patches,
+                                  const std::vector<DisplacementRange>& ranges) {
     static_assert(sizeof(BezierPatch) == kPatchPoints * 4 * sizeof(float), "BezierPatch must be 16 packed float4");
     if (!ranges.empty() && ranges.size() != patches.size())
         throw Error("GL: DisplacedCuller::set_patches: " + std::to_string(ranges.size()) + " ranges for " +

@@ -28,14 +28,17 @@ DisplacedPass::DisplacedPass(DisplacedPass&&) noexcept = default;
 DisplacedPass& DisplacedPass::operator=(DisplacedPass&&) noexcept = default;
 DisplacedPass::~DisplacedPass() = default;
 
-void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, DisplacedBoundKind bound, NormalConeKind cone,
-                        const DisplacedCullView& view, const HiZTexture* hiz, bool only_displaced, std::uint32_t bounds) {
+void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, DisplacedBoundKind bound,
+                        NormalConeKind cone, const DisplacedCullView& view, const HiZTexture* hiz, bool only_displaced,
+                        std::uint32_t bounds) {
     Impl& m = *impl_;
     detail::begin_pass("DisplacedPass");
     detail::check_patch_buffers("DisplacedPass", patches);
     const std::size_t end = patches.first + patches.count;
     if (ranges) detail::check_buffer_size("DisplacedPass", "range", ranges, end * sizeof(DisplacementRange));
-    if (bounds) detail::check_buffer_size("DisplacedPass", "bound", bounds, end * shared::kDisplacedBoundValues * sizeof(float));
+    if (bounds)
+        detail::check_buffer_size("DisplacedPass", "bound", bounds,
+                                  end * shared::kDisplacedBoundValues * sizeof(float));
     if (hiz && (!glIsTexture(hiz->texture) || hiz->width < 1 || hiz->height < 1))
         throw Error("GL: DisplacedPass: no Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
     if (hiz && hiz->reversed != is_reversed(view.depth))
@@ -49,7 +52,8 @@ void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, Displ
         const Vec4& r = view.view_planes.rows[q];
         params.view_planes[q] = {r.x, r.y, r.z, r.w};
     }
-    for (int i = 0; i < 3; ++i) params.axis_unit[i] = {view.axis_unit[i].x, view.axis_unit[i].y, view.axis_unit[i].z, 0};
+    for (int i = 0; i < 3; ++i)
+        params.axis_unit[i] = {view.axis_unit[i].x, view.axis_unit[i].y, view.axis_unit[i].z, 0};
     params.axis_length = {view.axis_length[0], view.axis_length[1], view.axis_length[2], 0};
     params.abs_row_z = {view.abs_row_z[0], view.abs_row_z[1], view.abs_row_z[2], view.abs_row_z[3]};
     const Mat4& pr = view.projection;

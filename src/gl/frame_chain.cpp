@@ -16,7 +16,8 @@ void FrameChain::mark_culled(std::size_t first, std::size_t end) {
     for (const PatchSpan& s : plan_.culled) {
         const std::size_t a = std::max(s.first, first), b = std::min(s.first + s.count, end);
         if (a < b)
-            glClearNamedBufferSubData(m_.renderer.flag_buffer(), GL_R32UI, static_cast<GLintptr>(a * sizeof(std::uint32_t)),
+            glClearNamedBufferSubData(m_.renderer.flag_buffer(), GL_R32UI,
+                                      static_cast<GLintptr>(a * sizeof(std::uint32_t)),
                                       static_cast<GLsizeiptr>((b - a) * sizeof(std::uint32_t)), GL_RED_INTEGER,
                                       GL_UNSIGNED_INT, &object_word);
     }
@@ -29,7 +30,8 @@ void FrameChain::begin_gaps() {
 
 void FrameChain::end_gaps() {
     for (const std::vector<PatchSpan>& spans : plan_.gap_spans)
-        for (const PatchSpan& s : spans) m_.status.end(buffers_of(s), m_.counters, plan_.objects.size() * m_.counter_stride);
+        for (const PatchSpan& s : spans)
+            m_.status.end(buffers_of(s), m_.counters, plan_.objects.size() * m_.counter_stride);
 }
 
 void FrameChain::run(const HiZTexture* hiz, const std::vector<std::size_t>* only, bool timed) {
@@ -45,11 +47,13 @@ void FrameChain::run(const HiZTexture* hiz, const std::vector<std::size_t>* only
     if (with_gaps) {
         if (!plan_.culled.empty()) mark_culled(0, plan_.patch_count);
     } else {
-        for (std::size_t i : *only) mark_culled(plan_.objects[i].first, plan_.objects[i].first + plan_.objects[i].count);
+        for (std::size_t i : *only)
+            mark_culled(plan_.objects[i].first, plan_.objects[i].first + plan_.objects[i].count);
     }
     run_tests(hiz, *only, timed);
     for (std::size_t i : *only)
-        for (const PatchSpan& s : plan_.object_spans[i]) m_.status.end(buffers_of(s), m_.counters, i * m_.counter_stride);
+        for (const PatchSpan& s : plan_.object_spans[i])
+            m_.status.end(buffers_of(s), m_.counters, i * m_.counter_stride);
     if (with_gaps) end_gaps();
     if (timed) clock_.mark();
 }
@@ -95,7 +99,8 @@ void FrameChain::run_tests(const HiZTexture* hiz, const std::vector<std::size_t>
         for (const PatchSpan& s : plan_.object_spans[i]) {
             if (occluding && !f_.fused) m_.occlusion.run(buffers_of(s), f_.view, *occluding, false);
             if (bounds)
-                m_.displaced.run(buffers_of(s), f_.ranges, params_.bound, params_.cone, displaced_view, occluding, true);
+                m_.displaced.run(buffers_of(s), f_.ranges, params_.bound, params_.cone, displaced_view, occluding,
+                                 true);
         }
     }
 }

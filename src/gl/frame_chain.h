@@ -15,22 +15,22 @@ namespace patchcull::gl {
 
 /// What a frame's tests are, decided once per frame.
 struct FrameTests {
-    std::uint32_t tests = 0;     ///< kCullFrustum | kCullBackPatch | kCullOcclusion bits to run
+    std::uint32_t tests = 0;  ///< kCullFrustum | kCullBackPatch | kCullOcclusion bits to run
     /// The mode has occlusion: the frame is drawn in two passes around a Hi-Z pyramid (even when
     /// no test may run, e.g. displaced without margins).
     bool two_pass = false;
-    bool fused = false;          ///< FusedCullPass runs frustum, cone and Hi-Z together
-    bool aabb = false;           ///< FrustumDispPass instead of FrustumPass
-    PatchBuffers chain;          ///< the renderer's buffers (margins 0 when drawn undisplaced)
-    std::uint32_t ranges = 0;    ///< displacement ranges buffer when displacing, else 0
-    CullView view;               ///< the frame's view (its eye checked: a singular view is refused)
+    bool fused = false;        ///< FusedCullPass runs frustum, cone and Hi-Z together
+    bool aabb = false;         ///< FrustumDispPass instead of FrustumPass
+    PatchBuffers chain;        ///< the renderer's buffers (margins 0 when drawn undisplaced)
+    std::uint32_t ranges = 0;  ///< displacement ranges buffer when displacing, else 0
+    CullView view;             ///< the frame's view (its eye checked: a singular view is refused)
     BackpatchOptions backpatch_options;
 };
 
 class FrameChain {
 public:
-    FrameChain(CullPipeline::Impl& pipeline, const PipelineParams& params, const FrameTests& frame, const SpanPlan& plan,
-               PassClock& clock)
+    FrameChain(CullPipeline::Impl& pipeline, const PipelineParams& params, const FrameTests& frame,
+               const SpanPlan& plan, PassClock& clock)
         : m_(pipeline), params_(params), f_(frame), plan_(plan), clock_(clock) {}
 
     /// The chain on the objects `only` names (every object and every gap when null), against hiz

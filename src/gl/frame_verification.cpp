@@ -100,11 +100,16 @@ void write_ids_png(const std::string& path, const std::vector<std::uint32_t>& id
 
 const char* cull_mode_name(CullMode mode) {
     switch (mode) {
-        case CullMode::none: return "none";
-        case CullMode::frustum: return "frustum";
-        case CullMode::backpatch: return "backpatch";
-        case CullMode::occlusion: return "occlusion";
-        case CullMode::all: return "all";
+        case CullMode::none:
+            return "none";
+        case CullMode::frustum:
+            return "frustum";
+        case CullMode::backpatch:
+            return "backpatch";
+        case CullMode::occlusion:
+            return "occlusion";
+        case CullMode::all:
+            return "all";
     }
     return "?";
 }
@@ -121,10 +126,14 @@ bool parse_cull_mode(const char* text, CullMode& mode) {
 
 const char* timing_method_name(TimingMethod method) {
     switch (method) {
-        case TimingMethod::automatic: return "automatic";
-        case TimingMethod::wall_clock: return "wall-clock";
-        case TimingMethod::timer_query: return "timer-query";
-        case TimingMethod::off: return "off";
+        case TimingMethod::automatic:
+            return "automatic";
+        case TimingMethod::wall_clock:
+            return "wall-clock";
+        case TimingMethod::timer_query:
+            return "timer-query";
+        case TimingMethod::off:
+            return "off";
     }
     return "?";
 }

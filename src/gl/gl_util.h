@@ -68,7 +68,7 @@ inline GLuint compile_shader(const char* name, GLenum stage, const std::string& 
 }
 
 inline GLuint link_program(const std::vector<std::pair<const char*, GLenum>>& stages, const char* label,
-                    const std::string& defines = {}) {
+                           const std::string& defines = {}) {
     const GLuint program = glCreateProgram();
     std::vector<GLuint> shaders;
     try {

@@ -17,15 +17,15 @@ HiZBuildPass& HiZBuildPass::operator=(HiZBuildPass&&) noexcept = default;
 HiZBuildPass::~HiZBuildPass() = default;
 
 void HiZBuildPass::run(std::uint32_t depth_texture, const HiZTexture& hiz) {
-    if (hiz.reversed)
-        throw Error("GL: HiZBuildPass: the pyramid was built reversed; pass its convention to run()");
+    if (hiz.reversed) throw Error("GL: HiZBuildPass: the pyramid was built reversed; pass its convention to run()");
     HiZTexture forward = hiz;
     run(depth_texture, forward, ClipDepth::zero_to_one);
 }
 
 void HiZBuildPass::run(std::uint32_t depth_texture, HiZTexture& hiz, ClipDepth convention) {
     detail::begin_pass("HiZBuildPass");
-    if (!glIsTexture(depth_texture)) throw Error("GL: HiZBuildPass: " + std::to_string(depth_texture) + " is not a texture");
+    if (!glIsTexture(depth_texture))
+        throw Error("GL: HiZBuildPass: " + std::to_string(depth_texture) + " is not a texture");
     if (!glIsTexture(hiz.texture) || hiz.width < 1 || hiz.height < 1)
         throw Error("GL: HiZBuildPass: no Hi-Z texture (create_hiz_texture)");
     GLint format = 0;
@@ -33,14 +33,18 @@ void HiZBuildPass::run(std::uint32_t depth_texture, HiZTexture& hiz, ClipDepth c
     bool unorm24 = false;
     switch (format) {
         case GL_DEPTH_COMPONENT32F:
-        case GL_DEPTH32F_STENCIL8: break;
+        case GL_DEPTH32F_STENCIL8:
+            break;
         case GL_DEPTH_COMPONENT24:
-        case GL_DEPTH24_STENCIL8: unorm24 = true; break;
+        case GL_DEPTH24_STENCIL8:
+            unorm24 = true;
+            break;
         default: {
             char hex[16];
             std::snprintf(hex, sizeof hex, "0x%04X", static_cast<unsigned>(format));
-            throw Error(std::string("GL: HiZBuildPass: depth texture format ") + hex +
-                        " is not GL_DEPTH_COMPONENT32F, GL_DEPTH32F_STENCIL8, GL_DEPTH_COMPONENT24 or GL_DEPTH24_STENCIL8");
+            throw Error(
+                std::string("GL: HiZBuildPass: depth texture format ") + hex +
+                " is not GL_DEPTH_COMPONENT32F, GL_DEPTH32F_STENCIL8, GL_DEPTH_COMPONENT24 or GL_DEPTH24_STENCIL8");
         }
     }
     hiz.reversed = is_reversed(convention);

@@ -18,12 +18,12 @@
 #include <random>
 
 #include "gl_util.h"
-#include "shared.h"
-#include "patchcull/objects/bounding_volumes.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/gl/gl_object_queries.h"
+#include "patchcull/objects/bounding_volumes.h"
 #include "patchcull/objects/object_bvh.h"
+#include "shared.h"
 
 namespace patchcull::gl {
 
@@ -31,10 +31,14 @@ using namespace detail;
 
 const char* query_method_name(QueryMethod method) {
     switch (method) {
-        case QueryMethod::stop_and_wait: return "stop-and-wait";
-        case QueryMethod::batched: return "batched";
-        case QueryMethod::chc: return "chc";
-        case QueryMethod::chcpp: return "chc++";
+        case QueryMethod::stop_and_wait:
+            return "stop-and-wait";
+        case QueryMethod::batched:
+            return "batched";
+        case QueryMethod::chc:
+            return "chc";
+        case QueryMethod::chcpp:
+            return "chc++";
     }
     return "?";
 }
@@ -63,8 +67,8 @@ double persistence(std::uint32_t hidden_frames) { return 0.99 - 0.7 * std::exp(-
 Bounds widened_query_box(const Bounds& box, const Mat4& world_to_clip, Vec3 eye) {
     const Vec3 d = box.max - box.min;
     const float diag = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    const float extent = std::max({std::fabs(box.min.x), std::fabs(box.min.y), std::fabs(box.min.z), std::fabs(box.max.x),
-                                   std::fabs(box.max.y), std::fabs(box.max.z)});
+    const float extent = std::max({std::fabs(box.min.x), std::fabs(box.min.y), std::fabs(box.min.z),
+                                   std::fabs(box.max.x), std::fabs(box.max.y), std::fabs(box.max.z)});
     // The corner farthest from the eye, and the depth slope along the ray to it, in double.
     Vec3 far{eye.x < box.center().x ? box.max.x : box.min.x, eye.y < box.center().y ? box.max.y : box.min.y,
              eye.z < box.center().z ? box.max.z : box.min.z};
@@ -77,7 +81,8 @@ Bounds widened_query_box(const Bounds& box, const Mat4& world_to_clip, Vec3 eye)
         return c[3] != 0 ? c[2] / c[3] : 0.0;
     };
     const Vec3 to_far = far - eye;
-    const double distance = std::sqrt(double(to_far.x) * to_far.x + double(to_far.y) * to_far.y + double(to_far.z) * to_far.z);
+    const double distance =
+        std::sqrt(double(to_far.x) * to_far.x + double(to_far.y) * to_far.y + double(to_far.z) * to_far.z);
     double depth_margin = 0;
     if (distance > 0) {
         const double slope = (window_depth(1.0) - window_depth(1.0 - 1e-3)) / (distance * 1e-3);
@@ -174,7 +179,8 @@ struct ObjectQueries::Impl {
         proxy_mode = false;
     }
     GLenum query_target() const {
-        return options.pixel_threshold == 0 && options.any_samples ? GL_ANY_SAMPLES_PASSED_CONSERVATIVE : GL_SAMPLES_PASSED;
+        return options.pixel_threshold == 0 && options.any_samples ? GL_ANY_SAMPLES_PASSED_CONSERVATIVE
+                                                                   : GL_SAMPLES_PASSED;
     }
     // Draws tree node t's proxy: CHC++'s tight boxes for an object when asked, else its box.
     void draw_proxy(std::uint32_t t) {
@@ -463,8 +469,9 @@ ObjectQueries::ObjectQueries() : ObjectQueries(Current{}) {}
 
 ObjectQueries::ObjectQueries(Current) : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
-    m.program = link_program({{"object_queries.vert.glsl", GL_VERTEX_SHADER}, {"object_queries.frag.glsl", GL_FRAGMENT_SHADER}},
-                             "object queries");
+    m.program =
+        link_program({{"object_queries.vert.glsl", GL_VERTEX_SHADER}, {"object_queries.frag.glsl", GL_FRAGMENT_SHADER}},
+                     "object queries");
     m.world_to_clip_loc = glGetUniformLocation(m.program, "u_world_to_clip");
     glCreateVertexArrays(1, &m.vao);
     glCreateBuffers(1, &m.box_buffer);
@@ -485,7 +492,8 @@ ObjectQueries::~ObjectQueries() {
 void ObjectQueries::set_frame(const FrameObjects& frame, const QueryOptions& options) {
     if (options.batch_size == 0) throw Error("ObjectQueries: batch size 0 (it must be at least 1)");
     if (options.visible_interval == 0) throw Error("ObjectQueries: visible interval 0 (it must be at least 1)");
-    if (frame.count > 0 && !frame.boxes) throw Error("ObjectQueries: no boxes for " + std::to_string(frame.count) + " objects");
+    if (frame.count > 0 && !frame.boxes)
+        throw Error("ObjectQueries: no boxes for " + std::to_string(frame.count) + " objects");
     Impl& m = *impl_;
     const bool rebuild = frame.count != m.objects || m.parent.empty() || options.seed != m.options.seed ||
                          options.visible_interval != m.options.visible_interval;

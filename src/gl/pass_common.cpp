@@ -109,15 +109,26 @@ std::vector<float> PassContext::probe(BackpatchProbe op, const std::vector<Vec3>
     glUniform1ui(glGetUniformLocation(program, "u_count"), static_cast<GLuint>(abc.size()));
     GLuint mode = shared::kProbeFma;
     switch (op) {
-        case BackpatchProbe::fma: mode = shared::kProbeFma; break;
-        case BackpatchProbe::div: mode = shared::kProbeDiv; break;
-        case BackpatchProbe::sqrt: mode = shared::kProbeSqrt; break;
-        case BackpatchProbe::div_from: mode = shared::kProbeDivFrom; break;
-        case BackpatchProbe::sqrt_from: mode = shared::kProbeSqrtFrom; break;
+        case BackpatchProbe::fma:
+            mode = shared::kProbeFma;
+            break;
+        case BackpatchProbe::div:
+            mode = shared::kProbeDiv;
+            break;
+        case BackpatchProbe::sqrt:
+            mode = shared::kProbeSqrt;
+            break;
+        case BackpatchProbe::div_from:
+            mode = shared::kProbeDivFrom;
+            break;
+        case BackpatchProbe::sqrt_from:
+            mode = shared::kProbeSqrtFrom;
+            break;
     }
     glUniform1ui(glGetUniformLocation(program, "u_mode"), mode);
     if (!abc.empty())
-        glDispatchCompute(static_cast<GLuint>((abc.size() + shared::kProbeGroupSize - 1) / shared::kProbeGroupSize), 1, 1);
+        glDispatchCompute(static_cast<GLuint>((abc.size() + shared::kProbeGroupSize - 1) / shared::kProbeGroupSize), 1,
+                          1);
     glUseProgram(0);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     std::vector<float> out(abc.size());
@@ -174,7 +185,8 @@ HiZTexture create_hiz_texture(int width, int height) {
 }
 
 std::vector<float> read_hiz_texture(const HiZTexture& hiz) {
-    if (!glIsTexture(hiz.texture)) throw Error("GL: read_hiz_texture: " + std::to_string(hiz.texture) + " is not a texture");
+    if (!glIsTexture(hiz.texture))
+        throw Error("GL: read_hiz_texture: " + std::to_string(hiz.texture) + " is not a texture");
     const std::vector<HiZLevel> layout = hiz_layout(hiz.width, hiz.height);
     const HiZLevel& last = layout.back();
     std::vector<float> out(last.offset + static_cast<std::size_t>(last.width) * last.height);

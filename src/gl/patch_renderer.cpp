@@ -34,8 +34,8 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
     m.mark_program = link_program(patch_stages, "patch (mark front)", "#define PATCHCULL_MARK_FRONT 1\n");
     m.draw_loc.locate(m.draw_program);
     m.mark_loc.locate(m.mark_program);
-    m.occluder_program =
-        link_program({{"occluder.vert.glsl", GL_VERTEX_SHADER}, {"occluder.frag.glsl", GL_FRAGMENT_SHADER}}, "occluder");
+    m.occluder_program = link_program(
+        {{"occluder.vert.glsl", GL_VERTEX_SHADER}, {"occluder.frag.glsl", GL_FRAGMENT_SHADER}}, "occluder");
     m.occluder_loc = {glGetUniformLocation(m.occluder_program, "u_object_to_clip"),
                       glGetUniformLocation(m.occluder_program, "u_eye")};
 
@@ -176,7 +176,8 @@ void PatchRenderer::set_flag_words(const std::vector<std::uint32_t>& words) {
 
 void PatchRenderer::render(const RenderParams& params) {
     begin_frame_drawing(params, params.use_cull_flags);
-    draw_selected(params.use_cull_flags ? sh::kDrawMaskUnculled : 0u, params.use_cull_flags ? sh::kDrawValueUnculled : 0u);
+    draw_selected(params.use_cull_flags ? sh::kDrawMaskUnculled : 0u,
+                  params.use_cull_flags ? sh::kDrawValueUnculled : 0u);
 }
 
 void PatchRenderer::begin_frame(const RenderParams& params) { begin_frame_drawing(params, true); }
@@ -240,8 +241,7 @@ namespace {
 std::vector<std::uint8_t> read_marks(GLuint buffer, std::size_t count) {
     std::vector<std::uint32_t> words(count);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    if (count)
-        glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(count * sizeof(std::uint32_t)), words.data());
+    if (count) glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(count * sizeof(std::uint32_t)), words.data());
     check_gl("read patch marks");
     std::vector<std::uint8_t> marks(count);
     for (std::size_t p = 0; p < count; ++p) marks[p] = words[p] != 0;

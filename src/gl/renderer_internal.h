@@ -9,16 +9,16 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "patchcull/core/error.h"
-#include "patchcull/gl/gl_renderer.h"
-#include "patchcull/core/hiz.h"
 #include "gl_util.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/gl/gl_renderer.h"
 #include "png_file.h"
 #include "shader_sources.h"
 #include "shared.h"
@@ -28,7 +28,6 @@ namespace patchcull::gl {
 namespace sh = shared;
 
 using namespace detail;
-
 
 struct PatchRenderer::Impl {
     GLuint vao = 0;
@@ -44,10 +43,10 @@ struct PatchRenderer::Impl {
     bool has_displacement_map = false;
     bool has_max_displacement = false;
     bool has_ranges = false;
-    bool has_tangents = false;  // the tangent buffer holds kTangentVec4s vec4 per patch
-    int frame_level = 1;        // begin_frame's effective tessellation level
+    bool has_tangents = false;                      // the tangent buffer holds kTangentVec4s vec4 per patch
+    int frame_level = 1;                            // begin_frame's effective tessellation level
     ClipDepth clip_depth = ClipDepth::zero_to_one;  // the last set_draw_uniforms' RenderParams::depth
-    std::uint64_t flag_generation = 0;  // PatchRenderer::flag_generation
+    std::uint64_t flag_generation = 0;              // PatchRenderer::flag_generation
     GLuint fbo = 0, color = 0, ids = 0, depth = 0;
     int width = 0, height = 0;
     std::size_t count = 0;
@@ -60,17 +59,23 @@ struct PatchRenderer::Impl {
 
     // Uniform locations of a patch program (draw_program, mark_program).
     struct DrawUniforms {
-        GLint tess_level, draw_mask, draw_value, adaptive, tess_reference, object_to_clip, displace,
-            displacement_scale, displacement_midlevel, eye, color_mode, has_tangents, mark_drawn,
-            discard_back_facing, has_margins;
+        GLint tess_level, draw_mask, draw_value, adaptive, tess_reference, object_to_clip, displace, displacement_scale,
+            displacement_midlevel, eye, color_mode, has_tangents, mark_drawn, discard_back_facing, has_margins;
         void locate(GLuint p) {
-            *this = {glGetUniformLocation(p, "u_tess_level"),         glGetUniformLocation(p, "u_draw_mask"),
-                     glGetUniformLocation(p, "u_draw_value"),         glGetUniformLocation(p, "u_adaptive"),
-                     glGetUniformLocation(p, "u_tess_reference"),     glGetUniformLocation(p, "u_object_to_clip"),
-                     glGetUniformLocation(p, "u_displace"),           glGetUniformLocation(p, "u_displacement_scale"),
-                     glGetUniformLocation(p, "u_displacement_midlevel"), glGetUniformLocation(p, "u_eye"),
-                     glGetUniformLocation(p, "u_color_mode"),         glGetUniformLocation(p, "u_has_tangents"),
-                     glGetUniformLocation(p, "u_mark_drawn"),         glGetUniformLocation(p, "u_discard_back_facing"),
+            *this = {glGetUniformLocation(p, "u_tess_level"),
+                     glGetUniformLocation(p, "u_draw_mask"),
+                     glGetUniformLocation(p, "u_draw_value"),
+                     glGetUniformLocation(p, "u_adaptive"),
+                     glGetUniformLocation(p, "u_tess_reference"),
+                     glGetUniformLocation(p, "u_object_to_clip"),
+                     glGetUniformLocation(p, "u_displace"),
+                     glGetUniformLocation(p, "u_displacement_scale"),
+                     glGetUniformLocation(p, "u_displacement_midlevel"),
+                     glGetUniformLocation(p, "u_eye"),
+                     glGetUniformLocation(p, "u_color_mode"),
+                     glGetUniformLocation(p, "u_has_tangents"),
+                     glGetUniformLocation(p, "u_mark_drawn"),
+                     glGetUniformLocation(p, "u_discard_back_facing"),
                      glGetUniformLocation(p, "u_has_margins")};
         }
     };
@@ -81,8 +86,8 @@ struct PatchRenderer::Impl {
 
     ~Impl() {
         for (GLuint p : {draw_program, mark_program, occluder_program}) glDeleteProgram(p);
-        const GLuint buffers[] = {control_points, cull_flags, max_displacement, texcoords,   ranges,
-                                  occluder_vertices, tangents, drawn_marks, front_marks, tess_scale};
+        const GLuint buffers[] = {control_points,    cull_flags, max_displacement, texcoords,   ranges,
+                                  occluder_vertices, tangents,   drawn_marks,      front_marks, tess_scale};
         glDeleteBuffers(10, buffers);
         const GLuint textures[] = {displacement_texture, color, ids, depth, vis_color, vis_depth};
         glDeleteTextures(6, textures);
@@ -155,7 +160,8 @@ struct PatchRenderer::Impl {
             if (t >= 0 && static_cast<std::size_t>(t) >= a.tangents.size())
                 throw Error("GL: set_patches: tangent_index " + std::to_string(t) + " is past the " +
                             std::to_string(a.tangents.size()) + " tangent patches");
-        if (n > 0x7FFFFFFFu / kPatchPoints) throw Error("GL: set_patches: too many patches for one draw (" + std::to_string(n) + ")");
+        if (n > 0x7FFFFFFFu / kPatchPoints)
+            throw Error("GL: set_patches: too many patches for one draw (" + std::to_string(n) + ")");
         if (keep_flags && n != count)
             throw Error("GL: update_patches: " + std::to_string(n) + " patches for a set of " + std::to_string(count));
         count = n;
@@ -218,7 +224,8 @@ struct PatchRenderer::Impl {
         const int level = std::clamp(params.tess_level, 1, 64);
         Mat4 view_inverse;
         Vec3 eye{0, 0, 0};
-        if (invert(params.view, view_inverse)) eye = {view_inverse.at(0, 3), view_inverse.at(1, 3), view_inverse.at(2, 3)};
+        if (invert(params.view, view_inverse))
+            eye = {view_inverse.at(0, 3), view_inverse.at(1, 3), view_inverse.at(2, 3)};
         const bool displace = params.displace && has_displacement_map;
         // The front-facing test evaluates the undisplaced patch: displaced patches are drawn
         // two-sided (no back-patch test bounds them; backpatch.h); patch_displaced.h says which.
@@ -239,7 +246,8 @@ struct PatchRenderer::Impl {
             glProgramUniform1i(dp, loc->has_margins, has_max_displacement ? 1 : 0);
             glProgramUniform1i(dp, loc->mark_drawn, dp == draw_program && mark_drawn ? 1 : 0);
         }
-        if (mark_drawn && count > 0) glClearNamedBufferData(drawn_marks, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+        if (mark_drawn && count > 0)
+            glClearNamedBufferData(drawn_marks, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
         glProgramUniformMatrix4fv(occluder_program, occluder_loc.object_to_clip, 1, GL_FALSE, object_to_clip.m);
         glProgramUniform3f(occluder_program, occluder_loc.eye, eye.x, eye.y, eye.z);
         return level;
@@ -337,7 +345,8 @@ struct PatchRenderer::Impl {
                 counts.push_back(static_cast<GLsizei>(std::min(per_draw, end - first) * kPatchPoints));
             }
         }
-        if (!firsts.empty()) glMultiDrawArrays(GL_PATCHES, firsts.data(), counts.data(), static_cast<GLsizei>(firsts.size()));
+        if (!firsts.empty())
+            glMultiDrawArrays(GL_PATCHES, firsts.data(), counts.data(), static_cast<GLsizei>(firsts.size()));
         glBindVertexArray(0);
         glUseProgram(0);
     }

@@ -55,7 +55,8 @@ SpanPlan plan_spans(std::size_t count, const std::vector<ObjectRange>& objects,
     plan.objects = objects;
     if (plan.objects.empty()) plan.objects.push_back({0, count, true});
     std::vector<ObjectRange> sorted = plan.objects;
-    std::sort(sorted.begin(), sorted.end(), [](const ObjectRange& a, const ObjectRange& b) { return a.first < b.first; });
+    std::sort(sorted.begin(), sorted.end(),
+              [](const ObjectRange& a, const ObjectRange& b) { return a.first < b.first; });
     std::size_t covered = 0;
     for (const ObjectRange& o : sorted) {
         if (o.first > count || o.count > count - o.first)
@@ -71,9 +72,10 @@ SpanPlan plan_spans(std::size_t count, const std::vector<ObjectRange>& objects,
     std::size_t culled_end = 0;
     for (const PatchSpan& s : plan.culled) {
         if (s.first > count || s.count > count - s.first)
-            throw Error("render_frame: object-culled span [" + std::to_string(s.first) + ", +" + std::to_string(s.count) +
-                        ") leaves the set of " + std::to_string(count) + " patches");
-        if (s.first < culled_end) throw Error("render_frame: object-culled spans overlap at patch " + std::to_string(s.first));
+            throw Error("render_frame: object-culled span [" + std::to_string(s.first) + ", +" +
+                        std::to_string(s.count) + ") leaves the set of " + std::to_string(count) + " patches");
+        if (s.first < culled_end)
+            throw Error("render_frame: object-culled spans overlap at patch " + std::to_string(s.first));
         culled_end = s.first + s.count;
     }
     plan_dispatch_and_draws(plan);

@@ -8,10 +8,10 @@
 #include <vector>
 
 #include "gl_util.h"
-#include "shared.h"
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_posing.h"
 #include "patchcull/gl/gl_renderer.h"
+#include "shared.h"
 
 namespace patchcull::gl {
 
@@ -22,7 +22,7 @@ constexpr GLuint kOutPoints = shared::kBindingControlPoints, kOutTangents = shar
                  kVertices = shared::kBindingPoseVertices, kInstances = shared::kBindingPoseInstances,
                  kPatchTable = shared::kBindingPosePatchTable, kOffsets = shared::kBindingPoseOffsets,
                  kTerms = shared::kBindingPoseTerms, kTangentTable = shared::kBindingPoseTangentTable;
-constexpr GLuint kGroupSize = 256;            // local_size_x of the shader
+constexpr GLuint kGroupSize = 256;                           // local_size_x of the shader
 constexpr std::uint64_t kPointRows = 16, kTangentRows = 24;  // invocations per patch, per tangent block
 
 struct GpuInstance {
@@ -70,11 +70,11 @@ struct StencilPoser::Impl {
     GLuint program = 0;
     GLint count_location = -1, tangent_count_location = -1;
     GLuint offsets = 0, terms = 0, patch_table = 0, vertices = 0, instances = 0, tangent_table = 0;
-    std::size_t tangent_count = 0;  // entries of tangent_table
+    std::size_t tangent_count = 0;                              // entries of tangent_table
     std::size_t vertices_capacity = 0, instances_capacity = 0;  // bytes of the per-frame buffers
     std::vector<std::uint32_t> instance_models;
     std::vector<std::uint32_t> model_vertex_counts;
-    std::vector<std::uint32_t> model_first_row;     // first patch row of each model in offsets
+    std::vector<std::uint32_t> model_first_row;  // first patch row of each model in offsets
     std::vector<std::uint32_t> instance_first_patch;
     std::vector<GpuInstance> staging;
     std::size_t count = 0;
@@ -121,7 +121,8 @@ bool StencilPoser::has_tangents() const { return impl_->tangents; }
 std::size_t StencilPoser::last_upload_bytes() const { return impl_->last_bytes; }
 std::size_t StencilPoser::table_bytes() const { return impl_->table_bytes; }
 
-void StencilPoser::set_tables(const std::vector<PosingModel>& models, const std::vector<std::uint32_t>& instance_models) {
+void StencilPoser::set_tables(const std::vector<PosingModel>& models,
+                              const std::vector<std::uint32_t>& instance_models) {
     Impl& m = *impl_;
     // One offsets table: every model's patch rows, then every model's tangent rows.
     std::vector<std::uint32_t> offsets{0}, terms;
@@ -129,8 +130,8 @@ void StencilPoser::set_tables(const std::vector<PosingModel>& models, const std:
     for (std::size_t i = 0; i < models.size(); ++i) {
         const PosingModel& model = models[i];
         if (model.patch_points.rows % 16 != 0)
-            throw Error("GL: StencilPoser: model " + std::to_string(i) + ": " + std::to_string(model.patch_points.rows) +
-                        " patch rows is not 16 per patch");
+            throw Error("GL: StencilPoser: model " + std::to_string(i) + ": " +
+                        std::to_string(model.patch_points.rows) + " patch rows is not 16 per patch");
         if (model.tangent_index.size() != model.patch_points.rows / 16)
             throw Error("GL: StencilPoser: model " + std::to_string(i) + ": tangent_index has " +
                         std::to_string(model.tangent_index.size()) + " entries for " +

@@ -92,8 +92,10 @@ void compact_into(Terms& t, Terms& out) {
     std::sort(t.begin(), t.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     out.clear();
     for (const auto& [index, weight] : t) {
-        if (!out.empty() && out.back().first == index) out.back().second += weight;
-        else out.emplace_back(index, weight);
+        if (!out.empty() && out.back().first == index)
+            out.back().second += weight;
+        else
+            out.emplace_back(index, weight);
     }
     std::erase_if(out, [](const auto& p) { return p.second == 0.0; });
 }
@@ -160,14 +162,12 @@ void edge_point(std::uint32_t v, const VertexRing& r, std::size_t i, Terms& out)
 
 // Whether v's patches are exact B-spline patches at v: interior valence 4, or a boundary vertex
 // with 2 faces, or a corner.
-bool regular_vertex(const VertexRing& r) {
-    return r.boundary ? r.face_count() <= 2 : r.face_count() == 4;
-}
+bool regular_vertex(const VertexRing& r) { return r.boundary ? r.face_count() <= 2 : r.face_count() == 4; }
 
 // What an extraordinary patch needs from one vertex's one-ring beyond its point rows.
 struct VertexRule {
-    double edge_cos = 0;          // c in t_{i-1} + t_{i+1} = 2 c t_i, for interior edges
-    std::vector<Terms> tangent;   // per ring edge: limit tangent pointing along that edge
+    double edge_cos = 0;         // c in t_{i-1} + t_{i+1} = 2 c t_i, for interior edges
+    std::vector<Terms> tangent;  // per ring edge: limit tangent pointing along that edge
 };
 
 VertexRule interior_rule(const VertexRing& r) {
@@ -227,9 +227,9 @@ VertexRule boundary_rule(std::uint32_t v, const VertexRing& r) {
 // next corner (counter-clockwise) and the previous one. Corner k of face (v0 v1 v2 v3) sits at
 // (u,v) = (0,0), (1,0), (1,1), (0,1).
 struct CornerFrame {
-    int i, j;          // corner point
-    int ni, nj;        // step towards the next corner
-    int pi, pj;        // step towards the previous corner
+    int i, j;    // corner point
+    int ni, nj;  // step towards the next corner
+    int pi, pj;  // step towards the previous corner
 };
 constexpr CornerFrame kCorners[4] = {
     {0, 0, 1, 0, 0, 1}, {3, 0, 0, 1, -1, 0}, {3, 3, -1, 0, 0, -1}, {0, 3, 0, -1, 1, 0}};
@@ -546,17 +546,22 @@ std::vector<std::uint8_t> faces_left_out(const ControlMesh& mesh) {
             if (v < nv) ++faces_at[v];
         for (std::uint32_t v = 0; v < nv; ++v)
             if (faces_at[v] == 1)
-                throw Error(where + "boundary interpolation 'edges only' (interpolateboundary 2) keeps corners smooth; the acc "
-                                    "scheme keeps them sharp (vertex " + std::to_string(v + 1) + " has one face): use the osd scheme");
+                throw Error(where +
+                            "boundary interpolation 'edges only' (interpolateboundary 2) keeps corners smooth; the acc "
+                            "scheme keeps them sharp (vertex " +
+                            std::to_string(v + 1) + " has one face): use the osd scheme");
         return out;  // no corner: the same surface as edges and corners
     }
     // none: boundary edges are the edges of one face.
-    const auto key = [](std::uint32_t a, std::uint32_t b) { return std::uint64_t{std::min(a, b)} << 32 | std::max(a, b); };
+    const auto key = [](std::uint32_t a, std::uint32_t b) {
+        return std::uint64_t{std::min(a, b)} << 32 | std::max(a, b);
+    };
     std::vector<std::uint64_t> edges;
     edges.reserve(mesh.face_vertices.size());
     for (std::size_t f = 0; f < nf; ++f) {
         const std::uint32_t b = mesh.face_offsets[f], n = mesh.face_size(f);
-        for (std::uint32_t k = 0; k < n; ++k) edges.push_back(key(mesh.face_vertices[b + k], mesh.face_vertices[b + (k + 1) % n]));
+        for (std::uint32_t k = 0; k < n; ++k)
+            edges.push_back(key(mesh.face_vertices[b + k], mesh.face_vertices[b + (k + 1) % n]));
     }
     std::sort(edges.begin(), edges.end());
     std::vector<std::uint64_t> infinite;  // edges with an infinitely sharp crease (Sdc: sharpness >= 10)
@@ -576,8 +581,10 @@ std::vector<std::uint8_t> faces_left_out(const ControlMesh& mesh) {
     }
     for (std::uint32_t v = 0; v < nv; ++v)
         if (state[v] == 1)
-            throw Error(where + "with no boundary interpolation (interpolateboundary 0), creases sharpen every boundary edge "
-                                "of vertex " + std::to_string(v + 1) + ", which the acc scheme ignores: use the osd scheme");
+            throw Error(where +
+                        "with no boundary interpolation (interpolateboundary 0), creases sharpen every boundary edge "
+                        "of vertex " +
+                        std::to_string(v + 1) + ", which the acc scheme ignores: use the osd scheme");
     for (std::size_t f = 0; f < nf; ++f)
         for (std::uint32_t c = mesh.face_offsets[f]; c < mesh.face_offsets[f + 1]; ++c)
             if (mesh.face_vertices[c] < nv && state[mesh.face_vertices[c]] != 0) out[f] = 1;
@@ -633,7 +640,8 @@ SubdivisionModel build_acc_model(const ControlMesh& mesh) {
         build_quad_patches(refined.mesh, &refined.stencils, model);
         std::vector<std::uint32_t> parent;
         parent.reserve(refined.mesh.face_count());
-        for (std::size_t f = 0; f < mesh.face_count(); ++f) parent.insert(parent.end(), mesh.face_size(f), static_cast<std::uint32_t>(f));
+        for (std::size_t f = 0; f < mesh.face_count(); ++f)
+            parent.insert(parent.end(), mesh.face_size(f), static_cast<std::uint32_t>(f));
         if (parent.size() != model.patches.size())
             throw Error(mesh.name + ": unexpected face count after Catmull-Clark refinement");
         for (PatchInfo& p : model.patches) p.base_face = parent[p.base_face];

@@ -48,8 +48,7 @@ void rotation_delta(float angle, float x, float y, float& dx, float& dy) {
 
 }  // namespace
 
-void animate(const std::vector<Vec3>& rest, float time_seconds, const AnimationParams& params,
-             std::vector<Vec3>& out) {
+void animate(const std::vector<Vec3>& rest, float time_seconds, const AnimationParams& params, std::vector<Vec3>& out) {
     out.resize(rest.size());
     if (rest.empty()) return;
 

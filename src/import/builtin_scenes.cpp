@@ -21,9 +21,9 @@ namespace {
 
 using namespace detail;
 
-constexpr float kClearance = 0.1f;    // gap between a character's reach and a building or wall
+constexpr float kClearance = 0.1f;      // gap between a character's reach and a building or wall
 constexpr float kPhaseSeconds = 0.37f;  // time offset between phases (the default scene's step)
-constexpr int kReachSamples = 48;      // animation samples per period for the reach
+constexpr int kReachSamples = 48;       // animation samples per period for the reach
 
 struct Rng {
     std::mt19937 engine;
@@ -53,8 +53,11 @@ void check_range(const char* name, double value, double lo, double hi) {
 class SpacingGrid {
 public:
     SpacingGrid(float x0, float z0, float width_x, float width_z, float max_reach)
-        : x0_(x0), z0_(z0), cell_(std::max({2 * max_reach, width_x / 256, width_z / 256, 1e-3f})),
-          nx_(static_cast<int>(width_x / cell_) + 1), nz_(static_cast<int>(width_z / cell_) + 1),
+        : x0_(x0),
+          z0_(z0),
+          cell_(std::max({2 * max_reach, width_x / 256, width_z / 256, 1e-3f})),
+          nx_(static_cast<int>(width_x / cell_) + 1),
+          nz_(static_cast<int>(width_z / cell_) + 1),
           cells_(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(nz_)) {}
 
     // True when the square of half side r around p is clear of every placed one's square.
@@ -253,7 +256,8 @@ Scene make_city_scene(Scheme scheme, const CityParams& params) {
             // street the camera walks is not empty; the others in any street.
             const bool in_camera_street = rng.below(5) == 0;
             const bool along_z = in_camera_street || rng.below(2) == 0;
-            const int index = in_camera_street ? street : rng.below(along_z ? params.blocks_x + 1 : params.blocks_z + 1);
+            const int index =
+                in_camera_street ? street : rng.below(along_z ? params.blocks_x + 1 : params.blocks_z + 1);
             const float lateral = rng.uniform(-0.5f * S, 0.5f * S);
             const float along = rng.uniform(0, along_z ? width_z : width_x);
             const bool walking = rng.uniform() < params.walking_fraction;
@@ -333,7 +337,8 @@ Scene make_building_scene(Scheme scheme, const BuildingParams& params) {
         }
     auto add_to_cells = [&](std::initializer_list<std::pair<int, int>> rooms) {
         for (auto [i, j] : rooms)
-            if (i >= 0 && i < nx && j >= 0 && j < nz) scene.cells[room(i, j)].environment.push_back(scene.environment.size() - 1);
+            if (i >= 0 && i < nx && j >= 0 && j < nz)
+                scene.cells[room(i, j)].environment.push_back(scene.environment.size() - 1);
     };
     int wall_pieces = 0;
     auto add_wall_box = [&](Vec3 lo, Vec3 hi, std::initializer_list<std::pair<int, int>> rooms) {
@@ -403,8 +408,8 @@ Scene make_building_scene(Scheme scheme, const BuildingParams& params) {
     for (int k = 0; k <= nx; ++k)
         for (int j = 0; j < nz; ++j) {
             const bool inner = k > 0 && k < nx;
-            add_segment(false, wall_x(k), wall_z(j) + h, wall_z(j + 1) - h, inner ? ((j + k) % 2 == 0 ? door : window) : none,
-                        {k - 1, j}, {k, j});
+            add_segment(false, wall_x(k), wall_z(j) + h, wall_z(j + 1) - h,
+                        inner ? ((j + k) % 2 == 0 ? door : window) : none, {k - 1, j}, {k, j});
         }
 
     // The camera walks the middle column from its south room (largest z) north, through the

@@ -19,8 +19,8 @@
 #include <utility>
 #include <vector>
 
-#include "patchcull/core/error.h"
 #include "input_file.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull {
 namespace {
@@ -39,8 +39,9 @@ std::string explain_stb_failure(const char* code, const char* before) {
     if (code == before) return "corrupt PNG: its pixel data cannot be decoded (stb_image gives no reason)";
     const std::string why = code ? code : "";
     if (why.empty()) return "unknown reason";
-    static const char* const kDeflate[] = {"bad codelengths", "bad sizes", "bad huffman code", "bad dist", "bad zlib header",
-                                           "no preset dict", "bad compression", "zlib corrupt", "output buffer limit",
+    static const char* const kDeflate[] = {"bad codelengths",  "bad sizes",       "bad huffman code",
+                                           "bad dist",         "bad zlib header", "no preset dict",
+                                           "bad compression",  "zlib corrupt",    "output buffer limit",
                                            "read past buffer", "outofdata"};
     static const std::pair<const char*, const char*> kWords[] = {
         {"first not IHDR", "corrupt PNG: it does not start with an IHDR chunk"},
@@ -130,8 +131,7 @@ DisplacementMap decode_displacement_png(const unsigned char* data, std::size_t s
                                         float scale, float midlevel) {
     if (!std::isfinite(scale)) throw Error(name + ": displacement scale is not finite");
     static constexpr unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-    if (size < sizeof kSignature || std::memcmp(data, kSignature, sizeof kSignature) != 0)
-        fail(name, "not a PNG file");
+    if (size < sizeof kSignature || std::memcmp(data, kSignature, sizeof kSignature) != 0) fail(name, "not a PNG file");
     if (size > static_cast<std::size_t>(INT_MAX)) fail(name, "file too large");
     check_png_layout(data, size, name);
     const int length = static_cast<int>(size);

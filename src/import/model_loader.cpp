@@ -8,8 +8,8 @@
 #include <filesystem>
 
 #include "patchcull/core/error.h"
-#include "patchcull/import/obj.h"
 #include "patchcull/core/teapot.h"
+#include "patchcull/import/obj.h"
 
 namespace patchcull {
 namespace {
@@ -37,11 +37,13 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
     LoadedModel model;
     model.name = spec;
     model.split_levels = split_levels;
-    if (split_levels < 0 || split_levels > 4) throw Error("--split: must be between 0 and 4, got " + std::to_string(split_levels));
+    if (split_levels < 0 || split_levels > 4)
+        throw Error("--split: must be between 0 and 4, got " + std::to_string(split_levels));
     if (spec == "teapot") {
         model.rest.patches = teapot_patches();
         model.rest.info.assign(model.rest.patches.size(), PatchInfo{});
-        for (std::size_t p = 0; p < model.rest.info.size(); ++p) model.rest.info[p].base_face = static_cast<std::uint32_t>(p);
+        for (std::size_t p = 0; p < model.rest.info.size(); ++p)
+            model.rest.info[p].base_face = static_cast<std::uint32_t>(p);
         split_in_place(model.rest, split_levels, spec);
         return model;
     }
@@ -74,7 +76,8 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
     model.subdiv = build_model(mesh, scheme);
     model.origin = mesh.origin;
     for (const std::string& w : model.subdiv->mesh.warnings)
-        if (std::find(model.warnings.begin(), model.warnings.end(), w) == model.warnings.end()) model.warnings.push_back(w);
+        if (std::find(model.warnings.begin(), model.warnings.end(), w) == model.warnings.end())
+            model.warnings.push_back(w);
     evaluate_patches(*model.subdiv, model.subdiv->mesh.positions, split_levels, model.rest);
     // A hole (OBJ "t hole") opens the surface even where the control mesh is closed: through it the
     // inside shows, so the model is drawn two-sided and back-patch culling is off.

@@ -12,8 +12,8 @@
 #include <sstream>
 #include <string_view>
 
-#include "patchcull/core/error.h"
 #include "input_file.h"
+#include "patchcull/core/error.h"
 
 namespace patchcull {
 namespace {
@@ -109,7 +109,8 @@ void parse_tag_counts(std::string_view token, long counts[3], const LineContext&
     for (int k = 0; k < 3; ++k) {
         const auto [next, ec] = std::from_chars(p, end, counts[k]);
         const bool separated = k < 2 ? next != end && *next == '/' : next == end;
-        if (ec != std::errc() || counts[k] < 0 || !separated) ctx.fail("malformed tag argument counts " + quote_input(token));
+        if (ec != std::errc() || counts[k] < 0 || !separated)
+            ctx.fail("malformed tag argument counts " + quote_input(token));
         p = k < 2 ? next + 1 : next;
     }
 }
@@ -136,15 +137,24 @@ struct TagState {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> holes;  // (face, line), checked at the end
 };
 
-void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, TagState& state, const LineContext& ctx) {
-    if (tokens.size() < 3) ctx.fail("malformed tag line (expected 't NAME ints/floats/strings arguments...', e.g. 't crease 2/1/0 v0 v1 sharpness')");
+void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, TagState& state,
+               const LineContext& ctx) {
+    if (tokens.size() < 3)
+        ctx.fail(
+            "malformed tag line (expected 't NAME ints/floats/strings arguments...', e.g. 't crease 2/1/0 v0 v1 "
+            "sharpness')");
     const std::string_view kind = tokens[1];
     std::string tag = "'";  // built with += : GCC 12 warns falsely (-Wrestrict) on "'" + std::string
     tag += kind;
     tag += "' tag";
-    static constexpr std::string_view kKnown[] = {"crease", "corner", "hole", "interpolateboundary",
-                                                  "facevaryinginterpolateboundary", "facevaryingpropagatecorners",
-                                                  "creasemethod", "smoothtriangles"};
+    static constexpr std::string_view kKnown[] = {"crease",
+                                                  "corner",
+                                                  "hole",
+                                                  "interpolateboundary",
+                                                  "facevaryinginterpolateboundary",
+                                                  "facevaryingpropagatecorners",
+                                                  "creasemethod",
+                                                  "smoothtriangles"};
     if (std::find(std::begin(kKnown), std::end(kKnown), kind) == std::end(kKnown)) {
         if (kind == "vertexedit" || kind == "edgeedit" || kind == "faceedit")
             ctx.fail("unsupported tag " + quote_input(kind) + " (hierarchical edits are not part of OpenSubdiv 3)");
@@ -156,8 +166,10 @@ void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, T
     parse_tag_counts(tokens[2], counts, ctx);
     const long ints = counts[0], floats = counts[1], strings = counts[2];
     const auto arguments = static_cast<long>(tokens.size() - 3);
-    if (ints > arguments || floats > arguments - ints || strings != arguments - ints - floats)  // (no sum: it can overflow)
-        ctx.fail("malformed " + tag + ": " + std::to_string(arguments) + " arguments for counts " + quote_input(tokens[2]));
+    if (ints > arguments || floats > arguments - ints ||
+        strings != arguments - ints - floats)  // (no sum: it can overflow)
+        ctx.fail("malformed " + tag + ": " + std::to_string(arguments) + " arguments for counts " +
+                 quote_input(tokens[2]));
     const auto expect = [&](bool ok, const char* form) {
         if (!ok) ctx.fail("malformed " + tag + ": expected " + form);
     };
@@ -167,7 +179,8 @@ void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, T
     if (kind == "crease" || kind == "corner") {
         const bool crease = kind == "crease";
         if (crease) {
-            expect(ints >= 2 && strings == 0, "'t crease 2/1/0 v0 v1 sharpness' (or n/1/0 with n vertices, read as n/2 edges)");
+            expect(ints >= 2 && strings == 0,
+                   "'t crease 2/1/0 v0 v1 sharpness' (or n/1/0 with n vertices, read as n/2 edges)");
             if (ints % 2 != 0)
                 ctx.fail("'crease' tag over an odd number of vertices (" + std::to_string(ints) +
                          "): OpenSubdiv's shape format lists a crease's edges as vertex pairs");
@@ -190,7 +203,8 @@ void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, T
         std::vector<float> sharpness;
         for (long k = 0; k < floats; ++k) {
             sharpness.push_back(parse_float(tokens[static_cast<std::size_t>(3 + ints + k)], ctx, "sharpness"));
-            if (sharpness.back() < 0) ctx.fail("negative sharpness " + quote_input(tokens[static_cast<std::size_t>(3 + ints + k)]));
+            if (sharpness.back() < 0)
+                ctx.fail("negative sharpness " + quote_input(tokens[static_cast<std::size_t>(3 + ints + k)]));
         }
         const auto line = static_cast<std::uint32_t>(ctx.line);
         if (crease) {
@@ -222,9 +236,10 @@ void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, T
         expect(ints == 1 && floats == 0 && strings == 0, "'t interpolateboundary 1/0/0 m' with m 0, 1 or 2");
         const long m = integer(0);
         if (m < 0 || m > 2)
-            ctx.fail("'interpolateboundary' " + std::to_string(m) + ": expected 0 (none), 1 (edges and corners) or 2 (edges only)");
+            ctx.fail("'interpolateboundary' " + std::to_string(m) +
+                     ": expected 0 (none), 1 (edges and corners) or 2 (edges only)");
         once(state.boundary_line);
-        mesh.options.boundary = m == 0 ? BoundaryInterpolation::none
+        mesh.options.boundary = m == 0   ? BoundaryInterpolation::none
                                 : m == 1 ? BoundaryInterpolation::edge_and_corner
                                          : BoundaryInterpolation::edge_only;
         mesh.options.boundary_line = state.boundary_line;
@@ -235,14 +250,15 @@ void parse_tag(const std::vector<std::string_view>& tokens, ControlMesh& mesh, T
         const std::string_view value = word(0);
         const std::string_view plain = method ? "normal" : "catmark", special = method ? "chaikin" : "smooth";
         if (value != plain && value != special)
-            ctx.fail(tag + " " + quote_input(value) + ": expected " + std::string(plain) + " or " + std::string(special));
+            ctx.fail(tag + " " + quote_input(value) + ": expected " + std::string(plain) + " or " +
+                     std::string(special));
         once(method ? state.crease_method_line : state.triangles_line);
         (method ? mesh.options.chaikin_creases : mesh.options.smooth_triangles) = value == special;
     } else {  // face-varying options: checked, no effect (see above)
         const bool boundary = kind == "facevaryinginterpolateboundary";
-        expect(ints == 1 && floats == 0 && strings == 0,
-               boundary ? "'t facevaryinginterpolateboundary 1/0/0 m' with m 0..5"
-                        : "'t facevaryingpropagatecorners 1/0/0 0' or '1'");
+        expect(ints == 1 && floats == 0 && strings == 0, boundary
+                                                             ? "'t facevaryinginterpolateboundary 1/0/0 m' with m 0..5"
+                                                             : "'t facevaryingpropagatecorners 1/0/0 0' or '1'");
         const long m = integer(0);
         if (m < 0 || m > (boundary ? 5 : 1))
             ctx.fail(tag + " value " + std::to_string(m) + ": expected " + (boundary ? "0 to 5" : "0 or 1"));
@@ -261,7 +277,9 @@ void check_tags(ControlMesh& mesh, TagState& state, const std::string& name) {
     std::sort(mesh.holes.begin(), mesh.holes.end());
     mesh.holes.erase(std::unique(mesh.holes.begin(), mesh.holes.end()), mesh.holes.end());
     if (mesh.creases.empty()) return;
-    const auto key = [](std::uint32_t a, std::uint32_t b) { return std::uint64_t{std::min(a, b)} << 32 | std::max(a, b); };
+    const auto key = [](std::uint32_t a, std::uint32_t b) {
+        return std::uint64_t{std::min(a, b)} << 32 | std::max(a, b);
+    };
     std::vector<std::uint64_t> wanted;
     for (const Crease& c : mesh.creases) wanted.push_back(key(c.v0, c.v1));
     std::sort(wanted.begin(), wanted.end());
@@ -303,8 +321,10 @@ bool parse_face(const std::vector<std::string_view>& tokens, ControlMesh& mesh, 
         std::size_t count = 0, begin = 0;
         for (;;) {
             const std::size_t slash = corner.find('/', begin);
-            if (count == 3) ctx.fail("malformed face corner " + quote_input(corner) + " (expected v, v/vt, v//vn or v/vt/vn)");
-            parts[count++] = corner.substr(begin, slash == std::string_view::npos ? std::string_view::npos : slash - begin);
+            if (count == 3)
+                ctx.fail("malformed face corner " + quote_input(corner) + " (expected v, v/vt, v//vn or v/vt/vn)");
+            parts[count++] =
+                corner.substr(begin, slash == std::string_view::npos ? std::string_view::npos : slash - begin);
             if (slash == std::string_view::npos) break;
             begin = slash + 1;
         }
@@ -407,8 +427,8 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
             if (values != 3 && values != 4 && values != 6 && values != 7)
                 ctx.fail("vertex has " + std::to_string(values) + (values == 1 ? " value" : " values") +
                          "; expected 3 (x y z), 4 (x y z w), 6 (x y z r g b) or 7 (x y z r g b a)");
-            world_positions.push_back({parse_coordinate(tokens[1], ctx), parse_coordinate(tokens[2], ctx),
-                                       parse_coordinate(tokens[3], ctx)});
+            world_positions.push_back(
+                {parse_coordinate(tokens[1], ctx), parse_coordinate(tokens[2], ctx), parse_coordinate(tokens[3], ctx)});
             mesh.positions.push_back(to_float(world_positions.back()));  // origin 0 until recentre()
             for (std::size_t k = 4; k < tokens.size(); ++k) parse_float(tokens[k], ctx);
         } else if (key == "vt") {
@@ -424,8 +444,10 @@ ControlMesh parse_obj(std::istream& in, const std::string& name) {
                 faces_with_uv = true;
             else
                 faces_without_uv = true;
-            const auto face = static_cast<std::uint32_t>(mesh.face_count() - 1), line = static_cast<std::uint32_t>(line_number);
-            if (mesh.face_line_runs.empty() || mesh.face_line(face - 1) + 1 != line) mesh.face_line_runs.emplace_back(face, line);
+            const auto face = static_cast<std::uint32_t>(mesh.face_count() - 1),
+                       line = static_cast<std::uint32_t>(line_number);
+            if (mesh.face_line_runs.empty() || mesh.face_line(face - 1) + 1 != line)
+                mesh.face_line_runs.emplace_back(face, line);
         } else if (key == "t") {
             parse_tag(tokens, mesh, tags, ctx);
         } else if (key == "o" || key == "g" || key == "s" || key == "usemtl" || key == "mtllib" || key == "l" ||

@@ -140,14 +140,18 @@ Vec2 ptex_texcoord(const ControlMesh& mesh, std::uint32_t f, int sub, double u, 
 
 // Composes weighted sums of stencil rows into one row over the control vertices. The rows of
 // level 0 are the control vertices themselves (identity stencils); a row of level L > 0 is a
-// stencil over level L-1 (indices within that level), a local point one over absolute rows. Terms are accumulated densely and expanded from the highest touched row down, so each
-// touched row is expanded once: the cost is the sum of the touched rows' sizes.
+// stencil over level L-1 (indices within that level), a local point one over absolute rows. Terms are accumulated
+// densely and expanded from the highest touched row down, so each touched row is expanded once: the cost is the sum of
+// the touched rows' sizes.
 class StencilExpander {
 public:
     /// Rows: base's (level by level, level 0 the control vertices), then local's (null: none).
     StencilExpander(const ControlMesh& mesh, const Far::TopologyRefiner& refiner,
                     const Far::StencilTableReal<double>& base, const Far::StencilTableReal<double>* local)
-        : mesh_(mesh), base_(base), local_(local), base_count_(base.GetNumStencils()),
+        : mesh_(mesh),
+          base_(base),
+          local_(local),
+          base_count_(base.GetNumStencils()),
           control_count_(refiner.GetLevel(0).GetNumVertices()),
           acc_(static_cast<std::size_t>(base_count_ + (local ? local->GetNumStencils() : 0)), 0.0),
           seen_(acc_.size(), 0) {
@@ -205,7 +209,9 @@ public:
 
 private:
     int level_of(int row) const {
-        return static_cast<int>(std::upper_bound(level_start_.begin(), level_start_.end(), row) - level_start_.begin()) - 1;
+        return static_cast<int>(std::upper_bound(level_start_.begin(), level_start_.end(), row) -
+                                level_start_.begin()) -
+               1;
     }
 
     const ControlMesh& mesh_;
@@ -216,7 +222,7 @@ private:
     std::vector<double> acc_;
     std::vector<std::uint8_t> seen_;
     std::vector<int> level_start_;  // first base row of each refinement level
-    std::vector<int> pending_;  // max-heap of touched rows above the control vertices
+    std::vector<int> pending_;      // max-heap of touched rows above the control vertices
     std::vector<std::uint32_t> control_;
 };
 
@@ -257,7 +263,8 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh) {
     sopt.generateControlVerts = true;
     sopt.generateIntermediateLevels = true;
     sopt.factorizeIntermediateLevels = false;
-    std::unique_ptr<const Far::StencilTableReal<double>> base(Far::StencilTableFactoryReal<double>::Create(*refiner, sopt));
+    std::unique_ptr<const Far::StencilTableReal<double>> base(
+        Far::StencilTableFactoryReal<double>::Create(*refiner, sopt));
     if (!base || base->GetNumStencils() != refiner->GetNumVerticesTotal())
         throw Error(mesh.name + ": OpenSubdiv produced an unexpected number of refinement stencils");
     // Local points are stencils over absolute vertex indices (control vertices included), the
@@ -306,7 +313,7 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh) {
                     }
                 }
 
-            for (int j = 0; j < 4; ++j)      // Bezier row (v)
+            for (int j = 0; j < 4; ++j)        // Bezier row (v)
                 for (int i = 0; i < 4; ++i) {  // Bezier column (u)
                     for (int row = 0; row < 4; ++row)
                         for (int col = 0; col < 4; ++col) {

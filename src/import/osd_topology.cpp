@@ -57,7 +57,8 @@ std::string one_line(std::string s) {
 void validate(const ControlMesh& mesh) {
     const std::size_t nv = mesh.positions.size();
     if (mesh.face_count() == 0) fail(mesh, "mesh has no faces");
-    if (mesh.face_offsets.empty() || mesh.face_offsets.front() != 0 || mesh.face_offsets.back() != mesh.face_vertices.size())
+    if (mesh.face_offsets.empty() || mesh.face_offsets.front() != 0 ||
+        mesh.face_offsets.back() != mesh.face_vertices.size())
         fail(mesh, "face offsets do not match the face vertex list");
     if (mesh.has_texcoords() && mesh.face_texcoords.size() != mesh.face_vertices.size())
         fail(mesh, "face texcoord list does not match the face vertex list");
@@ -70,7 +71,8 @@ void validate(const ControlMesh& mesh) {
                                " out of range (" + std::to_string(nv) + " vertices)");
             for (std::uint32_t d = b; d < c; ++d)
                 if (mesh.face_vertices[d] == mesh.face_vertices[c])
-                    fail(mesh, "face " + std::to_string(f) + " repeats vertex " + std::to_string(mesh.face_vertices[c]));
+                    fail(mesh,
+                         "face " + std::to_string(f) + " repeats vertex " + std::to_string(mesh.face_vertices[c]));
             if (mesh.has_texcoords() && mesh.face_texcoords[c] >= mesh.texcoords.size())
                 fail(mesh, "face " + std::to_string(f) + " uses texcoord " + std::to_string(mesh.face_texcoords[c]) +
                                " out of range");
@@ -133,7 +135,8 @@ void check_manifold(const ControlMesh& mesh, const OSD::TopologyLevel& base) {
         const std::uint32_t first = mesh.face_offsets[flipped.face], n = mesh.face_size(flipped.face);
         const auto k = static_cast<std::uint32_t>(flipped.corner);
         throw Error(detail::edge_orientation_message(mesh, static_cast<std::size_t>(faces[0]), flipped.face,
-                                                     mesh.face_vertices[first + k], mesh.face_vertices[first + (k + 1) % n]));
+                                                     mesh.face_vertices[first + k],
+                                                     mesh.face_vertices[first + (k + 1) % n]));
     }
     for (int v = 0; v < base.GetNumVertices(); ++v) {
         // An unused vertex (no faces) is harmless: no stencil refers to it.
@@ -194,9 +197,10 @@ RefinerPtr create_refiner(const ControlMesh& mesh, std::vector<std::string>* war
     // The mesh's options (mesh.h: patchcull's defaults, or the OBJ's OpenSubdiv tags).
     using Sdc = OpenSubdiv::Sdc::Options;
     Sdc sdc;
-    sdc.SetVtxBoundaryInterpolation(mesh.options.boundary == BoundaryInterpolation::none        ? Sdc::VTX_BOUNDARY_NONE
-                                    : mesh.options.boundary == BoundaryInterpolation::edge_only ? Sdc::VTX_BOUNDARY_EDGE_ONLY
-                                                                                                : Sdc::VTX_BOUNDARY_EDGE_AND_CORNER);
+    sdc.SetVtxBoundaryInterpolation(mesh.options.boundary == BoundaryInterpolation::none ? Sdc::VTX_BOUNDARY_NONE
+                                    : mesh.options.boundary == BoundaryInterpolation::edge_only
+                                        ? Sdc::VTX_BOUNDARY_EDGE_ONLY
+                                        : Sdc::VTX_BOUNDARY_EDGE_AND_CORNER);
     sdc.SetCreasingMethod(mesh.options.chaikin_creases ? Sdc::CREASE_CHAIKIN : Sdc::CREASE_UNIFORM);
     sdc.SetTriangleSubdivision(mesh.options.smooth_triangles ? Sdc::TRI_SUB_SMOOTH : Sdc::TRI_SUB_CATMARK);
     // Texture coordinates are interpolated bilinearly (patchcull's PatchInfo::uv is bilinear).
@@ -211,7 +215,8 @@ RefinerPtr create_refiner(const ControlMesh& mesh, std::vector<std::string>* war
     t_errors = nullptr;
     t_warnings = nullptr;
     if (!refiner)
-        fail(mesh, "OpenSubdiv rejected the topology: " + (errors.empty() ? std::string("unknown error") : one_line(errors.front())));
+        fail(mesh, "OpenSubdiv rejected the topology: " +
+                       (errors.empty() ? std::string("unknown error") : one_line(errors.front())));
     if (!errors.empty()) fail(mesh, "OpenSubdiv: " + one_line(errors.front()));
     if (warnings)
         for (const std::string& w : warns) warnings->push_back(mesh.name + ": OpenSubdiv: " + one_line(w));

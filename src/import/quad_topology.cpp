@@ -43,7 +43,8 @@ QuadTopology build_quad_topology(const ControlMesh& mesh) {
                 fail(mesh, "face " + std::to_string(f) + " uses vertex " + std::to_string(v) + " out of range (" +
                                std::to_string(nv) + " vertices)");
             for (int j = 0; j < k; ++j)
-                if (vert(4 * f + j) == v) fail(mesh, "face " + std::to_string(f) + " repeats vertex " + std::to_string(v));
+                if (vert(4 * f + j) == v)
+                    fail(mesh, "face " + std::to_string(f) + " repeats vertex " + std::to_string(v));
         }
     }
 

@@ -61,7 +61,8 @@ RefinedMesh refine_uniform_once(const ControlMesh& mesh) {
     sopt.generateIntermediateLevels = false;
     sopt.generateOffsets = true;
     sopt.generateControlVerts = false;
-    std::unique_ptr<const Far::StencilTableReal<double>> table(Far::StencilTableFactoryReal<double>::Create(*refiner, sopt));
+    std::unique_ptr<const Far::StencilTableReal<double>> table(
+        Far::StencilTableFactoryReal<double>::Create(*refiner, sopt));
     const int nv = level.GetNumVertices();
     if (!table || table->GetNumStencils() != nv)
         throw Error(mesh.name + ": OpenSubdiv produced an unexpected number of refinement stencils");
@@ -70,7 +71,8 @@ RefinedMesh refine_uniform_once(const ControlMesh& mesh) {
         const auto s = table->GetStencil(r);
         terms.clear();
         for (int k = 0; k < s.GetSize(); ++k)
-            terms.emplace_back(static_cast<std::uint32_t>(s.GetVertexIndices()[k]), static_cast<float>(s.GetWeights()[k]));
+            terms.emplace_back(static_cast<std::uint32_t>(s.GetVertexIndices()[k]),
+                               static_cast<float>(s.GetWeights()[k]));
         out.stencils.add_row(terms);
     }
     out.mesh.positions.resize(static_cast<std::size_t>(nv));

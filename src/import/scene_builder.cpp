@@ -121,8 +121,8 @@ float animated_reach(const LoadedModel& model, const Mat4& standing, const Anima
     std::vector<Vec3> positions;
     PatchFrame frame;
     for (int k = 0; k < samples; ++k) {
-        animate(model.subdiv->mesh.positions, animation.period_seconds * static_cast<float>(k) / static_cast<float>(samples),
-                animation, positions);
+        animate(model.subdiv->mesh.positions,
+                animation.period_seconds * static_cast<float>(k) / static_cast<float>(samples), animation, positions);
         evaluate_frame(model, positions, frame);
         measure(frame);
     }
@@ -135,9 +135,12 @@ using namespace detail;
 
 void add_environment_object(Scene& scene, std::string name, const std::vector<Vec3>& vertices,
                             const std::vector<std::uint32_t>& indices, bool one_sided) {
-    if (indices.size() % 3 != 0) throw Error(name + ": " + std::to_string(indices.size()) + " indices, not whole triangles");
+    if (indices.size() % 3 != 0)
+        throw Error(name + ": " + std::to_string(indices.size()) + " indices, not whole triangles");
     for (std::uint32_t i : indices)
-        if (i >= vertices.size()) throw Error(name + ": index " + std::to_string(i) + " beyond the " + std::to_string(vertices.size()) + " vertices");
+        if (i >= vertices.size())
+            throw Error(name + ": index " + std::to_string(i) + " beyond the " + std::to_string(vertices.size()) +
+                        " vertices");
     add_triangles(scene, std::move(name), vertices, indices, one_sided);
 }
 

@@ -41,7 +41,8 @@ Mat4 instance_to_world(const SceneInstance& instance, float time_seconds) {
 }
 
 DVec3 scene_frame_near(DVec3 eye) {
-    if (std::fabs(eye.x) <= kSceneWorldFrame && std::fabs(eye.y) <= kSceneWorldFrame && std::fabs(eye.z) <= kSceneWorldFrame)
+    if (std::fabs(eye.x) <= kSceneWorldFrame && std::fabs(eye.y) <= kSceneWorldFrame &&
+        std::fabs(eye.z) <= kSceneWorldFrame)
         return {};
     auto snap = [](double x) { return std::nearbyint(x / kSceneFrameGrid) * kSceneFrameGrid; };
     return {snap(eye.x), snap(eye.y), snap(eye.z)};
@@ -68,8 +69,9 @@ void rebase_scene(const Scene& world, DVec3 origin, Scene& frame) {
     frame.cell_world = world.cell_world;
     for (std::size_t i = 0; i < frame.cells.size(); ++i) {
         Bounds& box = frame.cells[i].box;
-        box = world.cell_world.empty() ? Bounds{moved(box.min), moved(box.max)}
-                                       : Bounds{to_float(world.cell_world[i][0] - origin), to_float(world.cell_world[i][1] - origin)};
+        box = world.cell_world.empty()
+                  ? Bounds{moved(box.min), moved(box.max)}
+                  : Bounds{to_float(world.cell_world[i][0] - origin), to_float(world.cell_world[i][1] - origin)};
     }
     frame.portals = world.portals;
     frame.portal_world = world.portal_world;
@@ -101,8 +103,9 @@ std::vector<WorldCamera> Scene::world_camera_path(int frames, float aspect) cons
     for (int f = 0; f < frames; ++f) {
         WorldCamera cam;
         if (camera.walk) {
-            cam.eye = o + to_double(camera.walk_start) + DVec3{double(camera.walk_step.x) * f, double(camera.walk_step.y) * f,
-                                                               double(camera.walk_step.z) * f};
+            cam.eye =
+                o + to_double(camera.walk_start) +
+                DVec3{double(camera.walk_step.x) * f, double(camera.walk_step.y) * f, double(camera.walk_step.z) * f};
             cam.target = cam.eye + to_double(camera.walk_direction);
         } else {
             const double a = (double(camera.start_degrees) + double(f) * double(camera.degrees_per_frame)) *

@@ -60,7 +60,8 @@ SceneObjectLevel::SceneObjectLevel(Scene& scene, const ObjectLevelSetup& setup)
         const std::size_t begin = 3 * std::size_t{object.first_triangle};
         const std::size_t end = begin + 3 * std::size_t{object.triangle_count};
         std::vector<Vec3> points;
-        for (std::size_t i = begin; i < end; ++i) points.push_back(scene.occluder_vertices.at(scene.occluder_indices[i]));
+        for (std::size_t i = begin; i < end; ++i)
+            points.push_back(scene.occluder_vertices.at(scene.occluder_indices[i]));
         boxes_[instances + e] = aabb_of_points(points.data(), points.size());
         spheres_[instances + e] = sphere_of_points(points.data(), points.size());
         obbs_[instances + e] = obb_of_points(points.data(), points.size());
@@ -159,8 +160,8 @@ const ObjectCullResult& SceneObjectLevel::cull(const std::vector<BezierPatch>& p
     const float eye_far = std::max({std::fabs(camera.eye.x), std::fabs(camera.eye.y), std::fabs(camera.eye.z)});
     for (std::size_t i = 0; i < culler_.object_count(); ++i) {
         const Bounds& b = boxes_[i];
-        const float far = std::max({eye_far, std::fabs(b.min.x), std::fabs(b.min.y), std::fabs(b.min.z), std::fabs(b.max.x),
-                                    std::fabs(b.max.y), std::fabs(b.max.z)});
+        const float far = std::max({eye_far, std::fabs(b.min.x), std::fabs(b.min.y), std::fabs(b.min.z),
+                                    std::fabs(b.max.x), std::fabs(b.max.y), std::fabs(b.max.z)});
         const float diagonal = length(b.max - b.min);
         if (!(far <= kClusterRoundingRatio * diagonal)) clusters_usable_[i] = 0;
     }

@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "patchcull/objects/bounding_volumes.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
+#include "patchcull/objects/bounding_volumes.h"
 
 namespace patchcull {
 
@@ -29,7 +29,8 @@ namespace {
 // The corner index of v in the box (bit 4: x at max, 2: y, 1: z), or -1 when v is no corner.
 int corner_index(const Bounds& box, Vec3 v) {
     auto side = [](float x, float lo, float hi) { return x == lo ? 0 : x == hi ? 1 : -1; };
-    const int x = side(v.x, box.min.x, box.max.x), y = side(v.y, box.min.y, box.max.y), z = side(v.z, box.min.z, box.max.z);
+    const int x = side(v.x, box.min.x, box.max.x), y = side(v.y, box.min.y, box.max.y),
+              z = side(v.z, box.min.z, box.max.z);
     return x < 0 || y < 0 || z < 0 ? -1 : 4 * x + 2 * y + z;
 }
 
@@ -88,7 +89,8 @@ std::vector<std::size_t> box_environment_objects(const Scene& scene) {
             if (object.one_sided) {
                 const Vec3 n = cross(b - a, c - a);
                 const float outward = (axis == 0 ? n.x : axis == 1 ? n.y : n.z) * (f % 2 ? 1.0f : -1.0f);
-                if (!(outward > 0)) continue;  // faces inwards: drawn from inside only, covers nothing seen from outside
+                if (!(outward > 0))
+                    continue;  // faces inwards: drawn from inside only, covers nothing seen from outside
             }
             // The face's corners in a fixed order: the two other axes' bits, lexicographic.
             int others[2], n_others = 0;
@@ -141,7 +143,8 @@ SceneOcclusion::SceneOcclusion(const Scene& scene, const SceneObjectLevel& level
         const std::size_t instances = scene.instances.size();
         for (std::size_t e : box_environment_objects(scene)) occluder_objects_.push_back(instances + e);
         if (occluder_objects_.empty())
-            throw Error("horizon: scene '" + scene.name + "' has no box occluders (environment objects that are closed boxes)");
+            throw Error("horizon: scene '" + scene.name +
+                        "' has no box occluders (environment objects that are closed boxes)");
     }
 }
 
@@ -168,14 +171,15 @@ bool SceneOcclusion::near_pyramid_touches_environment(const Mat4& world_to_clip,
     const std::vector<Bounds>& boxes = level_->boxes();
     for (std::size_t i = scene_->instances.size(); i < boxes.size(); ++i) {
         const Bounds& b = boxes[i];
-        if (b.min.x <= pyramid.max.x && b.max.x >= pyramid.min.x && b.min.y <= pyramid.max.y && b.max.y >= pyramid.min.y &&
-            b.min.z <= pyramid.max.z && b.max.z >= pyramid.min.z)
+        if (b.min.x <= pyramid.max.x && b.max.x >= pyramid.min.x && b.min.y <= pyramid.max.y &&
+            b.max.y >= pyramid.min.y && b.min.z <= pyramid.max.z && b.max.z >= pyramid.min.z)
             return true;
     }
     return false;
 }
 
-const ObjectCullResult& SceneOcclusion::cull(const ObjectCullResult& result, const Camera& camera, int width, int height) {
+const ObjectCullResult& SceneOcclusion::cull(const ObjectCullResult& result, const Camera& camera, int width,
+                                             int height) {
     const std::vector<Bounds>& boxes = level_->boxes();
     const ObjectCuller& culler = level_->culler();
     const std::size_t n = culler.object_count();

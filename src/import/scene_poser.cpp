@@ -201,7 +201,8 @@ const std::vector<BezierPatch>& ScenePoser::pose(float time_seconds) {
                     for (int j = 0; j < 3; ++j)
                         for (int k = 0; k < 4; ++k) mapped.dv[4 * j + k] = linear(source.du[3 * k + j]);
                 } else {
-                    for (int k = 0; k < 12; ++k) mapped.du[k] = linear(source.du[k]), mapped.dv[k] = linear(source.dv[k]);
+                    for (int k = 0; k < 12; ++k)
+                        mapped.du[k] = linear(source.du[k]), mapped.dv[k] = linear(source.dv[k]);
                 }
                 tangent_index_[next] = static_cast<std::int32_t>(next_tangent);
                 ++next_tangent;

@@ -13,9 +13,12 @@ namespace patchcull {
 const char* scheme_name(Scheme scheme) { return scheme == Scheme::acc ? "acc" : "osd"; }
 
 bool parse_scheme(const std::string& text, Scheme& scheme) {
-    if (text == "acc") scheme = Scheme::acc;
-    else if (text == "osd") scheme = Scheme::osd;
-    else return false;
+    if (text == "acc")
+        scheme = Scheme::acc;
+    else if (text == "osd")
+        scheme = Scheme::osd;
+    else
+        return false;
     return true;
 }
 
@@ -95,9 +98,9 @@ void check_preprocessing_limits(const ControlMesh& mesh) {
             // Report the vertex with its full valence.
             std::uint32_t n = 0;
             for (const std::uint32_t w : mesh.face_vertices) n += w == v;
-            throw Error(mesh.name + ": vertex " + std::to_string(std::uint64_t{v} + 1) + " has valence " + std::to_string(n) +
-                        " (faces around it); patchcull takes vertices of valence at most " + std::to_string(kMaxValence) +
-                        " (preprocessing costs ~n^2 in a vertex's valence n)");
+            throw Error(mesh.name + ": vertex " + std::to_string(std::uint64_t{v} + 1) + " has valence " +
+                        std::to_string(n) + " (faces around it); patchcull takes vertices of valence at most " +
+                        std::to_string(kMaxValence) + " (preprocessing costs ~n^2 in a vertex's valence n)");
         }
 }
 

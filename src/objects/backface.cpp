@@ -25,8 +25,8 @@
 #include <limits>
 #include <string>
 
-#include "patchcull/objects/backface.h"
 #include "patchcull/core/error.h"
+#include "patchcull/objects/backface.h"
 
 #include "core/scalar_clones.h"
 
@@ -152,8 +152,8 @@ int BackMask::marked() const {
     return total;
 }
 
-void make_back_mask(const NormalMaskGrid& grid, const Mat4& world_to_clip, ClipDepth depth, int sector_x,
-                    int sector_y, int sectors, BackMask& out) {
+void make_back_mask(const NormalMaskGrid& grid, const Mat4& world_to_clip, ClipDepth depth, int sector_x, int sector_y,
+                    int sectors, BackMask& out) {
     if (sectors < 1 || sector_x < 0 || sector_y < 0 || sector_x >= sectors || sector_y >= sectors)
         throw Error("make_back_mask: sector (" + std::to_string(sector_x) + ", " + std::to_string(sector_y) +
                     ") is not in a " + std::to_string(sectors) + " x " + std::to_string(sectors) + " grid");
@@ -182,8 +182,7 @@ void make_back_mask(const NormalMaskGrid& grid, const Mat4& world_to_clip, ClipD
     if (!invert_double(m, inv)) return;
     const double len_e = std::sqrt(E[0] * E[0] + E[1] * E[1] + E[2] * E[2]);
     const bool perspective = std::fabs(E[3]) > 1e-12 * len_e;
-    const double eye[3] = {perspective ? E[0] / E[3] : 0, perspective ? E[1] / E[3] : 0,
-                           perspective ? E[2] / E[3] : 0};
+    const double eye[3] = {perspective ? E[0] / E[3] : 0, perspective ? E[1] / E[3] : 0, perspective ? E[2] / E[3] : 0};
 
     // Corner rays of the (grown) sector, at a depth inside the clip volume.
     const double grow = 2e-5;
@@ -213,8 +212,8 @@ void make_back_mask(const NormalMaskGrid& grid, const Mat4& world_to_clip, ClipD
         grid.class_corners(static_cast<std::uint16_t>(cls), corners);
         bool back = true;
         for (int i = 0; i < 4 && back; ++i) {
-            const double len_n =
-                std::sqrt(corners[i][0] * corners[i][0] + corners[i][1] * corners[i][1] + corners[i][2] * corners[i][2]);
+            const double len_n = std::sqrt(corners[i][0] * corners[i][0] + corners[i][1] * corners[i][1] +
+                                           corners[i][2] * corners[i][2]);
             for (int j = 0; j < 4 && back; ++j) {
                 const double d = corners[i][0] * rays[j][0] + corners[i][1] * rays[j][1] + corners[i][2] * rays[j][2];
                 back = d > 1e-12 * len_n * ray_len[j];

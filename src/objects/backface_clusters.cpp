@@ -40,8 +40,8 @@
 #include <queue>
 #include <string>
 
-#include "patchcull/objects/backface_clusters.h"
 #include "patchcull/core/error.h"
+#include "patchcull/objects/backface_clusters.h"
 
 namespace patchcull {
 
@@ -175,7 +175,8 @@ BackfaceCluster make_cluster_from_planes(const ClusterPlane* planes, std::size_t
             const double y[3] = {double(c.x) - p.o.x, double(c.y) - p.o.y, double(c.z) - p.o.z};
             const double v = p.a - (p.n[0] * y[0] + p.n[1] * y[1] + p.n[2] * y[2]);
             const double l1 = std::fabs(y[0]) + std::fabs(y[1]) + std::fabs(y[2]);
-            const double mag = std::fabs(p.a) + std::fabs(p.n[0] * y[0]) + std::fabs(p.n[1] * y[1]) + std::fabs(p.n[2] * y[2]);
+            const double mag =
+                std::fabs(p.a) + std::fabs(p.n[0] * y[0]) + std::fabs(p.n[1] * y[1]) + std::fabs(p.n[2] * y[2]);
             const double err = p.en * l1 + p.ea + kPlaneSlack * mag;
             d = std::min(d, v - err);
             D = std::max(D, v + err);
@@ -188,7 +189,8 @@ BackfaceCluster make_cluster_from_planes(const ClusterPlane* planes, std::size_t
     cl.c = best_c;
     cl.d = round_down(best_d);
     cl.d_front = round_up(best_D);
-    if (!is_finite(cl.n_min) || !is_finite(cl.m_max) || !std::isfinite(best_d) || !std::isfinite(best_D)) make_invalid(cl);
+    if (!is_finite(cl.n_min) || !is_finite(cl.m_max) || !std::isfinite(best_d) || !std::isfinite(best_D))
+        make_invalid(cl);
     return cl;
 }
 
@@ -255,8 +257,9 @@ BackfaceCluster make_triangle_cluster(const Vec3* vertices, const std::uint32_t*
         }
         if (!degenerate) planes.push_back(p);
     }
-    return make_cluster_from_planes(planes.data(), planes.size(), triangle_box(vertices, indices, first_triangle, count),
-                                    first_triangle, count, valid);
+    return make_cluster_from_planes(planes.data(), planes.size(),
+                                    triangle_box(vertices, indices, first_triangle, count), first_triangle, count,
+                                    valid);
 }
 
 double triangle_cluster_d(const Vec3* vertices, const std::uint32_t* indices, std::uint32_t first_triangle,
@@ -276,7 +279,8 @@ double triangle_cluster_d(const Vec3* vertices, const std::uint32_t* indices, st
         const double y[3] = {double(c.x) - p.o.x, double(c.y) - p.o.y, double(c.z) - p.o.z};
         const double v = p.a - (p.n[0] * y[0] + p.n[1] * y[1] + p.n[2] * y[2]);
         const double l1 = std::fabs(y[0]) + std::fabs(y[1]) + std::fabs(y[2]);
-        const double mag = std::fabs(p.a) + std::fabs(p.n[0] * y[0]) + std::fabs(p.n[1] * y[1]) + std::fabs(p.n[2] * y[2]);
+        const double mag =
+            std::fabs(p.a) + std::fabs(p.n[0] * y[0]) + std::fabs(p.n[1] * y[1]) + std::fabs(p.n[2] * y[2]);
         d = std::min(d, v - (p.en * l1 + p.ea + kPlaneSlack * mag));
     }
     (void)box;
@@ -475,8 +479,8 @@ std::vector<MergeNode> merge_adjacent(const std::vector<BackfaceCluster>& units,
 
 }  // namespace
 
-std::vector<BackfaceCluster> merge_into_leaves(const std::vector<BackfaceCluster>& units, const ClusterBuildOptions& options,
-                                               const Bounds& default_viewpoints) {
+std::vector<BackfaceCluster> merge_into_leaves(const std::vector<BackfaceCluster>& units,
+                                               const ClusterBuildOptions& options, const Bounds& default_viewpoints) {
     std::vector<std::int64_t> roots;
     const std::vector<MergeNode> t =
         merge_adjacent(units, viewpoint_box(options, default_viewpoints), options.tc_over_r, options.max_leaf, roots);
@@ -490,8 +494,9 @@ ClusterHierarchy build_cluster_hierarchy(const std::vector<BackfaceCluster>& lea
                                          const Bounds& default_viewpoints) {
     ClusterHierarchy h;
     std::vector<std::int64_t> roots;
-    const std::vector<MergeNode> t = merge_adjacent(leaves, viewpoint_box(options, default_viewpoints), options.tc_over_r,
-                                                    std::numeric_limits<std::uint64_t>::max(), roots);
+    const std::vector<MergeNode> t =
+        merge_adjacent(leaves, viewpoint_box(options, default_viewpoints), options.tc_over_r,
+                       std::numeric_limits<std::uint64_t>::max(), roots);
     h.nodes.reserve(t.size());
     std::vector<std::int64_t> stack;
     std::uint32_t leaf_counter = 0;
@@ -579,7 +584,8 @@ Bounds near_field_viewpoints(const Bounds& b) {
 ClusterHierarchy build_triangle_clusters(const std::vector<Vec3>& vertices, const std::vector<std::uint32_t>& indices,
                                          const ClusterBuildOptions& options) {
     if (indices.size() % 3 != 0)
-        throw Error("build_triangle_clusters: index count " + std::to_string(indices.size()) + " is not a multiple of 3");
+        throw Error("build_triangle_clusters: index count " + std::to_string(indices.size()) +
+                    " is not a multiple of 3");
     for (std::uint32_t i : indices)
         if (i >= vertices.size())
             throw Error("build_triangle_clusters: index " + std::to_string(i) + " is past the " +
@@ -706,7 +712,8 @@ ClusterHierarchy build_triangle_clusters(const std::vector<Vec3>& vertices, cons
     const Bounds U = near_field_viewpoints(vb);
     const std::vector<BackfaceCluster> merged = merge_into_leaves(leaves, options, U);
     leaves.clear();
-    for (const BackfaceCluster& m : merged) leaves.push_back(make_triangle_cluster(vertices.data(), reordered.data(), m.first, m.count));
+    for (const BackfaceCluster& m : merged)
+        leaves.push_back(make_triangle_cluster(vertices.data(), reordered.data(), m.first, m.count));
     ClusterHierarchy h = build_cluster_hierarchy(leaves, options, U);
     h.indices = std::move(reordered);
     h.triangle_order = std::move(tri_order);

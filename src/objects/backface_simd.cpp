@@ -64,8 +64,8 @@ HWY_INLINE MF TriangleGroup(DF d, const VF p[9], const VF eye[3]) {
     VF perm = hn::Mul(px, hn::Abs(wx));
     perm = Fma(d, py, hn::Abs(wy), perm);
     perm = Fma(d, pz, hn::Abs(wz), perm);
-    const VF margin = Fma(d, hn::Set(d, kTriangleTestErrorBound), perm,
-                          hn::Set(d, 32 * std::numeric_limits<float>::denorm_min()));
+    const VF margin =
+        Fma(d, hn::Set(d, kTriangleTestErrorBound), perm, hn::Set(d, 32 * std::numeric_limits<float>::denorm_min()));
     auto same = [&](int a, int b) {
         return hn::And(hn::And(hn::Eq(p[3 * a], p[3 * b]), hn::Eq(p[3 * a + 1], p[3 * b + 1])),
                        hn::Eq(p[3 * a + 2], p[3 * b + 2]));
@@ -113,7 +113,8 @@ void CullTriangles(const Vec3* vertices, const std::uint32_t* indices, std::size
             for (int k = 0; k < 3; ++k) {
                 const auto off = hn::Add(hn::ShiftLeft<1>(idx[k]), idx[k]);
                 for (int c = 0; c < 3; ++c)
-                    p[3 * k + c] = hn::GatherIndex(d, base, hn::BitCast(di, hn::Add(off, hn::Set(du, std::uint32_t(c)))));
+                    p[3 * k + c] =
+                        hn::GatherIndex(d, base, hn::BitCast(di, hn::Add(off, hn::Set(du, std::uint32_t(c)))));
             }
         } else {
             fill(t, N, p);
@@ -175,8 +176,7 @@ void cull_backfacing_triangles_simd(const Vec3* vertices, const std::uint32_t* i
     HWY_DYNAMIC_DISPATCH(CullTriangles)(vertices, indices, triangle_count, eye, culled);
 }
 
-void cull_by_normal_mask_simd(const std::uint16_t* classes, std::size_t n, const BackMask& mask,
-                              std::uint8_t* culled) {
+void cull_by_normal_mask_simd(const std::uint16_t* classes, std::size_t n, const BackMask& mask, std::uint8_t* culled) {
     if (n == 0) return;
     if (mask.class_count <= 0 || mask.bits.size() * 64 < static_cast<std::size_t>(mask.class_count)) {
         std::memset(culled, 0, n);

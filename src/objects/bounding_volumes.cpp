@@ -13,8 +13,8 @@
 //             outside_k: fma(len, g, v(c)) < nthr;  inside_k: fma(nlen, g, v(c)) > pthr
 //   AABB:     M = max of the six |coordinates| (min.x, min.y, min.z, max.x, max.y, max.z),
 //             fin = (((((min.x + min.y) + min.z) + max.x) + max.y) + max.z) * 0 (NaN for a NaN or
-//             infinite coordinate, else +-0), g = eps * (M + M) + fin; p-vertex P_a = (x_a >= 0 ? max_a : min_a), n-vertex the other
-//             outside_k: fma(len, g, v(P)) < nthr;  inside_k: fma(nlen, g, v(N)) > pthr
+//             infinite coordinate, else +-0), g = eps * (M + M) + fin; p-vertex P_a = (x_a >= 0 ? max_a : min_a),
+//             n-vertex the other outside_k: fma(len, g, v(P)) < nthr;  inside_k: fma(nlen, g, v(N)) > pthr
 //   OBB:      M as the sphere's, H = (h0 + h1) + h2, s = M + H, g = eps * (s + s),
 //             d_i = fma(z, a_i.z, fma(y, a_i.y, x * a_i.x)),
 //             e = fma(h2, |d2|, fma(h1, |d1|, h0 * |d0|)), hi = v(c) + e, lo = v(c) - e
@@ -168,14 +168,15 @@ struct ObbTerms {
             const Vec3 a = b->axes[i];
             d[i] = std::fabs(std::fma(p.z, a.z, std::fma(p.y, a.y, p.x * a.x)));
         }
-        const float e = std::fma(b->half_extents[2], d[2], std::fma(b->half_extents[1], d[1], b->half_extents[0] * d[0]));
+        const float e =
+            std::fma(b->half_extents[2], d[2], std::fma(b->half_extents[1], d[1], b->half_extents[0] * d[0]));
         return plane_side(p, g, v + e, v - e);
     }
 };
 
 template <class Terms, class Volume>
 PATCHCULL_INLINE Containment classify_masked(const FrustumPlanes& planes, const Volume& volume, PlaneCullState& state,
-                            std::uint32_t& plane_tests) {
+                                             std::uint32_t& plane_tests) {
     if (empty(volume)) return Containment::outside;
     const Terms terms(volume);
     std::uint8_t mask = state.plane_mask & 0x3f;
@@ -308,14 +309,16 @@ double obb_measure(const Obb& o) {
     return h0 * h1 * h2;
 }
 
-
 }  // namespace
 
 const char* containment_name(Containment c) {
     switch (c) {
-        case Containment::outside: return "outside";
-        case Containment::intersecting: return "intersecting";
-        case Containment::inside: return "inside";
+        case Containment::outside:
+            return "outside";
+        case Containment::intersecting:
+            return "intersecting";
+        case Containment::inside:
+            return "inside";
     }
     return "invalid";
 }
@@ -475,7 +478,8 @@ Bounds transformed_aabb(const Bounds& b, const Mat4& m) {
         const double nc = m0 * c.x + m1 * c.y + m2 * c.z + m3;
         const double ne = std::fabs(m0) * e.x + std::fabs(m1) * e.y + std::fabs(m2) * e.z;
         // Double rounding of the sums above: a few 1e-16 of the terms' magnitudes.
-        const double slack = 1e-12 * (std::fabs(m0 * c.x) + std::fabs(m1 * c.y) + std::fabs(m2 * c.z) + std::fabs(m3) + ne);
+        const double slack =
+            1e-12 * (std::fabs(m0 * c.x) + std::fabs(m1 * c.y) + std::fabs(m2 * c.z) + std::fabs(m3) + ne);
         lo[r] = round_down(nc - ne - slack);
         hi[r] = round_up(nc + ne + slack);
     }
@@ -506,7 +510,8 @@ Containment classify_aabb(const FrustumPlanes& planes, const Bounds& box, PlaneC
 }
 
 PATCHCULL_SCALAR_CLONES
-Containment classify_obb(const FrustumPlanes& planes, const Obb& box, PlaneCullState& state, std::uint32_t& plane_tests) {
+Containment classify_obb(const FrustumPlanes& planes, const Obb& box, PlaneCullState& state,
+                         std::uint32_t& plane_tests) {
     return classify_masked<ObbTerms>(planes, box, state, plane_tests);
 }
 

@@ -146,9 +146,8 @@ void ObjectBvh::build_node(std::uint32_t index, std::uint32_t begin, std::uint32
         for (int k = 1; k < 3; ++k)
             if (axis(cmax, k) - axis(cmin, k) > axis(cmax, a) - axis(cmin, a)) a = k;
         mid = begin + count / 2;
-        std::nth_element(first, slot_object_.data() + mid, last, [&](std::uint32_t x, std::uint32_t y) {
-            return axis(centres[x], a) < axis(centres[y], a);
-        });
+        std::nth_element(first, slot_object_.data() + mid, last,
+                         [&](std::uint32_t x, std::uint32_t y) { return axis(centres[x], a) < axis(centres[y], a); });
     }
     const std::uint32_t left = static_cast<std::uint32_t>(nodes_.size());
     nodes_.emplace_back();
@@ -197,7 +196,8 @@ void ObjectBvh::cull(const FrustumPlanes& planes, Options options, Containment* 
         ++stats.nodes_visited;
         if (options.coherence) node_last_[e.node] = state.last_plane;
         if (c == Containment::outside) {
-            for (std::uint32_t s = node.slot_begin; s < node.slot_end; ++s) per_object[slot_object_[s]] = Containment::outside;
+            for (std::uint32_t s = node.slot_begin; s < node.slot_end; ++s)
+                per_object[slot_object_[s]] = Containment::outside;
         } else if (c == Containment::inside) {
             // Empty boxes are outside by their own test (they add nothing to the node's box).
             for (std::uint32_t s = node.slot_begin; s < node.slot_end; ++s)

@@ -15,17 +15,21 @@ namespace patchcull {
 
 const char* object_cull_method_name(ObjectCullMethod method) {
     switch (method) {
-        case ObjectCullMethod::none: return "none";
-        case ObjectCullMethod::frustum: return "frustum";
-        case ObjectCullMethod::bvh: return "bvh";
-        case ObjectCullMethod::bvh_backface: return "bvh+backface";
+        case ObjectCullMethod::none:
+            return "none";
+        case ObjectCullMethod::frustum:
+            return "frustum";
+        case ObjectCullMethod::bvh:
+            return "bvh";
+        case ObjectCullMethod::bvh_backface:
+            return "bvh+backface";
     }
     return "?";
 }
 
 bool parse_object_cull_method(const std::string& text, ObjectCullMethod& method) {
-    for (ObjectCullMethod m : {ObjectCullMethod::none, ObjectCullMethod::frustum, ObjectCullMethod::bvh,
-                               ObjectCullMethod::bvh_backface})
+    for (ObjectCullMethod m :
+         {ObjectCullMethod::none, ObjectCullMethod::frustum, ObjectCullMethod::bvh, ObjectCullMethod::bvh_backface})
         if (text == object_cull_method_name(m)) {
             method = m;
             return true;
@@ -35,9 +39,12 @@ bool parse_object_cull_method(const std::string& text, ObjectCullMethod& method)
 
 const char* object_volume_name(ObjectVolume v) {
     switch (v) {
-        case ObjectVolume::aabb: return "aabb";
-        case ObjectVolume::sphere: return "sphere";
-        case ObjectVolume::obb: return "obb";
+        case ObjectVolume::aabb:
+            return "aabb";
+        case ObjectVolume::sphere:
+            return "sphere";
+        case ObjectVolume::obb:
+            return "obb";
     }
     return "?";
 }
@@ -53,15 +60,19 @@ bool parse_object_volume(const std::string& text, ObjectVolume& v) {
 
 const char* triangle_backface_name(TriangleBackface t) {
     switch (t) {
-        case TriangleBackface::clusters: return "clusters";
-        case TriangleBackface::normal_masks: return "masks";
-        case TriangleBackface::per_triangle: return "triangles";
+        case TriangleBackface::clusters:
+            return "clusters";
+        case TriangleBackface::normal_masks:
+            return "masks";
+        case TriangleBackface::per_triangle:
+            return "triangles";
     }
     return "?";
 }
 
 bool parse_triangle_backface(const std::string& text, TriangleBackface& t) {
-    for (TriangleBackface v : {TriangleBackface::clusters, TriangleBackface::normal_masks, TriangleBackface::per_triangle})
+    for (TriangleBackface v :
+         {TriangleBackface::clusters, TriangleBackface::normal_masks, TriangleBackface::per_triangle})
         if (text == triangle_backface_name(v)) {
             t = v;
             return true;
@@ -109,8 +120,11 @@ Vec3 transform_point(const Mat4& m, Vec3 p) { return cartesian(m * Vec4{p.x, p.y
 }  // namespace
 
 ObjectCuller::ObjectCuller(std::vector<CullableObject> objects)
-    : objects_(std::move(objects)), clusters_(objects_.size()), object_space_(objects_.size(), 0),
-      flat_states_(objects_.size()), containment_(objects_.size()) {
+    : objects_(std::move(objects)),
+      clusters_(objects_.size()),
+      object_space_(objects_.size(), 0),
+      flat_states_(objects_.size()),
+      containment_(objects_.size()) {
     check_disjoint(objects_, false);
     check_disjoint(objects_, true);
 }
@@ -131,7 +145,8 @@ void ObjectCuller::set_clusters(std::size_t object, ClusterHierarchy clusters, b
 void ObjectCuller::set_triangle_mesh(std::vector<Vec3> vertices, std::vector<std::uint32_t> indices) {
     if (indices.size() % 3 != 0) throw Error("object level: set_triangle_mesh: indices not a multiple of 3");
     for (std::uint32_t i : indices)
-        if (i >= vertices.size()) throw Error("object level: set_triangle_mesh: index " + std::to_string(i) + " out of range");
+        if (i >= vertices.size())
+            throw Error("object level: set_triangle_mesh: index " + std::to_string(i) + " out of range");
     for (const CullableObject& o : objects_)
         if (o.triangles && o.span.first + o.span.count > indices.size() / 3)
             throw Error("object level: " + o.name + ": its triangles leave the mesh");
@@ -145,13 +160,14 @@ void ObjectCuller::set_triangle_mesh(std::vector<Vec3> vertices, std::vector<std
 // The normal-mask or per-triangle back-face test of one triangle object: runs of culled
 // triangles become spans. Returns the triangles culled.
 std::size_t ObjectCuller::cull_triangles_individually(std::size_t object, const ObjectFrame& frame,
-                                               const ObjectCullOptions& options, std::vector<IndexSpan>& culled) {
+                                                      const ObjectCullOptions& options,
+                                                      std::vector<IndexSpan>& culled) {
     const IndexSpan span = objects_[object].span;
     if (span.count == 0 || mesh_indices_.size() < 3 * (span.first + span.count)) return 0;
     triangle_culled_.resize(span.count);
     if (options.triangle_backface == TriangleBackface::per_triangle) {
-        cull_backfacing_triangles_simd(mesh_vertices_.data(), mesh_indices_.data() + 3 * span.first, span.count, frame.eye,
-                                       triangle_culled_.data());
+        cull_backfacing_triangles_simd(mesh_vertices_.data(), mesh_indices_.data() + 3 * span.first, span.count,
+                                       frame.eye, triangle_culled_.data());
     } else {
         // The sector mask when the object's box projects into one sector (every corner in
         // front of the eye and in that sector: then every triangle has a point there), else the
@@ -162,13 +178,15 @@ std::size_t ObjectCuller::cull_triangles_individually(std::size_t object, const 
             const Bounds& b = frame.boxes[object];
             int sector = -2;
             for (int k = 0; k < 8 && sector != -1; ++k) {
-                const Vec3 corner{(k & 1) ? b.max.x : b.min.x, (k & 2) ? b.max.y : b.min.y, (k & 4) ? b.max.z : b.min.z};
+                const Vec3 corner{(k & 1) ? b.max.x : b.min.x, (k & 2) ? b.max.y : b.min.y,
+                                  (k & 4) ? b.max.z : b.min.z};
                 const int s = sector_of_point(frame.world_to_clip, corner, sectors);
                 sector = (sector == -2 || sector == s) ? s : -1;
             }
             if (sector >= 0) mask = 1 + static_cast<std::size_t>(sector);
         }
-        cull_by_normal_mask_simd(triangle_classes_.data() + span.first, span.count, masks_[mask], triangle_culled_.data());
+        cull_by_normal_mask_simd(triangle_classes_.data() + span.first, span.count, masks_[mask],
+                                 triangle_culled_.data());
     }
     result_.stats.triangle_tests += span.count;
     std::size_t count = 0;
@@ -195,7 +213,8 @@ const ObjectCullResult& ObjectCuller::cull(const ObjectFrame& frame, const Objec
     const FrustumPlanes planes = make_frustum_planes(frame.world_to_clip, frame.depth);
     ObjectBvh::Stats bvh_stats;
     if (options.method == ObjectCullMethod::frustum) {
-        cull_objects_flat(planes, frame.boxes, n, flat_states_.data(), options.coherence, containment_.data(), bvh_stats);
+        cull_objects_flat(planes, frame.boxes, n, flat_states_.data(), options.coherence, containment_.data(),
+                          bvh_stats);
     } else {
         if (!bvh_built_ || bvh_.object_count() != n) {
             bvh_.build(frame.boxes, n);
@@ -266,11 +285,13 @@ const ObjectCullResult& ObjectCuller::cull(const ObjectFrame& frame, const Objec
         if (options.method != ObjectCullMethod::bvh_backface || clusters_[i].nodes.empty()) continue;
         if (frame.clusters_usable && !frame.clusters_usable[i]) continue;
         if (o.triangles && individual) {
-            if (cull_triangles_individually(i, frame, options, culled) == o.span.count) r.verdicts[i] = ObjectVerdict::backface;
+            if (cull_triangles_individually(i, frame, options, culled) == o.span.count)
+                r.verdicts[i] = ObjectVerdict::backface;
             continue;
         }
-        const Vec3 eye = object_space_[i] && frame.world_to_cluster ? transform_point(frame.world_to_cluster[i], frame.eye)
-                                                                    : frame.eye;
+        const Vec3 eye = object_space_[i] && frame.world_to_cluster
+                             ? transform_point(frame.world_to_cluster[i], frame.eye)
+                             : frame.eye;
         const std::size_t leaves = cluster_leaf_count(clusters_[i]);
         leaf_culled_.assign(leaves, 0);
         cull_cluster_hierarchy(clusters_[i], eye, leaf_culled_.data(), r.stats.cluster_tests);

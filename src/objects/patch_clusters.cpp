@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/objects/backface_clusters.h"
 #include "patchcull/core/error.h"
+#include "patchcull/objects/backface_clusters.h"
 
 namespace patchcull {
 
@@ -120,7 +120,8 @@ bool append_patch_planes(const BezierPatch& patch, std::vector<ClusterPlane>& ou
     // they stay short (any positive scale keeps a plane's side).
     double longest = 0;
     for (int k = 0; k < 64; ++k)
-        longest = std::max(longest, std::sqrt(planes[k].x * planes[k].x + planes[k].y * planes[k].y + planes[k].z * planes[k].z));
+        longest = std::max(
+            longest, std::sqrt(planes[k].x * planes[k].x + planes[k].y * planes[k].y + planes[k].z * planes[k].z));
     for (int k = 0; k < 64; ++k) {
         const PlaneD& t = planes[k];
         const PlaneD& e = error[k];
@@ -168,7 +169,8 @@ BackfaceCluster make_patch_cluster(const BezierPatch* patches, std::uint32_t fir
     std::vector<ClusterPlane> planes;
     planes.reserve(64 * std::size_t(count));
     bool valid = true;
-    for (std::size_t p = first; p < std::size_t(first) + count && valid; ++p) valid = append_patch_planes(patches[p], planes);
+    for (std::size_t p = first; p < std::size_t(first) + count && valid; ++p)
+        valid = append_patch_planes(patches[p], planes);
     bool finite = true;
     const Bounds box = control_point_box(patches, first, count, finite);
     return make_cluster_from_planes(planes.data(), planes.size(), box, first, count, valid && finite);

@@ -13,9 +13,9 @@
 namespace patchcull {
 namespace {
 
-constexpr double kMarginRelative = 1e-7;       // m = 1e-7 R (header: Rounding)
-constexpr double kNearPortalRelative = 1e-5;   // eyes closer to a portal's plane cross it unnarrowed
-constexpr double kMinEdgeSine = 1e-6;          // edge planes with a smaller angle at the eye are left out
+constexpr double kMarginRelative = 1e-7;      // m = 1e-7 R (header: Rounding)
+constexpr double kNearPortalRelative = 1e-5;  // eyes closer to a portal's plane cross it unnarrowed
+constexpr double kMinEdgeSine = 1e-6;         // edge planes with a smaller angle at the eye are left out
 
 struct D3 {
     double x, y, z;

@@ -62,12 +62,14 @@ TEST(Cli, CullPrintsTheContractShapeWithNoFalseCulls) {
         EXPECT_GT(mj["ns_per_patch"].get<double>(), 0.0);
     }
     // frustum tests the convex hull, frustum-disp its AABB: the hull is never culled less.
-    EXPECT_GE(j["methods"]["frustum"]["cull_rate"].get<double>(), j["methods"]["frustum-disp"]["cull_rate"].get<double>());
+    EXPECT_GE(j["methods"]["frustum"]["cull_rate"].get<double>(),
+              j["methods"]["frustum-disp"]["cull_rate"].get<double>());
 }
 
 TEST(Cli, CullWithProceduralDisplacementOnARealModel) {
-    const CliRun r = run("cull " + model("bigguy.obj") + " --views 30 --view-mode free --displace procedural "
-                      "--displace-scale 0.5 --json");
+    const CliRun r = run("cull " + model("bigguy.obj") +
+                         " --views 30 --view-mode free --displace procedural "
+                         "--displace-scale 0.5 --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["methods"]["frustum"]["false_culls"], 0);
@@ -133,8 +135,9 @@ TEST(Cli, CullBackPatchMethodsOnTheTeapot) {
 // eye distance moves the back-patch rates: near eyes (1..1.2 times the containing distance) see
 // less of BigGuy than far ones (4..6 times) and cull more with each method.
 TEST(Cli, CullDistanceViewsHoldTheObjectAndDistanceMovesTheRates) {
-    const std::string common = "cull " + model("bigguy.obj") +
-                               " --views 60 --seed 5 --view-mode distance --methods frustum,frustum-disp,tcone,ncone,ptp --json";
+    const std::string common =
+        "cull " + model("bigguy.obj") +
+        " --views 60 --seed 5 --view-mode distance --methods frustum,frustum-disp,tcone,ncone,ptp --json";
     const CliRun near_run = run(common + " --distance-range 1,1.2");
     const CliRun far_run = run(common + " --distance-range 4,6");
     ASSERT_EQ(near_run.status, 0) << near_run.err;
@@ -198,7 +201,8 @@ TEST(Cli, EveryNumericAndStringFlagRejectsBadValues) {
         {"info teapot", "--scheme", {"''", "ACC", "loop"}},
         {"cull teapot --views 1", "--seed", {"-1", "1e23", "18446744073709551616", "0x10", "+5", "''", "1.0"}},
         {"cull teapot", "--views", {"0", "-1", "10000001", "1e3", "99999999999999999999", "''", "nan"}},
-        {"cull teapot --views 1 --methods frustum --displace procedural", "--displace-scale",
+        {"cull teapot --views 1 --methods frustum --displace procedural",
+         "--displace-scale",
          {"-1", "nan", "inf", "-inf", "1e999", "''", "1e10", "0x1p3", "'1 '"}},
         {"cull teapot --views 1 --methods frustum", "--displace", {"''"}},
         {"cull teapot --views 1", "--methods", {"''", "frustum,,ncone", "frustum,frustum", "frustum,", ",frustum"}},
@@ -243,7 +247,8 @@ TEST(Cli, EveryNumericAndStringFlagRejectsBadValues) {
 
 TEST(Cli, BadFlagValuesAreQuotedOnOneLine) {
     // A control byte or a newline in a value must not break the one-line error.
-    expect_one_line_error(run("cull teapot --views \"$(printf '1\\n2')\""), "--views: expected an integer in 1..10000000");
+    expect_one_line_error(run("cull teapot --views \"$(printf '1\\n2')\""),
+                          "--views: expected an integer in 1..10000000");
     expect_one_line_error(run("render teapot --size \"$(printf '64\\nx64')\""), "--size");
     expect_one_line_error(run("info teapot --scheme \"$(printf 'a\\033[31m')\""), "--scheme: expected one of acc|osd");
     const CliRun r = run("cull teapot --views 1 --methods \"$(printf 'frustum,x\\001y')\"");
@@ -279,8 +284,10 @@ TEST(Cli, OutputPathsAreCheckedBeforeTheWork) {
     const std::string dir = scratch_dir();
     std::filesystem::create_directories(dir + "/blocked/frame.png");  // a directory where a file goes
     // demo: the directory cannot be created, its parent is a file, or one of its files cannot be written.
-    expect_one_line_error(run("demo --out-dir /proc/nonexistent"), "--out-dir: cannot create directory '/proc/nonexistent'");
-    expect_one_line_error(run("demo --out-dir " + file + "/sub"), "--out-dir: cannot create directory '" + file + "/sub'");
+    expect_one_line_error(run("demo --out-dir /proc/nonexistent"),
+                          "--out-dir: cannot create directory '/proc/nonexistent'");
+    expect_one_line_error(run("demo --out-dir " + file + "/sub"),
+                          "--out-dir: cannot create directory '" + file + "/sub'");
     expect_one_line_error(run("demo --out-dir " + file), "--out-dir: cannot create directory '" + file + "'");
     expect_one_line_error(run("demo --out-dir " + dir + "/blocked"),
                           "--out-dir: cannot write '" + dir + "/blocked/frame.png': is a directory");
@@ -290,7 +297,8 @@ TEST(Cli, OutputPathsAreCheckedBeforeTheWork) {
         SCOPED_TRACE(command);
         expect_one_line_error(run(command + " " + flag + " /nonexistent/dir/x.png"),
                               flag + ": cannot write '/nonexistent/dir/x.png': No such file or directory");
-        expect_one_line_error(run(command + " " + flag + " " + dir), flag + ": cannot write '" + dir + "': is a directory");
+        expect_one_line_error(run(command + " " + flag + " " + dir),
+                              flag + ": cannot write '" + dir + "': is a directory");
         expect_one_line_error(run(command + " " + flag + " " + file + "/x.png"),
                               flag + ": cannot write '" + file + "/x.png': Not a directory");
         expect_one_line_error(run(command + " " + flag + " ''"), flag + ": empty path");

@@ -8,9 +8,9 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -32,7 +32,8 @@ inline std::string slurp(const std::string& path) {
 /// A scratch directory of this test process (under the system's temporary directory).
 inline const std::string& scratch_dir() {
     static const std::string dir = [] {
-        std::string d = (std::filesystem::temp_directory_path() / ("patchcull_cli_" + std::to_string(getpid()))).string();
+        std::string d =
+            (std::filesystem::temp_directory_path() / ("patchcull_cli_" + std::to_string(getpid()))).string();
         std::filesystem::create_directories(d);
         return d;
     }();
@@ -65,8 +66,7 @@ inline std::string write_file(const std::string& name, const std::string& conten
 /// significant digits, so a file's own decimals survive translations up to 1e7) and, when
 /// reverse is set, every face's corner order reversed; other lines as they are. For tests of
 /// edits of the shipped models: translated, mirrored, inside out, folded, flat.
-inline std::string edited_obj(const std::string& path,
-                              const std::function<void(int, double&, double&, double&)>& move,
+inline std::string edited_obj(const std::string& path, const std::function<void(int, double&, double&, double&)>& move,
                               bool reverse = false) {
     std::istringstream in(slurp(path));
     std::ostringstream out;

@@ -14,7 +14,8 @@ using namespace patchcull::cli_test;
 
 TEST(CliFarOrigin, TranslatedBigGuyCullsAsAtTheOrigin) {
     const std::string far = write_file("bigguy_far.obj", translated_bigguy(1e6));
-    const std::string args = " --views 24 --view-mode free --methods frustum,frustum-disp,tcone,ncone,ptp,ptp-pcnt --json";
+    const std::string args =
+        " --views 24 --view-mode free --methods frustum,frustum-disp,tcone,ncone,ptp,ptp-pcnt --json";
     const CliRun base = run("cull " + model("bigguy.obj") + args);
     const CliRun moved = run("cull " + far + args);
     ASSERT_EQ(base.status, 0) << base.err;

@@ -36,7 +36,8 @@ TEST(CliInputErrors, AMegabyteLineIsQuotedByItsStartOnly) {
 }
 
 TEST(CliInputErrors, AMisspeltCreaseTagIsAnError) {
-    const std::string path = write_file("tag.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt creese 2/1/0 0 1 10\n");
+    const std::string path =
+        write_file("tag.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt creese 2/1/0 0 1 10\n");
     expect_printable_error(run("info " + path), "tag.obj:6: unknown tag 'creese'");
 }
 
@@ -68,13 +69,15 @@ TEST(CliInputErrors, AVertexRecordSaysHowManyValuesItHas) {
 }
 
 TEST(CliInputErrors, ABadSharpnessIsCalledASharpness) {
-    const std::string path = write_file("sharp.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt crease 2/1/0 0 1 nan\n");
+    const std::string path =
+        write_file("sharp.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt crease 2/1/0 0 1 nan\n");
     expect_printable_error(run("info " + path), "sharp.obj:6: non-finite sharpness 'nan'");
 }
 
 TEST(CliInputErrors, NonManifoldEdgesGiveOneBasedVerticesAndTheLineWithBothSchemes) {
-    const std::string path = write_file("fin.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 1 -1 0\nv 0 -1 0\nv 1 0 1\n"
-                                                   "v 0 0 1\nf 1 2 3 4\nf 2 1 6 5\nf 1 2 7 8\n");
+    const std::string path = write_file("fin.obj",
+                                        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 1 -1 0\nv 0 -1 0\nv 1 0 1\n"
+                                        "v 0 0 1\nf 1 2 3 4\nf 2 1 6 5\nf 1 2 7 8\n");
     for (const char* scheme : {"acc", "osd"})
         expect_printable_error(run("info " + path + " --scheme " + scheme),
                                "fin.obj:11: non-manifold edge between vertices 1 and 2: 3 faces share it");

@@ -13,8 +13,7 @@ using namespace patchcull::cli_test;
 TEST(CliInputFile, DevicesAndDirectoriesAreRefusedBeforeAnyRead) {
     expect_one_line_error(run("info /dev/zero"), "not a regular file");
     expect_one_line_error(run("info " + scratch_dir()), "not a regular file");
-    expect_one_line_error(run("cull " + model("bigguy.obj") + " --views 1 --displace /dev/zero"),
-                          "not a regular file");
+    expect_one_line_error(run("cull " + model("bigguy.obj") + " --views 1 --displace /dev/zero"), "not a regular file");
 }
 
 TEST(CliInputFile, FifoIsRefusedWithoutBlocking) {

@@ -8,7 +8,9 @@ using namespace patchcull::cli_test;
 
 namespace {
 
-std::string shape(const char* name) { return std::string(PATCHCULL_SOURCE_DIR) + "/tests/data/opensubdiv/" + name + ".obj"; }
+std::string shape(const char* name) {
+    return std::string(PATCHCULL_SOURCE_DIR) + "/tests/data/opensubdiv/" + name + ".obj";
+}
 
 }  // namespace
 
@@ -19,8 +21,9 @@ TEST(CliOpenSubdivShapes, TheHelmetAndAHoledCubeCullWithoutFalseCullsWithBothSch
     for (const char* name : {"catmark_helmet", "catmark_hole_test1"})
         for (const char* scheme : {"acc", "osd"}) {
             SCOPED_TRACE(std::string(name) + " " + scheme);
-            const CliRun r = run("cull " + shape(name) + " --scheme " + scheme +
-                                 " --views 12 --seed 7 --view-mode free --methods frustum,frustum-disp,tcone,ptp --json");
+            const CliRun r =
+                run("cull " + shape(name) + " --scheme " + scheme +
+                    " --views 12 --seed 7 --view-mode free --methods frustum,frustum-disp,tcone,ptp --json");
             ASSERT_EQ(r.status, 0) << r.err;
             const auto j = nlohmann::json::parse(r.out);
             EXPECT_GT(j["patches"].get<int>(), 0);

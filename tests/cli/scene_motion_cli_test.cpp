@@ -22,7 +22,8 @@ std::string test_scene(const char* name) { return std::string(PATCHCULL_SOURCE_D
 TEST(SceneMotionCli, MotionBeyondTheLimitIsRefusedBeforeRendering) {
     // 1e6 units per second for a time offset of 1000 s: 1e9 units out at frame 0.
     const CliRun r = run("render " + test_scene("runaway.json") + " --frames 3 --size 64x48 --tess 1 --verify --json");
-    expect_one_line_error(r, "runaway.json: objects[1].animation.time_offset: the moving model ('monsterfrog#0') reaches x = ");
+    expect_one_line_error(
+        r, "runaway.json: objects[1].animation.time_offset: the moving model ('monsterfrog#0') reaches x = ");
     EXPECT_NE(r.err.find(" at frame 0 (time 0 s); scenes take world coordinates up to "), std::string::npos) << r.err;
     // The same refusal from the other commands that render a scene's frames.
     const CliRun demo = run("demo --scene " + test_scene("runaway.json") + " --frames 2 --size 64x48");

@@ -9,15 +9,15 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <random>
-#include <cstdio>
 #include <vector>
 
+#include "patchcull/core/error.h"
 #include "patchcull/objects/backface.h"
 #include "patchcull/objects/backface_clusters.h"
-#include "patchcull/core/error.h"
 
 using namespace patchcull;
 
@@ -31,13 +31,13 @@ struct Mesh {
 
 // n . (e - p0) in double and the magnitude of its terms.
 double facing(const Mesh& m, std::size_t t, Vec3 e, double& mag) {
-    const Vec3 p0 = m.vertices[m.indices[3 * t]], p1 = m.vertices[m.indices[3 * t + 1]], p2 = m.vertices[m.indices[3 * t + 2]];
+    const Vec3 p0 = m.vertices[m.indices[3 * t]], p1 = m.vertices[m.indices[3 * t + 1]],
+               p2 = m.vertices[m.indices[3 * t + 2]];
     const double a[3] = {double(p1.x) - p0.x, double(p1.y) - p0.y, double(p1.z) - p0.z};
     const double b[3] = {double(p2.x) - p0.x, double(p2.y) - p0.y, double(p2.z) - p0.z};
     const double w[3] = {double(e.x) - p0.x, double(e.y) - p0.y, double(e.z) - p0.z};
     const double n[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-    mag = std::fabs(n[0] * w[0]) + std::fabs(n[1] * w[1]) + std::fabs(n[2] * w[2]) +
-          1e-300;
+    mag = std::fabs(n[0] * w[0]) + std::fabs(n[1] * w[1]) + std::fabs(n[2] * w[2]) + 1e-300;
     return n[0] * w[0] + n[1] * w[1] + n[2] * w[2];
 }
 
@@ -104,7 +104,8 @@ std::vector<Vec3> test_eyes(std::mt19937& rng, const BackfaceCluster& c, Vec3 ce
         if (!(f > 0) || !(c.d > 0)) continue;
         const double t = c.d / f;
         for (double s : {1.0 - 1e-3, 1.0 - 1e-6, 1.0, 1.0 + 1e-6, 1.0 + 1e-3})
-            eyes.push_back({float(c.c.x + s * t * dir[0]), float(c.c.y + s * t * dir[1]), float(c.c.z + s * t * dir[2])});
+            eyes.push_back(
+                {float(c.c.x + s * t * dir[0]), float(c.c.y + s * t * dir[1]), float(c.c.z + s * t * dir[2])});
     }
     return eyes;
 }
@@ -191,13 +192,13 @@ TEST(BackfaceClusters, CIsTheBestOfTheBoxCentreAndCorners) {
         for (int i = 0; i < 8; ++i)
             cands.push_back({(i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y, (i & 4) ? b.max.z : b.min.z});
         double best = -1e300;
-        for (Vec3 cand : cands) best = std::max(best, triangle_cluster_d(m.vertices.data(), m.indices.data(), 0, T, cand));
+        for (Vec3 cand : cands)
+            best = std::max(best, triangle_cluster_d(m.vertices.data(), m.indices.data(), 0, T, cand));
         const double chosen = triangle_cluster_d(m.vertices.data(), m.indices.data(), 0, T, c.c);
         EXPECT_EQ(chosen, best);
-        EXPECT_TRUE(std::find_if(cands.begin(), cands.end(), [&](Vec3 v) {
-                        return v.x == c.c.x && v.y == c.c.y && v.z == c.c.z;
-                    }) != cands.end());
-        EXPECT_LE(double(c.d), chosen);                      // rounded down
+        EXPECT_TRUE(std::find_if(cands.begin(), cands.end(),
+                                 [&](Vec3 v) { return v.x == c.c.x && v.y == c.c.y && v.z == c.c.z; }) != cands.end());
+        EXPECT_LE(double(c.d), chosen);  // rounded down
         EXPECT_GE(double(c.d), chosen - 1e-6 * (1 + std::fabs(chosen)));
         // The box holds every vertex.
         for (const Vec3& v : m.vertices) {
@@ -291,12 +292,14 @@ TEST(BackfaceClusters, CullingProbabilityMatchesMonteCarlo) {
         const Vec3 centre{3 * u(rng), 3 * u(rng), 3 * u(rng)};
         Mesh m = random_cluster(rng, centre, 1.0f, 0.3f, {u(rng), u(rng), u(rng)}, 0.1f + 0.1f * k, 20, k % 2 == 1);
         const BackfaceCluster c = make_triangle_cluster(m.vertices.data(), m.indices.data(), 0, 20);
-        const Bounds U{centre - Vec3{4 + u(rng), 5 + u(rng), 3 + u(rng)}, centre + Vec3{4 + u(rng), 3 + u(rng), 5 + u(rng)}};
+        const Bounds U{centre - Vec3{4 + u(rng), 5 + u(rng), 3 + u(rng)},
+                       centre + Vec3{4 + u(rng), 3 + u(rng), 5 + u(rng)}};
         const double p = culling_probability(c, U);
         const int N = 200000;
         int hits = 0;
         for (int i = 0; i < N; ++i) {
-            const Vec3 e{float(U.min.x + unit(rng) * (U.max.x - U.min.x)), float(U.min.y + unit(rng) * (U.max.y - U.min.y)),
+            const Vec3 e{float(U.min.x + unit(rng) * (U.max.x - U.min.x)),
+                         float(U.min.y + unit(rng) * (U.max.y - U.min.y)),
                          float(U.min.z + unit(rng) * (U.max.z - U.min.z))};
             hits += cluster_value(c, e) <= 0;
         }
@@ -340,8 +343,8 @@ Mesh sphere(Vec3 centre, float r, int stacks, int slices) {
     for (int i = 0; i <= stacks; ++i)
         for (int j = 0; j < slices; ++j) {
             const double th = pi * i / stacks, ph = 2 * pi * j / slices;
-            m.vertices.push_back(centre + Vec3{float(r * std::sin(th) * std::cos(ph)), float(r * std::sin(th) * std::sin(ph)),
-                                               float(r * std::cos(th))});
+            m.vertices.push_back(centre + Vec3{float(r * std::sin(th) * std::cos(ph)),
+                                               float(r * std::sin(th) * std::sin(ph)), float(r * std::cos(th))});
         }
     auto id = [&](int i, int j) {
         if (i == 0) return 0u;
@@ -380,8 +383,10 @@ Mesh tessellated_box(Vec3 centre, float h, int k) {
                 for (int i = 0; i < k; ++i) {
                     const std::uint32_t a = base + j * (k + 1) + i, bb = a + 1, cc = a + k + 2, d = a + k + 1;
                     // (e_b x e_c) = +e_axis: counter-clockwise seen from +axis.
-                    if (side) m.indices.insert(m.indices.end(), {a, bb, cc, a, cc, d});
-                    else m.indices.insert(m.indices.end(), {a, cc, bb, a, d, cc});
+                    if (side)
+                        m.indices.insert(m.indices.end(), {a, bb, cc, a, cc, d});
+                    else
+                        m.indices.insert(m.indices.end(), {a, cc, bb, a, d, cc});
                 }
         }
     return m;
@@ -473,22 +478,23 @@ TEST(BackfaceClusters, HierarchyOnAClosedMeshEqualsLeavesAloneAndTestsFewer) {
                     }
                 }
                 std::vector<std::uint8_t> per(m.triangles());
-                cull_backfacing_triangles_scalar(reordered.vertices.data(), reordered.indices.data(), m.triangles(), eye,
-                                                 per.data());
+                cull_backfacing_triangles_scalar(reordered.vertices.data(), reordered.indices.data(), m.triangles(),
+                                                 eye, per.data());
                 tri_culled += std::accumulate(per.begin(), per.end(), std::size_t{0});
             }
             EXPECT_EQ(differ, 0u);
             if (box) {
-                EXPECT_LT(hier_tests, leaf_tests) << "tC/r " << tcr;  // flat faces: whole subtrees decide at once
+                EXPECT_LT(hier_tests, leaf_tests) << "tC/r " << tcr;      // flat faces: whole subtrees decide at once
                 EXPECT_EQ(cluster_culled, tri_culled) << "tC/r " << tcr;  // flat faces cull exactly
             } else {
                 EXPECT_GT(cluster_culled, tri_culled / 4) << "tC/r " << tcr;
                 EXPECT_LE(cluster_culled, tri_culled);
             }
-            std::printf("[ info ] %s offset %g tC/r %g: %zu leaves, %zu nodes, tests/frame %.1f (leaves alone %.1f), "
-                        "culled %.3f of triangles (per-triangle test %.3f)\n",
-                        box ? "box" : "sphere", off, tcr, cluster_leaf_count(h), h.nodes.size(), hier_tests / 200.0,
-                        leaf_tests / 200.0, cluster_culled / (200.0 * m.triangles()), tri_culled / (200.0 * m.triangles()));
+            std::printf(
+                "[ info ] %s offset %g tC/r %g: %zu leaves, %zu nodes, tests/frame %.1f (leaves alone %.1f), "
+                "culled %.3f of triangles (per-triangle test %.3f)\n",
+                box ? "box" : "sphere", off, tcr, cluster_leaf_count(h), h.nodes.size(), hier_tests / 200.0,
+                leaf_tests / 200.0, cluster_culled / (200.0 * m.triangles()), tri_culled / (200.0 * m.triangles()));
         }
     }
 }

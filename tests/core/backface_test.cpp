@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/objects/backface.h"
 #include "patchcull/core/clip_space.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/math.h"
+#include "patchcull/objects/backface.h"
 
 using namespace patchcull;
 
@@ -89,7 +89,7 @@ GridCase grid_case(std::mt19937& rng, float step, double centre, int extent, std
         const int a[3] = {d(rng), d(rng), d(rng)}, b[3] = {d(rng), d(rng), d(rng)};
         p[1] = point(x + a[0], y + a[1], z + a[2]);
         p[2] = point(x + b[0], y + b[1], z + b[2]);
-        if (kind == 8) p[2] = p[1];                                              // coincident
+        if (kind == 8) p[2] = p[1];                                             // coincident
         if (kind == 9) p[2] = point(x + 2 * a[0], y + 2 * a[1], z + 2 * a[2]);  // collinear
         for (int k = 0; k < 3; ++k) {
             g.mesh.indices.push_back(static_cast<std::uint32_t>(g.mesh.vertices.size()));
@@ -148,7 +148,8 @@ TEST(BackfaceTriangles, ExactOnGridsNearAndFarFromTheOrigin) {
             const auto sc = run(false, g.mesh, eye), si = run(true, g.mesh, eye);
             ASSERT_EQ(sc, si) << "scalar and SIMD differ, step " << s.step << " centre " << s.centre;
             for (std::size_t t = 0; t < g.mesh.triangles(); ++t) {
-                const Vec3 p0 = g.mesh.vertices[3 * t], p1 = g.mesh.vertices[3 * t + 1], p2 = g.mesh.vertices[3 * t + 2];
+                const Vec3 p0 = g.mesh.vertices[3 * t], p1 = g.mesh.vertices[3 * t + 1],
+                           p2 = g.mesh.vertices[3 * t + 2];
                 const int sign = exact_sign(p0, p1, p2, eye, s.step);
                 if (sc[t]) {
                     ++culled_total;
@@ -302,7 +303,8 @@ void unproject(const Camera& c, double x, double y, double z, ClipDepth depth, d
     const double zc = depth == ClipDepth::zero_to_one ? z : 2 * z - 1;
     const double v[4] = {x, y, zc, 1};
     double h[4];
-    for (int r = 0; r < 4; ++r) h[r] = c.inv[r][0] * v[0] + c.inv[r][1] * v[1] + c.inv[r][2] * v[2] + c.inv[r][3] * v[3];
+    for (int r = 0; r < 4; ++r)
+        h[r] = c.inv[r][0] * v[0] + c.inv[r][1] * v[1] + c.inv[r][2] * v[2] + c.inv[r][3] * v[3];
     for (int a = 0; a < 3; ++a) out[a] = h[a] / h[3];
 }
 
@@ -358,8 +360,10 @@ TEST(NormalMasks, ClassifyPutsEveryDirectionIntoItsCell) {
             for (int e = 0; e < 4; ++e) {
                 const double* p = c[e];
                 const double* q = c[(e + 1) % 4];
-                const double side[3] = {p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]};
-                const double inward = c[(e + 2) % 4][0] * side[0] + c[(e + 2) % 4][1] * side[1] + c[(e + 2) % 4][2] * side[2];
+                const double side[3] = {p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2],
+                                        p[0] * q[1] - p[1] * q[0]};
+                const double inward =
+                    c[(e + 2) % 4][0] * side[0] + c[(e + 2) % 4][1] * side[1] + c[(e + 2) % 4][2] * side[2];
                 const double s = v[0] * side[0] + v[1] * side[1] + v[2] * side[2];
                 EXPECT_GE(s * (inward > 0 ? 1 : -1), 0) << "normal outside its class cone";
             }
@@ -446,7 +450,8 @@ TEST(NormalMasks, SectorMasksHoldForTheirSubFrustaAndContainTheWholeMask) {
                         const double y = -1 + 2 * (sy + (k == 2 ? 0.0 : k == 3 ? 1.0 : t(rng))) / S;
                         double p[3];
                         unproject(cam, x, y, t(rng), ClipDepth::zero_to_one, p);
-                        const double f = n[0] * (cam.eye[0] - p[0]) + n[1] * (cam.eye[1] - p[1]) + n[2] * (cam.eye[2] - p[2]);
+                        const double f =
+                            n[0] * (cam.eye[0] - p[0]) + n[1] * (cam.eye[1] - p[1]) + n[2] * (cam.eye[2] - p[2]);
                         ASSERT_LE(f, 0) << "sector " << sx << "," << sy << " class " << cls;
                     }
                 }
@@ -479,7 +484,8 @@ TEST(NormalMasks, TrianglesCulledByMasksAreBackFacingAndAlsoByTheDotProduct) {
         make_back_mask(grid, cam.world_to_clip, ClipDepth::zero_to_one, 0, 0, 1, whole);
         const int S = 3;
         std::vector<BackMask> sectors(S * S);
-        for (int s = 0; s < S * S; ++s) make_back_mask(grid, cam.world_to_clip, ClipDepth::zero_to_one, s % S, s / S, S, sectors[s]);
+        for (int s = 0; s < S * S; ++s)
+            make_back_mask(grid, cam.world_to_clip, ClipDepth::zero_to_one, s % S, s / S, S, sectors[s]);
         const Vec3 ef{float(cam.eye[0]), float(cam.eye[1]), float(cam.eye[2])};
         const auto dot_culled = run(false, m, ef);
         const auto by_mask = mask_lookup(false, classes, whole);
@@ -506,8 +512,8 @@ TEST(NormalMasks, TrianglesCulledByMasksAreBackFacingAndAlsoByTheDotProduct) {
         }
         EXPECT_GT(mask_count, 50u);
         EXPECT_GT(sector_count, mask_count);  // sector masks hold the whole mask and mark more
-        EXPECT_LE(mask_count, dot_count);         // the mask keeps more than the exact test
-        EXPECT_LE(not_by_dot, 2u);                // only within the dot test's rounding margin
+        EXPECT_LE(mask_count, dot_count);     // the mask keeps more than the exact test
+        EXPECT_LE(not_by_dot, 2u);            // only within the dot test's rounding margin
     }
 }
 

@@ -120,8 +120,8 @@ void check_conservative(Kernel k, const BezierPatch& patch, const std::vector<Ve
         if (!scalar[0]) continue;
         ++tally.culled;
         const double f17 = max_facing(patch, eye, kGroundTruthGrid);
-        ASSERT_LE(f17, 1e-9) << kernel_name(k) << " false cull: " << what << " " << index << " eye (" << eye.x
-                             << ", " << eye.y << ", " << eye.z << ")";
+        ASSERT_LE(f17, 1e-9) << kernel_name(k) << " false cull: " << what << " " << index << " eye (" << eye.x << ", "
+                             << eye.y << ", " << eye.z << ")";
         ASSERT_LE(max_facing(patch, eye, 33), 1e-9) << kernel_name(k) << " " << what << " " << index;
         // The project's ground truth (tangent planes from cross4) agrees.
         PlaneD planes[kGroundTruthGrid * kGroundTruthGrid];
@@ -248,7 +248,8 @@ TEST(BackpatchCones, ScalarAndSimdIdentical) {
                                           std::size_t(17), std::size_t(31), std::size_t(33), std::size_t(1000)}) {
                         const auto sub = run(k, Impl::kSimd, batch.view().subrange(first_p, n), eye);
                         for (std::size_t p = 0; p < n; ++p)
-                            ASSERT_EQ(sub[p], ref[first_p + p]) << kernel_name(k) << " subrange " << first_p << "+" << n;
+                            ASSERT_EQ(sub[p], ref[first_p + p])
+                                << kernel_name(k) << " subrange " << first_p << "+" << n;
                     }
             });
         }

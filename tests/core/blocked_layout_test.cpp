@@ -152,9 +152,11 @@ std::vector<NamedKernel> kernels() {
         };
     };
     std::vector<NamedKernel> k;
-    k.push_back({"tcone_scalar", [=](const PatchBatchView& v, std::uint8_t* o) { cull_tcone_scalar(v, eye, o); }, false});
+    k.push_back(
+        {"tcone_scalar", [=](const PatchBatchView& v, std::uint8_t* o) { cull_tcone_scalar(v, eye, o); }, false});
     k.push_back({"tcone_simd", [=](const PatchBatchView& v, std::uint8_t* o) { cull_tcone_simd(v, eye, o); }, false});
-    k.push_back({"ncone_scalar", [=](const PatchBatchView& v, std::uint8_t* o) { cull_ncone_scalar(v, eye, o); }, true});
+    k.push_back(
+        {"ncone_scalar", [=](const PatchBatchView& v, std::uint8_t* o) { cull_ncone_scalar(v, eye, o); }, true});
     k.push_back({"ncone_simd", [=](const PatchBatchView& v, std::uint8_t* o) { cull_ncone_simd(v, eye, o); }, true});
     k.push_back({"ptp_ncnt_scalar", ptp(false, PtpRule::ncnt), true});
     k.push_back({"ptp_ncnt_simd", ptp(true, PtpRule::ncnt), true});
@@ -164,12 +166,14 @@ std::vector<NamedKernel> kernels() {
     // part of this file's contract).
     const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
     auto disp = std::make_shared<std::vector<float>>(8192, 0.05f);
-    k.push_back({"frustum_simd", [=](const PatchBatchView& v, std::uint8_t* o) {
-                     cull_frustum_simd(v, disp->data(), planes, o);
-                 }, false});
-    k.push_back({"frustum_disp_simd", [=](const PatchBatchView& v, std::uint8_t* o) {
+    k.push_back({"frustum_simd",
+                 [=](const PatchBatchView& v, std::uint8_t* o) { cull_frustum_simd(v, disp->data(), planes, o); },
+                 false});
+    k.push_back({"frustum_disp_simd",
+                 [=](const PatchBatchView& v, std::uint8_t* o) {
                      cull_frustum_disp_simd(v, disp->data(), object_to_clip, ClipDepth::zero_to_one, o);
-                 }, false});
+                 },
+                 false});
     return k;
 }
 
@@ -200,8 +204,10 @@ void check_plain_equals_blocked(bool fast_target) {
                 for (std::size_t len : {std::size_t{1}, std::size_t{17}, n - first}) {
                     if (first + len > n) continue;
                     const std::vector<std::uint8_t> want(plain.begin() + first, plain.begin() + first + len);
-                    ASSERT_EQ(want, run(k.fn, blocks.view().subrange(first, len))) << "first " << first << " len " << len;
-                    ASSERT_EQ(want, run(k.fn, batch.view().subrange(first, len))) << "first " << first << " len " << len;
+                    ASSERT_EQ(want, run(k.fn, blocks.view().subrange(first, len)))
+                        << "first " << first << " len " << len;
+                    ASSERT_EQ(want, run(k.fn, batch.view().subrange(first, len)))
+                        << "first " << first << " len " << len;
                 }
             }
         }

@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/objects/bounding_volumes.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/ground_truth.h"
+#include "patchcull/objects/bounding_volumes.h"
 
 using namespace patchcull;
 
@@ -93,7 +93,7 @@ P3 random_centre(std::mt19937& rng, const Camera& cam) {
 double random_size(std::mt19937& rng, const Camera& cam) {
     std::uniform_real_distribution<double> unit(0, 1);
     const int kind = int(unit(rng) * 10);
-    if (kind == 0) return 0;                               // zero-size
+    if (kind == 0) return 0;                                // zero-size
     if (kind == 1) return cam.far * (1 + unit(rng));        // huge: may hold the eye / the frustum
     return cam.near * std::pow(10.0, 3 * unit(rng) - 1.5);  // tiny to large
 }
@@ -187,18 +187,20 @@ void check_against_samples(const Camera& cam, const V& v, Containment c, const s
     if (c == Containment::outside) {
         for (const P3& p : pts)
             ASSERT_FALSE(in_clip(cam.world_to_clip, p)) << what << ": outside, but the point (" << p.x << ", " << p.y
-                                                       << ", " << p.z << ") is inside the frustum";
+                                                        << ", " << p.z << ") is inside the frustum";
     } else if (c == Containment::inside) {
         for (const P3& p : pts)
-            ASSERT_TRUE(in_all_planes(cam.world_to_clip, p)) << what << ": inside, but the point (" << p.x << ", " << p.y
-                                                            << ", " << p.z << ") is outside a plane";
+            ASSERT_TRUE(in_all_planes(cam.world_to_clip, p))
+                << what << ": inside, but the point (" << p.x << ", " << p.y << ", " << p.z << ") is outside a plane";
     }
     (void)v;
 }
 
 struct Tally {
     int outside = 0, intersecting = 0, inside = 0;
-    void add(Containment c) { (c == Containment::outside ? outside : c == Containment::inside ? inside : intersecting)++; }
+    void add(Containment c) {
+        (c == Containment::outside ? outside : c == Containment::inside ? inside : intersecting)++;
+    }
 };
 
 void run_ground_truth(P3 offset, double scale, unsigned seed) {
@@ -239,7 +241,8 @@ void run_ground_truth(P3 offset, double scale, unsigned seed) {
             const int n = 1 + i * 3;
             for (int k = 0; k < n; ++k) pts.push_back(to_f(c + P3{u(rng), (i % 4 == 0) ? 0.0 : u(rng), u(rng)} * s));
             const bool any_in = any_point_in_clip_volume(cam.world_to_clip, pts.data(), pts.size());
-            const bool all_in = std::all_of(pts.begin(), pts.end(), [&](Vec3 p) { return in_all_planes(cam.world_to_clip, p3(p)); });
+            const bool all_in =
+                std::all_of(pts.begin(), pts.end(), [&](Vec3 p) { return in_all_planes(cam.world_to_clip, p3(p)); });
             std::uint32_t t = 0;
             PlaneCullState st;
             const Containment r[3] = {classify_sphere(cam.planes, sphere_of_points(pts.data(), pts.size()), st, t),
@@ -295,8 +298,10 @@ void run_touching(P3 offset, double scale, unsigned seed) {
                 // A point on face k near its middle: NDC of the face centre with a random offset.
                 double ndc[3] = {0.6 * u(rng), 0.6 * u(rng), 0.3 + 0.4 * unit(rng)};
                 const int a = k / 2;
-                if (a < 2) ndc[a] = (k % 2) ? 1 : -1;
-                else ndc[2] = (k % 2) ? 1 : 0;
+                if (a < 2)
+                    ndc[a] = (k % 2) ? 1 : -1;
+                else
+                    ndc[2] = (k % 2) ? 1 : 0;
                 const Vec4 h = inv * Vec4{float(ndc[0]), float(ndc[1]), float(ndc[2]), 1};
                 P3 q{double(h.x) / h.w, double(h.y) / h.w, double(h.z) / h.w};
                 // Project q onto the plane exactly (double).
@@ -326,8 +331,10 @@ void run_touching(P3 offset, double scale, unsigned seed) {
                 double lo[3], hi[3];
                 for (int c = 0; c < 3; ++c) {
                     const double pc = comp(q, c) + comp(n, c) * delta;
-                    if (pl[c] >= 0) hi[c] = pc, lo[c] = pc - size;
-                    else lo[c] = pc, hi[c] = pc + size;
+                    if (pl[c] >= 0)
+                        hi[c] = pc, lo[c] = pc - size;
+                    else
+                        lo[c] = pc, hi[c] = pc + size;
                 }
                 b.min = {float(lo[0]), float(lo[1]), float(lo[2])};
                 b.max = {float(hi[0]), float(hi[1]), float(hi[2])};
@@ -421,16 +428,19 @@ bool box_holds(const Bounds& b, Vec3 p) {
 // Coordinates of p in the OBB's float axes, solved in long double.
 bool obb_holds(const Obb& o, Vec3 p) {
     using LD = long double;
-    const LD a[3][3] = {{o.axes[0].x, o.axes[1].x, o.axes[2].x}, {o.axes[0].y, o.axes[1].y, o.axes[2].y},
+    const LD a[3][3] = {{o.axes[0].x, o.axes[1].x, o.axes[2].x},
+                        {o.axes[0].y, o.axes[1].y, o.axes[2].y},
                         {o.axes[0].z, o.axes[1].z, o.axes[2].z}};
-    const LD det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+    const LD det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                   a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
                    a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
     const LD d[3] = {LD(p.x) - o.center.x, LD(p.y) - o.center.y, LD(p.z) - o.center.z};
     for (int i = 0; i < 3; ++i) {  // Cramer's rule: replace column i by d
         LD m[3][3];
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c) m[r][c] = c == i ? d[r] : a[r][c];
-        const LD di = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+        const LD di = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                      m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
                       m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
         if (std::fabs(di / det) > LD(o.half_extents[i])) return false;
     }
@@ -451,11 +461,21 @@ TEST(BoundingVolumes, EnclosingVolumesHoldEveryPoint) {
         for (int i = 0; i < n; ++i) {
             P3 p;
             switch (kind) {
-                case 0: p = o + P3{u(rng), u(rng), u(rng)} * size; break;
-                case 1: p = o + dir * (10 * size * u(rng)) + P3{u(rng), u(rng), u(rng)} * (0.1 * size); break;
-                case 2: p = o + dir * (size * u(rng)); break;
-                case 3: p = o + dir * (size * u(rng)) + dir2 * (size * u(rng)); break;
-                default: p = o; break;
+                case 0:
+                    p = o + P3{u(rng), u(rng), u(rng)} * size;
+                    break;
+                case 1:
+                    p = o + dir * (10 * size * u(rng)) + P3{u(rng), u(rng), u(rng)} * (0.1 * size);
+                    break;
+                case 2:
+                    p = o + dir * (size * u(rng));
+                    break;
+                case 3:
+                    p = o + dir * (size * u(rng)) + dir2 * (size * u(rng));
+                    break;
+                default:
+                    p = o;
+                    break;
             }
             pts.push_back(to_f(p));
         }
@@ -481,7 +501,8 @@ TEST(BoundingVolumes, EnclosingVolumesHoldEveryPoint) {
         // largest pairwise distance is <= the minimal radius); the sphere of the box is tight.
         double diam2 = 0;
         for (std::size_t i = 0; i < pts.size(); i += 7)
-            for (std::size_t j = 0; j < pts.size(); ++j) diam2 = std::max(diam2, dotp(p3(pts[i]) - p3(pts[j]), p3(pts[i]) - p3(pts[j])));
+            for (std::size_t j = 0; j < pts.size(); ++j)
+                diam2 = std::max(diam2, dotp(p3(pts[i]) - p3(pts[j]), p3(pts[i]) - p3(pts[j])));
         EXPECT_LE(s.radius, 1.2 * std::sqrt(sb.radius * double(sb.radius)) + 1e-6 * (off + size));
         EXPECT_GE(s.radius, 0.5 * std::sqrt(diam2) * (1 - 1e-6));
         // The PCA box never has more volume than the axis-aligned one; on stretched clouds much less.
@@ -495,8 +516,7 @@ TEST(BoundingVolumes, EnclosingVolumesHoldEveryPoint) {
         }
         // Axes orthonormal.
         for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                EXPECT_NEAR(dot(ob.axes[i], ob.axes[j]), i == j ? 1.0 : 0.0, 1e-6);
+            for (int j = 0; j < 3; ++j) EXPECT_NEAR(dot(ob.axes[i], ob.axes[j]), i == j ? 1.0 : 0.0, 1e-6);
     }
 }
 
@@ -534,7 +554,8 @@ TEST(BoundingVolumes, TransformedAabbHoldsTheTransformedBox) {
             const P3 p{(k & 1) ? b.max.x : b.min.x, (k & 2) ? b.max.y : b.min.y, (k & 4) ? b.max.z : b.min.z};
             P3 q;
             double* qc = &q.x;
-            for (int r = 0; r < 3; ++r) qc[r] = m.at(r, 0) * p.x + m.at(r, 1) * p.y + m.at(r, 2) * p.z + double(m.at(r, 3));
+            for (int r = 0; r < 3; ++r)
+                qc[r] = m.at(r, 0) * p.x + m.at(r, 1) * p.y + m.at(r, 2) * p.z + double(m.at(r, 3));
             ASSERT_TRUE(t.min.x <= q.x && q.x <= t.max.x && t.min.y <= q.y && q.y <= t.max.y && t.min.z <= q.z &&
                         q.z <= t.max.z)
                 << "trial " << trial;
@@ -689,7 +710,8 @@ void check_at_boundary(std::mt19937& rng, const FrustumPlanes& planes, Make make
         scalar(planes, batch.data(), batch.size(), x.data());
         simd(planes, batch.data(), batch.size(), y.data());
         ASSERT_EQ(x, y);
-        if (std::count(x.begin(), x.end(), flip) > 0 && std::count(x.begin(), x.end(), flip) < std::ptrdiff_t(x.size())) ++mixed;
+        if (std::count(x.begin(), x.end(), flip) > 0 && std::count(x.begin(), x.end(), flip) < std::ptrdiff_t(x.size()))
+            ++mixed;
     }
 }
 
@@ -703,8 +725,10 @@ TEST(BoundingVolumes, ScalarEqualsSimdAtTheDecisionBoundary) {
         ASSERT_TRUE(invert(cam.world_to_clip, inv));
         for (int k = 0; k < 6; ++k) {
             double ndc[3] = {0.5 * u(rng), 0.5 * u(rng), 0.5};
-            if (k < 4) ndc[k / 2] = (k % 2) ? 1 : -1;
-            else ndc[2] = k == 4 ? 0 : 1;
+            if (k < 4)
+                ndc[k / 2] = (k % 2) ? 1 : -1;
+            else
+                ndc[2] = k == 4 ? 0 : 1;
             const Vec4 h = inv * Vec4{float(ndc[0]), float(ndc[1]), float(ndc[2]), 1};
             const P3 q{double(h.x) / h.w, double(h.y) / h.w, double(h.z) / h.w};
             const Vec4 r = cam.planes.rows[k];
@@ -726,10 +750,12 @@ TEST(BoundingVolumes, ScalarEqualsSimdAtTheDecisionBoundary) {
             };
             const double far_out = 4 * size + 1e-3 * cam.far, far_in = -std::min(3 * size, 0.2 * cam.near);
             for_each_simd_target([&] {
-                check_at_boundary<Sphere>(rng, cam.planes, sphere, far_out, -size * 1.01 - 1e-4 * cam.far, classify_spheres_scalar,
-                                          classify_spheres_simd, mixed);
-                check_at_boundary<Bounds>(rng, cam.planes, box, far_out, far_in, classify_aabbs_scalar, classify_aabbs_simd, mixed);
-                check_at_boundary<Obb>(rng, cam.planes, obb, far_out, far_in, classify_obbs_scalar, classify_obbs_simd, mixed);
+                check_at_boundary<Sphere>(rng, cam.planes, sphere, far_out, -size * 1.01 - 1e-4 * cam.far,
+                                          classify_spheres_scalar, classify_spheres_simd, mixed);
+                check_at_boundary<Bounds>(rng, cam.planes, box, far_out, far_in, classify_aabbs_scalar,
+                                          classify_aabbs_simd, mixed);
+                check_at_boundary<Obb>(rng, cam.planes, obb, far_out, far_in, classify_obbs_scalar, classify_obbs_simd,
+                                       mixed);
             });
         }
     }
@@ -866,7 +892,8 @@ TEST(BoundingVolumes, MaskingAndCoherenceNeverChangeTheAnswer) {
                 tc = tf = 0;
                 sb[i].plane_mask = 0x3f;
                 fresh = {};
-                ASSERT_EQ(classify_aabb(cam.planes, boxes[i], sb[i], tc), classify_aabb(cam.planes, boxes[i], fresh, tf));
+                ASSERT_EQ(classify_aabb(cam.planes, boxes[i], sb[i], tc),
+                          classify_aabb(cam.planes, boxes[i], fresh, tf));
                 so[i].plane_mask = 0x3f;
                 fresh = {};
                 ASSERT_EQ(classify_obb(cam.planes, obbs[i], so[i], tc), classify_obb(cam.planes, obbs[i], fresh, tf));
@@ -895,7 +922,8 @@ TEST(BoundingVolumes, PlaneMaskingOfNestedBoxes) {
             const float* plo = &parent.min.x;
             const float* phi = &parent.max.x;
             for (int a = 0; a < 3; ++a) {
-                double x = plo[a] + (double(phi[a]) - plo[a]) * unit(rng), y = plo[a] + (double(phi[a]) - plo[a]) * unit(rng);
+                double x = plo[a] + (double(phi[a]) - plo[a]) * unit(rng),
+                       y = plo[a] + (double(phi[a]) - plo[a]) * unit(rng);
                 if (x > y) std::swap(x, y);
                 lo[a] = std::clamp(float(x), plo[a], phi[a]);
                 hi[a] = std::clamp(float(y), plo[a], phi[a]);
@@ -920,7 +948,8 @@ TEST(BoundingVolumes, PlaneMaskingOfNestedBoxes) {
             // The same for spheres and OBBs of the child box (inside the parent box too).
             PlaneCullState s1, s2;
             s1.plane_mask = ps.plane_mask;
-            ASSERT_EQ(classify_obb(cam.planes, obb_of_aabb(child), s1, tm), classify_obb(cam.planes, obb_of_aabb(child), s2, tf));
+            ASSERT_EQ(classify_obb(cam.planes, obb_of_aabb(child), s1, tm),
+                      classify_obb(cam.planes, obb_of_aabb(child), s2, tf));
         }
     }
     EXPECT_GT(masked_planes, 1000);

@@ -83,7 +83,8 @@ TEST(ClipDepth, EveryDepthSensitiveEntryDecidesAlikeInBothConventions) {
     constexpr int kGrid = 9;
     std::vector<Vec3> samples(n * kGrid * kGrid);
     const Vec2 uv[4] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
-    for (std::size_t i = 0; i < n; ++i) sample_displaced_patch(patches[i], nullptr, uv, nullptr, kGrid, &samples[i * kGrid * kGrid]);
+    for (std::size_t i = 0; i < n; ++i)
+        sample_displaced_patch(patches[i], nullptr, uv, nullptr, kGrid, &samples[i * kGrid * kGrid]);
     // A Hi-Z pyramid of a wall at window depth 0.2 over the left half of a 64x64 screen.
     constexpr int W = 64, H = 64;
     std::vector<float> depth(W * H, 1.0f);
@@ -103,7 +104,8 @@ TEST(ClipDepth, EveryDepthSensitiveEntryDecidesAlikeInBothConventions) {
         frustum_culled += count_set(b);
         for (std::size_t i = 0; i < n; ++i)
             if (b[i]) {
-                EXPECT_FALSE(any_point_in_clip_volume(c.zo, &samples[i * kGrid * kGrid], kGrid * kGrid)) << v << " " << i;
+                EXPECT_FALSE(any_point_in_clip_volume(c.zo, &samples[i * kGrid * kGrid], kGrid * kGrid))
+                    << v << " " << i;
             }
 
         cull_frustum_disp_scalar(batch.view(), nullptr, c.zo, ClipDepth::zero_to_one, a.data());
@@ -146,11 +148,12 @@ TEST(ClipDepth, MisreadingAnOpenGlMatrixCullsVisiblePatches) {
     for (int v = 0; v < 20; ++v) {
         const Pair c = both_conventions(views.next());
         std::vector<std::uint8_t> culled(n);
-        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(c.no, ClipDepth::minus_one_to_one), culled.data());
+        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(c.no, ClipDepth::minus_one_to_one),
+                            culled.data());
         right += count_set(culled);
         cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(c.no, ClipDepth::zero_to_one), culled.data());
         misread += count_set(culled);
     }
-    EXPECT_EQ(right, 0u);  // contain views: the whole teapot is in view
+    EXPECT_EQ(right, 0u);   // contain views: the whole teapot is in view
     EXPECT_GT(misread, n);  // the misread near plane cuts into the teapot in many views
 }

@@ -231,9 +231,10 @@ TEST(Cones, SampledNormalsInsideBothCones) {
         n_only += n.valid && !t.valid;
         t_only += t.valid && !n.valid;
     }
-    std::printf("[ cones ] %d random patches: TCONE valid %d, NCONE valid %d (NCONE only %d, TCONE only %d); "
-                "both valid %d: mean half-angle TCONE %.2f deg, NCONE %.2f deg\n",
-                n_patches, t_valid, n_valid, n_only, t_only, both, t_sum / both, n_sum / both);
+    std::printf(
+        "[ cones ] %d random patches: TCONE valid %d, NCONE valid %d (NCONE only %d, TCONE only %d); "
+        "both valid %d: mean half-angle TCONE %.2f deg, NCONE %.2f deg\n",
+        n_patches, t_valid, n_valid, n_only, t_only, both, t_sum / both, n_sum / both);
     EXPECT_GT(both, 1000 / kSanitizerDivisor);
     EXPECT_LE(n_sum, t_sum);  // NCONE never wider than TCONE on average
     EXPECT_GE(n_valid, t_valid);
@@ -256,10 +257,11 @@ TEST(Cones, NconeNotWiderThanTconeOnAverage) {
             n_sum += half_angle_deg(n);
             n_wider += half_angle_deg(n) > half_angle_deg(t);
         }
-        std::printf("[ cones ] sheets, bump %.3f: valid TCONE %d NCONE %d of 2000; mean half-angle TCONE %.2f "
-                    "NCONE %.2f deg (ratio %.2f), NCONE wider in %d\n",
-                    bump, t_valid, n_valid, t_sum / std::max(both, 1), n_sum / std::max(both, 1),
-                    n_sum / std::max(t_sum, 1e-30), n_wider);
+        std::printf(
+            "[ cones ] sheets, bump %.3f: valid TCONE %d NCONE %d of 2000; mean half-angle TCONE %.2f "
+            "NCONE %.2f deg (ratio %.2f), NCONE wider in %d\n",
+            bump, t_valid, n_valid, t_sum / std::max(both, 1), n_sum / std::max(both, 1),
+            n_sum / std::max(t_sum, 1e-30), n_wider);
         EXPECT_LE(n_sum, t_sum) << "bump " << bump;
         EXPECT_GE(n_valid, t_valid) << "bump " << bump;
     }
@@ -319,9 +321,10 @@ TEST(Cones, AxisChoice) {
         n[m] = mean_half_angle(nsets, m);
         t[m] = mean_half_angle(tsets, m);
     }
-    std::printf("[ axis ] mean half-angle (deg), NCONE vectors / TCONE tangent vectors: normalised sum %.3f / %.3f, "
-                "raw sum %.3f / %.3f, box centre %.3f / %.3f\n",
-                n[0], t[0], n[1], t[1], n[2], t[2]);
+    std::printf(
+        "[ axis ] mean half-angle (deg), NCONE vectors / TCONE tangent vectors: normalised sum %.3f / %.3f, "
+        "raw sum %.3f / %.3f, box centre %.3f / %.3f\n",
+        n[0], t[0], n[1], t[1], n[2], t[2]);
     EXPECT_LE(n[2], n[0]);
     EXPECT_LE(t[2], t[0]);
 }
@@ -363,7 +366,7 @@ TEST(Cones, CollapsedEdge) {
     const NormalCone n = normal_patch_cone(fan);
     ASSERT_TRUE(n.valid);
     EXPECT_EQ(n.axis.z, n0.z > 0 ? 1.0f : -1.0f);
-    EXPECT_LT(half_angle_deg(n), 0.5);  // the rounding bound widens it a little (see cones.cpp)
+    EXPECT_LT(half_angle_deg(n), 0.5);              // the rounding bound widens it a little (see cones.cpp)
     const NormalCone t = tangent_normal_cone(fan);  // valid here (tangents spread 30 / 45 deg), but wide
     EXPECT_TRUE(!t.valid || half_angle_deg(t) > 30);
     PatchGen gen(62);
@@ -439,17 +442,21 @@ TEST(Cones, BackFacingHandCases) {
     PatchSphere s{{0, 0, 0}, 1.0f};
     EXPECT_TRUE(cone_back_facing(up, s, {0, 0, -10}));
     EXPECT_FALSE(cone_back_facing(up, s, {0, 0, 10}));
-    EXPECT_FALSE(cone_back_facing(up, s, {0, 0, -0.5f}));   // eye inside the sphere
-    EXPECT_FALSE(cone_back_facing(up, s, {10, 0, 0}));      // in the plane
+    EXPECT_FALSE(cone_back_facing(up, s, {0, 0, -0.5f}));  // eye inside the sphere
+    EXPECT_FALSE(cone_back_facing(up, s, {10, 0, 0}));     // in the plane
     // Perspective: beta = asin(1/2) = 30deg; a . d/|d| must be <= -sin(30deg).
     EXPECT_TRUE(cone_back_facing(up, s, {0, 0, -2}));
     // d at 61deg / 59deg from -z: angle(a, d) = 119deg (< 120deg) / 121deg.
-    EXPECT_FALSE(cone_back_facing(up, s, {2 * std::sin(float(61 * kPi / 180)), 0, -2 * std::cos(float(61 * kPi / 180))}));
-    EXPECT_TRUE(cone_back_facing(up, s, {2 * std::sin(float(59 * kPi / 180)), 0, -2 * std::cos(float(59 * kPi / 180))}));
+    EXPECT_FALSE(
+        cone_back_facing(up, s, {2 * std::sin(float(61 * kPi / 180)), 0, -2 * std::cos(float(61 * kPi / 180))}));
+    EXPECT_TRUE(
+        cone_back_facing(up, s, {2 * std::sin(float(59 * kPi / 180)), 0, -2 * std::cos(float(59 * kPi / 180))}));
     // With alpha = 20deg the limit moves to angle(a, d) >= 140deg.
     NormalCone up20 = make_cone({0, 0, 1}, 20 * kPi / 180);
-    EXPECT_TRUE(cone_back_facing(up20, s, {2 * std::sin(float(39 * kPi / 180)), 0, -2 * std::cos(float(39 * kPi / 180))}));
-    EXPECT_FALSE(cone_back_facing(up20, s, {2 * std::sin(float(41 * kPi / 180)), 0, -2 * std::cos(float(41 * kPi / 180))}));
+    EXPECT_TRUE(
+        cone_back_facing(up20, s, {2 * std::sin(float(39 * kPi / 180)), 0, -2 * std::cos(float(39 * kPi / 180))}));
+    EXPECT_FALSE(
+        cone_back_facing(up20, s, {2 * std::sin(float(41 * kPi / 180)), 0, -2 * std::cos(float(41 * kPi / 180))}));
     // alpha + beta > 90deg can never cull, though a . d/|d| <= -sin(alpha + beta) holds:
     // alpha = 80deg, beta = 80deg (|d| = 1/sin 80deg), angle(a, d) = 175deg.
     NormalCone wide = make_cone({0, 0, 1}, 80 * kPi / 180);

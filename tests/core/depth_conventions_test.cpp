@@ -49,9 +49,12 @@ bool visible_in(const Mat4& object_to_clip, ClipDepth depth, Vec3 s) {
     if (!(w > 0) || x < -w - slack || x > w + slack || y < -w - slack || y > w + slack) return false;
     switch (depth) {
         case ClipDepth::zero_to_one:
-        case ClipDepth::reversed: return z >= -slack && z <= w + slack;
-        case ClipDepth::minus_one_to_one: return z >= -w - slack && z <= w + slack;
-        case ClipDepth::reversed_infinite: return z <= w + slack;
+        case ClipDepth::reversed:
+            return z >= -slack && z <= w + slack;
+        case ClipDepth::minus_one_to_one:
+            return z >= -w - slack && z <= w + slack;
+        case ClipDepth::reversed_infinite:
+            return z <= w + slack;
     }
     return false;
 }
@@ -68,7 +71,9 @@ TEST(DepthConventions, PerspectiveMapsNearAndFarInEachConvention) {
     for (ClipDepth depth : kConventions) {
         const Mat4 p = perspective(1.0f, 1.5f, 0.5f, 20.0f, depth);
         const Vec4 n = p * Vec4{0, 0, -0.5f, 1}, f = p * Vec4{0, 0, -20.0f, 1};
-        const float near_depth = depth == ClipDepth::zero_to_one ? 0.0f : depth == ClipDepth::minus_one_to_one ? -1.0f : 1.0f;
+        const float near_depth = depth == ClipDepth::zero_to_one        ? 0.0f
+                                 : depth == ClipDepth::minus_one_to_one ? -1.0f
+                                                                        : 1.0f;
         EXPECT_NEAR(n.z / n.w, near_depth, 1e-6f) << clip_depth_name(depth);
         if (depth == ClipDepth::reversed_infinite) {
             EXPECT_NEAR(f.z / f.w, 0.5f / 20.0f, 1e-6f);  // near / distance
@@ -80,7 +85,8 @@ TEST(DepthConventions, PerspectiveMapsNearAndFarInEachConvention) {
         EXPECT_EQ(parsed, depth);
     }
     // An infinite far plane gives a finite matrix.
-    const Mat4 inf = perspective(1.0f, 1.0f, 0.1f, std::numeric_limits<float>::infinity(), ClipDepth::reversed_infinite);
+    const Mat4 inf =
+        perspective(1.0f, 1.0f, 0.1f, std::numeric_limits<float>::infinity(), ClipDepth::reversed_infinite);
     for (float v : inf.m) EXPECT_TRUE(std::isfinite(v));
     ClipDepth unused;
     EXPECT_FALSE(parse_clip_depth("reverse", unused));
@@ -119,8 +125,8 @@ TEST(DepthConventions, EveryEntryDecidesAsZeroToOneAndCullsNothingVisible) {
             HiZPyramid hiz;
             hiz.build(buffer.data(), W, H, depth);
 
-            std::vector<std::uint8_t> frustum(n), frustum_simd(n), disp(n), disp_simd(n), occ(n), occ_simd(n),
-                fused(n), displaced(n), displaced_occ(n);
+            std::vector<std::uint8_t> frustum(n), frustum_simd(n), disp(n), disp_simd(n), occ(n), occ_simd(n), fused(n),
+                displaced(n), displaced_occ(n);
             const FrustumPlanes planes = make_frustum_planes(m, depth);
             cull_frustum_scalar(batch.view(), nullptr, planes, frustum.data());
             cull_frustum_simd(batch.view(), nullptr, planes, frustum_simd.data());
@@ -155,8 +161,8 @@ TEST(DepthConventions, EveryEntryDecidesAsZeroToOneAndCullsNothingVisible) {
                     const double t = -double((view * Vec4{p.x, p.y, p.z, 1}).z);
                     if (c.x / c.w >= -1e-4f || t < t_wall * (1 - 1e-5)) any_unhidden = true;
                 }
-                const std::string where = std::string(clip_depth_name(depth)) + " view " + std::to_string(v) +
-                                          " patch " + std::to_string(i);
+                const std::string where =
+                    std::string(clip_depth_name(depth)) + " view " + std::to_string(v) + " patch " + std::to_string(i);
                 if (any_visible) {
                     EXPECT_EQ(frustum[i], 0) << where;
                     EXPECT_EQ(disp[i], 0) << where;
@@ -220,12 +226,14 @@ TEST(DepthConventions, ContradictingMatricesAndPyramidsAreRefused) {
                                   << clip_depth_name(declared);
                 } catch (const Error& e) {
                     const std::string what = e.what();
-                    EXPECT_NE(what.find(std::string("declared ") + clip_depth_name(declared)), std::string::npos) << what;
+                    EXPECT_NE(what.find(std::string("declared ") + clip_depth_name(declared)), std::string::npos)
+                        << what;
                     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
                 }
             };
             expect("make_frustum_planes", [&] { (void)make_frustum_planes(m, declared); });
-            expect("cull_frustum_disp_simd", [&] { cull_frustum_disp_simd(batch.view(), nullptr, m, declared, out.data()); });
+            expect("cull_frustum_disp_simd",
+                   [&] { cull_frustum_disp_simd(batch.view(), nullptr, m, declared, out.data()); });
             expect("cull_occlusion_scalar", [&] { cull_occlusion_scalar(batch.view(), m, declared, hiz, out.data()); });
             expect("cull_occlusion_simd", [&] { cull_occlusion_simd(batch.view(), m, declared, hiz, out.data()); });
             expect("make_displaced_cull_view", [&] { (void)make_displaced_cull_view(camera.view(), proj, declared); });
@@ -246,9 +254,9 @@ TEST(DepthConventions, ContradictingMatricesAndPyramidsAreRefused) {
     ortho.at(2, 3) = 0.0f;
     for (ClipDepth declared : kConventions) EXPECT_NO_THROW((void)make_frustum_planes(ortho * camera.view(), declared));
     HiZPyramid never_built;
-    EXPECT_THROW(cull_occlusion_scalar(batch.view(), camera.view_projection(), ClipDepth::zero_to_one, never_built,
-                                       out.data()),
-                 Error);
+    EXPECT_THROW(
+        cull_occlusion_scalar(batch.view(), camera.view_projection(), ClipDepth::zero_to_one, never_built, out.data()),
+        Error);
 }
 
 // No far plane: a patch a million near distances away in view is kept by every kernel with
@@ -256,12 +264,14 @@ TEST(DepthConventions, ContradictingMatricesAndPyramidsAreRefused) {
 TEST(DepthConventions, InfiniteFarPlaneKeepsDistantPatches) {
     BezierPatch far_patch;
     for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) far_patch.cp[4 * j + i] = {1000.0f * (i - 1.5f), 1000.0f * (j - 1.5f), -1.0e6f, 1.0f};
+        for (int i = 0; i < 4; ++i)
+            far_patch.cp[4 * j + i] = {1000.0f * (i - 1.5f), 1000.0f * (j - 1.5f), -1.0e6f, 1.0f};
     const PatchBatch batch = make_batch({far_patch});
     const Camera camera;  // at (0, 0, 5) looking down -z
     for (ClipDepth depth : {ClipDepth::reversed_infinite, ClipDepth::reversed}) {
-        const Mat4 proj = perspective(camera.fovy_radians, 1.0f, 0.1f, depth == ClipDepth::reversed ? 1000.0f
-                                                                                                      : std::numeric_limits<float>::infinity(), depth);
+        const Mat4 proj =
+            perspective(camera.fovy_radians, 1.0f, 0.1f,
+                        depth == ClipDepth::reversed ? 1000.0f : std::numeric_limits<float>::infinity(), depth);
         const Mat4 m = proj * camera.view();
         const std::uint8_t expected = depth == ClipDepth::reversed ? 1 : 0;
         std::uint8_t a = 9, b = 9, c = 9, d = 9;

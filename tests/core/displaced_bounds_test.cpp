@@ -67,8 +67,10 @@ SurfacePointD evaluate_exact(const BezierPatch& patch, double u, double v, doubl
         }
     SurfacePointD s;
     s.p = {h[0] / h[3], h[1] / h[3], h[2] / h[3]};
-    const double pu[3] = {(hu[0] - s.p.x * hu[3]) / h[3], (hu[1] - s.p.y * hu[3]) / h[3], (hu[2] - s.p.z * hu[3]) / h[3]};
-    const double pv[3] = {(hv[0] - s.p.x * hv[3]) / h[3], (hv[1] - s.p.y * hv[3]) / h[3], (hv[2] - s.p.z * hv[3]) / h[3]};
+    const double pu[3] = {(hu[0] - s.p.x * hu[3]) / h[3], (hu[1] - s.p.y * hu[3]) / h[3],
+                          (hu[2] - s.p.z * hu[3]) / h[3]};
+    const double pv[3] = {(hv[0] - s.p.x * hv[3]) / h[3], (hv[1] - s.p.y * hv[3]) / h[3],
+                          (hv[2] - s.p.z * hv[3]) / h[3]};
     const double n[3] = {pu[1] * pv[2] - pu[2] * pv[1], pu[2] * pv[0] - pu[0] * pv[2], pu[0] * pv[1] - pu[1] * pv[0]};
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     // Collapsed edges give |n| ~ 1e-16 size^2 of cancellation noise, whose direction means nothing.
@@ -135,7 +137,8 @@ struct Checker {
                                         std::fabs(V[r][3]));
             }
         double row = 0;
-        for (int r = 0; r < 3; ++r) row = std::max(row, std::sqrt(V[r][0] * V[r][0] + V[r][1] * V[r][1] + V[r][2] * V[r][2]));
+        for (int r = 0; r < 3; ++r)
+            row = std::max(row, std::sqrt(V[r][0] * V[r][0] + V[r][1] * V[r][1] + V[r][2] * V[r][2]));
         slack = 4e-6 * (mag + row * std::max(-double(range.d_min), double(range.d_max)));
     }
 
@@ -169,9 +172,12 @@ struct Checker {
         double c[4];
         for (int r = 0; r < 4; ++r) c[r] = P[r][0] * h[0] + P[r][1] * h[1] + P[r][2] * h[2] + P[r][3] * h[3];
         const double planes[6] = {c[3] + c[0], c[3] - c[0], c[3] + c[1], c[3] - c[1], c[2], c[3] - c[2]};
-        const double grad[6] = {std::fabs(P[0][0]) + 1 + std::fabs(P[0][2]), std::fabs(P[0][0]) + 1 + std::fabs(P[0][2]),
-                                std::fabs(P[1][1]) + 1 + std::fabs(P[1][2]), std::fabs(P[1][1]) + 1 + std::fabs(P[1][2]),
-                                std::fabs(P[2][2]), std::fabs(P[2][2]) + 1};
+        const double grad[6] = {std::fabs(P[0][0]) + 1 + std::fabs(P[0][2]),
+                                std::fabs(P[0][0]) + 1 + std::fabs(P[0][2]),
+                                std::fabs(P[1][1]) + 1 + std::fabs(P[1][2]),
+                                std::fabs(P[1][1]) + 1 + std::fabs(P[1][2]),
+                                std::fabs(P[2][2]),
+                                std::fabs(P[2][2]) + 1};
         for (int q = 0; q < 6; ++q)
             if (!(planes[q] > grad[q] * slack)) return false;
         return c[3] > slack;
@@ -262,7 +268,7 @@ std::vector<float> random_depth_buffer(std::mt19937& rng, int W, int H, double a
 
 struct Tally {
     std::size_t bounds = 0, projected = 0, samples = 0, outside = 0;  // containment
-    std::size_t frustum_culled = 0, occluded = 0;                       // decisions
+    std::size_t frustum_culled = 0, occluded = 0;                     // decisions
     std::size_t containment_violations = 0, frustum_violations = 0, occlusion_violations = 0;
     std::string first;
     void note(const std::string& what) {
@@ -285,12 +291,12 @@ void check_bound(const Checker& ck, const DisplacedBound& b, const std::vector<V
             if (contained && !ck.inside_bound(b, s)) {
                 contained = false;
                 char text[400];
-                std::snprintf(text, sizeof text,
-                              ": sample outside the bound: t %.9g, ndc (%.9g, %.9g) depth %.9g (slacks %.3g %.3g %.3g) vs "
-                              "rect [%.9g, %.9g] x [%.9g, %.9g], depth [%.9g, %.9g]",
-                              s.t, ck.ndc_x(s), ck.ndc_y(s), ck.depth(s), ck.ndc_x_slack(s), ck.ndc_y_slack(s),
-                              ck.depth_slack(s), b.ndc_xmin, b.ndc_xmax, b.ndc_ymin, b.ndc_ymax, b.depth_near,
-                              b.depth_far);
+                std::snprintf(
+                    text, sizeof text,
+                    ": sample outside the bound: t %.9g, ndc (%.9g, %.9g) depth %.9g (slacks %.3g %.3g %.3g) vs "
+                    "rect [%.9g, %.9g] x [%.9g, %.9g], depth [%.9g, %.9g]",
+                    s.t, ck.ndc_x(s), ck.ndc_y(s), ck.depth(s), ck.ndc_x_slack(s), ck.ndc_y_slack(s), ck.depth_slack(s),
+                    b.ndc_xmin, b.ndc_xmax, b.ndc_ymin, b.ndc_ymax, b.depth_near, b.depth_far);
                 tally.note(where + text);
             }
         }
@@ -320,12 +326,15 @@ void check_occlusion(const Checker& ck, std::uint8_t decision, const std::vector
         }
         const double wx = (ck.ndc_x(s) + 1) * 0.5 * W, wy = (ck.ndc_y(s) + 1) * 0.5 * H;
         const double ex = ck.ndc_x_slack(s) * 0.5 * W, ey = ck.ndc_y_slack(s) * 0.5 * H;
-        const int x0 = static_cast<int>(std::max(0.0, std::floor(wx - ex))), x1 = static_cast<int>(std::min(W - 1.0, std::floor(wx + ex)));
-        const int y0 = static_cast<int>(std::max(0.0, std::floor(wy - ey))), y1 = static_cast<int>(std::min(H - 1.0, std::floor(wy + ey)));
+        const int x0 = static_cast<int>(std::max(0.0, std::floor(wx - ex))),
+                  x1 = static_cast<int>(std::min(W - 1.0, std::floor(wx + ex)));
+        const int y0 = static_cast<int>(std::max(0.0, std::floor(wy - ey))),
+                  y1 = static_cast<int>(std::min(H - 1.0, std::floor(wy + ey)));
         if (x0 > x1 || y0 > y1 || wx + ex < 0 || wy + ey < 0) continue;  // off screen
         float buffer_min = 1.0f;
         for (int y = y0; y <= y1; ++y)
-            for (int x = x0; x <= x1; ++x) buffer_min = std::min(buffer_min, depth[static_cast<std::size_t>(y) * W + x]);
+            for (int x = x0; x <= x1; ++x)
+                buffer_min = std::min(buffer_min, depth[static_cast<std::size_t>(y) * W + x]);
         if (ck.depth(s) + ck.depth_slack(s) <= buffer_min) {
             ++tally.occlusion_violations;
             tally.note(where + ": occluded but a sample at depth " + std::to_string(ck.depth(s)) +
@@ -349,12 +358,15 @@ NormalCone half_aperture(NormalCone c) {
 DisplacedBound bound_for(Variant v, const BezierPatch& patch, DisplacementRange range, DisplacedBoundKind b,
                          NormalConeKind c, const DisplacedCullView& view) {
     switch (v) {
-        case Variant::kReal: return compute_displaced_bound(patch, range, b, c, view);
+        case Variant::kReal:
+            return compute_displaced_bound(patch, range, b, c, view);
         case Variant::kHalfRange:
             return compute_displaced_bound(patch, {range.d_min * 0.5f, range.d_max * 0.5f}, b, c, view);
-        case Variant::kNoDisplacement: return compute_displaced_bound(patch, {}, b, c, view);
+        case Variant::kNoDisplacement:
+            return compute_displaced_bound(patch, {}, b, c, view);
         case Variant::kHalfAperture:
-            return compute_displaced_bound_with_cone(patch, range, half_aperture(displaced_normal_cone(patch, c)), b, view);
+            return compute_displaced_bound_with_cone(patch, range, half_aperture(displaced_normal_cone(patch, c)), b,
+                                                     view);
     }
     return {};
 }
@@ -377,7 +389,8 @@ std::vector<Tally> run_property(Variant variant, int patches, unsigned seed) {
         for (int cam_index = 0; cam_index < 3; ++cam_index) {
             const Camera cam = views.next();
             const Mat4 object_to_view = rng() % 4 == 0 ? cam.view() * random_model(rng) : cam.view();
-            const DisplacedCullView view = make_displaced_cull_view(object_to_view, cam.projection(), ClipDepth::zero_to_one);
+            const DisplacedCullView view =
+                make_displaced_cull_view(object_to_view, cam.projection(), ClipDepth::zero_to_one);
             EXPECT_TRUE(view.valid);
             Checker ck(object_to_view, cam.projection());
             ck.set_slack(patch, range);
@@ -399,8 +412,8 @@ std::vector<Tally> run_property(Variant variant, int patches, unsigned seed) {
             int index = 0;
             for (DisplacedBoundKind b : kBounds)
                 for (NormalConeKind c : kCones) {
-                    const std::string where = combo_name(b, c) + " trial " + std::to_string(trial) + " camera " +
-                                              std::to_string(cam_index);
+                    const std::string where =
+                        combo_name(b, c) + " trial " + std::to_string(trial) + " camera " + std::to_string(cam_index);
                     const DisplacedBound bound = bound_for(variant, patch, range, b, c, view);
                     check_bound(ck, bound, samples, tally[index], where);
                     check_occlusion(ck, displaced_bound_hiz_decision(bound, hiz), samples, depth, kW, kH, tally[index],
@@ -482,7 +495,8 @@ TEST(DisplacedBounds, FacingSquareByHand) {
     // Without displacement the CAF is the screen box of the control points (Niessner & Loop, "Patch-Based
     // Occlusion Culling for Hardware Tessellation" §4.2: "the same result as non-displaced patches"): corners
     // at x = +-1, t = 10.
-    const DisplacedBound flat = compute_displaced_bound(square, {}, DisplacedBoundKind::caf, NormalConeKind::acon, view);
+    const DisplacedBound flat =
+        compute_displaced_bound(square, {}, DisplacedBoundKind::caf, NormalConeKind::acon, view);
     EXPECT_FLOAT_EQ(flat.ndc_xmax, float(f / 10));
     EXPECT_FLOAT_EQ(flat.depth_near, float(depth_at(10)));
 }
@@ -590,7 +604,8 @@ TEST(DisplacedBounds, NonFiniteInputsAndUnsupportedViewsAreNeverCulled) {
     shifted.at(0, 3) = 0.5f;
     Mat4 singular;
     singular.at(1, 0) = singular.at(1, 1) = singular.at(1, 2) = 0.0f;
-    for (const DisplacedCullView& v : {make_displaced_cull_view(Mat4{}, ortho, ClipDepth::zero_to_one), make_displaced_cull_view(Mat4{}, shifted, ClipDepth::zero_to_one),
+    for (const DisplacedCullView& v : {make_displaced_cull_view(Mat4{}, ortho, ClipDepth::zero_to_one),
+                                       make_displaced_cull_view(Mat4{}, shifted, ClipDepth::zero_to_one),
                                        make_displaced_cull_view(singular, proj, ClipDepth::zero_to_one)}) {
         EXPECT_FALSE(v.valid);
         for (DisplacedBoundKind b : kBounds) {
@@ -638,7 +653,8 @@ TEST(DisplacedBounds, CafWithAConeLiesInsideTheFullCaf) {
         ViewGenerator views(bounds_of(p, float(size)), trial % 2 ? ViewMode::free : ViewMode::contain, trial);
         const Camera cam = views.next();
         const DisplacedCullView view = make_displaced_cull_view(cam.view(), cam.projection(), ClipDepth::zero_to_one);
-        const DisplacedBound full = compute_displaced_bound(p, range, DisplacedBoundKind::caf, NormalConeKind::full, view);
+        const DisplacedBound full =
+            compute_displaced_bound(p, range, DisplacedBoundKind::caf, NormalConeKind::full, view);
         for (NormalConeKind c : {NormalConeKind::acon, NormalConeKind::con}) {
             const DisplacedBound b = compute_displaced_bound(p, range, DisplacedBoundKind::caf, c, view);
             if (full.status == kDisplacedBoundProjected) {
@@ -702,7 +718,8 @@ TEST(DisplacedBounds, BatchMatchesSinglePatch) {
                     EXPECT_EQ(decision[k], 0xAB);
                 }
                 for (std::size_t i = 0; i < n; ++i) {
-                    const DisplacedBound one = compute_displaced_bound(patches[first + i], ranges[first + i], b, c, view);
+                    const DisplacedBound one =
+                        compute_displaced_bound(patches[first + i], ranges[first + i], b, c, view);
                     EXPECT_EQ(culled[i], displaced_bound_outside_frustum(one) ? 1 : 0);
                     EXPECT_EQ(decision[i], displaced_bound_hiz_decision(one, hiz));
                     EXPECT_EQ(bounds[i].status, one.status);
@@ -739,9 +756,10 @@ TEST(DisplacedBoundsTruth, EverySampleInsideEveryBound) {
             EXPECT_GT(t.frustum_culled, 0u);
             EXPECT_GT(t.occluded, 0u);
             EXPECT_GT(t.samples, 100000u / kSanitizerDivisor);
-            std::printf("[ displaced truth ] %-9s bounds %zu, projected %zu, samples %zu, frustum-culled %zu, "
-                        "occluded %zu\n",
-                        combo_name(b, c).c_str(), t.bounds, t.projected, t.samples, t.frustum_culled, t.occluded);
+            std::printf(
+                "[ displaced truth ] %-9s bounds %zu, projected %zu, samples %zu, frustum-culled %zu, "
+                "occluded %zu\n",
+                combo_name(b, c).c_str(), t.bounds, t.projected, t.samples, t.frustum_culled, t.occluded);
         }
 }
 
@@ -765,16 +783,17 @@ TEST(DisplacedBoundsTruth, ShrunkBoundsAreCaught) {
             const Tally& a = half_cone[index];
             const Tally& z = no_disp[index];
             ++index;
-            EXPECT_GT(r.containment_violations, r.bounds / 50) << "half the displacement range must leave samples outside";
+            EXPECT_GT(r.containment_violations, r.bounds / 50)
+                << "half the displacement range must leave samples outside";
             if (b == DisplacedBoundKind::caf && c != NormalConeKind::full) {
                 EXPECT_GT(a.containment_violations, 0u) << "half the cone aperture must leave samples outside";
             }
             decision_violations += z.frustum_violations + z.occlusion_violations;
-            std::printf("[ displaced shrunk ] %-9s half range: %zu containment, %zu frustum, %zu occlusion violations "
-                        "of %zu; half aperture: %zu containment; no displacement: %zu frustum, %zu occlusion\n",
-                        combo_name(b, c).c_str(), r.containment_violations, r.frustum_violations,
-                        r.occlusion_violations, r.bounds, a.containment_violations, z.frustum_violations,
-                        z.occlusion_violations);
+            std::printf(
+                "[ displaced shrunk ] %-9s half range: %zu containment, %zu frustum, %zu occlusion violations "
+                "of %zu; half aperture: %zu containment; no displacement: %zu frustum, %zu occlusion\n",
+                combo_name(b, c).c_str(), r.containment_violations, r.frustum_violations, r.occlusion_violations,
+                r.bounds, a.containment_violations, z.frustum_violations, z.occlusion_violations);
         }
     EXPECT_GT(decision_violations, 0u) << "ignoring the displacement must produce false frustum or Hi-Z culls";
 }

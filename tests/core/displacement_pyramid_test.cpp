@@ -29,7 +29,8 @@ void random_footprint(std::mt19937& rng, float size, Vec2 uv[4]) {
     std::uniform_real_distribution<float> coord(-3.0f, 4.0f), unit(0, 1);
     const Vec2 base{coord(rng), coord(rng)};
     for (int k = 0; k < 4; ++k)
-        uv[k] = base + Vec2{(k & 1) * size * (0.5f + unit(rng)) + size * 0.3f * unit(rng), (k >> 1) * size * (0.5f + unit(rng))};
+        uv[k] = base + Vec2{(k & 1) * size * (0.5f + unit(rng)) + size * 0.3f * unit(rng),
+                            (k >> 1) * size * (0.5f + unit(rng))};
 }
 
 }  // namespace
@@ -40,7 +41,8 @@ TEST(DisplacementPyramid, ContainsTheExactRangeAndEveryBilinearSample) {
     const float sizes[] = {0.001f, 0.01f, 0.05f, 0.2f, 0.6f, 1.5f};  // up to footprints larger than the map
     for (int trial = 0; trial < 600; ++trial) {
         const float scale = (trial % 3 == 0 ? -1.0f : 1.0f) * (0.1f + unit(rng));
-        DisplacementMap m = random_map(rng, 1 + trial % 97 + (trial % 5) * 40, 1 + trial % 61 + (trial % 7) * 30, scale);
+        DisplacementMap m =
+            random_map(rng, 1 + trial % 97 + (trial % 5) * 40, 1 + trial % 61 + (trial % 7) * 30, scale);
         m.midlevel = unit(rng);
         Vec2 uv[4];
         random_footprint(rng, sizes[trial % 6], uv);
@@ -65,7 +67,8 @@ TEST(DisplacementPyramid, EqualsTheExactRangeOnFootprintsWithinATexelCell) {
         const float x = std::floor(cell(rng)) + 0.5f, y = std::floor(cell(rng)) + 0.5f;
         Vec2 uv[4];
         for (int k = 0; k < 4; ++k)
-            uv[k] = {(x + 0.999f * unit(rng)) / static_cast<float>(m.width), (y + 0.999f * unit(rng)) / static_cast<float>(m.height)};
+            uv[k] = {(x + 0.999f * unit(rng)) / static_cast<float>(m.width),
+                     (y + 0.999f * unit(rng)) / static_cast<float>(m.height)};
         const DisplacementRange r = m.patch_range(uv), e = m.patch_range_exact(uv);
         ASSERT_EQ(r.d_min, e.d_min) << "trial " << trial;
         ASSERT_EQ(r.d_max, e.d_max) << "trial " << trial;

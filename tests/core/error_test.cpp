@@ -9,7 +9,9 @@ using namespace patchcull;
 TEST(ErrorText, QuoteKeepsPrintableTextAndEscapesTheRest) {
     EXPECT_EQ(quote_input("abc"), "'abc'");
     EXPECT_EQ(quote_input(""), "''");
-    EXPECT_EQ(quote_input("a\x01" "b"), "'a\\x01b'");
+    EXPECT_EQ(quote_input("a\x01"
+                          "b"),
+              "'a\\x01b'");
     EXPECT_EQ(quote_input(std::string_view("a\0b", 3)), "'a\\x00b'");
     EXPECT_EQ(quote_input("a\nb\rc\td\x7F"), "'a\\nb\\rc\\td\\x7F'");
     EXPECT_EQ(quote_input("it's a\\b"), "'it\\'s a\\\\b'");
@@ -18,16 +20,18 @@ TEST(ErrorText, QuoteKeepsPrintableTextAndEscapesTheRest) {
 
 TEST(ErrorText, InvalidUtf8IsEscapedBytewise) {
     EXPECT_EQ(quote_input("\xFF"), "'\\xFF'");
-    EXPECT_EQ(quote_input("a\xC3"), "'a\\xC3'");                    // truncated sequence
-    EXPECT_EQ(quote_input("\xC0\xAF"), "'\\xC0\\xAF'");             // overlong '/'
-    EXPECT_EQ(quote_input("\xED\xA0\x80"), "'\\xED\\xA0\\x80'");    // UTF-16 surrogate
+    EXPECT_EQ(quote_input("a\xC3"), "'a\\xC3'");                           // truncated sequence
+    EXPECT_EQ(quote_input("\xC0\xAF"), "'\\xC0\\xAF'");                    // overlong '/'
+    EXPECT_EQ(quote_input("\xED\xA0\x80"), "'\\xED\\xA0\\x80'");           // UTF-16 surrogate
     EXPECT_EQ(quote_input("\xF4\x90\x80\x80"), "'\\xF4\\x90\\x80\\x80'");  // above U+10FFFF
 }
 
 TEST(ErrorText, UnicodeControlsAndReorderingAreEscaped) {
-    EXPECT_EQ(quote_input("\xC2\x85"), "'\\u0085'");         // NEL, a C1 control
-    EXPECT_EQ(quote_input("\xE2\x80\xA8"), "'\\u2028'");     // line separator
-    EXPECT_EQ(quote_input("\xE2\x80\xAE" "abc"), "'\\u202Eabc'");  // right-to-left override
+    EXPECT_EQ(quote_input("\xC2\x85"), "'\\u0085'");      // NEL, a C1 control
+    EXPECT_EQ(quote_input("\xE2\x80\xA8"), "'\\u2028'");  // line separator
+    EXPECT_EQ(quote_input("\xE2\x80\xAE"
+                          "abc"),
+              "'\\u202Eabc'");  // right-to-left override
 }
 
 TEST(ErrorText, QuoteIsCutAfterMaxBytesOnACharacterBoundary) {

@@ -36,8 +36,8 @@ std::vector<std::uint8_t> run_cull(Kernel kernel, Impl impl, const PatchBatchVie
         const FrustumPlanes planes = make_frustum_planes(object_to_clip, ClipDepth::zero_to_one);
         (impl == Impl::kScalar ? cull_frustum_scalar : cull_frustum_simd)(view, disp, planes, out.data());
     } else {
-        (impl == Impl::kScalar ? cull_frustum_disp_scalar : cull_frustum_disp_simd)(view, disp, object_to_clip, ClipDepth::zero_to_one,
-                                                                                     out.data());
+        (impl == Impl::kScalar ? cull_frustum_disp_scalar : cull_frustum_disp_simd)(view, disp, object_to_clip,
+                                                                                    ClipDepth::zero_to_one, out.data());
     }
     for (std::size_t i = view.count; i < out.size(); ++i) EXPECT_EQ(out[i], 0xAB) << "wrote past count at " << i;
     out.resize(view.count);
@@ -79,9 +79,7 @@ BezierPatch rect_at(float x0, float x1, float y0, float y1, float z) {
 
 // 90 degree square frustum, camera at the origin looking down -z, near 1, far 100: at depth t the
 // visible square is [-t, t]^2.
-Mat4 simple_view() {
-    return perspective(0.5f * kPi, 1.0f, 1.0f, 100.0f) * look_at({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
-}
+Mat4 simple_view() { return perspective(0.5f * kPi, 1.0f, 1.0f, 100.0f) * look_at({0, 0, 0}, {0, 0, -1}, {0, 1, 0}); }
 
 struct Decision {
     bool frustum, frustum_disp;
@@ -177,7 +175,8 @@ TEST(FrustumKernels, KeepPatchStraddlingTheEyePlaneThatAnNdcTestWouldCull) {
         some_w_negative |= c.w < 0;
         some_w_positive |= c.w > 0;
     }
-    ASSERT_TRUE(all_right_after_divide && some_w_negative && some_w_positive) << "test patch does not straddle as intended";
+    ASSERT_TRUE(all_right_after_divide && some_w_negative && some_w_positive)
+        << "test patch does not straddle as intended";
     const Vec4 mid = m * evaluate_homogeneous(patch, 0.5f, 0.5f);
     ASSERT_TRUE(mid.w > 0 && std::fabs(mid.x) <= mid.w && std::fabs(mid.y) <= mid.w && mid.z >= 0 && mid.z <= mid.w);
 
@@ -193,8 +192,8 @@ TEST(FrustumKernels, DisplacementMarginKeepsPatchJustOutside) {
     const Mat4 identity;
     for (float w : {1.0f, 3.0f}) {
         SCOPED_TRACE(w);
-        const BezierPatch patch = bilinear_patch({1.05f, -0.5f, 0.2f}, {1.05f, 0.5f, 0.2f}, {1.05f, -0.5f, 0.8f},
-                                                 {1.05f, 0.5f, 0.8f}, w);
+        const BezierPatch patch =
+            bilinear_patch({1.05f, -0.5f, 0.2f}, {1.05f, 0.5f, 0.2f}, {1.05f, -0.5f, 0.8f}, {1.05f, 0.5f, 0.8f}, w);
         const float small = 0.02f, large = 0.1f;
         const Decision none = cull_one(patch, identity);
         const Decision s = cull_one(patch, identity, &small);
@@ -209,8 +208,7 @@ TEST(FrustumKernels, DisplacementMarginKeepsPatchJustOutside) {
     const Mat4 m = simple_view();
     for (float w : {1.0f, 0.5f}) {
         SCOPED_TRACE(w);
-        const BezierPatch patch =
-            bilinear_patch({11, -1, -10.5f}, {11, 1, -10.5f}, {11, -1, -9.5f}, {11, 1, -9.5f}, w);
+        const BezierPatch patch = bilinear_patch({11, -1, -10.5f}, {11, 1, -10.5f}, {11, -1, -9.5f}, {11, 1, -9.5f}, w);
         const float d02 = 0.2f, d03 = 0.3f, d04 = 0.4f;
         const Decision a = cull_one(patch, m, &d02);
         const Decision b = cull_one(patch, m, &d03);
@@ -248,7 +246,8 @@ View random_view(std::mt19937& rng) {
     model.at(2, 3) = t.z;
     View v;
     const float fovy = (40 + 40 * (u(rng) + 1) / 2) * kPi / 180;
-    v.object_to_clip = perspective(fovy, 1.0f + 0.8f * (u(rng) + 1) / 2, 0.1f, 60.0f) * look_at(eye, target, {0, 1, 0}) * model;
+    v.object_to_clip =
+        perspective(fovy, 1.0f + 0.8f * (u(rng) + 1) / 2, 0.1f, 60.0f) * look_at(eye, target, {0, 1, 0}) * model;
     EXPECT_TRUE(invert(v.object_to_clip, v.clip_to_object));
     v.eye_object = {(eye.x - t.x) / s.x, (eye.y - t.y) / s.y, (eye.z - t.z) / s.z};
     return v;
@@ -366,9 +365,10 @@ TEST(FrustumSimd, MatchesScalarExactlyOnRandomPatches) {
                 if (disp) culled_total[k == Kernel::kFrustum ? 0 : 1] += count_culled(ref);
                 for_each_simd_target([&](bool best) {
                     const std::size_t n = best ? batch.size() : kOtherTargetCount;
-                    const auto simd = run_cull(k, Impl::kSimd, batch.view().subrange(0, n), disp, scene.view.object_to_clip);
-                    expect_same(std::vector<std::uint8_t>(ref.begin(), ref.begin() + static_cast<std::ptrdiff_t>(n)), simd,
-                                disp ? "with displacement" : "without displacement");
+                    const auto simd =
+                        run_cull(k, Impl::kSimd, batch.view().subrange(0, n), disp, scene.view.object_to_clip);
+                    expect_same(std::vector<std::uint8_t>(ref.begin(), ref.begin() + static_cast<std::ptrdiff_t>(n)),
+                                simd, disp ? "with displacement" : "without displacement");
                 });
             }
         }
@@ -390,8 +390,8 @@ TEST(FrustumSimd, MatchesScalarOnUnalignedSubranges) {
     ASSERT_EQ(batch.stride(), batch.size());
     const std::size_t n = batch.size();
     const std::pair<std::size_t, std::size_t> ranges[] = {
-        {0, 1}, {1, 1}, {3, 5}, {5, 17}, {7, 33}, {1, 1023}, {13, 2000}, {n - 21, 21}, {n - 1, 1}, {n - 37, 37},
-        {17, n - 17}, {100, 0},
+        {0, 1},     {1, 1},       {3, 5},     {5, 17},      {7, 33},      {1, 1023},
+        {13, 2000}, {n - 21, 21}, {n - 1, 1}, {n - 37, 37}, {17, n - 17}, {100, 0},
     };
     for (Kernel k : {Kernel::kFrustum, Kernel::kFrustumDisp}) {
         SCOPED_TRACE(kernel_name(k));

@@ -22,7 +22,8 @@ constexpr unsigned H = 1u << static_cast<unsigned>(FusedStage::occlusion);
 
 // A profile of `groups` groups (16 patches each) in which stage costs are cost[F,B,H] seconds per
 // group and subset S decides decided(S) * groups of them (and culls the same fraction of patches).
-FusedProfile make_profile(double cf, double cb, double ch, double pf, double pb, double ph, std::uint64_t groups = 1000) {
+FusedProfile make_profile(double cf, double cb, double ch, double pf, double pb, double ph,
+                          std::uint64_t groups = 1000) {
     FusedProfile p;
     p.groups = groups;
     const double cost[3] = {cf, cb, ch};
@@ -108,7 +109,8 @@ TEST(FusedCostModel, ProfilesFirstThenEveryIntervalStaggered) {
     config.profile_interval = 4;
     FusedCostModel m(3, config);
     for (std::size_t o = 0; o < 3; ++o) EXPECT_TRUE(m.should_profile(o, kAllFusedStages)) << "never profiled";
-    for (std::size_t o = 0; o < 3; ++o) m.observe_profile(o, kAllFusedStages, make_profile(1e-6, 1e-6, 1e-6, 0, 0, 0), 16);
+    for (std::size_t o = 0; o < 3; ++o)
+        m.observe_profile(o, kAllFusedStages, make_profile(1e-6, 1e-6, 1e-6, 0, 0, 0), 16);
     std::vector<std::vector<int>> due(3);
     for (int frame = 1; frame <= 12; ++frame) {
         m.next_frame();

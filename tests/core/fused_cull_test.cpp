@@ -100,7 +100,8 @@ Case random_case(std::uint32_t seed, int W, int H, Vec3 offset) {
         for (int j = 0; j < 4; ++j)
             for (int k = 0; k < 4; ++k) {
                 const float s = k / 3.0f - 0.5f, t = j / 3.0f - 0.5f;
-                const Vec3 pv = centre + (a * s + b * t) * size + cross(a, b) * (bulge * size * (s * s + t * t) * u(rng));
+                const Vec3 pv =
+                    centre + (a * s + b * t) * size + cross(a, b) * (bulge * size * (s * s + t * t) * u(rng));
                 const Vec4 w4 = inv * Vec4{pv.x, pv.y, pv.z, 1};
                 const float w = kind == 5 ? 0.5f + 1.5f * unit(rng) : 1.0f;
                 p.cp[4 * j + k] = homogeneous(Vec3{w4.x, w4.y, w4.z}, w);
@@ -158,8 +159,8 @@ std::vector<FusedPlan> all_plans() {
 
 using Kernel = void (*)(const PatchBatchView&, const FusedCullSetup&, const FusedPlan&, std::uint8_t*, FusedCullStats*);
 
-std::vector<std::uint8_t> run(Kernel kernel, const PatchBatchView& v, const FusedCullSetup& setup, const FusedPlan& plan,
-                              FusedCullStats* stats = nullptr) {
+std::vector<std::uint8_t> run(Kernel kernel, const PatchBatchView& v, const FusedCullSetup& setup,
+                              const FusedPlan& plan, FusedCullStats* stats = nullptr) {
     constexpr std::size_t kGuard = 32;
     std::vector<std::uint8_t> out(v.count + kGuard, 0xAB);
     kernel(v, setup, plan, out.data(), stats);
@@ -206,7 +207,8 @@ TEST(FusedCull, EveryPlanEqualsTheSeparateKernelsScalarAndSimdBothLayouts) {
         const PatchBlocks blocks(batch.view());
         for (BackPatchCone cone : {BackPatchCone::tcone, BackPatchCone::ncone}) {
             const Verdicts verdicts = separate_verdicts(c, batch.view(), cone);
-            const FusedCullSetup setup = make_fused_setup(c.object_to_clip, ClipDepth::zero_to_one, c.eye, cone, &c.hiz);
+            const FusedCullSetup setup =
+                make_fused_setup(c.object_to_clip, ClipDepth::zero_to_one, c.eye, cone, &c.hiz);
             for (const FusedPlan& plan : all_plans()) {
                 SCOPED_TRACE("seed " + std::to_string(seed) + " plan " + fused_plan_name(plan));
                 const std::vector<std::uint8_t> expected = expected_decisions(verdicts, plan);
@@ -256,7 +258,8 @@ TEST(FusedCull, FrustumThenOcclusionIsTheHiZKernel) {
 TEST(FusedCull, StatisticsAndProfileAreConsistent) {
     const Case c = random_case(21, 320, 180, {0, 0, 0});
     const PatchBatch batch = make_batch(c.patches);
-    const FusedCullSetup setup = make_fused_setup(c.object_to_clip, ClipDepth::zero_to_one, c.eye, BackPatchCone::tcone, &c.hiz);
+    const FusedCullSetup setup =
+        make_fused_setup(c.object_to_clip, ClipDepth::zero_to_one, c.eye, BackPatchCone::tcone, &c.hiz);
     for (const FusedPlan& plan : all_plans()) {
         SCOPED_TRACE(fused_plan_name(plan));
         FusedCullStats stats;
@@ -309,7 +312,8 @@ TEST(FusedCull, ProfilingASampleOfGroupsDecidesTheSame) {
     const Case more = random_case(32, 320, 180, {0, 0, 0});
     for (int i = 0; i < 6; ++i) c.patches.insert(c.patches.end(), more.patches.begin(), more.patches.end());
     const PatchBatch batch = make_batch(c.patches);
-    const FusedCullSetup setup = make_fused_setup(c.object_to_clip, ClipDepth::zero_to_one, c.eye, BackPatchCone::tcone, &c.hiz);
+    const FusedCullSetup setup =
+        make_fused_setup(c.object_to_clip, ClipDepth::zero_to_one, c.eye, BackPatchCone::tcone, &c.hiz);
     const FusedPlan plan;  // FBH
     const std::vector<std::uint8_t> d = run(cull_fused_simd, batch.view(), setup, plan);
     for (std::size_t max_groups : {std::size_t{1}, std::size_t{8}, std::size_t{32}}) {

@@ -56,7 +56,8 @@ std::vector<float> random_depth(std::mt19937& rng, int W, int H) {
     for (auto& v : d) v = base * u(rng);
     for (int b = 0; b < 6; ++b) {
         const int x0 = static_cast<int>(rng() % W), y0 = static_cast<int>(rng() % H);
-        const int bw = 1 + static_cast<int>(rng() % std::max(1, W / 3)), bh = 1 + static_cast<int>(rng() % std::max(1, H / 3));
+        const int bw = 1 + static_cast<int>(rng() % std::max(1, W / 3)),
+                  bh = 1 + static_cast<int>(rng() % std::max(1, H / 3));
         const float v = u(rng);
         for (int y = y0; y < std::min(H, y0 + bh); ++y)
             for (int x = x0; x < std::min(W, x0 + bw); ++x) d[static_cast<std::size_t>(y) * W + x] = v;
@@ -103,8 +104,10 @@ TEST(HiZPyramid, LevelSizesRoundUpDownTo1x1) {
 // covers), for random NPOT sizes.
 TEST(HiZPyramid, EveryTexelIsTheMaxOverExactlyItsFootprint) {
     std::mt19937 rng(7);
-    std::vector<std::pair<int, int>> sizes = {{1, 1}, {1, 7}, {7, 1}, {2, 2}, {3, 3}, {5, 5}, {257, 131}, {131, 257}, {64, 64}};
-    for (int i = 0; i < 25; ++i) sizes.push_back({1 + static_cast<int>(rng() % 300), 1 + static_cast<int>(rng() % 300)});
+    std::vector<std::pair<int, int>> sizes = {{1, 1}, {1, 7},     {7, 1},     {2, 2},  {3, 3},
+                                              {5, 5}, {257, 131}, {131, 257}, {64, 64}};
+    for (int i = 0; i < 25; ++i)
+        sizes.push_back({1 + static_cast<int>(rng() % 300), 1 + static_cast<int>(rng() % 300)});
     for (const auto& [W, H] : sizes) {
         SCOPED_TRACE(std::to_string(W) + "x" + std::to_string(H));
         const std::vector<float> depth = random_depth(rng, W, H);
@@ -140,7 +143,8 @@ TEST(HiZPyramid, EqualsTheSeedsZeroPaddedPowerOfTwoMap) {
         const int P = static_cast<int>(std::bit_ceil(static_cast<unsigned>(std::max({W, H, 2}))));
         std::vector<float> cur(static_cast<std::size_t>(P) * P, 0.0f);  // unused texels: 0
         for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x) cur[static_cast<std::size_t>(y) * P + x] = depth[static_cast<std::size_t>(y) * W + x];
+            for (int x = 0; x < W; ++x)
+                cur[static_cast<std::size_t>(y) * P + x] = depth[static_cast<std::size_t>(y) * W + x];
         int size = P;
         for (int l = 0; l < hiz.levels(); ++l) {
             const int half = size / 2;
@@ -149,7 +153,8 @@ TEST(HiZPyramid, EqualsTheSeedsZeroPaddedPowerOfTwoMap) {
                 for (int x = 0; x < half; ++x) {
                     auto at = [&](int xx, int yy) { return cur[static_cast<std::size_t>(yy) * size + xx]; };
                     next[static_cast<std::size_t>(y) * half + x] =
-                        std::max(std::max(at(2 * x, 2 * y), at(2 * x + 1, 2 * y)), std::max(at(2 * x, 2 * y + 1), at(2 * x + 1, 2 * y + 1)));
+                        std::max(std::max(at(2 * x, 2 * y), at(2 * x + 1, 2 * y)),
+                                 std::max(at(2 * x, 2 * y + 1), at(2 * x + 1, 2 * y + 1)));
                 }
             for (int ty = 0; ty < hiz.level(l).height; ++ty)
                 for (int tx = 0; tx < hiz.level(l).width; ++tx)
@@ -224,7 +229,8 @@ TEST(HiZLevel, FinestLevelCoveringTheRectangleWithAtMost2x2Texels) {
             ASSERT_EQ(l, brute) << W << "x" << H << " rect " << r.x0 << "," << r.y0 << " - " << r.x1 << "," << r.y1;
             float pix_max = 0;
             for (int y = r.y0; y <= r.y1; ++y)
-                for (int x = r.x0; x <= r.x1; ++x) pix_max = std::max(pix_max, depth[static_cast<std::size_t>(y) * W + x]);
+                for (int x = r.x0; x <= r.x1; ++x)
+                    pix_max = std::max(pix_max, depth[static_cast<std::size_t>(y) * W + x]);
             const float h = hiz_rect_max(hiz, r);
             ASSERT_GE(h, pix_max);
             ASSERT_EQ(h, corner_max(hiz, r, l));
@@ -259,7 +265,7 @@ TEST(HiZLevel, FloorLevelUnderCoversAndCeilDoesNot) {
         EXPECT_EQ(floor_level(r, hiz.levels()), 0);
         EXPECT_EQ(corner_max(hiz, r, 0), 0.1f);  // floor: a patch at depth 0.5 would be "occluded"
         EXPECT_EQ(hiz_select_level(r, hiz.levels()), 1);
-        EXPECT_EQ(hiz_rect_max(hiz, r), 0.9f);   // ceil: it is not
+        EXPECT_EQ(hiz_rect_max(hiz, r), 0.9f);  // ceil: it is not
     }
     // Random rectangles: floor finds under-covered ones, the real selection never does.
     std::mt19937 rng(17);
@@ -275,7 +281,8 @@ TEST(HiZLevel, FloorLevelUnderCoversAndCeilDoesNot) {
             const PixelRect r = random_rect(rng, W, H);
             float pix_max = 0;
             for (int y = r.y0; y <= r.y1; ++y)
-                for (int x = r.x0; x <= r.x1; ++x) pix_max = std::max(pix_max, depth[static_cast<std::size_t>(y) * W + x]);
+                for (int x = r.x0; x <= r.x1; ++x)
+                    pix_max = std::max(pix_max, depth[static_cast<std::size_t>(y) * W + x]);
             ++tried;
             floor_under += corner_max(hiz, r, floor_level(r, hiz.levels())) < pix_max;
             ceil_under += hiz_rect_max(hiz, r) < pix_max;
@@ -312,7 +319,8 @@ enum class Impl { kScalar, kSimd };
 std::vector<std::uint8_t> run_kernel(Impl impl, const PatchBatchView& v, const Mat4& m, const HiZPyramid& hiz) {
     constexpr std::size_t kGuard = 64;
     std::vector<std::uint8_t> out(v.count + kGuard, 0xAB);
-    (impl == Impl::kScalar ? cull_occlusion_scalar : cull_occlusion_simd)(v, m, ClipDepth::zero_to_one, hiz, out.data());
+    (impl == Impl::kScalar ? cull_occlusion_scalar : cull_occlusion_simd)(v, m, ClipDepth::zero_to_one, hiz,
+                                                                          out.data());
     for (std::size_t i = v.count; i < out.size(); ++i) EXPECT_EQ(out[i], 0xAB) << "wrote past count at " << i;
     out.resize(v.count);
     return out;
@@ -358,19 +366,21 @@ TEST(HiZKernels, HandBuiltDecisions) {
     hiz.build(depth.data(), W, H);
 
     std::vector<BezierPatch> patches = {
-        flat_patch({-1, -1, -10}, {2, 0, 0}, {0, 2, 0}),          // 0: behind the wall: occluded
-        flat_patch({-1, -1, -3}, {2, 0, 0}, {0, 2, 0}),           // 1: in front: visible
-        flat_patch({50, 0, -10}, {1, 0, 0}, {0, 1, 0}),           // 2: far right, outside: frustum
-        flat_patch({-1, -1, -5.5f}, {2, 0, 0}, {0, 0, 2}),        // 3: crosses the wall plane: visible
-        flat_patch({-2, -1, 4}, {4, 0, 0}, {0, 0, -30}),          // 4: from behind the eye to far behind the wall: not projectable
+        flat_patch({-1, -1, -10}, {2, 0, 0}, {0, 2, 0}),    // 0: behind the wall: occluded
+        flat_patch({-1, -1, -3}, {2, 0, 0}, {0, 2, 0}),     // 1: in front: visible
+        flat_patch({50, 0, -10}, {1, 0, 0}, {0, 1, 0}),     // 2: far right, outside: frustum
+        flat_patch({-1, -1, -5.5f}, {2, 0, 0}, {0, 0, 2}),  // 3: crosses the wall plane: visible
+        flat_patch({-2, -1, 4}, {4, 0, 0},
+                   {0, 0, -30}),  // 4: from behind the eye to far behind the wall: not projectable
         flat_patch({6, -1, -10}, {10, 0, 0}, {0, 2, 0}),          // 5: partly off-screen, behind: occluded
         flat_patch({0, 0, -20}, {0.001f, 0, 0}, {0, 0.001f, 0}),  // 6: tiny (sub-pixel), behind: occluded
         flat_patch({-1, -1, -10}, {2, 0, 0}, {0, 2, 0}, 2.0f),    // 7: rational weights (same points)
         flat_patch({-1, -1, -200}, {2, 0, 0}, {0, 2, 0}),         // 8: beyond the far plane: frustum
     };
     const PatchBatch batch = make_batch(patches);
-    const std::vector<std::uint8_t> want = {kHiZOccluded, kHiZVisible, kHiZFrustumCulled, kHiZVisible, kHiZVisible,
-                                            kHiZOccluded, kHiZOccluded, kHiZOccluded, kHiZFrustumCulled};
+    const std::vector<std::uint8_t> want = {kHiZOccluded, kHiZVisible,  kHiZFrustumCulled,
+                                            kHiZVisible,  kHiZVisible,  kHiZOccluded,
+                                            kHiZOccluded, kHiZOccluded, kHiZFrustumCulled};
     EXPECT_EQ(run_kernel(Impl::kScalar, batch.view(), proj, hiz), want);
     for_each_simd_target([&](bool) { EXPECT_EQ(run_kernel(Impl::kSimd, batch.view(), proj, hiz), want); });
 
@@ -407,8 +417,9 @@ TEST(HiZKernels, PatchStraddlingTheEyePlaneIsNeverOccluded) {
     std::vector<BezierPatch> patches;
     for (int i = 0; i < 200; ++i) {
         // Control points on both sides of z = 0 (view space): w = -z changes sign.
-        BezierPatch p = flat_patch({3 * u(rng), 3 * u(rng), 1 + u(rng) * 0.9f}, {4 * u(rng), 4 * u(rng), -5 - 5 * std::abs(u(rng))},
-                                   {4 * u(rng), 4 * u(rng), 2 * u(rng)});
+        BezierPatch p =
+            flat_patch({3 * u(rng), 3 * u(rng), 1 + u(rng) * 0.9f}, {4 * u(rng), 4 * u(rng), -5 - 5 * std::abs(u(rng))},
+                       {4 * u(rng), 4 * u(rng), 2 * u(rng)});
         patches.push_back(p);
     }
     const PatchBatch batch = make_batch(patches);
@@ -448,8 +459,10 @@ void raster_triangle(Scene& s, Vec4 a, Vec4 b, Vec4 c) {
     }
     const double area = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]);
     if (area == 0) return;
-    const int x0 = std::max(0, int(std::floor(std::min({X[0], X[1], X[2]})))), x1 = std::min(s.W - 1, int(std::ceil(std::max({X[0], X[1], X[2]}))));
-    const int y0 = std::max(0, int(std::floor(std::min({Y[0], Y[1], Y[2]})))), y1 = std::min(s.H - 1, int(std::ceil(std::max({Y[0], Y[1], Y[2]}))));
+    const int x0 = std::max(0, int(std::floor(std::min({X[0], X[1], X[2]})))),
+              x1 = std::min(s.W - 1, int(std::ceil(std::max({X[0], X[1], X[2]}))));
+    const int y0 = std::max(0, int(std::floor(std::min({Y[0], Y[1], Y[2]})))),
+              y1 = std::min(s.H - 1, int(std::ceil(std::max({Y[0], Y[1], Y[2]}))));
     for (int py = y0; py <= y1; ++py)
         for (int px = x0; px <= x1; ++px) {
             const double x = px + 0.5, y = py + 0.5;
@@ -472,8 +485,8 @@ bool quad_drawable(const Vec4 c[4]) {
 }
 
 void raster_quad(Scene& s, Vec3 p, Vec3 a, Vec3 b) {
-    const Vec4 c[4] = {to_clip(s.object_to_clip, p), to_clip(s.object_to_clip, p + a), to_clip(s.object_to_clip, p + a + b),
-                       to_clip(s.object_to_clip, p + b)};
+    const Vec4 c[4] = {to_clip(s.object_to_clip, p), to_clip(s.object_to_clip, p + a),
+                       to_clip(s.object_to_clip, p + a + b), to_clip(s.object_to_clip, p + b)};
     if (!quad_drawable(c)) return;
     raster_triangle(s, c[0], c[1], c[2]);
     raster_triangle(s, c[0], c[2], c[3]);
@@ -533,10 +546,10 @@ Scene random_scene(std::mt19937& rng, int W, int H) {
         float d = 5 + 40 * unit(rng);  // mostly behind the occluders
         float size = d * (0.01f + 0.15f * unit(rng));
         float lateral = 1.0f;
-        if (kind == 0) d = 0.5f + 4 * unit(rng);              // in front of most occluders
+        if (kind == 0) d = 0.5f + 4 * unit(rng);                   // in front of most occluders
         if (kind == 1) size = d * (0.0005f + 0.004f * unit(rng));  // tiny: a pixel or less
-        if (kind == 2) lateral = 1.0f + 2.0f * unit(rng);     // often partly or wholly off-screen
-        if (kind == 3) size = d * (0.3f + 0.7f * unit(rng));   // large
+        if (kind == 2) lateral = 1.0f + 2.0f * unit(rng);          // often partly or wholly off-screen
+        if (kind == 3) size = d * (0.3f + 0.7f * unit(rng));       // large
         Vec3 c{tx * d * u(rng) * lateral, ty * d * u(rng) * lateral, -d};
         Vec3 a = Vec3{u(rng), u(rng), 0.5f * u(rng)} * size, b = Vec3{u(rng), u(rng), 0.5f * u(rng)} * size;
         Vec3 n = Vec3{0.3f * u(rng), 0.3f * u(rng), 1} * (0.3f * size);
@@ -602,13 +615,15 @@ TruthReport check_against_truth(const Scene& s, const std::vector<std::uint8_t>&
                 if (decision[i] == kHiZFrustumCulled) {
                     bad = c[3] + c[0] >= 0 && c[3] - c[0] >= 0 && c[3] + c[1] >= 0 && c[3] - c[1] >= 0 && c[2] >= 0 &&
                           c[3] - c[2] >= 0 && c[3] > 0;
-                    if (bad && rep.first.empty()) rep.first = "patch " + std::to_string(i) + " frustum-culled with a sample inside";
+                    if (bad && rep.first.empty())
+                        rep.first = "patch " + std::to_string(i) + " frustum-culled with a sample inside";
                     continue;
                 }
                 ++rep.samples_checked;
                 if (!(c[3] > 0)) {
                     bad = true;
-                    if (rep.first.empty()) rep.first = "patch " + std::to_string(i) + " occluded with a sample at w <= 0";
+                    if (rep.first.empty())
+                        rep.first = "patch " + std::to_string(i) + " occluded with a sample at w <= 0";
                     continue;
                 }
                 const double x = (c[0] / c[3] + 1) * 0.5 * s.W, y = (c[1] / c[3] + 1) * 0.5 * s.H, z = c[2] / c[3];
@@ -689,9 +704,10 @@ TEST(HiZKernels, OccludedPatchesHaveNoSampleInFrontOfTheDepthBuffer) {
     EXPECT_GT(samples, 100000u);
     EXPECT_GT(floor_caught, 0u) << "a floor level selection must produce false occlusion here";
     EXPECT_GT(maxz_caught, 0u) << "testing max z instead of min z must produce false occlusion here";
-    std::printf("[ HiZ truth ] patches %zu, occluded %zu, frustum %zu, samples %zu; broken deciders caught: "
-                "floor level %zu, max z %zu\n",
-                total, occluded, frustum, samples, floor_caught, maxz_caught);
+    std::printf(
+        "[ HiZ truth ] patches %zu, occluded %zu, frustum %zu, samples %zu; broken deciders caught: "
+        "floor level %zu, max z %zu\n",
+        total, occluded, frustum, samples, floor_caught, maxz_caught);
 }
 
 // Subranges at unaligned offsets and lengths: same decisions as the whole batch, no write past count.
@@ -703,7 +719,8 @@ TEST(HiZKernels, SubrangesMatchTheWholeBatch) {
     const PatchBatch batch = make_batch(s.patches);
     const auto full = run_kernel(Impl::kScalar, batch.view(), s.object_to_clip, hiz);
     const std::size_t n = batch.size();
-    const std::pair<std::size_t, std::size_t> ranges[] = {{0, 1}, {1, 1}, {3, 5}, {5, 17}, {7, 300}, {n - 21, 21}, {n - 1, 1}, {13, n - 13}, {100, 0}};
+    const std::pair<std::size_t, std::size_t> ranges[] = {{0, 1},       {1, 1},     {3, 5},       {5, 17}, {7, 300},
+                                                          {n - 21, 21}, {n - 1, 1}, {13, n - 13}, {100, 0}};
     for (const auto& [first, len] : ranges) {
         SCOPED_TRACE("subrange " + std::to_string(first) + " + " + std::to_string(len));
         const PatchBatchView sub = batch.view().subrange(first, len);

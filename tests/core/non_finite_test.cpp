@@ -54,7 +54,9 @@ void expect_only_base_culled(const char* name, const BezierPatch& base, const Ke
     for (std::size_t i = 1; i < batch.size(); ++i) {
         const std::size_t j = i - 1;
         EXPECT_EQ(decision[i], 0) << name << ": point " << j / 12 << " component " << j / 3 % 4 << " value "
-                                  << (j % 3 == 0 ? "NaN" : j % 3 == 1 ? "+Inf" : "-Inf");
+                                  << (j % 3 == 0   ? "NaN"
+                                      : j % 3 == 1 ? "+Inf"
+                                                   : "-Inf");
     }
 }
 
@@ -66,58 +68,68 @@ TEST(NonFinite, NoKernelCullsAPatchWithANonFiniteCoordinate) {
         const Mat4 proj = perspective(camera.fovy_radians, camera.aspect, camera.z_near, camera.z_far, depth);
         const Mat4 m = proj * camera.view();
         const FrustumPlanes planes = make_frustum_planes(m, depth);
-        const BezierPatch outside = flat_patch(30.0f, 0.0f, 0.0f, false);  // far right of the view
-        const BezierPatch behind_wall = flat_patch(-0.5f, -0.5f, -2.0f, false);  // in view, behind depth 0.1
+        const BezierPatch outside = flat_patch(30.0f, 0.0f, 0.0f, false);              // far right of the view
+        const BezierPatch behind_wall = flat_patch(-0.5f, -0.5f, -2.0f, false);        // in view, behind depth 0.1
         const std::vector<float> wall(64 * 64, is_reversed(depth) ? 0.999f : 0.001f);  // just beyond the near plane
         HiZPyramid hiz;
         hiz.build(wall.data(), 64, 64, depth);
         const std::string tag = std::string(" (") + clip_depth_name(depth) + ")";
         const std::vector<float> zero_margin(1 + kPatchPoints * 12, 0.0f), margin(1 + kPatchPoints * 12, 0.25f);
 
-        expect_only_base_culled(("frustum scalar" + tag).c_str(), outside, [&](const PatchBatchView& v, std::uint8_t* d) {
-            cull_frustum_scalar(v, nullptr, planes, d);
-        });
+        expect_only_base_culled(
+            ("frustum scalar" + tag).c_str(), outside,
+            [&](const PatchBatchView& v, std::uint8_t* d) { cull_frustum_scalar(v, nullptr, planes, d); });
         expect_only_base_culled(("frustum simd" + tag).c_str(), outside, [&](const PatchBatchView& v, std::uint8_t* d) {
             cull_frustum_simd(v, nullptr, planes, d);
         });
-        expect_only_base_culled(("frustum scalar margins" + tag).c_str(), outside,
-                                [&](const PatchBatchView& v, std::uint8_t* d) { cull_frustum_scalar(v, margin.data(), planes, d); });
-        expect_only_base_culled(("frustum simd margins" + tag).c_str(), outside,
-                                [&](const PatchBatchView& v, std::uint8_t* d) { cull_frustum_simd(v, margin.data(), planes, d); });
-        expect_only_base_culled(("frustum-disp scalar" + tag).c_str(), outside, [&](const PatchBatchView& v, std::uint8_t* d) {
-            cull_frustum_disp_scalar(v, zero_margin.data(), m, depth, d);
-        });
-        expect_only_base_culled(("frustum-disp simd" + tag).c_str(), outside, [&](const PatchBatchView& v, std::uint8_t* d) {
-            cull_frustum_disp_simd(v, zero_margin.data(), m, depth, d);
-        });
+        expect_only_base_culled(
+            ("frustum scalar margins" + tag).c_str(), outside,
+            [&](const PatchBatchView& v, std::uint8_t* d) { cull_frustum_scalar(v, margin.data(), planes, d); });
+        expect_only_base_culled(
+            ("frustum simd margins" + tag).c_str(), outside,
+            [&](const PatchBatchView& v, std::uint8_t* d) { cull_frustum_simd(v, margin.data(), planes, d); });
+        expect_only_base_culled(("frustum-disp scalar" + tag).c_str(), outside,
+                                [&](const PatchBatchView& v, std::uint8_t* d) {
+                                    cull_frustum_disp_scalar(v, zero_margin.data(), m, depth, d);
+                                });
+        expect_only_base_culled(("frustum-disp simd" + tag).c_str(), outside,
+                                [&](const PatchBatchView& v, std::uint8_t* d) {
+                                    cull_frustum_disp_simd(v, zero_margin.data(), m, depth, d);
+                                });
         for (const BezierPatch* base : {&outside, &behind_wall}) {
             const std::string which = base == &outside ? " outside" : " occluded";
-            expect_only_base_culled(("occlusion scalar" + which + tag).c_str(), *base,
-                                    [&](const PatchBatchView& v, std::uint8_t* d) { cull_occlusion_scalar(v, m, depth, hiz, d); });
-            expect_only_base_culled(("occlusion simd" + which + tag).c_str(), *base,
-                                    [&](const PatchBatchView& v, std::uint8_t* d) { cull_occlusion_simd(v, m, depth, hiz, d); });
+            expect_only_base_culled(
+                ("occlusion scalar" + which + tag).c_str(), *base,
+                [&](const PatchBatchView& v, std::uint8_t* d) { cull_occlusion_scalar(v, m, depth, hiz, d); });
+            expect_only_base_culled(
+                ("occlusion simd" + which + tag).c_str(), *base,
+                [&](const PatchBatchView& v, std::uint8_t* d) { cull_occlusion_simd(v, m, depth, hiz, d); });
             const FusedCullSetup setup = make_fused_setup(m, depth, camera.eye, BackPatchCone::tcone, &hiz);
             FusedPlan plans[6];
             const int count = fused_plans_of(7u, plans);
             for (int i = 0; i < count; ++i) {
                 const std::string plan = " fused " + fused_plan_name(plans[i]);
                 expect_only_base_culled(("scalar" + plan + which + tag).c_str(), *base,
-                                        [&](const PatchBatchView& v, std::uint8_t* d) { cull_fused_scalar(v, setup, plans[i], d, nullptr); });
-                expect_only_base_culled(("simd" + plan + which + tag).c_str(), *base,
-                                        [&](const PatchBatchView& v, std::uint8_t* d) { cull_fused_simd(v, setup, plans[i], d, nullptr); });
+                                        [&](const PatchBatchView& v, std::uint8_t* d) {
+                                            cull_fused_scalar(v, setup, plans[i], d, nullptr);
+                                        });
+                expect_only_base_culled(
+                    ("simd" + plan + which + tag).c_str(), *base,
+                    [&](const PatchBatchView& v, std::uint8_t* d) { cull_fused_simd(v, setup, plans[i], d, nullptr); });
             }
             const DisplacedCullView dview = make_displaced_cull_view(camera.view(), proj, depth);
             for (DisplacedBoundKind kind : {DisplacedBoundKind::caf, DisplacedBoundKind::oobb}) {
                 const std::string k = kind == DisplacedBoundKind::caf ? " caf" : " oobb";
                 expect_only_base_culled(("displaced occlusion" + k + which + tag).c_str(), *base,
                                         [&](const PatchBatchView& v, std::uint8_t* d) {
-                                            cull_displaced_occlusion(v, nullptr, kind, NormalConeKind::full, dview, hiz, d);
+                                            cull_displaced_occlusion(v, nullptr, kind, NormalConeKind::full, dview, hiz,
+                                                                     d);
                                         });
                 if (base == &outside)
-                    expect_only_base_culled(("displaced frustum" + k + tag).c_str(), *base,
-                                            [&](const PatchBatchView& v, std::uint8_t* d) {
-                                                cull_displaced_frustum(v, nullptr, kind, NormalConeKind::full, dview, d);
-                                            });
+                    expect_only_base_culled(
+                        ("displaced frustum" + k + tag).c_str(), *base, [&](const PatchBatchView& v, std::uint8_t* d) {
+                            cull_displaced_frustum(v, nullptr, kind, NormalConeKind::full, dview, d);
+                        });
             }
         }
     }
@@ -133,9 +145,11 @@ TEST(NonFinite, NoBackPatchKernelCullsAPatchWithANonFiniteCoordinate) {
         {"tcone simd", [&](const PatchBatchView& v, std::uint8_t* d) { cull_tcone_simd(v, camera.eye, d); }},
         {"ncone scalar", [&](const PatchBatchView& v, std::uint8_t* d) { cull_ncone_scalar(v, camera.eye, d); }},
         {"ncone simd", [&](const PatchBatchView& v, std::uint8_t* d) { cull_ncone_simd(v, camera.eye, d); }},
-        {"ptp scalar", [&](const PatchBatchView& v, std::uint8_t* d) { cull_ptp_scalar(v, m, alpha, PtpRule::ncnt, d); }},
+        {"ptp scalar",
+         [&](const PatchBatchView& v, std::uint8_t* d) { cull_ptp_scalar(v, m, alpha, PtpRule::ncnt, d); }},
         {"ptp simd", [&](const PatchBatchView& v, std::uint8_t* d) { cull_ptp_simd(v, m, alpha, PtpRule::ncnt, d); }},
-        {"ptp simd pcnt", [&](const PatchBatchView& v, std::uint8_t* d) { cull_ptp_simd(v, m, alpha, PtpRule::pcnt, d); }},
+        {"ptp simd pcnt",
+         [&](const PatchBatchView& v, std::uint8_t* d) { cull_ptp_simd(v, m, alpha, PtpRule::pcnt, d); }},
     };
     for (const auto& [name, kernel] : kernels) expect_only_base_culled(name, facing_away, kernel);
 }

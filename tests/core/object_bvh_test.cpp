@@ -27,9 +27,7 @@ struct Scene {
     std::vector<Vec3> velocity;
 };
 
-Mat4 camera(Vec3 eye, Vec3 target) {
-    return perspective(1.1f, 1.6f, 0.5f, 300.0f) * look_at(eye, target, {0, 1, 0});
-}
+Mat4 camera(Vec3 eye, Vec3 target) { return perspective(1.1f, 1.6f, 0.5f, 300.0f) * look_at(eye, target, {0, 1, 0}); }
 
 // n boxes scattered over a city-sized area around a camera looking along -z; sizes from tiny to
 // huge, a few zero-size.
@@ -130,9 +128,11 @@ TEST(ObjectBvh, EqualsTheFlatListOnMovingScenes) {
                 // Plane tests per object over the run (printed for the record, not asserted: the BVH
                 // is not cheaper on every scene).
                 const double per = 1.0 / (double(n) * (frames + 1));
-                std::printf("n %zu offset %g: plane tests per object: bvh %.2f, +mask %.2f, +coh %.2f, +both %.2f, flat+coh %.2f\n",
-                            n, double(offset.x), stats[0].plane_tests * per, stats[1].plane_tests * per,
-                            stats[2].plane_tests * per, stats[3].plane_tests * per, stats[4].plane_tests * per);
+                std::printf(
+                    "n %zu offset %g: plane tests per object: bvh %.2f, +mask %.2f, +coh %.2f, +both %.2f, flat+coh "
+                    "%.2f\n",
+                    n, double(offset.x), stats[0].plane_tests * per, stats[1].plane_tests * per,
+                    stats[2].plane_tests * per, stats[3].plane_tests * per, stats[4].plane_tests * per);
                 // Masking never adds plane tests to the same traversal (it only drops planes).
                 EXPECT_LE(stats[1].plane_tests, stats[0].plane_tests);
                 EXPECT_EQ(stats[1].nodes_visited, stats[0].nodes_visited);
@@ -202,11 +202,16 @@ TEST(ObjectBvh, SpecialScenes) {
     for (int i = 0; i < 400; ++i) {
         const Vec3 c{100 * u(rng), 10 * u(rng), 100 * u(rng) - 50};
         const int kind = i % 8;
-        if (kind == 0) mixed.push_back({Vec3{-1e4f, -1e4f, -1e4f}, Vec3{1e4f, 1e4f, 1e4f}});
-        else if (kind == 1) mixed.push_back({c, c});
-        else if (kind == 2) mixed.push_back(aabb_of_points(nullptr, 0));
-        else if (kind == 3 && i < 40) mixed.push_back({Vec3{nan, 0, 0}, c});
-        else mixed.push_back({c - Vec3{1e-4f, 1e-4f, 1e-4f}, c + Vec3{1e-4f, 1e-4f, 1e-4f}});
+        if (kind == 0)
+            mixed.push_back({Vec3{-1e4f, -1e4f, -1e4f}, Vec3{1e4f, 1e4f, 1e4f}});
+        else if (kind == 1)
+            mixed.push_back({c, c});
+        else if (kind == 2)
+            mixed.push_back(aabb_of_points(nullptr, 0));
+        else if (kind == 3 && i < 40)
+            mixed.push_back({Vec3{nan, 0, 0}, c});
+        else
+            mixed.push_back({c - Vec3{1e-4f, 1e-4f, 1e-4f}, c + Vec3{1e-4f, 1e-4f, 1e-4f}});
     }
     check_all(mixed, "huge, tiny, empty and NaN");
     // Every object empty.
@@ -270,13 +275,15 @@ TEST(ObjectBvh, CulledObjectsHaveNoPointInTheFrustum) {
                 for (int k = 0; k < 64; ++k) {
                     const double t[3] = {k < 8 ? double(k & 1) : unit(rng), k < 8 ? double((k >> 1) & 1) : unit(rng),
                                          k < 8 ? double((k >> 2) & 1) : unit(rng)};
-                    const double p[3] = {b.min.x + (double(b.max.x) - b.min.x) * t[0], b.min.y + (double(b.max.y) - b.min.y) * t[1],
+                    const double p[3] = {b.min.x + (double(b.max.x) - b.min.x) * t[0],
+                                         b.min.y + (double(b.max.y) - b.min.y) * t[1],
                                          b.min.z + (double(b.max.z) - b.min.z) * t[2]};
                     double c[4];
                     for (int r = 0; r < 4; ++r)
                         c[r] = s.world_to_clip.at(r, 0) * p[0] + s.world_to_clip.at(r, 1) * p[1] +
                                s.world_to_clip.at(r, 2) * p[2] + double(s.world_to_clip.at(r, 3));
-                    const bool in = c[3] > 0 && std::fabs(c[0]) <= c[3] && std::fabs(c[1]) <= c[3] && c[2] >= 0 && c[2] <= c[3];
+                    const bool in =
+                        c[3] > 0 && std::fabs(c[0]) <= c[3] && std::fabs(c[1]) <= c[3] && c[2] >= 0 && c[2] <= c[3];
                     ASSERT_FALSE(in) << "object " << i << " culled with a point in the frustum";
                 }
             }

@@ -12,7 +12,9 @@
 namespace patchcull {
 namespace {
 
-Mat4 test_view_projection() { return perspective(1.0f, 1.0f, 0.1f, 100.0f) * look_at({0, 0, 10}, {0, 0, 0}, {0, 1, 0}); }
+Mat4 test_view_projection() {
+    return perspective(1.0f, 1.0f, 0.1f, 100.0f) * look_at({0, 0, 10}, {0, 0, 0}, {0, 1, 0});
+}
 
 Bounds box_at(Vec3 c, float r) { return {c - Vec3{r, r, r}, c + Vec3{r, r, r}}; }
 
@@ -67,7 +69,8 @@ TEST(ObjectCuller, FlatAndBvhAgreeOnRandomScenes) {
         for (int f = 0; f < 5; ++f) {
             ObjectFrame frame;
             frame.eye = {pos(rng), pos(rng), pos(rng)};
-            frame.world_to_clip = perspective(0.9f, 1.5f, 0.1f, 60.0f) * look_at(frame.eye, {pos(rng), pos(rng), pos(rng)}, {0, 1, 0});
+            frame.world_to_clip =
+                perspective(0.9f, 1.5f, 0.1f, 60.0f) * look_at(frame.eye, {pos(rng), pos(rng), pos(rng)}, {0, 1, 0});
             frame.boxes = boxes.data();
             for (Bounds& b : boxes) b.min.x += 0.3f, b.max.x += 0.3f;  // motion: the BVH refits
             ObjectCullOptions a, b;
@@ -120,8 +123,9 @@ TEST(ObjectCuller, CpuFrustumKernelSkipsCulledSpans) {
     ObjectCullResult result;
     result.culled_patches = {{2, 3}, {7, 1}};
     std::vector<std::uint8_t> culled(10, 9);
-    const std::size_t tested = cull_frustum_after_objects(
-        result, batch.view(), nullptr, make_frustum_planes(test_view_projection(), ClipDepth::zero_to_one), culled.data());
+    const std::size_t tested =
+        cull_frustum_after_objects(result, batch.view(), nullptr,
+                                   make_frustum_planes(test_view_projection(), ClipDepth::zero_to_one), culled.data());
     EXPECT_EQ(tested, 6u);
     EXPECT_EQ(culled, (std::vector<std::uint8_t>{0, 0, 1, 1, 1, 0, 0, 1, 0, 0}));
     std::vector<std::pair<std::size_t, std::size_t>> visited;

@@ -21,7 +21,8 @@ ControlMesh box(float a, float b, float c, Vec3 offset = {}) {
     m.name = "box";
     for (int i = 0; i < 8; ++i)
         m.positions.push_back({offset.x + (i & 1 ? a : 0), offset.y + (i & 2 ? b : 0), offset.z + (i & 4 ? c : 0)});
-    const std::uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    const std::uint32_t faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                       {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
     for (const auto& f : faces) {
         for (std::uint32_t v : f) m.face_vertices.push_back(v);
         m.face_offsets.push_back(static_cast<std::uint32_t>(m.face_vertices.size()));
@@ -87,7 +88,8 @@ TEST(Orientation, ThinSolidsKeepTheirOrientation) {
 TEST(Orientation, ReverseFacesKeepsTexcoordsWithTheirCorners) {
     ControlMesh m = box(1, 1, 1);
     m.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-    for (std::size_t c = 0; c < m.face_vertices.size(); ++c) m.face_texcoords.push_back(static_cast<std::uint32_t>(c % 4));
+    for (std::size_t c = 0; c < m.face_vertices.size(); ++c)
+        m.face_texcoords.push_back(static_cast<std::uint32_t>(c % 4));
     const std::vector<std::uint32_t> vertices = m.face_vertices, texcoords = m.face_texcoords;
     m.reverse_faces();
     for (std::size_t f = 0; f < m.face_count(); ++f)
@@ -215,7 +217,8 @@ void expect_oriented(const std::vector<ControlMesh>& parts, const std::vector<in
         const bool flipped = (shell_volume(shells, before, s) > 0) != (signs[s] > 0);
         for (std::size_t f = shells.first_face[s]; f < shells.first_face[s + 1]; ++f)
             for (std::uint32_t c = m.face_offsets[f], n = m.face_size(f), i = 0; i < n; ++i)
-                EXPECT_EQ(m.face_vertices[c + i], before.face_vertices[flipped ? c + n - 1 - i : c + i]) << "face " << f;
+                EXPECT_EQ(m.face_vertices[c + i], before.face_vertices[flipped ? c + n - 1 - i : c + i])
+                    << "face " << f;
     }
     EXPECT_EQ(classify_orientation(m), SurfaceOrientation::outward);  // idempotent
 }
@@ -243,18 +246,20 @@ TEST(OrientationShells, HollowSolidsCavityFacesIntoTheCavity) {
     for (bool outer_reversed : {false, true})
         for (bool inner_reversed : {false, true})
             expect_oriented({sphere({0, 0, 0}, 2, outer_reversed), sphere({0.3f, -0.2f, 0.1f}, 1, inner_reversed)},
-                            {+1, -1}, outer_reversed ? (inner_reversed ? "both reversed" : "outer reversed")
-                                                     : (inner_reversed ? "inner reversed" : "both written outward"));
+                            {+1, -1},
+                            outer_reversed ? (inner_reversed ? "both reversed" : "outer reversed")
+                                           : (inner_reversed ? "inner reversed" : "both written outward"));
     // Order in the file does not matter, nor do several cavities.
-    expect_oriented({sphere({-0.8f, 0, 0}, 0.5f), sphere({0, 0, 0}, 3), sphere({1, 0.5f, 0}, 0.4f, true)},
-                    {-1, +1, -1}, "two cavities, listed around the outer shell");
+    expect_oriented({sphere({-0.8f, 0, 0}, 0.5f), sphere({0, 0, 0}, 3), sphere({1, 0.5f, 0}, 0.4f, true)}, {-1, +1, -1},
+                    "two cavities, listed around the outer shell");
     // A hollow solid far from the origin: the nesting test works in double.
     expect_oriented({sphere({1e5f, -1e5f, 1e5f}, 20), sphere({1e5f, -1e5f, 1e5f}, 10)}, {+1, -1}, "far away");
     // And its total volume is the material's.
     ControlMesh hollow = join({sphere({0, 0, 0}, 2), sphere({0, 0, 0}, 1)}).mesh;
     orient_outward(hollow);
-    EXPECT_NEAR(hollow.signed_volume(), join({sphere({0, 0, 0}, 2)}).mesh.signed_volume() -
-                                            join({sphere({0, 0, 0}, 1)}).mesh.signed_volume(), 1e-9);
+    EXPECT_NEAR(hollow.signed_volume(),
+                join({sphere({0, 0, 0}, 2)}).mesh.signed_volume() - join({sphere({0, 0, 0}, 1)}).mesh.signed_volume(),
+                1e-9);
 }
 
 TEST(OrientationShells, NestedSpheresAlternateByNestingParity) {
@@ -272,7 +277,8 @@ TEST(OrientationShells, NestedSpheresAlternateByNestingParity) {
 
 TEST(OrientationShells, TwoToriEndUpBothOutward) {
     // The whole-mesh rule called this pair flat (total volume 0) and drew it two-sided.
-    expect_oriented({torus({-2.5f, 0, 0}, 1.5f, 0.5f), torus({2.5f, 0, 0}, 1.5f, 0.5f, true)}, {+1, +1}, "side by side");
+    expect_oriented({torus({-2.5f, 0, 0}, 1.5f, 0.5f), torus({2.5f, 0, 0}, 1.5f, 0.5f, true)}, {+1, +1},
+                    "side by side");
     // Linked like two chain links (each through the other's hole): neither is inside the other.
     // Swapping y and z turns the second's axis along y, through the first's hole, and mirrors it:
     // inside out.

@@ -13,12 +13,12 @@
 #include <random>
 #include <vector>
 
-#include "patchcull/objects/backface_clusters.h"
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/ground_truth.h"
-#include "patchcull/import/model_loader.h"
 #include "patchcull/core/teapot.h"
+#include "patchcull/import/model_loader.h"
+#include "patchcull/objects/backface_clusters.h"
 
 using namespace patchcull;
 
@@ -124,7 +124,8 @@ TEST(PatchClusters, ControlPlanesCombineToTheTangentPlanesAndBoundTheirRounding)
     std::uniform_real_distribution<float> u(-1, 1);
     for (int k = 0; k < 40; ++k) {
         const float off = (k % 4) * 2.5e4f;
-        const BezierPatch p = random_patch(rng, {off + u(rng), off * 0.5f, 2 * u(rng)}, k % 5 == 0 ? 1e-3f : 1.0f, k % 2 == 1);
+        const BezierPatch p =
+            random_patch(rng, {off + u(rng), off * 0.5f, 2 * u(rng)}, k % 5 == 0 ? 1e-3f : 1.0f, k % 2 == 1);
         // Object space (origin 0): the Bernstein combination is the sampled tangent plane (near the
         // origin only: far away both double computations cancel ~R^3 down to the plane's size).
         PlaneD t[64], err[64];
@@ -158,7 +159,8 @@ TEST(PatchClusters, ControlPlanesCombineToTheTangentPlanesAndBoundTheirRounding)
         for (int d = 0; d < 64; ++d) {
             const double v[4] = {t[d].x, t[d].y, t[d].z, t[d].w}, e[4] = {err[d].x, err[d].y, err[d].z, err[d].w};
             for (int c = 0; c < 4; ++c) {
-                EXPECT_LE(std::fabs((long double)v[c] - ref[d][c]), (long double)e[c]) << "plane " << d << " comp " << c;
+                EXPECT_LE(std::fabs((long double)v[c] - ref[d][c]), (long double)e[c])
+                    << "plane " << d << " comp " << c;
                 EXPECT_LT(e[c], 1e-9 * (1 + std::fabs(v[c])) + 1e-9);  // and the bound is not vacuous
             }
         }
@@ -238,7 +240,8 @@ TEST(PatchClusters, CulledClustersHoldOnlyBackFacingPatchesUnderRigidMotion) {
                     if (!leaf[l]) continue;
                     ++culled;
                     ASSERT_FALSE(faces_obj) << "culled patch " << i << " faces the eye (object space)";
-                    ASSERT_FALSE(patch_faces(world[i], eye_world, 17)) << "culled patch " << i << " faces the eye (world)";
+                    ASSERT_FALSE(patch_faces(world[i], eye_world, 17))
+                        << "culled patch " << i << " faces the eye (world)";
                 }
             }
         }
@@ -254,43 +257,45 @@ TEST(PatchClusters, BigGuyClustersAgainstThePerPatchKernels) {
     const std::vector<BezierPatch>& patches = model.rest.patches;
     const PatchBatch batch = make_batch(patches);
     for (double tcr : {0.01, 0.1, 1.0}) {
-    const ClusterHierarchy h = build_patch_clusters(patches.data(), patches.size(), tcr, 16);
-    const Bounds box = patch_bounds(model.rest);
-    const Vec3 centre = box.center();
-    const float radius = box.radius();
-    std::mt19937 rng(53);
-    std::uniform_real_distribution<float> u(-1, 1);
-    std::size_t by_cluster = 0, by_ptp = 0, by_tcone = 0, cluster_not_ptp = 0, tests_total = 0, frames = 0;
-    for (int k = 0; k < 24; ++k, ++frames) {
-        const Vec3 eye = centre + normalize(Vec3{u(rng), u(rng), u(rng)}) * (radius * (k % 2 ? 2.0f : 4.0f));
-        const Mat4 proj = perspective(0.9f, 1.0f, 0.1f * radius, 20 * radius);
-        const Mat4 m = proj * look_at(eye, centre, {0, 1, 0});
-        std::vector<std::uint8_t> ptp(patches.size()), tcone(patches.size()), leaf(cluster_leaf_count(h));
-        cull_ptp_scalar(batch.view(), m, clip_space_eye_alpha(proj), PtpRule::pcnt, ptp.data());
-        cull_tcone_scalar(batch.view(), eye, tcone.data());
-        std::uint32_t tests = 0;
-        cull_cluster_hierarchy(h, eye, leaf.data(), tests);
-        tests_total += tests;
-        for (std::size_t l = 0; l < leaf.size(); ++l) {
-            if (!leaf[l]) continue;
-            const BackfaceCluster& c = cluster_leaf(h, l);
-            for (std::size_t i = c.first; i < c.first + c.count; ++i) {
-                ++by_cluster;
-                cluster_not_ptp += !ptp[i];
-                ASSERT_FALSE(patch_faces(patches[i], eye, 9)) << "BigGuy patch " << i << " culled but faces the eye";
+        const ClusterHierarchy h = build_patch_clusters(patches.data(), patches.size(), tcr, 16);
+        const Bounds box = patch_bounds(model.rest);
+        const Vec3 centre = box.center();
+        const float radius = box.radius();
+        std::mt19937 rng(53);
+        std::uniform_real_distribution<float> u(-1, 1);
+        std::size_t by_cluster = 0, by_ptp = 0, by_tcone = 0, cluster_not_ptp = 0, tests_total = 0, frames = 0;
+        for (int k = 0; k < 24; ++k, ++frames) {
+            const Vec3 eye = centre + normalize(Vec3{u(rng), u(rng), u(rng)}) * (radius * (k % 2 ? 2.0f : 4.0f));
+            const Mat4 proj = perspective(0.9f, 1.0f, 0.1f * radius, 20 * radius);
+            const Mat4 m = proj * look_at(eye, centre, {0, 1, 0});
+            std::vector<std::uint8_t> ptp(patches.size()), tcone(patches.size()), leaf(cluster_leaf_count(h));
+            cull_ptp_scalar(batch.view(), m, clip_space_eye_alpha(proj), PtpRule::pcnt, ptp.data());
+            cull_tcone_scalar(batch.view(), eye, tcone.data());
+            std::uint32_t tests = 0;
+            cull_cluster_hierarchy(h, eye, leaf.data(), tests);
+            tests_total += tests;
+            for (std::size_t l = 0; l < leaf.size(); ++l) {
+                if (!leaf[l]) continue;
+                const BackfaceCluster& c = cluster_leaf(h, l);
+                for (std::size_t i = c.first; i < c.first + c.count; ++i) {
+                    ++by_cluster;
+                    cluster_not_ptp += !ptp[i];
+                    ASSERT_FALSE(patch_faces(patches[i], eye, 9))
+                        << "BigGuy patch " << i << " culled but faces the eye";
+                }
             }
+            for (std::size_t i = 0; i < patches.size(); ++i) by_ptp += ptp[i], by_tcone += tcone[i];
         }
-        for (std::size_t i = 0; i < patches.size(); ++i) by_ptp += ptp[i], by_tcone += tcone[i];
-    }
-    const double n = double(frames * patches.size());
-    std::printf("[ info ] BigGuy (%zu patches, tC/r %g: %zu leaves, %zu nodes): culled by clusters %.3f, by ptp-pcnt %.3f, "
-                "by tcone %.3f; cluster tests/frame %.1f vs %zu per-patch tests; cluster-culled not culled by ptp: %zu\n",
-                patches.size(), tcr, cluster_leaf_count(h), h.nodes.size(), by_cluster / n, by_ptp / n, by_tcone / n,
-                tests_total / double(frames), patches.size(), cluster_not_ptp);
-    EXPECT_GT(by_cluster, 0u);
-    EXPECT_LE(by_cluster, by_ptp + cluster_not_ptp);
-    // Every patch of a culled cluster has all 64 control planes behind the eye: ptp-pcnt (the same
-    // planes in clip space, with its own rounding margin) culls it too, but for rounding.
-    EXPECT_LE(cluster_not_ptp, by_cluster / 100 + 1);
+        const double n = double(frames * patches.size());
+        std::printf(
+            "[ info ] BigGuy (%zu patches, tC/r %g: %zu leaves, %zu nodes): culled by clusters %.3f, by ptp-pcnt %.3f, "
+            "by tcone %.3f; cluster tests/frame %.1f vs %zu per-patch tests; cluster-culled not culled by ptp: %zu\n",
+            patches.size(), tcr, cluster_leaf_count(h), h.nodes.size(), by_cluster / n, by_ptp / n, by_tcone / n,
+            tests_total / double(frames), patches.size(), cluster_not_ptp);
+        EXPECT_GT(by_cluster, 0u);
+        EXPECT_LE(by_cluster, by_ptp + cluster_not_ptp);
+        // Every patch of a culled cluster has all 64 control planes behind the eye: ptp-pcnt (the same
+        // planes in clip space, with its own rounding margin) culls it too, but for rounding.
+        EXPECT_LE(cluster_not_ptp, by_cluster / 100 + 1);
     }
 }

@@ -38,10 +38,10 @@ struct Opening {
 
 struct Wall {
     Bounds slab;
-    int axis = 0;      // 0: its thickness is along x (the wall lies in a plane x = mid), 2: along z; 1: floor, ceiling
-    float mid = 0;     // its mid-plane, where the cells meet and the portals lie
-    int line = 0;      // index into xs (axis 0) or zs (axis 2)
-    int segment = 0;   // the row (axis 0) or column (axis 2) it closes
+    int axis = 0;     // 0: its thickness is along x (the wall lies in a plane x = mid), 2: along z; 1: floor, ceiling
+    float mid = 0;    // its mid-plane, where the cells meet and the portals lie
+    int line = 0;     // index into xs (axis 0) or zs (axis 2)
+    int segment = 0;  // the row (axis 0) or column (axis 2) it closes
     std::vector<Opening> openings;
 };
 
@@ -61,8 +61,8 @@ struct Building {
 Vec3 on_wall(const Wall& w, float u, float y) { return w.axis == 0 ? Vec3{w.mid, y, u} : Vec3{u, y, w.mid}; }
 
 // Closed rooms (every wall a solid box; walls overlap at the junctions, so there are no seams).
-Building make_grid(const std::vector<float>& widths, const std::vector<float>& depths, float height,
-                   float thickness, Vec3 offset) {
+Building make_grid(const std::vector<float>& widths, const std::vector<float>& depths, float height, float thickness,
+                   Vec3 offset) {
     Building b;
     b.height = height;
     b.thickness = thickness;
@@ -206,7 +206,8 @@ bool blocked(const Building& b, DV e, DV p) {
         const DV q0{e.x + t0 * d.x, e.y + t0 * d.y, e.z + t0 * d.z};
         const DV q1{e.x + t1 * d.x, e.y + t1 * d.y, e.z + t1 * d.z};
         bool through = false;
-        for (const Opening& o : w.openings) through = through || (in_opening(w, o, q0, tol) && in_opening(w, o, q1, tol));
+        for (const Opening& o : w.openings)
+            through = through || (in_opening(w, o, q0, tol) && in_opening(w, o, q1, tol));
         if (!through) return true;
     }
     return false;
@@ -293,10 +294,18 @@ struct Sampler {
         const float across = face == 0 ? w->mid : face == 1 ? w->mid - h : w->mid + h;
         float u = between(o->u0, o->u1), y = between(o->y0, o->y1);
         switch (rng() % 4) {
-            case 0: u = o->u0; break;
-            case 1: u = o->u1; break;
-            case 2: y = o->y0; break;
-            default: y = o->y1; break;
+            case 0:
+                u = o->u0;
+                break;
+            case 1:
+                u = o->u1;
+                break;
+            case 2:
+                y = o->y0;
+                break;
+            default:
+                y = o->y1;
+                break;
         }
         const Vec3 q = on_wall(*w, u, y);
         return w->axis == 0 ? Vec3{across, q.y, q.z} : Vec3{q.x, q.y, across};
@@ -308,7 +317,8 @@ struct Sampler {
 };
 
 struct Tally {
-    long visible_points = 0, visible_through_portals = 0, hidden_in_frustum = 0, hidden_culled = 0, visible_boxes = 0, cases = 0, capped = 0;
+    long visible_points = 0, visible_through_portals = 0, hidden_in_frustum = 0, hidden_culled = 0, visible_boxes = 0,
+         cases = 0, capped = 0;
     long cells = 0, cells_reached = 0;
     int failures = 0;
 };
@@ -340,7 +350,8 @@ void run_case(std::mt19937& rng, int case_index, Tally& tally) {
     Vec3 offset{0, 0, 0};
     if (case_index % 4 == 3) {
         auto sign = [&] { return rng() % 2 ? 1.0f : -1.0f; };
-        offset = {sign() * (1e4f + 100 * unit(rng)), case_index % 8 == 7 ? 1e4f : 0.0f, sign() * (1e4f + 100 * unit(rng))};
+        offset = {sign() * (1e4f + 100 * unit(rng)), case_index % 8 == 7 ? 1e4f : 0.0f,
+                  sign() * (1e4f + 100 * unit(rng))};
     }
     const Building b = random_building(rng, offset);
     Sampler s{b, rng};
@@ -354,9 +365,12 @@ void run_case(std::mt19937& rng, int case_index, Tally& tally) {
     const bool openings = s.has_openings();
     Vec3 eye = s.in_room(0.02f), grazing_target{};
     bool grazing = false;
-    if (openings && mode < 0.15f) eye = s.in_doorway(false);
-    else if (openings && mode < 0.22f) eye = s.in_doorway(true);
-    else if (openings && mode < 0.27f) eye = s.in_doorway(false, true);
+    if (openings && mode < 0.15f)
+        eye = s.in_doorway(false);
+    else if (openings && mode < 0.22f)
+        eye = s.in_doorway(true);
+    else if (openings && mode < 0.27f)
+        eye = s.in_doorway(false, true);
     else if (openings && mode < 0.32f) {
         eye = s.on_opening_edge();
     } else if (openings && mode < 0.57f) {
@@ -364,8 +378,10 @@ void run_case(std::mt19937& rng, int case_index, Tally& tally) {
         grazing_target = s.on_opening_edge();
     }
     Vec3 dir = s.direction(0.5f);
-    if (grazing) dir = grazing_target - eye;
-    else if (openings && unit(rng) < 0.4f) dir = s.in_doorway(true) - eye + s.direction(0.3f) * 0.3f;
+    if (grazing)
+        dir = grazing_target - eye;
+    else if (openings && unit(rng) < 0.4f)
+        dir = s.in_doorway(true) - eye + s.direction(0.3f) * 0.3f;
     if (std::fabs(dir.x) + std::fabs(dir.z) < 1e-3f * length(dir)) dir = s.direction(0.5f);  // look_at needs a yaw
     const ClipDepth depth = rng() % 2 ? ClipDepth::zero_to_one : ClipDepth::minus_one_to_one;
     const float fovy = s.between(0.2f, 2.2f), aspect = s.between(0.5f, 2.5f);
@@ -373,7 +389,8 @@ void run_case(std::mt19937& rng, int case_index, Tally& tally) {
     // Points along random view rays (most points of a building are hidden; these find the seen ones).
     const Vec3 forward = normalize(dir), right = normalize(cross(forward, {0, 1, 0})), up = cross(right, forward);
     auto along_view_ray = [&] {
-        const float ty = std::tan(fovy / 2) * s.between(-1.05f, 1.05f), tx = std::tan(fovy / 2) * aspect * s.between(-1.05f, 1.05f);
+        const float ty = std::tan(fovy / 2) * s.between(-1.05f, 1.05f),
+                    tx = std::tan(fovy / 2) * aspect * s.between(-1.05f, 1.05f);
         const float near_first = s.between(0, 1);
         return eye + (forward + right * tx + up * ty) * (12 * near_first * near_first);
     };
@@ -389,9 +406,12 @@ void run_case(std::mt19937& rng, int case_index, Tally& tally) {
     for (int k = 0; k < 300; ++k) {
         const float r = unit(rng);
         Vec3 p;
-        if (r < 0.35f) p = along_view_ray();
-        else if (r < 0.65f || !openings) p = s.in_room(0);
-        else if (r < 0.8f) p = s.in_doorway(false);
+        if (r < 0.35f)
+            p = along_view_ray();
+        else if (r < 0.65f || !openings)
+            p = s.in_room(0);
+        else if (r < 0.8f)
+            p = s.in_doorway(false);
         else {
             // Beyond a point of an opening's edge, seen from the eye: rays that graze the edge.
             const Vec3 q = grazing && r < 0.9f ? grazing_target : s.on_opening_edge();
@@ -445,10 +465,12 @@ TEST(PortalCulling, EveryVisiblePointOfRandomBuildingsIsInAReachedCellAndBoxVisi
     EXPECT_GT(double(tally.hidden_culled), 0.5 * double(tally.hidden_in_frustum));
     EXPECT_LT(double(tally.cells_reached), 0.8 * double(tally.cells));
     EXPECT_GT(tally.capped, 10);
-    std::printf("portal culling: %ld cases, %ld capped, %ld visible points (%ld through portals), %ld visible boxes, %ld of %ld hidden points "
-                "in the frustum culled, %ld of %ld cells reached\n",
-                tally.cases, tally.capped, tally.visible_points, tally.visible_through_portals, tally.visible_boxes, tally.hidden_culled,
-                tally.hidden_in_frustum, tally.cells_reached, tally.cells);
+    std::printf(
+        "portal culling: %ld cases, %ld capped, %ld visible points (%ld through portals), %ld visible boxes, %ld of "
+        "%ld hidden points "
+        "in the frustum culled, %ld of %ld cells reached\n",
+        tally.cases, tally.capped, tally.visible_points, tally.visible_through_portals, tally.visible_boxes,
+        tally.hidden_culled, tally.hidden_in_frustum, tally.cells_reached, tally.cells);
     RecordProperty("visible_points", int(tally.visible_points));
     RecordProperty("hidden_culled_percent", int(100 * tally.hidden_culled / std::max(1L, tally.hidden_in_frustum)));
 }
@@ -570,16 +592,18 @@ TEST(PortalCulling, PointsExactlyOnAConeThroughAPortalEdgeAreKept) {
     for (int k = 0; k < 600; ++k) {
         const Vec3 o = k % 2 ? Vec3{8192, -4096, -12288} : Vec3{0, 0, 0};
         auto dyadic = [&](int lo, int hi) { return float(lo + int(rng() % std::uint32_t(hi - lo + 1))) / 64.0f; };
-        const std::vector<Bounds> cells = {{o + Vec3{0, 0, 0}, o + Vec3{4, 4, 4}}, {o + Vec3{4, 0, 0}, o + Vec3{8, 4, 4}}};
+        const std::vector<Bounds> cells = {{o + Vec3{0, 0, 0}, o + Vec3{4, 4, 4}},
+                                           {o + Vec3{4, 0, 0}, o + Vec3{8, 4, 4}}};
         const float x = o.x + 4, yc = o.y + dyadic(96, 160), zc = o.z + dyadic(96, 160);
         const float dy = dyadic(16, 60), dz = dyadic(16, 60);
         CellPortal window;
         window.cell_a = rng() % 2, window.cell_b = 1 - window.cell_a;
-        window.corners[0] = {x, yc - dy, zc}, window.corners[1] = {x, yc, zc + dz}, window.corners[2] = {x, yc + dy, zc},
-        window.corners[3] = {x, yc, zc - dz};
+        window.corners[0] = {x, yc - dy, zc}, window.corners[1] = {x, yc, zc + dz},
+        window.corners[2] = {x, yc + dy, zc}, window.corners[3] = {x, yc, zc - dz};
         PortalCuller culler(cells, {window});
         const Vec3 eye = o + Vec3{dyadic(64, 224), dyadic(32, 224), dyadic(32, 224)};
-        const FrustumPlanes planes = camera_planes(eye, Vec3{x, yc, zc} - eye, 2.0f, 1.0f, 0.01f, 50, ClipDepth::zero_to_one);
+        const FrustumPlanes planes =
+            camera_planes(eye, Vec3{x, yc, zc} - eye, 2.0f, 1.0f, 0.01f, 50, ClipDepth::zero_to_one);
         PortalStats stats;
         ASSERT_TRUE(culler.traverse(eye, planes, stats));
         for (int e = 0; e < 4; ++e) {

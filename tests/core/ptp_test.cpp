@@ -135,8 +135,8 @@ BezierPatch sheet(std::mt19937& rng, Vec3 c, float size, float bump, float wmin,
     BezierPatch p;
     for (int j = 0; j < 4; ++j)
         for (int i = 0; i < 4; ++i) {
-            const Vec3 pt = c + a * (i / 3.0f - 0.5f) + b * (j / 3.0f - 0.5f) +
-                            Vec3{u(rng), u(rng), u(rng)} * (bump * size);
+            const Vec3 pt =
+                c + a * (i / 3.0f - 0.5f) + b * (j / 3.0f - 0.5f) + Vec3{u(rng), u(rng), u(rng)} * (bump * size);
             p.cp[4 * j + i] = homogeneous(pt, wmin == wmax ? wmin : w(rng));
         }
     return p;
@@ -146,10 +146,14 @@ BezierPatch sheet(std::mt19937& rng, Vec3 c, float size, float bump, float wmin,
 BezierPatch collapse_edge(BezierPatch p, int e) {
     auto idx = [e](int k) {
         switch (e) {
-            case 0: return k;
-            case 1: return 4 * k + 3;
-            case 2: return 12 + k;
-            default: return 4 * k;
+            case 0:
+                return k;
+            case 1:
+                return 4 * k + 3;
+            case 2:
+                return 12 + k;
+            default:
+                return 4 * k;
         }
     };
     for (int k = 1; k < 4; ++k) p.cp[idx(k)] = p.cp[idx(0)];
@@ -163,12 +167,18 @@ BezierPatch random_patch(std::mt19937& rng, float spread) {
     const int kind = static_cast<int>(unit(rng) * 6);
     const float size = 0.3f + 2.0f * unit(rng);
     switch (kind) {
-        case 0: return sheet(rng, c, size, 0.05f, 1, 1);
-        case 1: return sheet(rng, c, size, 0.3f, 1, 1);
-        case 2: return sheet(rng, c, size, 0.2f, 0.4f, 2.5f);
-        case 3: return collapse_edge(sheet(rng, c, size, 0.15f, 1, 1), static_cast<int>(unit(rng) * 4) & 3);
-        case 4: return collapse_edge(sheet(rng, c, size, 0.15f, 0.5f, 2.0f), static_cast<int>(unit(rng) * 4) & 3);
-        default: return sheet(rng, c, size, 1.0f, 0.7f, 1.5f);  // wild, self-intersecting
+        case 0:
+            return sheet(rng, c, size, 0.05f, 1, 1);
+        case 1:
+            return sheet(rng, c, size, 0.3f, 1, 1);
+        case 2:
+            return sheet(rng, c, size, 0.2f, 0.4f, 2.5f);
+        case 3:
+            return collapse_edge(sheet(rng, c, size, 0.15f, 1, 1), static_cast<int>(unit(rng) * 4) & 3);
+        case 4:
+            return collapse_edge(sheet(rng, c, size, 0.15f, 0.5f, 2.0f), static_cast<int>(unit(rng) * 4) & 3);
+        default:
+            return sheet(rng, c, size, 1.0f, 0.7f, 1.5f);  // wild, self-intersecting
     }
 }
 
@@ -277,10 +287,9 @@ TEST(PtpTable, DefinitionGives516TermsWithTheSeedMatrix) {
     const ptp_gen::Expansion e = ptp_gen::expand_ptp();
     EXPECT_TRUE(e.reduced_exactly);
     EXPECT_EQ(e.terms.size(), 516u);
-    const std::vector<int> seed = {1, 2, 4,  5,  5,  4,  2,  1,  2, 4, 8,  10, 10, 8,  4,  2,
-                                   4, 8, 11, 17, 17, 11, 8,  4,  5, 10, 17, 21, 21, 17, 10, 5,
-                                   5, 10, 17, 21, 21, 17, 10, 5, 4, 8, 11, 17, 17, 11, 8,  4,
-                                   2, 4, 8,  10, 10, 8,  4,  2,  1, 2, 4,  5,  5,  4,  2,  1};
+    const std::vector<int> seed = {1,  2,  4, 5,  5,  4,  2,  1,  2,  4, 8, 10, 10, 8,  4,  2,  4,  8, 11, 17, 17, 11,
+                                   8,  4,  5, 10, 17, 21, 21, 17, 10, 5, 5, 10, 17, 21, 21, 17, 10, 5, 4,  8,  11, 17,
+                                   17, 11, 8, 4,  2,  4,  8,  10, 10, 8, 4, 2,  1,  2,  4,  5,  5,  4, 2,  1};
     EXPECT_EQ(ptp_gen::terms_per_destination(e.terms), seed);
     // Corner: T(0,0) = cross4(b0, 3(b1 - b0), 3(b4 - b0)) = 9 cross4(b0, b1, b4).
     EXPECT_EQ(e.terms[0].dest, 0);
@@ -350,8 +359,8 @@ TEST(PtpTable, ControlPlanesReproduceTheTangentPlane) {
     double worst = 0;
     for (int n = 0; n < 300; ++n) {
         const bool rational = n % 2 == 1;
-        BezierPatch p = sheet(rng, {0, 0, 0}, 2.0f, n % 3 == 0 ? 1.0f : 0.2f, rational ? 0.3f : 1.0f,
-                              rational ? 3.0f : 1.0f);
+        BezierPatch p =
+            sheet(rng, {0, 0, 0}, 2.0f, n % 3 == 0 ? 1.0f : 0.2f, rational ? 0.3f : 1.0f, rational ? 3.0f : 1.0f);
         if (n % 5 == 4) p = collapse_edge(p, n % 4);
         worst = std::max(worst, max_relative_plane_error(table, p, rng));
     }
@@ -407,7 +416,8 @@ TEST(PtpSchedule, ReproducesTheTableInDouble) {
             } else {
                 for (int s = kSchedule.dest_first[d]; s < kSchedule.dest_first[d + 1]; ++s) {
                     const auto& st = kSchedule.steps[s];
-                    t += st.weight * det_pair(q[kSchedule.pairs[st.pair].a], q[kSchedule.pairs[st.pair].b], q[st.third]);
+                    t +=
+                        st.weight * det_pair(q[kSchedule.pairs[st.pair].a], q[kSchedule.pairs[st.pair].b], q[st.third]);
                 }
             }
             // cross4's z component is det[[x],[y],[w]]: what the kernels compute in clip space.
@@ -646,7 +656,8 @@ TEST(PtpKernel, TeapotIsConservativeAndPcntCullsTheDegenerateTop) {
         for (int az = 0; az < 360; az += 15) {
             if (kSlowBuild && ((el > 0 && el != 40) || az % 30 != 0)) continue;
             const double e = el * kPi / 180, a = az * kPi / 180;
-            const Vec3 eye{static_cast<float>(6 * std::cos(e) * std::cos(a)), static_cast<float>(6 * std::cos(e) * std::sin(a)),
+            const Vec3 eye{static_cast<float>(6 * std::cos(e) * std::cos(a)),
+                           static_cast<float>(6 * std::cos(e) * std::sin(a)),
                            static_cast<float>(1.5 + 6 * std::sin(e))};
             const View view = make_view(eye, {0, 0, 1.5f});
             if (!kSlowBuild || az % 90 == 0) check_conservative(teapot, view, stats, "teapot ring");
@@ -660,7 +671,8 @@ TEST(PtpKernel, TeapotIsConservativeAndPcntCullsTheDegenerateTop) {
             }
         }
     for (int k : {20, 21, 22, 23}) EXPECT_GE(pcnt_only[k], 1) << "knob patch " << k << " never culled by pcnt";
-    for (int k : {28, 29, 30, 31}) EXPECT_GE(pcnt_only[k], kSlowBuild ? 1 : 50) << "bottom patch " << k << " rarely culled by pcnt";
+    for (int k : {28, 29, 30, 31})
+        EXPECT_GE(pcnt_only[k], kSlowBuild ? 1 : 50) << "bottom patch " << k << " rarely culled by pcnt";
     // Knob quarter 20 (u from +x towards -y) from the opposite side, level with the teapot's middle.
     const View opposite = make_view({-3.0f, 5.2f, 1.5f}, {0, 0, 1.5f});
     EXPECT_EQ(run_ptp(Impl::kSimd, batch.view(), opposite, PtpRule::pcnt)[20], 1);
@@ -709,7 +721,10 @@ TEST(PtpKernel, HandBuiltCasesAndOrientation) {
         Mat4 model_inv;
         ASSERT_TRUE(invert(model, model_inv));
         // Eyes given in object space, mapped to world through the model matrix.
-        auto world = [&](Vec3 o) { const Vec4 w = model * homogeneous(o); return Vec3{w.x, w.y, w.z}; };
+        auto world = [&](Vec3 o) {
+            const Vec4 w = model * homogeneous(o);
+            return Vec3{w.x, w.y, w.z};
+        };
         const View above = make_view(world({0.1f, 0.2f, 2.0f}), world({0, 0, 0}), model);
         const View below = make_view(world({0.1f, 0.2f, -2.0f}), world({0, 0, 0}), model);
         for (Impl impl : {Impl::kScalar, Impl::kSimd})
@@ -753,15 +768,18 @@ TEST(PtpKernel, ScalarAndSimdDecisionsAreIdentical) {
                 // libm, ~50x slower: they get a 10007-patch prefix.
                 const bool fast = target <= HWY_AVX2;  // x86 targets: better = lower bit
                 const std::size_t n_all = fast ? kCount : kSlowBuild ? 2003 : 10007;
-                const std::vector<std::uint8_t> simd = run_ptp(Impl::kSimd, batch.view().subrange(0, n_all), view, rule);
+                const std::vector<std::uint8_t> simd =
+                    run_ptp(Impl::kSimd, batch.view().subrange(0, n_all), view, rule);
                 std::size_t diff = 0;
                 for (std::size_t i = 0; i < n_all; ++i) diff += simd[i] != ref[i];
                 EXPECT_EQ(diff, 0u);
                 compared += n_all;
                 // Subranges at odd offsets and lengths (tails of every size).
                 for (std::size_t first : {std::size_t{1}, std::size_t{17}, std::size_t{4099}})
-                    for (std::size_t n : {std::size_t{1}, std::size_t{7}, std::size_t{15}, std::size_t{33}, std::size_t{1001}}) {
-                        const std::vector<std::uint8_t> sub = run_ptp(Impl::kSimd, batch.view().subrange(first, n), view, rule);
+                    for (std::size_t n :
+                         {std::size_t{1}, std::size_t{7}, std::size_t{15}, std::size_t{33}, std::size_t{1001}}) {
+                        const std::vector<std::uint8_t> sub =
+                            run_ptp(Impl::kSimd, batch.view().subrange(first, n), view, rule);
                         for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(sub[i], ref[first + i]) << first << "+" << i;
                     }
             });

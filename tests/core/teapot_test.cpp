@@ -27,10 +27,18 @@ std::array<Vec3, 4> edge(const BezierPatch& p, int e) {
     std::array<Vec3, 4> r;
     for (int k = 0; k < 4; ++k) {
         switch (e) {
-            case 0: r[k] = point(p, k, 0); break;
-            case 1: r[k] = point(p, 3, k); break;
-            case 2: r[k] = point(p, k, 3); break;
-            default: r[k] = point(p, 0, k); break;
+            case 0:
+                r[k] = point(p, k, 0);
+                break;
+            case 1:
+                r[k] = point(p, 3, k);
+                break;
+            case 2:
+                r[k] = point(p, k, 3);
+                break;
+            default:
+                r[k] = point(p, 0, k);
+                break;
         }
     }
     return r;
@@ -48,10 +56,18 @@ std::array<Vec3, 4> reversed(std::array<Vec3, 4> a) {
 // (u, v) of parameter t along edge e.
 void edge_uv(int e, float t, float& u, float& v) {
     switch (e) {
-        case 0: u = t, v = 0; break;
-        case 1: u = 1, v = t; break;
-        case 2: u = t, v = 1; break;
-        default: u = 0, v = t; break;
+        case 0:
+            u = t, v = 0;
+            break;
+        case 1:
+            u = 1, v = t;
+            break;
+        case 2:
+            u = t, v = 1;
+            break;
+        default:
+            u = 0, v = t;
+            break;
     }
 }
 

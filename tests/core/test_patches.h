@@ -35,8 +35,7 @@ inline Bounds control_point_bounds(const std::vector<BezierPatch>& patches) {
 inline BezierPatch flat_patch(float x0, float y0, float z, bool flipped) {
     BezierPatch p;
     for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i)
-            p.cp[4 * j + i] = {x0 + i / 3.0f, flipped ? y0 - j / 3.0f : y0 + j / 3.0f, z, 1.0f};
+        for (int i = 0; i < 4; ++i) p.cp[4 * j + i] = {x0 + i / 3.0f, flipped ? y0 - j / 3.0f : y0 + j / 3.0f, z, 1.0f};
     return p;
 }
 

@@ -35,8 +35,8 @@ bool contains(const Bounds& outer, const Bounds& inner) {
 }
 
 bool same(const Bounds& a, const Bounds& b) {
-    return a.min.x == b.min.x && a.min.y == b.min.y && a.min.z == b.min.z && a.max.x == b.max.x &&
-           a.max.y == b.max.y && a.max.z == b.max.z;
+    return a.min.x == b.min.x && a.min.y == b.min.y && a.min.z == b.min.z && a.max.x == b.max.x && a.max.y == b.max.y &&
+           a.max.z == b.max.z;
 }
 
 // Exact union of the non-empty boxes (independent of the implementation).
@@ -86,7 +86,8 @@ std::vector<Bounds> random_object(std::mt19937& rng, std::size_t n, Vec3 offset)
     const std::size_t blobs = 1 + std::size_t(unit(rng) * 6);
     std::vector<Bounds> pieces;
     for (std::size_t b = 0; b < blobs; ++b) {
-        const std::size_t count = b + 1 == blobs ? n - pieces.size() : std::min(n - pieces.size(), std::size_t(unit(rng) * n / 2));
+        const std::size_t count =
+            b + 1 == blobs ? n - pieces.size() : std::min(n - pieces.size(), std::size_t(unit(rng) * n / 2));
         add_blob(rng, pieces, count, offset + Vec3{u(rng), u(rng), u(rng)} * 3.0f, 0.1f + unit(rng));
     }
     return pieces;

@@ -29,8 +29,8 @@
 #include "core/ptp_schedule.h"
 #include "gl/gl_test_util.h"
 #include "patchcull/core/backpatch.h"
-#include "patchcull/gl/gl_backpatch.h"
 #include "patchcull/core/teapot.h"
+#include "patchcull/gl/gl_backpatch.h"
 
 namespace patchcull::gl {
 namespace {
@@ -74,7 +74,8 @@ std::string ptp_schedule_glsl() {
     o << "// shaders/ptp_schedule.h (GLSL only): the ptp kernels' evaluation schedule, GENERATED from\n"
          "// src/core/ptp_schedule.h's kSchedule (itself built from src/core/ptp_table.inc) by\n"
          "// tests/gl/backpatch_gpu_test.cpp, which fails when this file differs: do not edit. Regenerate:\n"
-         "//   PATCHCULL_WRITE_PTP_GLSL=1 <build>/tests/patchcull_gl_tests --gtest_filter=BackpatchGpu.PtpScheduleHeader*\n"
+         "//   PATCHCULL_WRITE_PTP_GLSL=1 <build>/tests/patchcull_gl_tests "
+         "--gtest_filter=BackpatchGpu.PtpScheduleHeader*\n"
          "// Used by backpatch_ptp.comp.glsl; the meaning of each array is that of ptp_schedule.h's Schedule:\n"
          "// - kPtpPairs[q] = a | b << 8: the point pairs (a < b) whose 2x2 minors (of (a, b - a)) are shared;\n"
          "// - kPtpSteps[s] = pair | third << 8 and kPtpStepWeights[s] (float bits, the table weight with the\n"
@@ -103,8 +104,9 @@ std::string ptp_schedule_glsl() {
         const ptp_detail::Corner& c = kSchedule.corners[i];
         return hex32(c.dest | (c.a << 8) | (c.b << 16) | (std::uint32_t(c.c) << 24));
     });
-    emit_array<std::uint32_t>(o, "uint", "kPtpCornerWeights", 4, 4,
-                              [&](std::size_t i) { return hex32(std::bit_cast<std::uint32_t>(kSchedule.corners[i].weight)); });
+    emit_array<std::uint32_t>(o, "uint", "kPtpCornerWeights", 4, 4, [&](std::size_t i) {
+        return hex32(std::bit_cast<std::uint32_t>(kSchedule.corners[i].weight));
+    });
     o << "const uint kPtpMarginC1 = " << hex32(std::bit_cast<std::uint32_t>(ptp_detail::kMarginC1)) << ";\n";
     o << "const uint kPtpMarginC2 = " << hex32(std::bit_cast<std::uint32_t>(ptp_detail::kMarginC2)) << ";\n";
     o << "const uint kPtpMarginC3 = " << hex32(std::bit_cast<std::uint32_t>(ptp_detail::kMarginC3)) << ";\n";
@@ -135,13 +137,17 @@ TEST(BackpatchGpu, PtpScheduleHeaderMatchesCore) {
 TEST(BackpatchGpu, ConeConstantsMatchCore) {
     const std::string text = read_text(fs::path(PATCHCULL_SOURCE_DIR) / "shaders/backpatch_cones.h");
     namespace cd = cones_detail;
-    const std::pair<const char*, float> constants[] = {
-        {"kMinLen2", cd::kMinLen2},         {"kMaxLen2", cd::kMaxLen2},         {"kCosSlack", cd::kCosSlack},
-        {"kSinSlack", cd::kSinSlack},       {"kNormalRoundoff", cd::kNormalRoundoff},
-        {"kRadiusScale", cd::kRadiusScale}, {"kFacingSlack", cd::kFacingSlack}};
+    const std::pair<const char*, float> constants[] = {{"kMinLen2", cd::kMinLen2},
+                                                       {"kMaxLen2", cd::kMaxLen2},
+                                                       {"kCosSlack", cd::kCosSlack},
+                                                       {"kSinSlack", cd::kSinSlack},
+                                                       {"kNormalRoundoff", cd::kNormalRoundoff},
+                                                       {"kRadiusScale", cd::kRadiusScale},
+                                                       {"kFacingSlack", cd::kFacingSlack}};
     for (const auto& [name, value] : constants) {
         char buf[96];
-        std::snprintf(buf, sizeof buf, "#define %s uintBitsToFloat(0x%08Xu)", name, std::bit_cast<std::uint32_t>(value));
+        std::snprintf(buf, sizeof buf, "#define %s uintBitsToFloat(0x%08Xu)", name,
+                      std::bit_cast<std::uint32_t>(value));
         EXPECT_NE(text.find(buf), std::string::npos) << "shaders/backpatch_cones.h lacks `" << buf << "`";
     }
 }
@@ -161,7 +167,8 @@ TEST(BackpatchGpu, FmaDivisionAndSqrtAreCorrectlyRounded) {
     for (int i = 0; i < 20000; ++i) {
         const float a = random_float(rng, -20, 20), b = random_float(rng, -20, 20);
         // c near -a*b half the time (cancellation), else random.
-        const float c = i % 2 ? -(a * b) * (1.0f + std::ldexp(random_float(rng, -1, 0), -20)) : random_float(rng, -40, 40);
+        const float c =
+            i % 2 ? -(a * b) * (1.0f + std::ldexp(random_float(rng, -1, 0), -20)) : random_float(rng, -40, 40);
         in.push_back({a, b, c});
     }
     // Near-midpoint cases (the renderer's fma check) and quotients / roots of nearby values.
@@ -180,7 +187,8 @@ TEST(BackpatchGpu, FmaDivisionAndSqrtAreCorrectlyRounded) {
     for (std::size_t i = 0; i < in.size(); ++i) {
         const float ef = std::fma(in[i].x, in[i].y, in[i].z);
         // Subnormal results are flushed on llvmpipe (documented): skip them.
-        if (std::fabs(ef) >= 0x1p-126f || ef == 0.0f) bad_fma += std::bit_cast<std::uint32_t>(fma[i]) != std::bit_cast<std::uint32_t>(ef);
+        if (std::fabs(ef) >= 0x1p-126f || ef == 0.0f)
+            bad_fma += std::bit_cast<std::uint32_t>(fma[i]) != std::bit_cast<std::uint32_t>(ef);
         bad_div += std::bit_cast<std::uint32_t>(div[i]) != std::bit_cast<std::uint32_t>(div_in[i].x / div_in[i].y);
         bad_sqrt += std::bit_cast<std::uint32_t>(sq[i]) != std::bit_cast<std::uint32_t>(std::sqrt(sqrt_in[i].x));
     }
@@ -279,16 +287,22 @@ void check_cones(BackpatchMethod method) {
     bool first_eye = true;
     for (const Vec3 eye : test_eyes()) {
         std::vector<std::uint8_t> cpu(patches.size()), gpu;
-        if (tcone) cull_tcone_scalar(batch.view(), eye, cpu.data());
-        else cull_ncone_scalar(batch.view(), eye, cpu.data());
+        if (tcone)
+            cull_tcone_scalar(batch.view(), eye, cpu.data());
+        else
+            cull_ncone_scalar(batch.view(), eye, cpu.data());
         if (first_eye) {
             // The cones and spheres themselves, bit for bit (valid cones; invalid ones only as invalid).
             std::vector<float> cones;
-            if (tcone) c.cull_tcone(eye, &gpu, &cones);
-            else c.cull_ncone(eye, &gpu, &cones);
+            if (tcone)
+                c.cull_tcone(eye, &gpu, &cones);
+            else
+                c.cull_ncone(eye, &gpu, &cones);
             ASSERT_EQ(cones.size(), patches.size() * 12);
             std::size_t valid = 0, bad = 0;
-            auto same = [](float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); };
+            auto same = [](float a, float b) {
+                return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
+            };
             for (std::size_t p = 0; p < patches.size(); ++p) {
                 const NormalCone cone = tcone ? cones_detail::tangent_cone_polynomial(patches[p])
                                               : cones_detail::normal_cone_polynomial(patches[p]);
@@ -302,12 +316,13 @@ void check_cones(BackpatchMethod method) {
                          same(g[3], cone.cos_angle) && same(g[4], cone.sin_angle);
                 }
                 if (!ok && bad++ < 5)
-                    ADD_FAILURE() << backpatch_method_name(method) << " patch " << p << ": GPU cone/sphere differs: valid "
-                                  << g[5] << " vs " << cone.valid << ", cos " << g[3] << " vs " << cone.cos_angle << ", sin "
-                                  << g[4] << " vs " << cone.sin_angle << ", radius " << g[9] << " vs " << sphere.radius;
+                    ADD_FAILURE() << backpatch_method_name(method) << " patch " << p
+                                  << ": GPU cone/sphere differs: valid " << g[5] << " vs " << cone.valid << ", cos "
+                                  << g[3] << " vs " << cone.cos_angle << ", sin " << g[4] << " vs " << cone.sin_angle
+                                  << ", radius " << g[9] << " vs " << sphere.radius;
             }
-            std::printf("[ %s ] cones: %zu valid of %zu, %zu differ from the CPU's (bitwise)\n", backpatch_method_name(method),
-                        valid, patches.size(), bad);
+            std::printf("[ %s ] cones: %zu valid of %zu, %zu differ from the CPU's (bitwise)\n",
+                        backpatch_method_name(method), valid, patches.size(), bad);
             EXPECT_EQ(bad, 0u);
             EXPECT_GT(valid, patches.size() / 2);
             first_eye = false;
@@ -316,10 +331,10 @@ void check_cones(BackpatchMethod method) {
         }
         ASSERT_EQ(gpu.size(), patches.size());
         const Comparison r = compare(cpu, gpu);
-        EXPECT_EQ(r.gpu_only, 0u) << backpatch_method_name(method) << ": GPU culls patches the CPU keeps, eye "
-                                  << eye.x << " " << eye.y << " " << eye.z;
-        EXPECT_EQ(r.cpu_only, 0u) << backpatch_method_name(method) << ": CPU culls patches the GPU keeps, eye "
-                                  << eye.x << " " << eye.y << " " << eye.z;
+        EXPECT_EQ(r.gpu_only, 0u) << backpatch_method_name(method) << ": GPU culls patches the CPU keeps, eye " << eye.x
+                                  << " " << eye.y << " " << eye.z;
+        EXPECT_EQ(r.cpu_only, 0u) << backpatch_method_name(method) << ": CPU culls patches the GPU keeps, eye " << eye.x
+                                  << " " << eye.y << " " << eye.z;
         all.total += r.total, all.cpu_culled += r.cpu_culled, all.gpu_culled += r.gpu_culled;
         all.gpu_only += r.gpu_only, all.cpu_only += r.cpu_only;
     }
@@ -397,21 +412,25 @@ TEST(BackpatchGpu, PtpDecisionsAndPlanesEqualCpu) {
                 ASSERT_TRUE(ptp_detail::ptp_rounding_margins(patches[p], rows, thr));
                 for (int d = 0; d < 64; ++d) {
                     planes_total += 2;
-                    const bool t_equal = std::bit_cast<std::uint32_t>(t[d]) == std::bit_cast<std::uint32_t>(planes[64 * p + d]);
+                    const bool t_equal =
+                        std::bit_cast<std::uint32_t>(t[d]) == std::bit_cast<std::uint32_t>(planes[64 * p + d]);
                     const bool thr_equal =
                         std::bit_cast<std::uint32_t>(thr[d]) == std::bit_cast<std::uint32_t>(margins[64 * p + d]);
                     if (!t_equal || !thr_equal) {
                         if (plane_mismatch < 5)
-                            ADD_FAILURE() << "view " << v << " patch " << p << " d " << d << ": CPU t " << t[d] << " thr "
-                                          << thr[d] << ", GPU t " << planes[64 * p + d] << " thr " << margins[64 * p + d];
+                            ADD_FAILURE()
+                                << "view " << v << " patch " << p << " d " << d << ": CPU t " << t[d] << " thr "
+                                << thr[d] << ", GPU t " << planes[64 * p + d] << " thr " << margins[64 * p + d];
                         plane_mismatch += !t_equal + !thr_equal;
                     }
                 }
             }
         }
     }
-    std::printf("[ ptp ] %zu decisions, CPU culled %zu, GPU culled %zu, GPU-only %zu, CPU-only %zu; planes and margins %zu of %zu differ\n",
-                all.total, all.cpu_culled, all.gpu_culled, all.gpu_only, all.cpu_only, plane_mismatch, planes_total);
+    std::printf(
+        "[ ptp ] %zu decisions, CPU culled %zu, GPU culled %zu, GPU-only %zu, CPU-only %zu; planes and margins %zu of "
+        "%zu differ\n",
+        all.total, all.cpu_culled, all.gpu_culled, all.gpu_only, all.cpu_only, plane_mismatch, planes_total);
     EXPECT_EQ(plane_mismatch, 0u);
     EXPECT_GT(all.cpu_culled, all.total / 10);
 }
@@ -447,7 +466,8 @@ TEST(BackpatchGpu, PtpCullsNothingForDegenerateViewsAndSmallSets) {
             const Vec3 eye{0.3f, 0.2f, -8};
             if (m == BackpatchMethod::tcone) cull_tcone_scalar(b.view(), eye, cc.data());
             if (m == BackpatchMethod::ncone) cull_ncone_scalar(b.view(), eye, cc.data());
-            if (m == BackpatchMethod::ptp) cull_ptp_scalar(b.view(), below.object_to_clip, below.alpha, PtpRule::pcnt, cc.data());
+            if (m == BackpatchMethod::ptp)
+                cull_ptp_scalar(b.view(), below.object_to_clip, below.alpha, PtpRule::pcnt, cc.data());
             c.cull(m, below.object_to_clip, eye, below.alpha, PtpRule::pcnt, &gpu);
             EXPECT_EQ(gpu, cc) << backpatch_method_name(m) << " with " << n << " patches";
         }

@@ -163,7 +163,7 @@ TEST(CullAutoPolicy, ObjectsThatCannotPayAreProbedOnlyEveryFourIntervals) {
     CullAutoPolicy policy(two_objects(), 200, config);
     policy.set_costs(costs(0.001, 0.002, 0.010, 0.0));
     policy.decide(kLevel8);
-    policy.observe(untimed_frame({50, 10}));  // frame 0: both culled
+    policy.observe(untimed_frame({50, 10}));            // frame 0: both culled
     policy.set_costs(costs(0.001, 0.002, 0.002, 0.0));  // x = 1.5
     std::vector<int> probes;
     for (int frame = 1; frame <= 9; ++frame) {
@@ -187,7 +187,8 @@ TEST(CullAutoPolicy, TheFrameRuleTurnsEverythingOffWhenTheHiZBuildCostsMoreThanT
     policy.observe(untimed_frame({50, 10}));
     const auto& d = policy.decide(kLevel8);
     EXPECT_FALSE(d[0].cull);
-    EXPECT_NE(d[0].reason.find("rate 0.50 > break-even 0.30; the frame would save 0.20 ms <= 1.10 ms"), std::string::npos)
+    EXPECT_NE(d[0].reason.find("rate 0.50 > break-even 0.30; the frame would save 0.20 ms <= 1.10 ms"),
+              std::string::npos)
         << d[0].reason;
     EXPECT_EQ(policy.frame_cull_mode(gl::CullMode::all), gl::CullMode::none);
     policy.observe(untimed_frame({0, 0}));
@@ -326,7 +327,8 @@ TEST(CullAutoCli, JsonHasTheObjectsOfEveryFrameAndVerifiesWithoutFalseCulls) {
     // Level 1: on llvmpipe the measured costs switch every object off after the bootstrap frames
     // (machine-dependent, so not asserted): the frames that turn culling off draw the patches
     // culled before as newly visible, and must still match the unculled render.
-    const cli_test::CliRun low = cli_test::run("render default --size 96x54 --tess 1 --frames 6 --cull auto --verify --json");
+    const cli_test::CliRun low =
+        cli_test::run("render default --size 96x54 --tess 1 --frames 6 --cull auto --verify --json");
     ASSERT_EQ(low.status, 0) << low.err;
     EXPECT_EQ(nlohmann::json::parse(low.out)["false_culls"], 0);
 
@@ -340,10 +342,12 @@ TEST(CullAutoCli, TextOutputHasOneAutoLinePerFrame) {
     const cli_test::CliRun r = cli_test::run(kSmallAuto);
     ASSERT_EQ(r.status, 0) << r.err;
     std::size_t lines = 0;
-    for (std::size_t at = r.out.find("auto: culling "); at != std::string::npos; at = r.out.find("auto: culling ", at + 1))
+    for (std::size_t at = r.out.find("auto: culling "); at != std::string::npos;
+         at = r.out.find("auto: culling ", at + 1))
         ++lines;
     EXPECT_EQ(lines, 4u) << r.out;
-    EXPECT_NE(r.out.find("auto: culling 6 of 6 objects: bigguy#0 on (probe: costs not measured yet)"), std::string::npos)
+    EXPECT_NE(r.out.find("auto: culling 6 of 6 objects: bigguy#0 on (probe: costs not measured yet)"),
+              std::string::npos)
         << r.out;
 }
 

@@ -1,7 +1,7 @@
 // CullPipeline (patchcull/gl/gl_pipeline.h): the GPU back-patch pass in the frame of Niessner & Loop,
 // "Patch-Based Occlusion Culling for Hardware Tessellation" §3 (the flag
-// chain of gl_passes.h), and the per-object switch (PipelineParams::objects). For tcone, ncone and ptp: the frame culls exactly the patches the
-// CPU scalar kernel culls (every patch is inside the frustum), the final id buffer equals the
+// chain of gl_passes.h), and the per-object switch (PipelineParams::objects). For tcone, ncone and ptp: the frame culls
+// exactly the patches the CPU scalar kernel culls (every patch is inside the frustum), the final id buffer equals the
 // unculled render's (no false cull), and after update_patches the pass reads the new pose.
 // Small: BigGuy (1450 patches; a closed surface, as back-patch culling requires), 64x64, level 2.
 #include <gtest/gtest.h>
@@ -42,8 +42,12 @@ std::size_t cpu_culled(BackpatchMethod method, const std::vector<BezierPatch>& p
     std::vector<std::uint8_t> culled(patches.size());
     const Mat4 object_to_clip = rp.projection * rp.view;
     switch (method) {
-        case BackpatchMethod::tcone: cull_tcone_scalar(batch.view(), eye_of_view(rp.view), culled.data()); break;
-        case BackpatchMethod::ncone: cull_ncone_scalar(batch.view(), eye_of_view(rp.view), culled.data()); break;
+        case BackpatchMethod::tcone:
+            cull_tcone_scalar(batch.view(), eye_of_view(rp.view), culled.data());
+            break;
+        case BackpatchMethod::ncone:
+            cull_ncone_scalar(batch.view(), eye_of_view(rp.view), culled.data());
+            break;
         case BackpatchMethod::ptp:
             cull_ptp_scalar(batch.view(), object_to_clip, clip_space_eye_alpha(rp.projection), PtpRule::ncnt,
                             culled.data());

@@ -52,7 +52,8 @@ GLuint depth_texture(GLenum format, int width, int height, const std::vector<flo
             std::memcpy(&words[2 * i], &depth[i], 4);
             words[2 * i + 1] = 0x5Au;
         }
-        glTextureSubImage2D(tex, 0, 0, 0, width, height, GL_DEPTH_STENCIL, GL_FLOAT_32_UNSIGNED_INT_24_8_REV, words.data());
+        glTextureSubImage2D(tex, 0, 0, 0, width, height, GL_DEPTH_STENCIL, GL_FLOAT_32_UNSIGNED_INT_24_8_REV,
+                            words.data());
     } else {  // GL_DEPTH24_STENCIL8
         std::vector<std::uint32_t> words(n);
         for (std::size_t i = 0; i < n; ++i)
@@ -84,7 +85,8 @@ struct RawPatches {
     std::size_t count = 0;
     RawPatches(const std::vector<BezierPatch>& patches, float margin) : count(patches.size()) {
         glCreateBuffers(1, &points);
-        glNamedBufferData(points, static_cast<GLsizeiptr>(patches.size() * sizeof(BezierPatch)), patches.data(), GL_STATIC_DRAW);
+        glNamedBufferData(points, static_cast<GLsizeiptr>(patches.size() * sizeof(BezierPatch)), patches.data(),
+                          GL_STATIC_DRAW);
         const std::vector<std::uint32_t> zero(count, 0u);
         glCreateBuffers(1, &flags);
         glNamedBufferData(flags, static_cast<GLsizeiptr>(count * 4), zero.data(), GL_DYNAMIC_COPY);
@@ -96,9 +98,7 @@ struct RawPatches {
         const GLuint b[] = {points, flags, margins};
         glDeleteBuffers(3, b);
     }
-    PatchBuffers buffers(bool with_margins) const {
-        return {points, flags, with_margins ? margins : 0u, 0, count};
-    }
+    PatchBuffers buffers(bool with_margins) const { return {points, flags, with_margins ? margins : 0u, 0, count}; }
     std::vector<std::uint32_t> words() const {
         std::vector<std::uint32_t> w(count);
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
@@ -116,7 +116,10 @@ void expect_only_base_culled(const std::string& name, const BezierPatch& base, f
     for (std::size_t i = 1; i < w.size(); ++i) {
         const std::size_t j = i - 1;
         EXPECT_EQ(w[i] & shared::kCullReasonMask, 0u)
-            << name << ": point " << j / 12 << " component " << j / 3 % 4 << " value " << (j % 3 == 0 ? "NaN" : j % 3 == 1 ? "+Inf" : "-Inf");
+            << name << ": point " << j / 12 << " component " << j / 3 % 4 << " value "
+            << (j % 3 == 0   ? "NaN"
+                : j % 3 == 1 ? "+Inf"
+                             : "-Inf");
     }
 }
 
@@ -153,7 +156,8 @@ TEST(DepthConventionsGpu, HiZBuildReadsEveryDepthFormatInEveryDirection) {
                                 far_end = std::max(far_end, is_reversed(convention) ? -(v - 0.5L) / 16777215.0L
                                                                                     : (v + 0.5L) / 16777215.0L);
                             }
-                        const float g = gpu[cpu.level(0).offset + static_cast<std::size_t>(ty) * cpu.level(0).width + tx];
+                        const float g =
+                            gpu[cpu.level(0).offset + static_cast<std::size_t>(ty) * cpu.level(0).width + tx];
                         EXPECT_GE(static_cast<long double>(g), far_end) << format << " texel " << tx << "," << ty;
                         EXPECT_LE(static_cast<long double>(g), far_end + 4.0L / 16777215.0L) << format;
                     }
@@ -161,7 +165,8 @@ TEST(DepthConventionsGpu, HiZBuildReadsEveryDepthFormatInEveryDirection) {
                 cpu.build(depth.data(), W, H, convention);
                 ASSERT_EQ(gpu.size(), cpu.size());
                 for (std::size_t t = 0; t < gpu.size(); ++t)
-                    ASSERT_EQ(gpu[t], cpu.data()[t]) << "format " << format << " " << clip_depth_name(convention) << " texel " << t;
+                    ASSERT_EQ(gpu[t], cpu.data()[t])
+                        << "format " << format << " " << clip_depth_name(convention) << " texel " << t;
             }
             glDeleteTextures(1, &hiz.texture);
         }
@@ -201,11 +206,13 @@ TEST(DepthConventionsGpu, NoPassCullsAPatchWithANonFiniteCoordinate) {
         HiZTexture hiz = create_hiz_texture(64, 64);
         build.run(tex, hiz, depth);
         const FrustumPlanes planes = make_frustum_planes(m, depth);
-        expect_only_base_culled("FrustumPass" + tag, outside, 0.0f, [&](const PatchBuffers& b) { frustum.run(b, planes); });
-        expect_only_base_culled("FrustumPass margins" + tag, outside, 0.25f,
-                                [&](const PatchBuffers& b) { frustum.run(b, planes); }, true);
-        expect_only_base_culled("FrustumDispPass" + tag, outside, 0.25f,
-                                [&](const PatchBuffers& b) { frustum_disp.run(b, m, depth); }, true);
+        expect_only_base_culled("FrustumPass" + tag, outside, 0.0f,
+                                [&](const PatchBuffers& b) { frustum.run(b, planes); });
+        expect_only_base_culled(
+            "FrustumPass margins" + tag, outside, 0.25f, [&](const PatchBuffers& b) { frustum.run(b, planes); }, true);
+        expect_only_base_culled(
+            "FrustumDispPass" + tag, outside, 0.25f, [&](const PatchBuffers& b) { frustum_disp.run(b, m, depth); },
+            true);
         for (const BezierPatch* base : {&outside, &behind_wall}) {
             const std::string which = base == &outside ? " outside" : " occluded";
             expect_only_base_culled("OcclusionPass" + which + tag, *base, 0.0f,
@@ -227,9 +234,8 @@ TEST(DepthConventionsGpu, NoPassCullsAPatchWithANonFiniteCoordinate) {
                             [&](const PatchBuffers& b) { cones.run(b, BackpatchMethod::tcone, camera.eye); });
     expect_only_base_culled("BackpatchConePass ncone", facing_away, 0.0f,
                             [&](const PatchBuffers& b) { cones.run(b, BackpatchMethod::ncone, camera.eye); });
-    expect_only_base_culled("BackpatchPtpPass", facing_away, 0.0f, [&](const PatchBuffers& b) {
-        ptp.run(b, camera.view_projection(), alpha, PtpRule::ncnt);
-    });
+    expect_only_base_culled("BackpatchPtpPass", facing_away, 0.0f,
+                            [&](const PatchBuffers& b) { ptp.run(b, camera.view_projection(), alpha, PtpRule::ncnt); });
 }
 
 // The strict id-buffer test in every convention: the same scene and camera path drawn, culled and
@@ -265,7 +271,8 @@ TEST(DepthConventionsGpu, RenderVerifiesEveryModeInEveryConvention) {
     for (const auto& [case_args, culls] : cases) {
         long reference_occluded = -1, reference_frustum = -1;
         for (const char* convention : {"zero-to-one", "minus-one-to-one", "reversed", "reversed-infinite"}) {
-            const std::string args = "render " + case_args + " --size 64x48 --tess 2 --clip-depth " + convention + " --verify --json";
+            const std::string args =
+                "render " + case_args + " --size 64x48 --tess 2 --clip-depth " + convention + " --verify --json";
             const CliRun r = run(args);
             ASSERT_EQ(r.status, 0) << args << "\n" << r.err;
             const auto j = nlohmann::json::parse(r.out);

@@ -26,8 +26,8 @@
 #include "gl/gl_test_util.h"
 #include "patchcull/core/camera.h"
 #include "patchcull/core/displaced_bounds.h"
-#include "patchcull/gl/gl_displaced.h"
 #include "patchcull/core/hiz.h"
+#include "patchcull/gl/gl_displaced.h"
 
 namespace patchcull::gl {
 namespace {
@@ -75,13 +75,20 @@ DisplacementRange random_range(std::mt19937& rng, double size) {
     std::uniform_real_distribution<double> unit(0, 1);
     auto magnitude = [&] { return float(size * std::pow(10.0, -3 + 3.0 * unit(rng))); };
     switch (rng() % 10) {
-        case 0: return {};
-        case 1: return {-0.0f, 0.0f};
-        case 2: return {0.0f, magnitude()};
-        case 3: return {-magnitude(), 0.0f};
-        case 4: return {0.5f * magnitude(), magnitude()};  // excludes 0: widened to [0, d_max]
-        case 5: return {-magnitude() * 20.0f, magnitude() * 20.0f};
-        default: return {-magnitude(), magnitude()};
+        case 0:
+            return {};
+        case 1:
+            return {-0.0f, 0.0f};
+        case 2:
+            return {0.0f, magnitude()};
+        case 3:
+            return {-magnitude(), 0.0f};
+        case 4:
+            return {0.5f * magnitude(), magnitude()};  // excludes 0: widened to [0, d_max]
+        case 5:
+            return {-magnitude() * 20.0f, magnitude() * 20.0f};
+        default:
+            return {-magnitude(), magnitude()};
     }
 }
 
@@ -155,11 +162,13 @@ std::vector<TestView> make_views(const Scene& s, unsigned seed) {
     ViewGenerator free_views(s.bounds, ViewMode::free, seed + 1, aspect);
     for (int i = 0; i < 2; ++i) {
         const Camera c = contain.next();
-        views.push_back({"contain " + std::to_string(i), make_displaced_cull_view(c.view(), c.projection(), ClipDepth::zero_to_one)});
+        views.push_back({"contain " + std::to_string(i),
+                         make_displaced_cull_view(c.view(), c.projection(), ClipDepth::zero_to_one)});
     }
     for (int i = 0; i < 2; ++i) {
         const Camera c = free_views.next();
-        views.push_back({"free " + std::to_string(i), make_displaced_cull_view(c.view(), c.projection(), ClipDepth::zero_to_one)});
+        views.push_back(
+            {"free " + std::to_string(i), make_displaced_cull_view(c.view(), c.projection(), ClipDepth::zero_to_one)});
     }
     {
         // The eye 0.02 in front of a teapot patch's centre, looking across the scene.
@@ -177,7 +186,8 @@ std::vector<TestView> make_views(const Scene& s, unsigned seed) {
     {
         std::mt19937 rng(seed);
         const Camera c = contain.next();
-        views.push_back({"non-rigid model", make_displaced_cull_view(c.view() * random_model(rng), c.projection(), ClipDepth::zero_to_one)});
+        views.push_back({"non-rigid model", make_displaced_cull_view(c.view() * random_model(rng), c.projection(),
+                                                                     ClipDepth::zero_to_one)});
     }
     for (const TestView& v : views) EXPECT_TRUE(v.view.valid) << v.name;
     return views;
@@ -188,10 +198,12 @@ std::vector<TestView> make_views(const Scene& s, unsigned seed) {
 HiZPyramid make_hiz(const Scene& s, const DisplacedCullView& view, std::mt19937& rng) {
     std::vector<DisplacedBound> b(s.patches.size());
     const PatchBatch batch = test::unchecked_batch(s.patches);
-    compute_displaced_bounds(batch.view(), s.ranges.data(), DisplacedBoundKind::caf, NormalConeKind::full, view, b.data());
+    compute_displaced_bounds(batch.view(), s.ranges.data(), DisplacedBoundKind::caf, NormalConeKind::full, view,
+                             b.data());
     std::vector<float> near;
     for (const DisplacedBound& x : b)
-        if (x.status == kDisplacedBoundProjected && x.depth_near >= 0.0f && x.depth_near <= 1.0f) near.push_back(x.depth_near);
+        if (x.status == kDisplacedBoundProjected && x.depth_near >= 0.0f && x.depth_near <= 1.0f)
+            near.push_back(x.depth_near);
     std::sort(near.begin(), near.end());
     const float lo = near.empty() ? 0.5f : near[near.size() / 5], hi = near.empty() ? 0.9f : near[near.size() * 4 / 5];
     std::vector<float> depth(static_cast<std::size_t>(kScreenW) * kScreenH, 1.0f);
@@ -293,11 +305,12 @@ TEST(DisplacedGpu, DecisionsAndBoundsEqualTheCpu) {
     for (DisplacedBoundKind b : kBounds)
         for (NormalConeKind c : kCones) {
             const Tally& t = tally[index++];
-            std::printf("[ displaced ] %-9s %zu decisions: frustum equal %zu (culled %zu), occlusion equal %zu "
-                        "(occluded %zu), bounds bit-identical %zu; projected %zu, outside-plane %zu, "
-                        "unprojectable %zu, invalid %zu\n",
-                        combo_name(b, c).c_str(), t.decisions, t.frustum_equal, t.frustum_culled, t.occlusion_equal,
-                        t.occluded, t.bounds_equal, t.projected, t.outside_plane, t.unprojectable, t.invalid);
+            std::printf(
+                "[ displaced ] %-9s %zu decisions: frustum equal %zu (culled %zu), occlusion equal %zu "
+                "(occluded %zu), bounds bit-identical %zu; projected %zu, outside-plane %zu, "
+                "unprojectable %zu, invalid %zu\n",
+                combo_name(b, c).c_str(), t.decisions, t.frustum_equal, t.frustum_culled, t.occlusion_equal, t.occluded,
+                t.bounds_equal, t.projected, t.outside_plane, t.unprojectable, t.invalid);
             EXPECT_EQ(t.frustum_equal, t.decisions) << combo_name(b, c);
             EXPECT_EQ(t.occlusion_equal, t.decisions) << combo_name(b, c);
             EXPECT_EQ(t.bounds_equal, t.decisions) << combo_name(b, c);
@@ -425,7 +438,8 @@ TEST(DisplacedGpu, BatchUploadMatchesTheCpu) {
     g.set_patches(batch.view(), s.ranges.data());
     ASSERT_EQ(g.patch_count(), n);
     std::vector<std::uint8_t> cpu(n), gpu;
-    cull_displaced_frustum(batch.view(), s.ranges.data(), DisplacedBoundKind::caf, NormalConeKind::full, view, cpu.data());
+    cull_displaced_frustum(batch.view(), s.ranges.data(), DisplacedBoundKind::caf, NormalConeKind::full, view,
+                           cpu.data());
     g.cull_frustum(DisplacedBoundKind::caf, NormalConeKind::full, view, &gpu);
     EXPECT_EQ(differences(cpu, gpu), 0u);
     EXPECT_GT(std::count(cpu.begin(), cpu.end(), 1), 0);

@@ -15,10 +15,10 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/import/builtin_scenes.h"
-#include "patchcull/import/scene_poser.h"
-#include "patchcull/import/model_loader.h"
 #include "patchcull/gl/gl_verification.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/model_loader.h"
+#include "patchcull/import/scene_poser.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;
@@ -38,7 +38,8 @@ Scene displaced_frog_scene(Scheme scheme = Scheme::acc) {
     const Vec3 toward{0, 0, 1};  // the path starts on +z
     const Vec3 mid = c.target + toward * (0.45f * c.distance);
     std::vector<Vec3> wall;
-    for (Vec3 p : {Vec3{-2, 0, 0}, Vec3{2, 0, 0}, Vec3{2, 0.45f, 0}, Vec3{-2, 0.45f, 0}}) wall.push_back(Vec3{p.x, p.y, mid.z});
+    for (Vec3 p : {Vec3{-2, 0, 0}, Vec3{2, 0, 0}, Vec3{2, 0.45f, 0}, Vec3{-2, 0.45f, 0}})
+        wall.push_back(Vec3{p.x, p.y, mid.z});
     // An environment object of its own (Scene::environment tiles occluder_indices), two-sided:
     // a single quad is no closed solid.
     add_environment_object(scene, "wall", wall, {0, 1, 2, 0, 2, 3}, false);
@@ -113,9 +114,9 @@ TEST(DisplacedPipeline, StrictForEveryBoundAndConeThroughAnAnimatedSequence) {
                 pp.cone = cone;
                 FrameStats s;
                 const std::vector<std::uint32_t> false_culled = false_culls_of_frame(pipeline, pp, s);
-                EXPECT_TRUE(false_culled.empty()) << combo << " frame " << f << ": " << false_culled.size()
-                                                  << " false culls, first patch "
-                                                  << (false_culled.empty() ? 0u : false_culled[0]);
+                EXPECT_TRUE(false_culled.empty())
+                    << combo << " frame " << f << ": " << false_culled.size() << " false culls, first patch "
+                    << (false_culled.empty() ? 0u : false_culled[0]);
                 EXPECT_EQ(s.backpatch_culled, 0u) << combo << ": every patch of the frog is displaced";
                 EXPECT_LE(s.displaced_occlusion_culled, s.occlusion_culled);
                 displaced_occluded += s.displaced_occlusion_culled;

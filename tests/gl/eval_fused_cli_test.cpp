@@ -20,10 +20,11 @@ using nlohmann::json;
 namespace {
 
 void check_contract(const json& j, int frames) {
-    EXPECT_EQ(json_keys(j), (std::set<std::string>{"scene", "clip_depth", "scheme", "target", "objects",
-                                              "fused_objects", "patches", "fused_patches", "frames", "size", "tess",
-                                              "repeats", "profile_interval", "cone", "culled", "plans", "best_plan",
-                                              "model", "oracle", "separate", "false_culls"}));
+    EXPECT_EQ(json_keys(j),
+              (std::set<std::string>{
+                  "scene",         "clip_depth", "scheme",    "target", "objects", "fused_objects",    "patches",
+                  "fused_patches", "frames",     "size",      "tess",   "repeats", "profile_interval", "cone",
+                  "culled",        "plans",      "best_plan", "model",  "oracle",  "separate",         "false_culls"}));
     EXPECT_EQ(j["false_culls"], 0);
     EXPECT_EQ(j["frames"], frames);
     EXPECT_GT(j["fused_objects"].get<int>(), 0);
@@ -45,7 +46,7 @@ void check_contract(const json& j, int frames) {
     EXPECT_TRUE(plans.count(j["best_plan"].get<std::string>()));
     const json& m = j["model"];
     EXPECT_EQ(json_keys(m), (std::set<std::string>{"seconds", "profile_seconds", "ratio_to_best", "ratio_to_oracle",
-                                              "agreement", "profiled", "choices"}));
+                                                   "agreement", "profiled", "choices"}));
     int chosen = 0;
     for (auto it = m["choices"].begin(); it != m["choices"].end(); ++it) {
         EXPECT_TRUE(plans.count(it.key())) << it.key();
@@ -71,7 +72,8 @@ TEST(EvalFusedCli, CitySmallContractAndNoFalseCulls) {
 
 TEST(EvalFusedCli, DefaultSceneBothSchemesAndNcone) {
     for (const std::string scheme : {"acc", "osd"}) {
-        const json j = run_json("eval fused default --scheme " + scheme + " --frames 2 --size 128x96 --repeats 1 --json");
+        const json j =
+            run_json("eval fused default --scheme " + scheme + " --frames 2 --size 128x96 --repeats 1 --json");
         check_contract(j, 2);
     }
     const json j = run_json("eval fused teapot --cone ncone --frames 2 --size 64x48 --repeats 1 --json");

@@ -14,8 +14,8 @@
 using namespace patchcull::cli_test;
 
 TEST(EvalTemporalCli, JsonHasTheContractShapeAndNoFalseCulls) {
-    const CliRun r = run("eval temporal " + model("bigguy.obj") +
-                         " --speeds 0,10,90 --frames 4 --size 96x96 --tess 2 --json");
+    const CliRun r =
+        run("eval temporal " + model("bigguy.obj") + " --speeds 0,10,90 --frames 4 --size 96x96 --tess 2 --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     for (const char* key : {"model", "scheme", "patches", "size", "tess", "frames", "speeds", "false_culls"})
@@ -60,9 +60,8 @@ TEST(EvalTemporalCli, TextOutputHasOneRowPerSpeed) {
 
 TEST(EvalTemporalCli, BadFlagsAreOneLineErrors) {
     const std::string base = "eval temporal teapot --frames 2 --size 16x16 ";
-    for (const char* speeds :
-         {"''", "a", "0,-1", "181", "0,,2", "1,", ",1", "nan", "inf", "5x", "0x5", "1e999",
-          "0,1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16"})
+    for (const char* speeds : {"''", "a", "0,-1", "181", "0,,2", "1,", ",1", "nan", "inf", "5x", "0x5", "1e999",
+                               "0,1,2,3,4,5,6,7,8,9,10,11,12,13,14,15,16"})
         expect_one_line_error(run(base + "--speeds=" + speeds), "--speeds");
     expect_one_line_error(run(base + "--speeds"), "--speeds");
     expect_one_line_error(run("eval temporal teapot --frames 1"), "--frames");
@@ -76,8 +75,9 @@ TEST(EvalTemporalCli, BadFlagsAreOneLineErrors) {
 
 TEST(EvalTemporalCli, SixteenSpeedsAndTheLimitsAreAccepted) {
     // The boundaries of the contract: 16 entries, 0 and 180 inclusive, decimals.
-    const CliRun r = run("eval temporal teapot --frames 2 --size 16x16 --tess 1 --json "
-                         "--speeds 0,180,0.5,1,2,3,4,5,6,7,8,9,10,11,12,13");
+    const CliRun r =
+        run("eval temporal teapot --frames 2 --size 16x16 --tess 1 --json "
+            "--speeds 0,180,0.5,1,2,3,4,5,6,7,8,9,10,11,12,13");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     ASSERT_EQ(j["speeds"].size(), 16u);

@@ -34,19 +34,27 @@ std::string far_scene(double d) {
     const std::string animated = R"("animation": {"time_offset": )" + x + R"(, "velocity": [1, 0, 0]})";
     return R"({"name": "far", "displacement": {"map": "procedural", "scale": 0.03, "size": 64},
  "objects": [
-  {"model": "bigguy", "transform": {"yaw_degrees": 200, "height": 1}, )" + animated + R"(},
+  {"model": "bigguy", "transform": {"yaw_degrees": 200, "height": 1}, )" +
+           animated + R"(},
   {"model": "bigguy", "transform": {"position": [0.9, 0, -1.3], "yaw_degrees": 160, "height": 1},
-   "animation": {"deform": false, "time_offset": )" + x + R"(, "velocity": [1, 0, 0]}},
-  {"model": "bigguy", "transform": {"position": [-0.8, 0, -2.2], "yaw_degrees": 180, "height": 1}, )" + animated + R"(},
-  {"model": "monsterfrog", "transform": {"position": [0.2, 0, -3.2], "height": 0.7}, )" + animated +
+   "animation": {"deform": false, "time_offset": )" +
+           x + R"(, "velocity": [1, 0, 0]}},
+  {"model": "bigguy", "transform": {"position": [-0.8, 0, -2.2], "yaw_degrees": 180, "height": 1}, )" +
+           animated + R"(},
+  {"model": "monsterfrog", "transform": {"position": [0.2, 0, -3.2], "height": 0.7}, )" +
+           animated +
            R"(, "displaced": true},
   {"model": "bigguy", "transform": {"position": [7, 0, 4], "height": 1},
-   "animation": {"deform": false, "time_offset": )" + x + R"(, "velocity": [1, 0, 0]}}],
+   "animation": {"deform": false, "time_offset": )" +
+           x + R"(, "velocity": [1, 0, 0]}}],
  "environment": [
-  {"name": "ground", "quad": [[)" + at(-6) + R"(, -0.002, -8], [)" + at(-6) + R"(, -0.002, 4], [)" + at(6) +
-           R"(, -0.002, 4], [)" + at(6) + R"(, -0.002, -8]], "one_sided": true},
-  {"name": "wall", "box": {"min": [)" + at(1.4) + R"(, 0, -2.6], "max": [)" + at(1.6) + R"(, 1.1, -0.8]}}],
- "camera": {"orbit": {"target": [)" + x + R"(, 0.5, -1.2], "distance": 4, "height": 0.8, "start_degrees": 20,
+  {"name": "ground", "quad": [[)" +
+           at(-6) + R"(, -0.002, -8], [)" + at(-6) + R"(, -0.002, 4], [)" + at(6) + R"(, -0.002, 4], [)" + at(6) +
+           R"(, -0.002, -8]], "one_sided": true},
+  {"name": "wall", "box": {"min": [)" +
+           at(1.4) + R"(, 0, -2.6], "max": [)" + at(1.6) + R"(, 1.1, -0.8]}}],
+ "camera": {"orbit": {"target": [)" +
+           x + R"(, 0.5, -1.2], "distance": 4, "height": 0.8, "start_degrees": 20,
             "degrees_per_frame": 25}, "z_near": 0.05, "z_far": 40}}
 )";
 }
@@ -90,7 +98,8 @@ Counts verified(const std::string& file, const std::string& args, std::size_t fr
     EXPECT_EQ(j["false_culls"], 0) << what;
     EXPECT_EQ(j["frames"].size(), frames) << what;
     for (const nlohmann::json& f : j["frames"]) {
-        EXPECT_EQ(f["false_culls"], 0) << what << ", frame " << f["frame"] << ": " << f.value("false_culled_patches", nlohmann::json()).dump();
+        EXPECT_EQ(f["false_culls"], 0) << what << ", frame " << f["frame"] << ": "
+                                       << f.value("false_culled_patches", nlohmann::json()).dump();
         EXPECT_GT(f["visible"].get<std::size_t>(), 0u) << what << ", frame " << f["frame"];
         c.backpatch += f["backpatch_culled"].get<std::size_t>();
         c.occlusion += f["occlusion_culled"].get<std::size_t>();
@@ -120,13 +129,20 @@ TEST(FarSceneCli, ObjectsPlacedFarByTheirTimeOffsetVerify) {
         EXPECT_GT(verified(file, "--cull frustum", 3).frustum, 0u);
         EXPECT_GT(verified(file, "--cull backpatch --backpatch ncone --objects bvh", 3).backpatch, 0u);
         EXPECT_GT(verified(file, "--cull backpatch --backpatch ptp --pose gpu", 3).backpatch, 0u);
-        EXPECT_GT(verified(file, "--cull occlusion --objects bvh+backface --object-occlusion horizon", 3).occlusion, 0u);
+        EXPECT_GT(verified(file, "--cull occlusion --objects bvh+backface --object-occlusion horizon", 3).occlusion,
+                  0u);
         const Counts all = verified(file, "--objects frustum --object-occlusion stop-and-wait", 3);
         EXPECT_GT(all.objects_frustum, 0u);
         EXPECT_GT(all.occlusion, 0u);
         EXPECT_GT(all.backpatch, 0u);
-        EXPECT_GT(verified(file, "--fused-pass --backpatch ncone --objects bvh --object-occlusion batched", 3).occlusion, 0u);
-        EXPECT_GT(verified(file, "--displace procedural --displace-scale 0.03 --bound oobb --objects frustum --object-occlusion chc", 3).occlusion, 0u);
+        EXPECT_GT(
+            verified(file, "--fused-pass --backpatch ncone --objects bvh --object-occlusion batched", 3).occlusion, 0u);
+        EXPECT_GT(
+            verified(
+                file,
+                "--displace procedural --displace-scale 0.03 --bound oobb --objects frustum --object-occlusion chc", 3)
+                .occlusion,
+            0u);
         verified(file, "--cull auto --objects bvh", 3);
         EXPECT_GT(verified(file, "--frustum aabb --objects bvh+backface --object-occlusion chc++", 3).occlusion, 0u);
     }
@@ -137,8 +153,11 @@ TEST(FarSceneCli, ObjectsPlacedFarByTheirTimeOffsetVerify) {
 // objects (of the room behind the wall) in some frame.
 TEST(FarSceneCli, PortalsFarOutVerify) {
     for (double d : {1e5, 1e6}) {
-        const std::string file = write_file("two_rooms_" + std::to_string(static_cast<long long>(d)) + ".json", two_rooms_at(d));
-        const CliRun r = run("render " + file + " --size 64x48 --tess 2 --frames 6 --objects frustum --object-occlusion portals --verify --json");
+        const std::string file =
+            write_file("two_rooms_" + std::to_string(static_cast<long long>(d)) + ".json", two_rooms_at(d));
+        const CliRun r =
+            run("render " + file +
+                " --size 64x48 --tess 2 --frames 6 --objects frustum --object-occlusion portals --verify --json");
         ASSERT_EQ(r.status, 0) << r.err;
         const nlohmann::json j = nlohmann::json::parse(r.out);
         EXPECT_EQ(j["false_culls"], 0) << d;
@@ -177,7 +196,8 @@ TEST(FarSceneCli, OneFrameCommandsTakeFarScenes) {
     r = run("eval scene " + far_walk + " --frames 12 --size 64x48 --methods portals --json");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("camera.walk.step: the camera's eye reaches z = "), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("at frame 9 (time 0.75 s); this command draws a scene in one float frame"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("at frame 9 (time 0.75 s); this command draws a scene in one float frame"), std::string::npos)
+        << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 
     const std::string bigguy = std::string(PATCHCULL_SOURCE_DIR) + "/data/models/bigguy.obj";

@@ -24,11 +24,11 @@ namespace {
 // BigGuy (1 high) with a still camera 1.8 away whose view centre is 1.75 to its side: about half
 // of the patches lie outside the frustum (the setup of the Sathe study, scripts/sathe_study.py).
 std::string half_out_scene(const std::string& scheme) {
-    return write_file("sathe_half_" + scheme + ".json",
-                      R"({"name":"sathe_half","objects":[{"model":")" + model("bigguy.obj") +
-                          R"(","scheme":")" + scheme +
-                          R"(","transform":{"position":[0,0,0],"height":1},"animation":{"deform":false}}],)"
-                          R"("camera":{"orbit":{"target":[1.75,0.5,0],"distance":1.8,"height":0,"degrees_per_frame":0}}})");
+    return write_file(
+        "sathe_half_" + scheme + ".json",
+        R"({"name":"sathe_half","objects":[{"model":")" + model("bigguy.obj") + R"(","scheme":")" + scheme +
+            R"(","transform":{"position":[0,0,0],"height":1},"animation":{"deform":false}}],)"
+            R"("camera":{"orbit":{"target":[1.75,0.5,0],"distance":1.8,"height":0,"degrees_per_frame":0}}})");
 }
 
 nlohmann::json render_json(const std::string& args) {
@@ -37,7 +37,9 @@ nlohmann::json render_json(const std::string& args) {
     return r.status == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
 }
 
-std::size_t last_frustum_culled(const nlohmann::json& j) { return j["frames"].back()["frustum_culled"].get<std::size_t>(); }
+std::size_t last_frustum_culled(const nlohmann::json& j) {
+    return j["frames"].back()["frustum_culled"].get<std::size_t>();
+}
 
 }  // namespace
 
@@ -98,8 +100,8 @@ TEST(FrustumDispCli, ViewRunsTheChosenTest) {
         const CliRun r = run("render " + args + " --json");
         ASSERT_EQ(r.status, 0) << r.err;
         culled[i] = last_frustum_culled(nlohmann::json::parse(r.out));
-        const std::string expected = "frame 1: drawn " + std::to_string(1450 - culled[i]) + " + 0 of 1450; culled frustum " +
-                                     std::to_string(culled[i]) + ",";
+        const std::string expected = "frame 1: drawn " + std::to_string(1450 - culled[i]) +
+                                     " + 0 of 1450; culled frustum " + std::to_string(culled[i]) + ",";
         EXPECT_NE(v.out.find(expected), std::string::npos) << v.out;
         ++i;
     }

@@ -251,7 +251,8 @@ void strict_views(PatchRenderer& r, const std::vector<BezierPatch>& patches, con
         std::vector<std::uint8_t> cpu_no_margin(patches.size());
         if (disp) cull_frustum_scalar(batch.view(), nullptr, planes, cpu_no_margin.data());
 
-        for (std::size_t p = 0; p < patches.size(); ++p) stats.cpu_gpu_disagreements += (flags[p] != 0) != (cpu[p] != 0);
+        for (std::size_t p = 0; p < patches.size(); ++p)
+            stats.cpu_gpu_disagreements += (flags[p] != 0) != (cpu[p] != 0);
         const auto present = test::ids_present(reference);
         for (std::uint32_t id : present) {
             if (flags[id - 1] != 0) {

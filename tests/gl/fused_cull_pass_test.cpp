@@ -21,8 +21,8 @@
 #include "gl_test_util.h"
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/camera.h"
-#include "patchcull/core/hiz.h"
 #include "patchcull/core/fused_cull.h"
+#include "patchcull/core/hiz.h"
 #include "shared.h"
 
 using namespace patchcull;
@@ -45,7 +45,7 @@ Passes& passes() {
 
 // One test setup: patches on the renderer, a camera, the pyramid of the drawn half.
 struct TestView {
-    Mat4 m;               // the camera's matrix in `depth`'s convention
+    Mat4 m;  // the camera's matrix in `depth`'s convention
     ClipDepth depth = ClipDepth::zero_to_one;
     Vec3 eye;
     HiZTexture hiz;
@@ -88,7 +88,8 @@ BezierPatch random_sheet(std::mt19937& rng, Vec3 centre, float size, bool ration
     BezierPatch patch;
     for (int j = 0; j < 4; ++j)
         for (int i = 0; i < 4; ++i) {
-            const Vec3 x = centre + a * (size * (i / 1.5f - 1)) + bdir * (size * (j / 1.5f - 1)) + n * (size * 0.3f * u(rng));
+            const Vec3 x =
+                centre + a * (size * (i / 1.5f - 1)) + bdir * (size * (j / 1.5f - 1)) + n * (size * 0.3f * u(rng));
             patch.cp[4 * j + i] = homogeneous(x, rational ? std::pow(2.0f, 1.5f * u(rng)) : 1.0f);
         }
     return patch;
@@ -164,7 +165,8 @@ TEST(FusedCullPass, FlagWordsEqualTheChainForEveryTestSubset) {
             for (BackpatchMethod method : {BackpatchMethod::tcone, BackpatchMethod::ncone}) {
                 for (std::uint32_t tests = 1; tests <= 7; ++tests) {
                     // ncone's program is slow on llvmpipe: its own subsets only in the first convention.
-                    if (method == BackpatchMethod::ncone && (!(tests & kCullBackPatch) || depth != ClipDepth::zero_to_one))
+                    if (method == BackpatchMethod::ncone &&
+                        (!(tests & kCullBackPatch) || depth != ClipDepth::zero_to_one))
                         continue;
                     const std::string what = "round " + std::to_string(round) + " " +
                                              (depth == ClipDepth::zero_to_one ? "0..1" : "-1..1") + " " +
@@ -226,9 +228,9 @@ TEST(FusedCullPass, ReasonsEqualTheCpuKernels) {
         std::vector<BezierPatch> patches = test::split_teapot(2);
         const Vec3 forward = normalize(cam.target - cam.eye);
         for (int p = 0; p < 500; ++p)
-            patches.push_back(random_sheet(rng, cam.eye + forward * range(0.3f, 9.0f) +
-                                                    Vec3{range(-2, 2), range(-2, 2), range(-2, 2)},
-                                           std::pow(10.0f, range(-1.8f, -0.4f)), p % 4 == 0));
+            patches.push_back(random_sheet(
+                rng, cam.eye + forward * range(0.3f, 9.0f) + Vec3{range(-2, 2), range(-2, 2), range(-2, 2)},
+                std::pow(10.0f, range(-1.8f, -0.4f)), p % 4 == 0));
         r.set_patches(patches);
         std::vector<std::uint8_t> drawn(patches.size(), 0);
         for (auto& c : drawn) c = u01(rng) < 0.5f;
@@ -261,9 +263,9 @@ TEST(FusedCullPass, ReasonsEqualTheCpuKernels) {
             std::size_t mismatched = 0;
             // The CPU fused kernel, plan F, B, H (its default), on the same pyramid.
             std::vector<std::uint8_t> fused_cpu(patches.size(), 0xEE);
-            const FusedCullSetup setup =
-                make_fused_setup(s.m, ClipDepth::zero_to_one, cam.eye,
-                                 method == BackpatchMethod::tcone ? BackPatchCone::tcone : BackPatchCone::ncone, &cpu_hiz);
+            const FusedCullSetup setup = make_fused_setup(
+                s.m, ClipDepth::zero_to_one, cam.eye,
+                method == BackpatchMethod::tcone ? BackPatchCone::tcone : BackPatchCone::ncone, &cpu_hiz);
             cull_fused_scalar(batch.view(), setup, FusedPlan{}, fused_cpu.data());
             for (std::size_t p = 0; p < patches.size(); ++p) {
                 const std::uint8_t d = fused_cpu[p];
@@ -298,14 +300,18 @@ TEST(FusedCullPass, RefusesPtpMissingPyramidsAndUnknownTests) {
     r.set_patches(test::split_teapot(0));
     const Mat4 m;  // identity
     FusedCullPass& fused = passes().fused;
-    EXPECT_THROW(fused.run(r.patch_buffers(), kCullBackPatch, m, ClipDepth::zero_to_one, BackpatchMethod::ptp, {}, nullptr),
-                 patchcull::Error);
-    EXPECT_THROW(fused.run(r.patch_buffers(), kCullOcclusion, m, ClipDepth::zero_to_one, BackpatchMethod::tcone, {}, nullptr),
-                 patchcull::Error);
-    EXPECT_THROW(fused.run(r.patch_buffers(), kCullObject, m, ClipDepth::zero_to_one, BackpatchMethod::tcone, {}, nullptr),
-                 patchcull::Error);
+    EXPECT_THROW(
+        fused.run(r.patch_buffers(), kCullBackPatch, m, ClipDepth::zero_to_one, BackpatchMethod::ptp, {}, nullptr),
+        patchcull::Error);
+    EXPECT_THROW(
+        fused.run(r.patch_buffers(), kCullOcclusion, m, ClipDepth::zero_to_one, BackpatchMethod::tcone, {}, nullptr),
+        patchcull::Error);
+    EXPECT_THROW(
+        fused.run(r.patch_buffers(), kCullObject, m, ClipDepth::zero_to_one, BackpatchMethod::tcone, {}, nullptr),
+        patchcull::Error);
     // ptp is fine when the back-patch test is not asked for; no pyramid is needed without occlusion.
-    EXPECT_NO_THROW(fused.run(r.patch_buffers(), kCullFrustum, m, ClipDepth::zero_to_one, BackpatchMethod::ptp, {}, nullptr));
+    EXPECT_NO_THROW(
+        fused.run(r.patch_buffers(), kCullFrustum, m, ClipDepth::zero_to_one, BackpatchMethod::ptp, {}, nullptr));
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }
 

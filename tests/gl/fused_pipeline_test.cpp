@@ -2,9 +2,9 @@
 // default scene and a small city, both schemes (acc, osd), at the origin and 3000+ units from it,
 // at low tessellation (1) on a small image (128x80) and high tessellation (8) on a large one
 // (480x272), every frame's id buffer with the fused pass shows every patch the unculled frame
-// shows (compare_frames: no false cull), and the frame equals the separate chain's (a second pipeline in lockstep: the same flag
-// words and counts). Also `render --fused-pass --verify` through the CLI, and the fallback to the
-// separate passes for ptp and the aabb frustum test.
+// shows (compare_frames: no false cull), and the frame equals the separate chain's (a second pipeline in lockstep: the
+// same flag words and counts). Also `render --fused-pass --verify` through the CLI, and the fallback to the separate
+// passes for ptp and the aabb frustum test.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,10 +15,10 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/import/builtin_scenes.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_verification.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 
 namespace patchcull::gl {
 namespace {
@@ -28,14 +28,15 @@ constexpr float kSecondsPerFrame = 1.0f / 12.0f;
 struct Case {
     const char* scene;  // "default" or "city" (small)
     Scheme scheme;
-    Vec3 offset;        // the whole scene, occluders and cameras moved by it
+    Vec3 offset;  // the whole scene, occluders and cameras moved by it
     int tess, width, height;
 };
 
 std::string describe(const Case& c) {
     return std::string(c.scene) + (c.scheme == Scheme::acc ? " acc" : " osd") + " offset (" +
-           std::to_string(int(c.offset.x)) + "," + std::to_string(int(c.offset.y)) + "," + std::to_string(int(c.offset.z)) +
-           ") tess " + std::to_string(c.tess) + " " + std::to_string(c.width) + "x" + std::to_string(c.height);
+           std::to_string(int(c.offset.x)) + "," + std::to_string(int(c.offset.y)) + "," +
+           std::to_string(int(c.offset.z)) + ") tess " + std::to_string(c.tess) + " " + std::to_string(c.width) + "x" +
+           std::to_string(c.height);
 }
 
 Scene make_scene(const Case& c) {

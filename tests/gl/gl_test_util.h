@@ -12,12 +12,12 @@
 #include <vector>
 
 #include "patchcull/core/displacement.h"
-#include "patchcull/gl/gl_passes.h"
-#include "patchcull/gl/gl_pipeline.h"
-#include "patchcull/gl/gl_renderer.h"
 #include "patchcull/core/mesh.h"
 #include "patchcull/core/patch.h"
 #include "patchcull/core/teapot.h"
+#include "patchcull/gl/gl_passes.h"
+#include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/gl/gl_renderer.h"
 
 #include "core/test_patches.h"
 
@@ -66,8 +66,6 @@ inline PatchAttributes margins_only(std::vector<float> max_displacement) {
     a.max_displacement = std::move(max_displacement);
     return a;
 }
-
-
 
 /// Attributes for `count` displaced patches, each sampling its own random square window of MAP
 /// (origin in [-0.5, 1.5)^2, side 0.05..0.35, drawn from SEED), with max_displacement = the

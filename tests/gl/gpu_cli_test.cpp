@@ -2,9 +2,9 @@
 // finding no false culls in any cull mode (strict: compare_frames against the unculled render of
 // every frame) and catching the ones back-patch culling makes on an open surface, one-line errors
 // with exit status 2 (bad flags, missing OpenGL), the main job writing both PNGs, and
-// `eval occlusion --json`, `eval displaced --json`. In the gl suite because it needs OpenGL (the cli suite also runs under
-// ASan with leak detection, which would report Mesa's own allocations). Everything runs on Mesa
-// llvmpipe at tiny sizes (64x64; the teapot, BigGuy at tessellation level 2).
+// `eval occlusion --json`, `eval displaced --json`. In the gl suite because it needs OpenGL (the cli suite also runs
+// under ASan with leak detection, which would report Mesa's own allocations). Everything runs on Mesa llvmpipe at tiny
+// sizes (64x64; the teapot, BigGuy at tessellation level 2).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -33,7 +33,8 @@ TEST(GpuCli, RenderJsonHasTheContractKeys) {
     const std::string png = scratch_dir() + "/render.png";
     std::filesystem::remove(png);
     // BigGuy, a closed surface, so `all` includes the back-patch test.
-    const CliRun r = run("render " + model("bigguy.obj") + " --size 64x64 --tess 2 --frames 3 --cull all --backpatch tcone --out " + png + " --json");
+    const CliRun r = run("render " + model("bigguy.obj") +
+                         " --size 64x64 --tess 2 --frames 3 --cull all --backpatch tcone --out " + png + " --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     ASSERT_TRUE(j.contains("frames"));
@@ -47,8 +48,8 @@ TEST(GpuCli, RenderJsonHasTheContractKeys) {
     for (int f = 0; f < 3; ++f) {
         const auto& frame = j["frames"][f];
         EXPECT_EQ(frame["frame"], f);
-        for (const char* key : {"pass1_drawn", "pass2_drawn", "frustum_culled", "backpatch_culled", "occlusion_culled",
-                                "false_culls"})
+        for (const char* key :
+             {"pass1_drawn", "pass2_drawn", "frustum_culled", "backpatch_culled", "occlusion_culled", "false_culls"})
             ASSERT_TRUE(frame.contains(key) && frame[key].is_number_unsigned()) << key << " in " << frame.dump();
         for (const char* key : {"pass1", "hiz", "cull", "pass2"})
             ASSERT_TRUE(frame["ms"].contains(key) && frame["ms"][key].is_number()) << key;
@@ -185,9 +186,9 @@ TEST(GpuCli, BadRenderFlagsAreOneLineErrors) {
 
 // eval displaced (Table 1 of Niessner & Loop, "Patch-Based Occlusion Culling for Hardware Tessellation"):
 // six rows with the contract's keys, no false culls against
-// the unculled displaced render (converged depth and running pipeline), and the nesting that is a theorem: a CAF with a cone lies inside
-// the CAF without one (DisplacedBounds.CafWithAConeLiesInsideTheFullCaf), so per view it culls
-// at least as much (a smaller rectangle reads a finer Hi-Z level, whose max is not larger).
+// the unculled displaced render (converged depth and running pipeline), and the nesting that is a theorem: a CAF with a
+// cone lies inside the CAF without one (DisplacedBounds.CafWithAConeLiesInsideTheFullCaf), so per view it culls at
+// least as much (a smaller rectangle reads a finer Hi-Z level, whose max is not larger).
 TEST(GpuCli, EvalDisplacedGivesSixRowsWithoutFalseCulls) {
     const CliRun r = run("eval displaced " + model("monsterfrog.obj") + " --views 4 --size 96x96 --tess 2 --json");
     ASSERT_EQ(r.status, 0) << r.err;
@@ -216,7 +217,8 @@ TEST(GpuCli, EvalDisplacedGivesSixRowsWithoutFalseCulls) {
 }
 
 TEST(GpuCli, EvalDisplacedBadInputIsAOneLineError) {
-    expect_one_line_error(run("eval displaced teapot --displace /nonexistent/height.png --views 1"), "/nonexistent/height.png");
+    expect_one_line_error(run("eval displaced teapot --displace /nonexistent/height.png --views 1"),
+                          "/nonexistent/height.png");
     expect_one_line_error(run("eval displaced teapot --views 0"), "--views");
     expect_one_line_error(run("eval displaced teapot --displace-scale nan --views 1"), "--displace-scale");
 }
@@ -258,7 +260,7 @@ TEST(GpuCli, EvalOcclusionOnTheTeapot) {
     EXPECT_LT(occluded, 1.0);
     EXPECT_LE(j["occluded_fraction_min"].get<double>(), occluded);
     EXPECT_GE(j["occluded_fraction_max"].get<double>(), occluded);
-    EXPECT_EQ(j["frustum_fraction"], 0.0);  // every view contains the whole object
+    EXPECT_EQ(j["frustum_fraction"], 0.0);           // every view contains the whole object
     EXPECT_GE(j["frames_mean"].get<double>(), 2.0);  // stability needs two equal frames
     EXPECT_TRUE(j["backpatch_fraction"].contains("tcone"));
 }

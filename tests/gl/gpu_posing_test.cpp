@@ -19,13 +19,13 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/import/builtin_scenes.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_posing.h"
 #include "patchcull/gl/gl_renderer.h"
+#include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/model_loader.h"
+#include "patchcull/import/scene_poser.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;
@@ -40,7 +40,9 @@ std::vector<T> read_buffer(std::uint32_t buffer, std::size_t count) {
     return out;
 }
 
-StencilTableView view_of(const PointStencils& s) { return {s.offsets.data(), s.rows(), s.indices.data(), s.weights.data()}; }
+StencilTableView view_of(const PointStencils& s) {
+    return {s.offsets.data(), s.rows(), s.indices.data(), s.weights.data()};
+}
 
 // A StencilPoser over the scene's tables (ScenePoser::gpu_tables), as tools/frame_poser.cpp
 // makes it.
@@ -49,7 +51,8 @@ StencilPoser make_poser(ScenePoser& poser) {
     for (const PoseModelTables& t : poser.gpu_tables())
         models.push_back({view_of(*t.patch_points), view_of(*t.tangent_points), t.tangent_index, t.vertex_count});
     std::vector<std::uint32_t> instance_models;
-    for (const SceneInstance& i : poser.scene().instances) instance_models.push_back(static_cast<std::uint32_t>(i.model));
+    for (const SceneInstance& i : poser.scene().instances)
+        instance_models.push_back(static_cast<std::uint32_t>(i.model));
     StencilPoser gpu(test::context());
     gpu.set_tables(models, instance_models);
     return gpu;
@@ -286,7 +289,8 @@ TEST(GpuPosingCli, VerifiesLikeCpuOnCitySmall) {
 // (cpu_patches) and stays exactly as conservative.
 TEST(GpuPosingCli, CpuReadersKeepACpuPose) {
     for (const char* extra : {"--objects bvh", "--cull auto"}) {
-        const CliRun r = run(std::string("render default --size 96x54 --tess 2 --frames 3 --verify --json --pose gpu ") + extra);
+        const CliRun r =
+            run(std::string("render default --size 96x54 --tess 2 --frames 3 --verify --json --pose gpu ") + extra);
         ASSERT_EQ(r.status, 0) << extra << ": " << r.err;
         const auto j = nlohmann::json::parse(r.out);
         EXPECT_EQ(j["false_culls"], 0) << extra;

@@ -258,8 +258,8 @@ TEST(GpuHiZ, DecisionsEqualCpuOnRandomPatches) {
         // The same camera as a standard OpenGL (-1..1) matrix: converted like the CPU kernel.
         const Mat4 gl_matrix =
             perspective(cam.fovy_radians, cam.aspect, cam.z_near, cam.z_far, ClipDepth::minus_one_to_one) * cam.view();
-        const DecisionCounts g = compare_decisions(r, patches, gl_matrix, cpu, (what + " (-1..1)").c_str(),
-                                                   ClipDepth::minus_one_to_one);
+        const DecisionCounts g =
+            compare_decisions(r, patches, gl_matrix, cpu, (what + " (-1..1)").c_str(), ClipDepth::minus_one_to_one);
         EXPECT_EQ(g.mismatched, 0u) << what << " (-1..1)";
         total.frustum += n.frustum;
         total.occluded += n.occluded;
@@ -273,11 +273,13 @@ TEST(GpuHiZ, DecisionsEqualCpuOnRandomPatches) {
 TEST(GpuHiZ, PassesRefuseMissingPyramidsAndBadSizes) {
     PatchRenderer r(test::context());
     r.set_patches(teapot_patches());
-    RenderParams p = params_for(teapot_camera(test::control_point_bounds(teapot_patches()), {0, -1, 0.3f}, 2.5f), 64, 64);
+    RenderParams p =
+        params_for(teapot_camera(test::control_point_bounds(teapot_patches()), {0, -1, 0.3f}, 2.5f), 64, 64);
     r.render(p);
     OcclusionPass occlusion(test::passes());
     HiZBuildPass build(test::passes());
-    EXPECT_THROW(occlusion.run(r.patch_buffers(), p.projection * p.view, ClipDepth::zero_to_one, HiZTexture{}), patchcull::Error);
+    EXPECT_THROW(occlusion.run(r.patch_buffers(), p.projection * p.view, ClipDepth::zero_to_one, HiZTexture{}),
+                 patchcull::Error);
     EXPECT_THROW(read_hiz_texture(HiZTexture{}), patchcull::Error);
     EXPECT_THROW(create_hiz_texture(0, 64), patchcull::Error);
     EXPECT_THROW(create_hiz_texture(64, 8193), patchcull::Error);

@@ -20,10 +20,10 @@
 
 #include "cli/cli_test_util.h"
 #include "gl_test_util.h"
-#include "patchcull/import/builtin_scenes.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/gl/gl_renderer.h"
+#include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/model_loader.h"
+#include "patchcull/import/scene_poser.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;

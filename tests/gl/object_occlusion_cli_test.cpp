@@ -1,6 +1,6 @@
 // Object-level occlusion through the CLI (under tests/gl: the GL-heavy CLI runs stay
-// out of the ASan build's core|cli run, where one eval scene took over 9 minutes): `eval scene SCENE --json` (the JSON contract in
-// tools/eval/eval_scene.cpp's head comment) and `render ... --objects M --object-occlusion O --verify
+// out of the ASan build's core|cli run, where one eval scene took over 9 minutes): `eval scene SCENE --json` (the JSON
+// contract in tools/eval/eval_scene.cpp's head comment) and `render ... --objects M --object-occlusion O --verify
 // --json` (tools/object_level_options.cpp). The methods: hardware occlusion queries stop-and-wait and
 // batched, CHC (Bittner, Wimmer, Piringer, Purgathofer, "Coherent Hierarchical Culling: Hardware
 // Occlusion Queries Made Useful") and CHC++ (Mattausch, Bittner, Wimmer, "CHC++: Coherent
@@ -37,7 +37,6 @@ constexpr std::size_t kCityObjects = 25, kCityCharacters = 20, kCityPatches = 27
 // two_rooms.json: 2 BigGuys (1,450 patches each), a MonsterFrog (1,292) and a teapot (32); 14 boxes.
 constexpr std::size_t kRoomsObjects = 18, kRoomsCharacters = 4, kRoomsPatches = 4224;
 constexpr std::size_t kBigGuyPatches = 1450, kFrogPatches = 1292;
-
 
 bool is_query_method(const std::string& m) {
     return m == "stop-and-wait" || m == "batched" || m == "chc" || m == "chc++";
@@ -89,7 +88,9 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
     const std::vector<json> rows(j["methods"].begin(), j["methods"].end());
     std::vector<std::string> names;
     for (const json& row : rows) names.push_back(row.value("name", "?"));
-    if (!methods.empty()) { EXPECT_EQ(names, expected_names) << args; }
+    if (!methods.empty()) {
+        EXPECT_EQ(names, expected_names) << args;
+    }
 
     const std::set<std::string> row_keys{"name",
                                          "object_method",
@@ -165,7 +166,9 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
             EXPECT_EQ(by_objects, 0) << what;
             EXPECT_EQ(row["ms"]["object_cpu"], 0) << what;
         }
-        if (name == "hiz") { EXPECT_GT(row["patches_occlusion_culled"].get<double>(), 0) << what; }
+        if (name == "hiz") {
+            EXPECT_GT(row["patches_occlusion_culled"].get<double>(), 0) << what;
+        }
         if (is_query_method(object)) {
             EXPECT_GT(row["queries"].get<double>(), 0) << what;
             EXPECT_GT(row["proxy_boxes"].get<double>(), 0) << what;
@@ -175,7 +178,9 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
                 EXPECT_EQ(row[k], 0) << what << ": " << k;
         }
         // Only CHC++ merges queries into multiqueries.
-        if (object != "chc++") { EXPECT_EQ(row["multiqueries"], 0) << what; }
+        if (object != "chc++") {
+            EXPECT_EQ(row["multiqueries"], 0) << what;
+        }
         EXPECT_LE(row["multiqueries_passed"].get<double>(), row["multiqueries"].get<double>()) << what;
     }
     return rows;
@@ -195,11 +200,13 @@ const json* row_named(const std::vector<json>& rows, const std::string& name) {
 TEST(ObjectOcclusionCli, ProbedFalseCullsStayFixed) {
     const std::string data = std::string(PATCHCULL_SOURCE_DIR) + "/tests/data/scenes/";
     for (const char* scene : {"holebox.json", "openbox.json"})
-        expect_one_line_error(run("render " + data + scene +
-                                  " --size 160x90 --tess 2 --frames 2 --objects bvh --object-occlusion horizon --verify --json"),
-                              "has no box occluders");
-    const json j = run_json("render " + data +
-                            "near_wall.json --size 160x90 --tess 2 --frames 4 --objects bvh --object-occlusion portals --verify --json");
+        expect_one_line_error(
+            run("render " + data + scene +
+                " --size 160x90 --tess 2 --frames 2 --objects bvh --object-occlusion horizon --verify --json"),
+            "has no box occluders");
+    const json j = run_json(
+        "render " + data +
+        "near_wall.json --size 160x90 --tess 2 --frames 4 --objects bvh --object-occlusion portals --verify --json");
     EXPECT_EQ(j.value("false_culls", -1), 0);
     ASSERT_TRUE(j.contains("frames") && j["frames"].size() == 4u) << j.dump().substr(0, 500);
     // Frames 0-2: the eye 0.03..0.05 from the wall, within z_near 0.05: nothing culled by portals.
@@ -229,7 +236,9 @@ TEST(ObjectOcclusionCli, EvalSceneCitySmallContract) {
         EXPECT_GT((*r)["patches_object_culled"].get<double>(), 0) << m;
     }
     // CHC++ merges the hidden characters' queries into multiqueries.
-    if (const json* r = row_named(rows, "chc++")) { EXPECT_GT((*r)["multiqueries"].get<double>(), 0); }
+    if (const json* r = row_named(rows, "chc++")) {
+        EXPECT_GT((*r)["multiqueries"].get<double>(), 0);
+    }
 }
 
 // two_rooms: every method the scene allows (the default list, portals and the horizon included),
@@ -275,9 +284,9 @@ TEST(ObjectOcclusionCli, RenderEveryOcclusionMethodHasNoFalseCulls) {
     const std::set<std::string> query_keys{"method",      "objects", "frustum_culled", "occlusion_culled",
                                            "drawn",       "queries", "multiqueries",   "multiqueries_passed",
                                            "proxy_boxes", "waits",   "unqueryable",    "aggressive"};
-    const std::set<std::string> scene_keys{"method",         "objects_tested",   "objects_culled",
-                                           "patches_culled", "triangles_culled", "eye_in_cell",  "near_geometry",
-                                           "cells_reached",  "portals_passed",   "occluders_inserted"};
+    const std::set<std::string> scene_keys{"method",           "objects_tested",    "objects_culled", "patches_culled",
+                                           "triangles_culled", "eye_in_cell",       "near_geometry",  "cells_reached",
+                                           "portals_passed",   "occluders_inserted"};
     for (const Case& c : cases) {
         const std::string args = "render " + c.scene + " --size 128x72 --frames " + std::to_string(c.frames) +
                                  " --objects " + c.objects + " --object-occlusion " + c.occlusion + " " + c.extra +
@@ -312,7 +321,9 @@ TEST(ObjectOcclusionCli, RenderEveryOcclusionMethodHasNoFalseCulls) {
                               occ["drawn"].get<std::size_t>(),
                           characters)
                     << what << ": " << occ.dump();
-                if (c.occlusion != "chc++") { EXPECT_EQ(occ["multiqueries"], 0) << what; }
+                if (c.occlusion != "chc++") {
+                    EXPECT_EQ(occ["multiqueries"], 0) << what;
+                }
                 occlusion_culled += occ["occlusion_culled"].get<std::size_t>();
                 queries += occ["queries"].get<std::size_t>();
             } else {
@@ -332,7 +343,9 @@ TEST(ObjectOcclusionCli, RenderEveryOcclusionMethodHasNoFalseCulls) {
         if (c.occlusion == "none") continue;
         // Objects culled by occlusion itself, not only by the frustum before it.
         EXPECT_GT(occlusion_culled, 0u) << args;
-        if (is_query_method(c.occlusion)) { EXPECT_GT(queries, 0u) << args; }
+        if (is_query_method(c.occlusion)) {
+            EXPECT_GT(queries, 0u) << args;
+        }
         if (c.occlusion == "portals") {
             // Frame 0, in the first room, looking through the door: the second room is reached
             // through it, and exactly its hidden BigGuy and frog are left out (the teapot shows

@@ -1,9 +1,9 @@
 // Hardware occlusion queries at the object level (gl_object_queries.h) inside the pipeline frame
 // (gl_pipeline.h ObjectPass): every method, alone (cull none) and followed by the patch passes
-// (cull occlusion: frustum and Hi-Z per patch), against the unculled render of the same frame (the strict test: no patch of the
-// reference's front set may be left undrawn), on a grid of teapots behind walls seen from random
-// cameras over several frames (the coherent methods carry visibility from frame to frame). Each
-// method must also cull: checks that fail if the queries never say "hidden".
+// (cull occlusion: frustum and Hi-Z per patch), against the unculled render of the same frame (the strict test: no
+// patch of the reference's front set may be left undrawn), on a grid of teapots behind walls seen from random cameras
+// over several frames (the coherent methods carry visibility from frame to frame). Each method must also cull: checks
+// that fail if the queries never say "hidden".
 #include <gtest/gtest.h>
 
 #include <random>
@@ -18,13 +18,13 @@
 namespace patchcull::gl {
 namespace {
 
-constexpr int kGrid = 4;            // kGrid x kGrid teapots
+constexpr int kGrid = 4;  // kGrid x kGrid teapots
 constexpr std::size_t kPerTeapot = 32;
 
 struct TeapotField {
     std::vector<BezierPatch> patches;
-    std::vector<Bounds> boxes;          // per teapot
-    std::vector<Bounds> tight;          // per teapot: its 8 four-patch groups' boxes
+    std::vector<Bounds> boxes;  // per teapot
+    std::vector<Bounds> tight;  // per teapot: its 8 four-patch groups' boxes
     std::vector<std::uint32_t> tight_first;
     std::vector<std::uint32_t> counts;
     std::vector<ObjectRange> objects;
@@ -169,8 +169,9 @@ void check_methods(Vec3 origin, int cameras, unsigned seed) {
                     const FrameCapture culled = capture_culled(pipeline);
                     const FrameComparison cmp = compare_frames(capture_reference(pipeline, rp), culled);
                     EXPECT_TRUE(cmp.false_culled.empty())
-                        << variant.name << ", mode " << cull_mode_name(mode) << ", camera " << c << ", frame " << frame << ": "
-                        << cmp.false_culled.size() << " false culls (first patch " << cmp.false_culled[0] << ")";
+                        << variant.name << ", mode " << cull_mode_name(mode) << ", camera " << c << ", frame " << frame
+                        << ": " << cmp.false_culled.size() << " false culls (first patch " << cmp.false_culled[0]
+                        << ")";
                 }
             }
             EXPECT_GT(occlusion_culled, 0u) << variant.name << " never left an object out behind the walls";

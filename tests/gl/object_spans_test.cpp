@@ -100,7 +100,8 @@ TEST(ObjectSpans, BadSpansAreRefused) {
 void unit_box(std::vector<Vec3>& v, std::vector<std::uint32_t>& idx, Vec3 lo, Vec3 hi) {
     const auto base = static_cast<std::uint32_t>(v.size());
     for (int i = 0; i < 8; ++i) v.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-    const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                       {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
     for (const auto& q : quads)
         for (int k : {0, 1, 2, 0, 2, 3}) idx.push_back(base + q[k]);
 }

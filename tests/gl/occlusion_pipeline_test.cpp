@@ -6,24 +6,24 @@
 // buffer with culling is identical to the unculled render's at the same resolution and
 // tessellation. A patch present in the unculled buffer but culled is a false cull and fails.
 // Also: the aggressive variant (§3.1) misses only newly visible patches and is exact again after
-// one static frame; adaptive tessellation; the flag chain of the passes and the back-patch mode; occluders; statistics, timing and
-// the status image.
+// one static frame; adaptive tessellation; the flag chain of the passes and the back-patch mode; occluders; statistics,
+// timing and the status image.
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "gl_test_util.h"
-#include "patchcull/import/animation.h"
 #include "patchcull/core/camera.h"
 #include "patchcull/core/displacement.h"
-#include "patchcull/import/model_loader.h"
 #include "patchcull/gl/gl_verification.h"
+#include "patchcull/import/animation.h"
+#include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;
@@ -133,8 +133,8 @@ std::vector<std::uint32_t> reference_ids(PatchRenderer& r, RenderParams params) 
 // other difference, and any patch of the unculled image missing from the culled one (a false cull),
 // fails.
 struct Diff {
-    std::size_t pixels = 0;       // differing pixels that are not verified ties
-    std::size_t ties = 0;         // verified exact depth ties
+    std::size_t pixels = 0;  // differing pixels that are not verified ties
+    std::size_t ties = 0;    // verified exact depth ties
     std::size_t false_culls = 0;
 };
 
@@ -151,8 +151,10 @@ float depth_of_patch_alone(const std::vector<BezierPatch>& patches, const Occlud
                            std::uint32_t p, std::size_t i) {
     static PatchRenderer* verifier = new PatchRenderer(test::context());
     verifier->set_patches(patches);
-    if (occ) verifier->set_occluders(occ->vertices, occ->indices);
-    else verifier->set_occluders({}, {});
+    if (occ)
+        verifier->set_occluders(occ->vertices, occ->indices);
+    else
+        verifier->set_occluders({}, {});
     std::vector<std::uint8_t> culled(patches.size(), 1);
     culled[p] = 0;
     verifier->set_cull_flags(culled.data());
@@ -256,7 +258,8 @@ Totals strict_frame(CullPipeline& pipeline, const std::vector<BezierPatch>& patc
     const std::vector<std::uint32_t> words = r.read_cull_flags();
     const Diff d = compare_frames(ref, got, words, &patches, occ, params, what);
     // The library's comparison: per patch, the front set against the drawn set.
-    const FrameComparison cmp = gl::compare_frames({ref.ids, ref.depth, front}, {got.ids, got.depth, r.read_drawn_patches()});
+    const FrameComparison cmp =
+        gl::compare_frames({ref.ids, ref.depth, front}, {got.ids, got.depth, r.read_drawn_patches()});
     EXPECT_TRUE(cmp.conservative()) << what;
     EXPECT_EQ(cmp.depth_ties, d.ties) << what;
     EXPECT_EQ(d.pixels, 0u) << what;
@@ -306,12 +309,12 @@ TEST(OcclusionPipeline, StrictIdBufferIdenticalAtFixedCameras) {
     r.set_patches(patches);
     r.set_occluders(occ.vertices, occ.indices);
     const Camera cams[] = {
-        camera_at(b, {0.3f, 0.35f, -1}, 2.4f),     // front, through the wall
-        camera_at(b, {1, 0.25f, 0.3f}, 2.0f),      // side
+        camera_at(b, {0.3f, 0.35f, -1}, 2.4f),            // front, through the wall
+        camera_at(b, {1, 0.25f, 0.3f}, 2.0f),             // side
         camera_at(b, {0.05f, 1, 0.1f}, 2.2f, {0, 0, 1}),  // top down
-        camera_at(b, {0.6f, 0.2f, -0.8f}, 0.8f),   // close: parts outside the frustum
-        camera_at(b, {0.2f, -1, -0.4f}, 2.0f),     // under the ground: everything hidden
-        camera_at(b, {-0.3f, 0.05f, -1}, 3.0f),    // low behind the wall
+        camera_at(b, {0.6f, 0.2f, -0.8f}, 0.8f),          // close: parts outside the frustum
+        camera_at(b, {0.2f, -1, -0.4f}, 2.0f),            // under the ground: everything hidden
+        camera_at(b, {-0.3f, 0.05f, -1}, 3.0f),           // low behind the wall
     };
     Totals total;
     for (CullMode mode : kModes) {
@@ -319,8 +322,8 @@ TEST(OcclusionPipeline, StrictIdBufferIdenticalAtFixedCameras) {
             pipeline.reset_visibility();
             // Two frames from the same camera: the first starts from the even half tagged visible.
             for (int frame = 0; frame < 2; ++frame) {
-                const std::string what = mode_name(mode) + " camera " + std::to_string(c) +
-                                         " frame " + std::to_string(frame);
+                const std::string what =
+                    mode_name(mode) + " camera " + std::to_string(c) + " frame " + std::to_string(frame);
                 const Totals t = strict_frame(pipeline, patches, &occ, params_for(cams[c]), mode, frame == 0, what);
                 total.frustum += t.frustum;
                 total.occluded += t.occluded;
@@ -333,8 +336,10 @@ TEST(OcclusionPipeline, StrictIdBufferIdenticalAtFixedCameras) {
     EXPECT_GT(total.frustum, 200u);
     EXPECT_GT(total.occluded, 1000u);
     EXPECT_GT(total.pass2, 100u);
-    std::printf("[ info     ] fixed cameras: %zu frustum-, %zu occlusion-culled, %zu second-pass draws, "
-                "%zu exact depth-tie pixels\n", total.frustum, total.occluded, total.pass2, total.ties);
+    std::printf(
+        "[ info     ] fixed cameras: %zu frustum-, %zu occlusion-culled, %zu second-pass draws, "
+        "%zu exact depth-tie pixels\n",
+        total.frustum, total.occluded, total.pass2, total.ties);
 }
 
 TEST(OcclusionPipeline, StrictIdBufferIdenticalThroughAnimatedTeapotSequence) {
@@ -359,17 +364,19 @@ TEST(OcclusionPipeline, StrictIdBufferIdenticalThroughAnimatedTeapotSequence) {
                     params.adaptive_tess = true;
                     params.tess_reference_distance = 1.5f * b.radius();
                 }
-                const std::string what = mode_name(mode) + (adaptive ? " adaptive" : "") +
-                                         " frame " + std::to_string(f);
+                const std::string what =
+                    mode_name(mode) + (adaptive ? " adaptive" : "") + " frame " + std::to_string(f);
                 const Totals t = strict_frame(pipeline, posed, &occ, params, mode, f == 0, what);
                 total.frustum += t.frustum;
                 total.occluded += t.occluded;
                 total.pass2 += t.pass2;
                 total.ties += t.ties;
             }
-            std::printf("[ info     ] teapot %s%s: %zu frustum-, %zu occlusion-culled, %zu second-pass draws, "
-                        "%zu tie pixels\n", mode_name(mode).c_str(), adaptive ? " adaptive" : "", total.frustum,
-                        total.occluded, total.pass2, total.ties);
+            std::printf(
+                "[ info     ] teapot %s%s: %zu frustum-, %zu occlusion-culled, %zu second-pass draws, "
+                "%zu tie pixels\n",
+                mode_name(mode).c_str(), adaptive ? " adaptive" : "", total.frustum, total.occluded, total.pass2,
+                total.ties);
             if (mode == kFrustumOcclusion) {
                 EXPECT_GT(total.frustum, 50u);
                 EXPECT_GT(total.occluded, 300u);
@@ -410,9 +417,10 @@ TEST(OcclusionPipeline, StrictIdBufferIdenticalThroughAnimatedBigGuy) {
             total.pass2 += t.pass2;
             total.ties += t.ties;
         }
-        std::printf("[ info     ] bigguy %s (%zu patches): %zu frustum-, %zu occlusion-culled, %zu second-pass "
-                    "draws, %zu tie pixels\n", cull_mode_name(mode), r.patch_count(), total.frustum, total.occluded,
-                    total.pass2, total.ties);
+        std::printf(
+            "[ info     ] bigguy %s (%zu patches): %zu frustum-, %zu occlusion-culled, %zu second-pass "
+            "draws, %zu tie pixels\n",
+            cull_mode_name(mode), r.patch_count(), total.frustum, total.occluded, total.pass2, total.ties);
         if (mode == CullMode::all) {
             EXPECT_GT(total.occluded, 500u);
         }
@@ -529,9 +537,12 @@ TEST(OcclusionPipeline, FlagChainKeepsTheFirstReasonAndSkipsCulledPatches) {
     std::size_t frustum_culled = 0, back_culled = 0;
     for (std::size_t p = 0; p < patches.size(); ++p) {
         std::uint32_t reason = 0;
-        if (p == 1) reason = kCullOcclusion;
-        else if (outside[p]) reason = kCullFrustum;
-        else if (back[p] && margins[p] == 0.0f) reason = kCullBackPatch;
+        if (p == 1)
+            reason = kCullOcclusion;
+        else if (outside[p])
+            reason = kCullFrustum;
+        else if (back[p] && margins[p] == 0.0f)
+            reason = kCullBackPatch;
         ASSERT_EQ(got[p] & kCullReasonMask, reason) << "patch " << p;
         ASSERT_EQ(got[p] & ~kCullReasonMask, kStatusVisible) << "patch " << p << ": statuses untouched";
         frustum_culled += reason == kCullFrustum;
@@ -540,7 +551,8 @@ TEST(OcclusionPipeline, FlagChainKeepsTheFirstReasonAndSkipsCulledPatches) {
     EXPECT_GT(frustum_culled, 5u);
     EXPECT_GT(back_culled, 5u);
     if (!outside[displaced]) {
-        EXPECT_EQ(got[displaced] & kCullReasonMask, 0u) << "the displaced patch " << displaced << " was back-patch tested";
+        EXPECT_EQ(got[displaced] & kCullReasonMask, 0u)
+            << "the displaced patch " << displaced << " was back-patch tested";
     }
     status.end(r.patch_buffers(), 0);
     const std::vector<std::uint32_t> ended = r.read_cull_flags();
@@ -596,7 +608,7 @@ TEST(OcclusionPipeline, OccludersWriteTaggedIdsAndHidePatches) {
             ++patch_ids;
         }
     }
-    EXPECT_GE(occluder_ids, 3u);  // ground (2 triangles) and wall
+    EXPECT_GE(occluder_ids, 3u);           // ground (2 triangles) and wall
     EXPECT_LT(patch_ids, without.size());  // the wall hides patches
     EXPECT_THROW(r.set_occluders(occ.vertices, {0, 1}), patchcull::Error);
     EXPECT_THROW(r.set_occluders(occ.vertices, {0, 1, 99}), patchcull::Error);
@@ -625,8 +637,10 @@ TEST(OcclusionPipeline, TimingMethodsAndStatusImage) {
         fp.timing = m;
         s = pipeline.render_frame(pipeline_params(fp));
         EXPECT_EQ(s.timing, m);
-        if (m == TimingMethod::off) EXPECT_EQ(s.total_ms, 0.0);
-        else EXPECT_GE(s.total_ms, 0.0);
+        if (m == TimingMethod::off)
+            EXPECT_EQ(s.total_ms, 0.0);
+        else
+            EXPECT_GE(s.total_ms, 0.0);
     }
     // Own camera: no occlusion-culled (red) or frustum-culled (blue) patch shows.
     auto count_colour = [](const std::vector<std::uint8_t>& rgba, auto pred) {
@@ -669,7 +683,7 @@ TEST(OcclusionPipeline, UpdatePatchesKeepsStatusAndChecksCount) {
     r.update_patches(patches);
     EXPECT_EQ(r.read_cull_flags(), words);
     FrameStats s = pipeline.render_frame(pipeline_params(fp));
-    EXPECT_EQ(s.newly_visible, 0u);  // same pose, same camera: nothing becomes visible
+    EXPECT_EQ(s.newly_visible, 0u);       // same pose, same camera: nothing becomes visible
     EXPECT_LE(s.visible, s.pass1_drawn);  // the fuller first pass may occlude more
     EXPECT_THROW(r.update_patches(std::vector<BezierPatch>(patches.begin(), patches.end() - 1)), patchcull::Error);
     r.set_patches(patches);  // a new set: statuses start again from the even half
@@ -695,9 +709,8 @@ TEST(OcclusionPipeline, CompareFramesJudgesFalseCullsPerPatch) {
     // (id 5) was not drawn: a false cull. Patch 6 was not drawn either: a false cull although the
     // reference's id buffer never shows it (a tie must not hide a culled patch). Patch 3 was not
     // drawn and is not at the front: a correct cull.
-    const FrameCapture culled = {{1, 3, 3, 7, 6, kIdOccluderBit},
-                                 {0.5f, 0.4f, 0.35f, 0.2f, 0.9f, 0.1f},
-                                 {1, 1, 1, 0, 0, 1, 0, 1}};
+    const FrameCapture culled = {
+        {1, 3, 3, 7, 6, kIdOccluderBit}, {0.5f, 0.4f, 0.35f, 0.2f, 0.9f, 0.1f}, {1, 1, 1, 0, 0, 1, 0, 1}};
     const FrameComparison c = gl::compare_frames(reference, culled);
     EXPECT_EQ(c.differing_pixels, 4u);
     EXPECT_EQ(c.depth_ties, 1u);
@@ -745,8 +758,10 @@ TEST(OcclusionPipeline, DisplacedPatchesWithoutRangesAreNotHiZTested) {
     for (int variant = 0; variant < 3; ++variant) {
         CullPipeline pipeline(test::context());
         PatchRenderer& r = pipeline.renderer();
-        if (variant == 1) r.set_patches(patches);  // no margins
-        else r.set_patches(patches, attributes);
+        if (variant == 1)
+            r.set_patches(patches);  // no margins
+        else
+            r.set_patches(patches, attributes);
         r.set_displacement_map(map);
         r.set_occluders(occ.vertices, occ.indices);
         RenderParams p = params;
@@ -774,6 +789,7 @@ TEST(OcclusionPipeline, DisplacedPatchesWithoutRangesAreNotHiZTested) {
     r.set_occluders(occ.vertices, occ.indices);
     Totals total;
     for (int frame = 0; frame < 2; ++frame)
-        total.occluded += strict_frame(pipeline, patches, &occ, params, kFrustumOcclusion, frame == 0, "zero margins").occluded;
+        total.occluded +=
+            strict_frame(pipeline, patches, &occ, params, kFrustumOcclusion, frame == 0, "zero margins").occluded;
     EXPECT_GT(total.occluded, 100u);
 }

@@ -13,7 +13,9 @@ using namespace patchcull::cli_test;
 
 namespace {
 
-std::string shape(const char* name) { return std::string(PATCHCULL_SOURCE_DIR) + "/tests/data/opensubdiv/" + name + ".obj"; }
+std::string shape(const char* name) {
+    return std::string(PATCHCULL_SOURCE_DIR) + "/tests/data/opensubdiv/" + name + ".obj";
+}
 
 }  // namespace
 

@@ -53,7 +53,8 @@ TEST(RenderDump, HiZLevelsHaveThePyramidsSizesAndMaxReduction) {
     std::filesystem::remove_all(dir);
     // 70x45: odd sizes, so every level rounds up (ceil) somewhere.
     const int W = 70, H = 45;
-    const CliRun r = run("render teapot --split 2 --size 70x45 --tess 4 --frames 2 --cull all --dump-hiz " + dir + " --json");
+    const CliRun r =
+        run("render teapot --split 2 --size 70x45 --tess 4 --frames 2 --cull all --dump-hiz " + dir + " --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(slurp(dir + "/hiz.json"));
     EXPECT_EQ(nlohmann::json::parse(r.out)["hiz_dump"], j);
@@ -88,7 +89,9 @@ TEST(RenderDump, HiZLevelsHaveThePyramidsSizesAndMaxReduction) {
                 const float d = level[l][std::size_t(y) * w + x];
                 some_drawn = some_drawn || d < 1;
                 const int grey = png.pixels[std::size_t(h - 1 - y) * w + x];
-                const int want = d >= 1 ? 255 : hi > lo ? int(std::lround(254.0 * (double(d) - lo) / (double(hi) - lo))) : 0;
+                const int want = d >= 1    ? 255
+                                 : hi > lo ? int(std::lround(254.0 * (double(d) - lo) / (double(hi) - lo)))
+                                           : 0;
                 ASSERT_EQ(grey, want) << "level " << l << " texel " << x << "," << y;
             }
     }
@@ -125,9 +128,10 @@ TEST(RenderDump, CafAndOobbRectanglesHoldEveryPixelOfTheirPatch) {
         all += std::to_string(p);
     }
     const int W = 96, H = 64;
-    const CliRun r = run("render teapot --split 2 --size 96x64 --tess 6 --frames 1 --cull occlusion --displace procedural "
-                         "--displace-scale 0.05 --cone acon --dump-hiz " + dir + " --draw-bounds " + all + " --out " + png +
-                         " --json");
+    const CliRun r =
+        run("render teapot --split 2 --size 96x64 --tess 6 --frames 1 --cull occlusion --displace procedural "
+            "--displace-scale 0.05 --cone acon --dump-hiz " +
+            dir + " --draw-bounds " + all + " --out " + png + " --json");
     ASSERT_EQ(r.status, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     ASSERT_EQ(j["patches"], 512);
@@ -158,7 +162,8 @@ TEST(RenderDump, CafAndOobbRectanglesHoldEveryPixelOfTheirPatch) {
             EXPECT_LT((x1 - x0 + 1) * (y1 - y0 + 1), W * H / 4) << b.dump();
         }
         const auto c = b["caf"]["rect"], o = b["oobb"]["rect"];
-        caf_smaller += (int(c[2]) - int(c[0])) * (int(c[3]) - int(c[1])) < (int(o[2]) - int(o[0])) * (int(o[3]) - int(o[1]));
+        caf_smaller +=
+            (int(c[2]) - int(c[0])) * (int(c[3]) - int(c[1])) < (int(o[2]) - int(o[0])) * (int(o[3]) - int(o[1]));
         ++checked;
         pixels_checked += pixels;
     }
@@ -178,8 +183,8 @@ TEST(RenderDump, CafAndOobbRectanglesHoldEveryPixelOfTheirPatch) {
 TEST(RenderDump, BadArgumentsAreOneLineNamingTheFlag) {
     const std::string file = write_file("not_a_dir", "x");
     expect_one_line_error(run("render teapot --size 32x32 --frames 1 --dump-hiz " + file + "/sub"), "--dump-hiz");
-    expect_one_line_error(run("render teapot --size 32x32 --frames 1 --cull frustum --dump-hiz " + scratch_dir() + "/d"),
-                          "--dump-hiz");
+    expect_one_line_error(
+        run("render teapot --size 32x32 --frames 1 --cull frustum --dump-hiz " + scratch_dir() + "/d"), "--dump-hiz");
     const std::string out = " --out " + scratch_dir() + "/b.png";
     expect_one_line_error(run("render teapot --size 32x32 --frames 1 --draw-bounds 32" + out), "--draw-bounds");
     expect_one_line_error(run("render teapot --size 32x32 --frames 1 --draw-bounds 1,,2" + out), "--draw-bounds");

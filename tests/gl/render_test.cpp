@@ -161,10 +161,9 @@ TEST(PatchRenderer, IdsPastTheFirst256PatchesAreCorrect) {
 
 TEST(PatchRenderer, HighTessellationLevelMatchesPerPatchDraws) {
     // Level 20 on 512 patches: 441 vertices per patch, 256 patches per 4096-vertex chunk would be
-    // 112,896 vertices, past llvmpipe's 65,536 (beyond it llvmpipe emits garbage triangles); the renderer splits draws. Check that
-    // drawing all patches equals the depth-merged union of 8 draws of 64 patches each (the others
-    // culled: 64 * 441 = 28,224 tessellated vertices per chunk, safe even without the split), and
-    // that ids stay in range.
+    // 112,896 vertices, past llvmpipe's 65,536 (beyond it llvmpipe emits garbage triangles); the renderer splits draws.
+    // Check that drawing all patches equals the depth-merged union of 8 draws of 64 patches each (the others culled: 64
+    // * 441 = 28,224 tessellated vertices per chunk, safe even without the split), and that ids stay in range.
     const std::vector<BezierPatch> patches = test::split_teapot(2);
     PatchRenderer r(test::context());
     r.set_patches(patches);

@@ -76,9 +76,9 @@ std::size_t run_scene(Scene scene, SceneOcclusionMethod method, int frames, int 
             const FrameCapture reference = {pipeline.renderer().read_ids(), pipeline.renderer().read_depth(),
                                             pipeline.renderer().mark_front_patches(reference_params)};
             const FrameComparison cmp = compare_frames(reference, frame);
-            EXPECT_TRUE(cmp.false_culled.empty()) << scene.name << " " << scene_occlusion_method_name(method) << ", mode "
-                                                  << cull_mode_name(mode) << ", frame " << f << ": "
-                                                  << cmp.false_culled.size() << " false culls";
+            EXPECT_TRUE(cmp.false_culled.empty())
+                << scene.name << " " << scene_occlusion_method_name(method) << ", mode " << cull_mode_name(mode)
+                << ", frame " << f << ": " << cmp.false_culled.size() << " false culls";
             EXPECT_EQ(culled_triangles_shown(reference.ids, culled.culled_triangles), 0u)
                 << scene.name << " frame " << f << ": a culled occluder triangle is in the reference";
         }

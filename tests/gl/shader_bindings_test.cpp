@@ -86,7 +86,7 @@ TEST(ShaderBindings, SharedPatchBlocksAreDeclaredOnlyInPatchBuffers) {
         if (!entry.is_regular_file() || name == "patch_buffers.h" || name == "patchcull_tcs.h") continue;
         const std::string text = read_text(entry.path());
         for (std::sregex_iterator it(text.begin(), text.end(), block_re), end; it != end; ++it)
-            EXPECT_FALSE(declared.count((*it)[1])) << name << " declares the block at " << (*it)[1]
-                                                   << " (patch_buffers.h declares it)";
+            EXPECT_FALSE(declared.count((*it)[1]))
+                << name << " declares the block at " << (*it)[1] << " (patch_buffers.h declares it)";
     }
 }

@@ -32,8 +32,8 @@ TEST(SpanPlan, GapsAreDrawnAndObjectCulledSpansAreNot) {
     const SpanPlan plan = plan_spans(12, {{8, 2, true}, {2, 4, true}}, {{8, 2}, {3, 2}});
     ASSERT_EQ(plan.gaps.size(), 3u);  // [0, 2), [6, 8), [10, 12)
     EXPECT_EQ(plan.gaps[1].first, 6u);
-    EXPECT_TRUE(same(plan.object_spans[0], {}));         // culled whole: no dispatch
-    EXPECT_TRUE(same(plan.object_spans[1], {{2, 4}}));   // dispatched whole, 3-4 pre-marked
+    EXPECT_TRUE(same(plan.object_spans[0], {}));        // culled whole: no dispatch
+    EXPECT_TRUE(same(plan.object_spans[1], {{2, 4}}));  // dispatched whole, 3-4 pre-marked
     EXPECT_TRUE(same(plan.active_spans(plan.objects[1]), {{2, 1}, {5, 1}}));
     EXPECT_TRUE(same(plan.gaps_drawn, {{0, 2}, {6, 2}, {10, 2}}));
     EXPECT_TRUE(same(plan.drawn, {{2, 1}, {5, 1}, {0, 2}, {6, 2}, {10, 2}}));

@@ -46,8 +46,8 @@ TEST(TessModeCli, ModeIsInTheJsonAndAdaptiveChangesTheImage) {
     ASSERT_EQ(uniform.status, 0) << uniform.err;
     EXPECT_EQ(nlohmann::json::parse(uniform.out)["tess_mode"], "uniform");
     // A reference distance far beyond the scene: every edge gets the full level, as uniform.
-    const CliRun far = run(kSmallDefault + "--cull none --tess-mode adaptive --tess-distance 1000 --out " +
-                           adaptive_png + " --json");
+    const CliRun far =
+        run(kSmallDefault + "--cull none --tess-mode adaptive --tess-distance 1000 --out " + adaptive_png + " --json");
     ASSERT_EQ(far.status, 0) << far.err;
     EXPECT_EQ(nlohmann::json::parse(far.out)["tess_mode"], "adaptive");
     EXPECT_EQ(slurp(adaptive_png), slurp(uniform_png)) << "adaptive at a huge reference distance must be uniform";

@@ -85,8 +85,10 @@ private:
 // Registers the toy once per process (the registry is append-only); returns its id.
 BackpatchMethod toy_method() {
     static const BackpatchMethod id = [] {
-        const BackpatchMethod m = register_backpatch_method({"toy", "x < 0 everywhere (a test's toy)", toy_kernel, nullptr, false});
-        register_backpatch_pass(m, [](PassContext&) -> std::unique_ptr<BackpatchPass> { return std::make_unique<ToyPass>(); });
+        const BackpatchMethod m =
+            register_backpatch_method({"toy", "x < 0 everywhere (a test's toy)", toy_kernel, nullptr, false});
+        register_backpatch_pass(
+            m, [](PassContext&) -> std::unique_ptr<BackpatchPass> { return std::make_unique<ToyPass>(); });
         return m;
     }();
     return id;

@@ -128,7 +128,8 @@ TEST(ViewerScript, MalformedLinesNameFileAndLine) {
     EXPECT_EQ(parse_error("1 set tess 65\n"), "s.txt:1: set tess: expected an integer in 1..64, got '65'");
     EXPECT_EQ(parse_error("1 set view side\n"),
               "s.txt:1: set view: expected one of colour, status, status-second, got 'side'");
-    EXPECT_EQ(parse_error("1 set displace.scale 0\n"), "s.txt:1: set displace.scale: expected a number in (0, 1], got '0'");
+    EXPECT_EQ(parse_error("1 set displace.scale 0\n"),
+              "s.txt:1: set displace.scale: expected a number in (0, 1], got '0'");
     EXPECT_EQ(parse_error("1 screenshot\n"), "s.txt:1: screenshot: expected 'FRAME screenshot PATH'");
     EXPECT_EQ(parse_error("1 quit now\n"), "s.txt:1: quit: expected 'FRAME quit'");
     EXPECT_EQ(parse_error("1 key \x01\n").rfind("s.txt:1: unknown key '\\x01'", 0), 0u);  // printable
@@ -174,7 +175,7 @@ TEST(ViewerCamera, OrbitKeepsTheDistanceAndZoomChangesIt) {
     EXPECT_GT(std::fabs(camera.eye().x), 3.0f);
     const Vec3 to_centre = normalize(start.target - camera.eye());
     EXPECT_GT(dot(camera.forward(), to_centre), 0.9999f);  // still looking at the centre
-    camera.orbit(0, 10000);  // far past the pole: clamped below it
+    camera.orbit(0, 10000);                                // far past the pole: clamped below it
     EXPECT_LT(camera.forward().y, 0);
     EXPECT_GT(std::fabs(camera.forward().y), 0.99f);
     EXPECT_LT(std::fabs(camera.forward().y), 1.0f);
@@ -248,7 +249,7 @@ TEST(ViewerControls, HeldKeysMoveForTheFrameOnly) {
     ViewerCamera camera(start, start.target);
     ViewerControls controls(s, camera);
     controls.key(ViewerKey::forward, start);  // a script's `key w`: held for one frame
-    controls.move(0.5f, start);                // half a second: a quarter of the start distance
+    controls.move(0.5f, start);               // half a second: a quarter of the start distance
     EXPECT_NEAR(camera.eye().z, 3.0f, 1e-4f);
     controls.move(0.5f, start);  // not held any more
     EXPECT_NEAR(camera.eye().z, 3.0f, 1e-4f);
@@ -280,8 +281,10 @@ TEST(ViewerControls, HeldKeysMoveForTheFrameOnly) {
 TEST(ViewerCli, MalformedScriptsAreOneLineErrorsBeforeAnyWindow) {
     // No DISPLAY: had the window been opened first, the error would be GLFW's.
     const std::string no_display = "env -u DISPLAY -u WAYLAND_DISPLAY";
-    const std::string bad = write_file("bad_script.txt", "0 orbit 1 1\n# fine so far\n3 set cull.occlusion sometimes\n");
-    expect_one_line_error(run("view teapot --script " + bad, no_display), bad + ":3: set cull.occlusion: expected on or off");
+    const std::string bad =
+        write_file("bad_script.txt", "0 orbit 1 1\n# fine so far\n3 set cull.occlusion sometimes\n");
+    expect_one_line_error(run("view teapot --script " + bad, no_display),
+                          bad + ":3: set cull.occlusion: expected on or off");
     const std::string order = write_file("order_script.txt", "2 quit\n1 quit\n");
     expect_one_line_error(run("view teapot --script " + order, no_display), order + ":2: frame 1 comes after frame 2");
     const std::string shot = write_file("shot_script.txt", "0 screenshot /nonexistent/dir/a.png\n");
@@ -301,30 +304,49 @@ TEST(ViewerCli, ScriptedCameraMoveToggleAndPanelShowInTheScreenshots) {
     // BigGuy is closed: back-patch culling runs, and from the second camera (turned 90 degrees and
     // raised, as cull.png) its culled back shows magenta. Paused, so only the script changes the
     // picture.
-    const std::string script = write_file("viewer_script.txt",
-                                          "0 set panel off\n"
-                                          "0 key space\n"
-                                          "2 screenshot " + d + "/still0.png\n"
-                                          "3 screenshot " + d + "/still1.png\n"
-                                          "3 key p\n"  // the screenshot key: DIR/view_0000.png
-                                          "4 orbit 200 0\n"
-                                          "4 screenshot " + d + "/orbited.png\n"
-                                          "5 set view status-second\n"
-                                          "6 screenshot " + d + "/status_on.png\n"
-                                          "7 set cull.backpatch off\n"
-                                          "8 screenshot " + d + "/status_off.png\n"
-                                          "9 key 2\n"
-                                          "10 screenshot " + d + "/status_again.png\n"
-                                          "11 key h\n"  // ImGui sizes a new window on its first frame, draws it on the next
-                                          "12 screenshot " + d + "/panel.png\n"
-                                          "13 set panel off\n"
-                                          "13 set view colour\n"
-                                          "14 screenshot " + d + "/plain.png\n"
-                                          "15 set displace on\n"  // BigGuy has no map: the procedural one
-                                          "15 set displace.scale 0.05\n"
-                                          "15 set objects bvh\n"  // rebuilds the scene with an object level
-                                          "16 screenshot " + d + "/displaced.png\n"
-                                          "16 quit\n");
+    const std::string script =
+        write_file("viewer_script.txt",
+                   "0 set panel off\n"
+                   "0 key space\n"
+                   "2 screenshot " +
+                       d +
+                       "/still0.png\n"
+                       "3 screenshot " +
+                       d +
+                       "/still1.png\n"
+                       "3 key p\n"  // the screenshot key: DIR/view_0000.png
+                       "4 orbit 200 0\n"
+                       "4 screenshot " +
+                       d +
+                       "/orbited.png\n"
+                       "5 set view status-second\n"
+                       "6 screenshot " +
+                       d +
+                       "/status_on.png\n"
+                       "7 set cull.backpatch off\n"
+                       "8 screenshot " +
+                       d +
+                       "/status_off.png\n"
+                       "9 key 2\n"
+                       "10 screenshot " +
+                       d +
+                       "/status_again.png\n"
+                       "11 key h\n"  // ImGui sizes a new window on its first frame, draws it on the next
+                       "12 screenshot " +
+                       d +
+                       "/panel.png\n"
+                       "13 set panel off\n"
+                       "13 set view colour\n"
+                       "14 screenshot " +
+                       d +
+                       "/plain.png\n"
+                       "15 set displace on\n"  // BigGuy has no map: the procedural one
+                       "15 set displace.scale 0.05\n"
+                       "15 set objects bvh\n"  // rebuilds the scene with an object level
+                       "16 screenshot " +
+                       d +
+                       "/displaced.png\n"
+                       "16 quit\n");
     const CliRun r = run_under_xvfb("view " + model("bigguy.obj") + " --size 640x300 --tess 2 --script " + script +
                                     " --screenshot-dir " + d + "/keyed");
     ASSERT_EQ(r.status, 0) << r.err;

@@ -58,9 +58,9 @@ TEST(Visibility, InsideOutClosedMeshIsCulledWithItsOutwardSide) {
     const nlohmann::json plain = render_json(model("bigguy.obj") + args);
     for (const char* edit : {"reversed", "mirrored"}) {
         const bool reversed = std::string(edit) == "reversed";
-        const std::string path = edited_bigguy(std::string("bigguy_") + edit + ".obj",
-                                               reversed ? unchanged : [](int, double& x, double&, double&) { x = -x; },
-                                               reversed);
+        const std::string path = edited_bigguy(
+            std::string("bigguy_") + edit + ".obj",
+            reversed ? unchanged : [](int, double& x, double&, double&) { x = -x; }, reversed);
         const CliRun r = run("render " + path + args + " --verify --json");
         ASSERT_EQ(r.status, 0) << edit << ": " << r.err;
         EXPECT_NE(r.err.find("oriented inward"), std::string::npos) << edit << ": " << r.err;
@@ -84,8 +84,8 @@ TEST(Visibility, FoldedAndSpikedClosedMeshesHaveNoFalseCulls) {
     });
     for (const std::string& path : {fold, spikes})
         for (const char* method : {"tcone", "ncone", "ptp"}) {
-            const nlohmann::json j = render_json(path + " --cull backpatch --backpatch " + method +
-                                                 " --size 192x192 --tess 2 --frames 2");
+            const nlohmann::json j =
+                render_json(path + " --cull backpatch --backpatch " + method + " --size 192x192 --tess 2 --frames 2");
             ASSERT_TRUE(j.contains("false_culls")) << path << " " << method;
             EXPECT_EQ(j["false_culls"], 0) << path << " " << method;
             EXPECT_GT(backpatch_culled(j, 1), 0u) << path << " " << method;

@@ -73,7 +73,8 @@ TEST(Watertight, OsdPatchesOfDifferentDepthMeetWithoutCracks) {
         const std::size_t before = pinholes_over_views(r, model, level);
         r.set_patches(model.rest.patches, with_depth);
         const std::size_t after = pinholes_over_views(r, model, level);
-        RecordProperty("pinholes_level_" + std::to_string(level), std::to_string(before) + " -> " + std::to_string(after));
+        RecordProperty("pinholes_level_" + std::to_string(level),
+                       std::to_string(before) + " -> " + std::to_string(after));
         std::printf("pinholes at level %d over 4 views: %zu without the depth scale, %zu with it\n", level, before,
                     after);
         EXPECT_GT(before, 50u) << level;  // the defect is there without the scale (248 and 96 measured)

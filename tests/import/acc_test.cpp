@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <random>
@@ -20,8 +20,8 @@
 #include <opensubdiv/far/topologyRefinerFactory.h>
 
 #include "patchcull/core/error.h"
-#include "patchcull/import/obj.h"
 #include "patchcull/core/patch.h"
+#include "patchcull/import/obj.h"
 #include "patchcull/import/subdivision.h"
 
 using namespace patchcull;
@@ -68,7 +68,8 @@ ControlMesh make_boundary_fan() {
     const auto at = [](double deg, double r) {
         const double a = deg * 3.14159265358979 / 180;
         const double x = r * std::cos(a), y = r * std::sin(a);
-        return Vec3{static_cast<float>(x), static_cast<float>(y), static_cast<float>(0.4 * x * x - 0.3 * y * y + 0.2 * x * y)};
+        return Vec3{static_cast<float>(x), static_cast<float>(y),
+                    static_cast<float>(0.4 * x * x - 0.3 * y * y + 0.2 * x * y)};
     };
     for (int i = 0; i < 4; ++i) p.push_back(at(60.0 * i, 1.0));       // m0..m3: 1..4
     for (int i = 0; i < 3; ++i) p.push_back(at(60.0 * i + 30, 1.5));  // c0..c2: 5..7
@@ -230,8 +231,7 @@ SeamReport seams(const SubdivisionModel& model, const PatchFrame& frame) {
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::pair<std::size_t, int>> half;
     // Patches of an all-quad mesh are its faces, in order.
     for (std::size_t f = 0; f < m.face_count(); ++f)
-        for (int q = 0; q < 4; ++q)
-            half[{m.face_vertices[4 * f + q], m.face_vertices[4 * f + (q + 1) % 4]}] = {f, q};
+        for (int q = 0; q < 4; ++q) half[{m.face_vertices[4 * f + q], m.face_vertices[4 * f + (q + 1) % 4]}] = {f, q};
     SeamReport r;
     for (const auto& [key, fq] : half) {
         if (key.first > key.second) continue;
@@ -251,7 +251,8 @@ SeamReport seams(const SubdivisionModel& model, const PatchFrame& frame) {
             r.max_gap = std::max(r.max_gap, length(a - b));
             if (compare_normals) {
                 ++r.checked_normals;
-                r.max_normal_angle = std::max(r.max_normal_angle, angle_between(patch_normal(frame, f, u0, v0), patch_normal(frame, g, u1, v1)));
+                r.max_normal_angle = std::max(
+                    r.max_normal_angle, angle_between(patch_normal(frame, f, u0, v0), patch_normal(frame, g, u1, v1)));
             }
         }
     }
@@ -265,7 +266,8 @@ std::size_t count_faces_at_irregular_vertices(const ControlMesh& m) {
     std::size_t n = 0;
     for (std::size_t f = 0; f < m.face_count(); ++f) {
         bool irregular = false;
-        for (std::uint32_t c = m.face_offsets[f]; c < m.face_offsets[f + 1]; ++c) irregular |= faces_at[m.face_vertices[c]] != 4;
+        for (std::uint32_t c = m.face_offsets[f]; c < m.face_offsets[f + 1]; ++c)
+            irregular |= faces_at[m.face_vertices[c]] != 4;
         n += irregular;
     }
     return n;
@@ -403,7 +405,8 @@ TEST_P(AccModels, ExtraordinaryPatchesStayCloseToLimitSurface) {
     for (std::size_t i = 0; i < locations.size(); ++i) {
         const float u = locations[i].u, v = locations[i].v;
         max_err = std::max(max_err, length(evaluate_position(frame.patches[patch_of[i]], u, v) - ref[i].position));
-        max_angle = std::max(max_angle, angle_between(patch_normal(frame, patch_of[i], u, v), cross(ref[i].du, ref[i].dv)));
+        max_angle =
+            std::max(max_angle, angle_between(patch_normal(frame, patch_of[i], u, v), cross(ref[i].du, ref[i].dv)));
     }
     RecordProperty("max_distance_over_radius", sci(max_err / radius));
     RecordProperty("max_normal_angle_rad", sci(max_angle));
@@ -444,8 +447,10 @@ TEST(Acc, PatchAndExtraordinaryCountsOfTestModels) {
         EXPECT_EQ(model.tangent_points.rows(), 24 * model.extraordinary_count());
         std::int32_t next_tangent = 0;
         for (const PatchInfo& p : model.patches) {
-            if (p.extraordinary) EXPECT_EQ(p.tangent_index, next_tangent++);
-            else EXPECT_EQ(p.tangent_index, -1);
+            if (p.extraordinary)
+                EXPECT_EQ(p.tangent_index, next_tangent++);
+            else
+                EXPECT_EQ(p.tangent_index, -1);
         }
         EXPECT_TRUE(model.mesh.warnings.empty());
         EXPECT_EQ(model.scheme, Scheme::acc);
@@ -453,7 +458,9 @@ TEST(Acc, PatchAndExtraordinaryCountsOfTestModels) {
 }
 
 INSTANTIATE_TEST_SUITE_P(TestModels, AccModels, ::testing::Values("bigguy.obj", "monsterfrog.obj"),
-                         [](const auto& info) { return std::string(info.param).substr(0, std::string(info.param).find('.')); });
+                         [](const auto& info) {
+                             return std::string(info.param).substr(0, std::string(info.param).find('.'));
+                         });
 
 // ---- 5. boundaries, non-quads, invalid input -------------------------------------------------
 
@@ -470,7 +477,8 @@ TEST(Acc, OpenRegularGridIsTheExactBoundaryLimitSurface) {
     const std::vector<LimitSample> ref = osd_limit_surface(mesh, locations);
     ASSERT_EQ(ref.size(), locations.size());
     for (std::size_t i = 0; i < locations.size(); ++i) {
-        const SurfacePoint sp = evaluate_surface(frame.patches[static_cast<std::size_t>(locations[i].face)], locations[i].u, locations[i].v);
+        const SurfacePoint sp = evaluate_surface(frame.patches[static_cast<std::size_t>(locations[i].face)],
+                                                 locations[i].u, locations[i].v);
         EXPECT_LT(length(sp.position - ref[i].position), 1e-5f) << "face " << locations[i].face;
         EXPECT_LT(length(sp.du - ref[i].du) + length(sp.dv - ref[i].dv), 1e-4f) << "face " << locations[i].face;
     }
@@ -510,7 +518,10 @@ TEST(Acc, IrregularBoundaryVertexGivesSaneExtraordinaryPatches) {
     const std::vector<LimitSample> ref = osd_limit_surface(mesh, locations);
     ASSERT_EQ(ref.size(), locations.size());
     for (std::size_t i = 0; i < locations.size(); ++i)
-        EXPECT_LT(length(evaluate_position(frame.patches[static_cast<std::size_t>(locations[i].face)], locations[i].u, locations[i].v) - ref[i].position), 1e-5f)
+        EXPECT_LT(length(evaluate_position(frame.patches[static_cast<std::size_t>(locations[i].face)], locations[i].u,
+                                           locations[i].v) -
+                         ref[i].position),
+                  1e-5f)
             << "face " << locations[i].face << " (" << locations[i].u << ", " << locations[i].v << ")";
     const SeamReport r = seams(model, frame);
     EXPECT_EQ(r.edges, 2u);
@@ -526,7 +537,7 @@ TEST(Acc, NonQuadMeshIsRefinedOnceAndStaysOverOriginalVertices) {
         p.push_back({std::cos(a), std::sin(a), 0});
         p.push_back({std::cos(a), std::sin(a), 1.5f});
     }
-    p.push_back({0, 0, 2.0f});  // apex: 10
+    p.push_back({0, 0, 2.0f});                                       // apex: 10
     std::vector<std::vector<std::uint32_t>> faces{{8, 6, 4, 2, 0}};  // bottom, seen from below
     for (std::uint32_t k = 0; k < 5; ++k) {
         const std::uint32_t a = 2 * k, b = 2 * ((k + 1) % 5);
@@ -613,7 +624,8 @@ TEST(Acc, AnimatedPositionsMoveThePatchesLinearly) {
     evaluate_patches(model, moved, 0, b);
     // Every row's weights sum to 1 (positions) or 0 (tangents): a translation moves points only.
     for (std::size_t p = 0; p < a.patches.size(); ++p)
-        for (int k = 0; k < 16; ++k) EXPECT_LT(length(xyz(b.patches[p].cp[k]) - xyz(a.patches[p].cp[k]) - Vec3{1, 2, 3}), 1e-5f);
+        for (int k = 0; k < 16; ++k)
+            EXPECT_LT(length(xyz(b.patches[p].cp[k]) - xyz(a.patches[p].cp[k]) - Vec3{1, 2, 3}), 1e-5f);
     for (std::size_t t = 0; t < a.tangents.size(); ++t)
         for (int k = 0; k < 12; ++k) {
             EXPECT_LT(length(b.tangents[t].du[k] - a.tangents[t].du[k]), 1e-5f);
@@ -623,8 +635,9 @@ TEST(Acc, AnimatedPositionsMoveThePatchesLinearly) {
 
 TEST(Acc, SmallClosedMeshes) {
     // Cube: every vertex has valence 3, so every patch is extraordinary at all four corners.
-    const ControlMesh cube = make_mesh("cube", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},
-                                       {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}});
+    const ControlMesh cube =
+        make_mesh("cube", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},
+                  {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}});
     const SubdivisionModel model = build_acc_model(cube);
     EXPECT_EQ(model.extraordinary_count(), 6u);
     const PatchFrame frame = evaluate(model);
@@ -638,13 +651,14 @@ TEST(Acc, SmallClosedMeshes) {
             const std::uint32_t v = cube.face_vertices[4 * p + q];
             EXPECT_LT(length(xyz(frame.patches[p].cp[kCornerCp[q]]) - limit.position[v]), 1e-6f);
             const Vec3 n = patch_normal(frame, p, kCornerU[q], kCornerV[q]);
-            EXPECT_GT(dot(n, limit.position[v] - Vec3{0.5f, 0.5f, 0.5f}), 0.0f);  // outwards
+            EXPECT_GT(dot(n, limit.position[v] - Vec3{0.5f, 0.5f, 0.5f}), 0.0f);             // outwards
             EXPECT_LT(angle_between(n, limit.position[v] - Vec3{0.5f, 0.5f, 0.5f}), 1e-4f);  // symmetric cube
         }
 
     // Pillow: two quads on the same four edges, valence-2 vertices. Degenerate, but builds finite
     // points (the tangent-patch normal may vanish at the valence-2 corners, which patch.h allows).
-    const ControlMesh pillow = make_mesh("pillow", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 1, 2, 3}, {3, 2, 1, 0}});
+    const ControlMesh pillow =
+        make_mesh("pillow", {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, {{0, 1, 2, 3}, {3, 2, 1, 0}});
     const PatchFrame pf = evaluate(build_acc_model(pillow));
     for (const BezierPatch& p : pf.patches)
         for (const Vec4& c : p.cp) EXPECT_TRUE(is_finite(xyz(c)));

@@ -10,9 +10,9 @@
 #include <random>
 
 #include "patchcull/core/backpatch.h"
-#include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/ground_truth.h"
 #include "patchcull/core/parallel.h"
+#include "patchcull/eval/cull_eval.h"
 #include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
@@ -72,7 +72,8 @@ void check_tessellation_triangles(const PatchFrame& frame, const std::vector<Cam
                 ++reports[method].culled;
                 if (!any_tessellation_triangle_faces_eye(&grid[p * 289], 17, c.eye)) continue;
                 ++reports[method].violations;
-                ASSERT_GE(method, 2) << kMethods[method] << " patch " << p << ": a cone method must have no facing triangle";
+                ASSERT_GE(method, 2) << kMethods[method] << " patch " << p
+                                     << ": a cone method must have no facing triangle";
                 ASSERT_FALSE(any_plane_faces_eye(&planes[p * 289], 289, c.eye)) << kMethods[method] << " patch " << p;
             }
         }

@@ -12,9 +12,9 @@
 #include <set>
 #include <string>
 
+#include "patchcull/core/error.h"
 #include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/scene_poser.h"
-#include "patchcull/core/error.h"
 
 using namespace patchcull;
 
@@ -58,8 +58,10 @@ double signed_volume(const Scene& scene, const EnvironmentObject& object) {
         const Vec3 a = scene.occluder_vertices[scene.occluder_indices[3 * t]];
         const Vec3 b = scene.occluder_vertices[scene.occluder_indices[3 * t + 1]];
         const Vec3 c = scene.occluder_vertices[scene.occluder_indices[3 * t + 2]];
-        v += (double(a.x) * (double(b.y) * c.z - double(b.z) * c.y) - double(a.y) * (double(b.x) * c.z - double(b.z) * c.x) +
-              double(a.z) * (double(b.x) * c.y - double(b.y) * c.x)) / 6.0;
+        v += (double(a.x) * (double(b.y) * c.z - double(b.z) * c.y) -
+              double(a.y) * (double(b.x) * c.z - double(b.z) * c.x) +
+              double(a.z) * (double(b.x) * c.y - double(b.y) * c.x)) /
+             6.0;
     }
     return v;
 }
@@ -225,7 +227,8 @@ TEST(CityScene, SameSeedSameSceneOtherSeedOther) {
     ASSERT_EQ(a.instances.size(), b.instances.size());
     bool differ = false;
     for (std::size_t i = 0; i < a.instances.size(); ++i) {
-        for (int k = 0; k < 16; ++k) EXPECT_EQ(a.instances[i].object_to_world.m[k], b.instances[i].object_to_world.m[k]);
+        for (int k = 0; k < 16; ++k)
+            EXPECT_EQ(a.instances[i].object_to_world.m[k], b.instances[i].object_to_world.m[k]);
         differ = differ || a.instances[i].object_to_world.m[12] != c.instances[i].object_to_world.m[12];
     }
     EXPECT_TRUE(differ);
@@ -286,15 +289,18 @@ TEST(CityScene, DISABLED_PoseTime) {
     const auto start = std::chrono::steady_clock::now();
     const int frames = 24;
     for (int f = 1; f <= frames; ++f) poser.pose(f * kFrameSeconds);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / frames;
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() / frames;
     // The same scene with every instance at its own phase: one evaluation per instance.
     Scene distinct = scene;
-    for (std::size_t i = 0; i < distinct.instances.size(); ++i) distinct.instances[i].time_offset += 1e-3f * static_cast<float>(i);
+    for (std::size_t i = 0; i < distinct.instances.size(); ++i)
+        distinct.instances[i].time_offset += 1e-3f * static_cast<float>(i);
     ScenePoser distinct_poser(distinct);
     distinct_poser.pose(0);
     const auto start2 = std::chrono::steady_clock::now();
     for (int f = 1; f <= frames; ++f) distinct_poser.pose(f * kFrameSeconds);
-    const double ms2 = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start2).count() / frames;
+    const double ms2 =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start2).count() / frames;
     std::cout << "city: " << scene.instances.size() << " instances, " << scene.patch_count() << " patches, pose " << ms
               << " ms/frame (shared phases), " << ms2 << " ms/frame (every instance its own phase)\n";
     const Scene building = make_building_scene();
@@ -302,7 +308,8 @@ TEST(CityScene, DISABLED_PoseTime) {
     building_poser.pose(0);
     const auto start3 = std::chrono::steady_clock::now();
     for (int f = 1; f <= frames; ++f) building_poser.pose(f * kFrameSeconds);
-    const double ms3 = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start3).count() / frames;
+    const double ms3 =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start3).count() / frames;
     std::cout << "building: " << building.instances.size() << " instances, " << building.patch_count() << " patches, "
               << building.environment.size() << " environment objects, " << building.occluder_indices.size() / 3
               << " triangles, pose " << ms3 << " ms/frame\n";
@@ -336,7 +343,8 @@ TEST(BuildingScene, RoomsDoorsAndWindows) {
         }
         const Vec3 n = cross(portal.corners[1] - portal.corners[0], portal.corners[2] - portal.corners[0]);
         EXPECT_GT(dot(n, a.center() - centre), 0.0f) << "counter-clockwise seen from cell_a";
-        EXPECT_NEAR(length(portal.corners[2] - portal.corners[0]), length(portal.corners[3] - portal.corners[1]), 1e-5f);
+        EXPECT_NEAR(length(portal.corners[2] - portal.corners[0]), length(portal.corners[3] - portal.corners[1]),
+                    1e-5f);
     }
     for (int d : degree) EXPECT_GE(d, 1);
     // Every environment object is listed by a cell; each cell lists its floor and ceiling; the
@@ -347,13 +355,15 @@ TEST(BuildingScene, RoomsDoorsAndWindows) {
         for (std::size_t e : cell.environment) {
             ASSERT_LT(e, scene.environment.size());
             ++listed[e];
-            floors += scene.environment[e].name.rfind("floor#", 0) == 0 || scene.environment[e].name.rfind("ceiling#", 0) == 0;
+            floors += scene.environment[e].name.rfind("floor#", 0) == 0 ||
+                      scene.environment[e].name.rfind("ceiling#", 0) == 0;
         }
         EXPECT_EQ(floors, 2) << cell.name;
         for (std::size_t i : cell.instances) {
             ASSERT_LT(i, scene.instances.size());
             ++instance_cells[i];
-            const Vec3 p{scene.instances[i].object_to_world.at(0, 3), 0.5f, scene.instances[i].object_to_world.at(2, 3)};
+            const Vec3 p{scene.instances[i].object_to_world.at(0, 3), 0.5f,
+                         scene.instances[i].object_to_world.at(2, 3)};
             EXPECT_TRUE(inside(p, cell.box)) << scene.instances[i].name << " in " << cell.name;
         }
     }

@@ -17,9 +17,9 @@
 #include <new>
 #include <vector>
 
-#include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/parallel.h"
 #include "patchcull/core/teapot.h"
+#include "patchcull/eval/cull_eval.h"
 
 namespace {
 
@@ -93,10 +93,11 @@ TEST(CullEvalMemory, PeakHeapGrowsByHundredsOfBytesPerPatchNotByTheSamples) {
     // patch. Each thread's window: 64 patches * 289 samples * 44 bytes (0.8 MB).
     const std::int64_t bound = 512 * n + std::int64_t{threads} * (1 << 20) + (4 << 20);
     const std::int64_t eager_samples = n * 289 * (12 + 32);
-    std::printf("[          ] peak heap growth %.1f MB for %lld patches (%.0f bytes a patch; bound %.1f MB; the eager "
-                "samples alone %.1f MB)\n",
-                growth / 1048576.0, static_cast<long long>(n), double(growth) / double(n), bound / 1048576.0,
-                eager_samples / 1048576.0);
+    std::printf(
+        "[          ] peak heap growth %.1f MB for %lld patches (%.0f bytes a patch; bound %.1f MB; the eager "
+        "samples alone %.1f MB)\n",
+        growth / 1048576.0, static_cast<long long>(n), double(growth) / double(n), bound / 1048576.0,
+        eager_samples / 1048576.0);
     EXPECT_LT(growth, bound);
     // The bound can fail: the eager truth's samples alone exceed it several times over.
     EXPECT_GT(eager_samples, 3 * bound);

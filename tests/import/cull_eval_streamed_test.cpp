@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/displacement.h"
 #include "patchcull/core/error.h"
+#include "patchcull/eval/cull_eval.h"
 #include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
@@ -69,36 +69,86 @@ void expect_same_as_old(const OldRun& run) {
 }  // namespace
 
 TEST(CullEvalStreamed, TeapotAccEveryMethodEqualsTheEagerTruths) {
-    expect_same_as_old({"teapot", Scheme::acc, false, ViewMode::free, false, 300, 1, true,
-                        {{"frustum", 6495}, {"frustum-disp", 6168}, {"tcone", 97}, {"ncone", 428}, {"ptp", 1496},
+    expect_same_as_old({"teapot",
+                        Scheme::acc,
+                        false,
+                        ViewMode::free,
+                        false,
+                        300,
+                        1,
+                        true,
+                        {{"frustum", 6495},
+                         {"frustum-disp", 6168},
+                         {"tcone", 97},
+                         {"ncone", 428},
+                         {"ptp", 1496},
                          {"ptp-pcnt", 2047}}});
 }
 
 TEST(CullEvalStreamed, TeapotOsdDisplacedEqualsTheEagerTruth) {
-    expect_same_as_old({"teapot", Scheme::osd, true, ViewMode::free, false, 300, 1, false,
+    expect_same_as_old({"teapot",
+                        Scheme::osd,
+                        true,
+                        ViewMode::free,
+                        false,
+                        300,
+                        1,
+                        false,
                         {{"frustum", 6317}, {"frustum-disp", 5911}}});
 }
 
 TEST(CullEvalStreamed, BigGuyAccEveryMethodEqualsTheEagerTruths) {
-    expect_same_as_old({"bigguy.obj", Scheme::acc, false, ViewMode::free, false, 40, 1, true,
-                        {{"frustum", 49515}, {"frustum-disp", 49045}, {"tcone", 15108}, {"ncone", 21488},
-                         {"ptp", 26035}, {"ptp-pcnt", 26035}}});
+    expect_same_as_old({"bigguy.obj",
+                        Scheme::acc,
+                        false,
+                        ViewMode::free,
+                        false,
+                        40,
+                        1,
+                        true,
+                        {{"frustum", 49515},
+                         {"frustum-disp", 49045},
+                         {"tcone", 15108},
+                         {"ncone", 21488},
+                         {"ptp", 26035},
+                         {"ptp-pcnt", 26035}}});
 }
 
 TEST(CullEvalStreamed, BigGuyOsdDisplacedEqualsTheEagerTruth) {
-    expect_same_as_old({"bigguy.obj", Scheme::osd, true, ViewMode::free, false, 6, 1, false,
+    expect_same_as_old({"bigguy.obj",
+                        Scheme::osd,
+                        true,
+                        ViewMode::free,
+                        false,
+                        6,
+                        1,
+                        false,
                         {{"frustum", 30158}, {"frustum-disp", 30006}}});
 }
 
 TEST(CullEvalStreamed, BigGuyAccDisplacedEqualsTheEagerTruth) {
-    expect_same_as_old({"bigguy.obj", Scheme::acc, true, ViewMode::free, false, 12, 5, false,
+    expect_same_as_old({"bigguy.obj",
+                        Scheme::acc,
+                        true,
+                        ViewMode::free,
+                        false,
+                        12,
+                        5,
+                        false,
                         {{"frustum", 12853}, {"frustum-disp", 12712}}});
 }
 
 TEST(CullEvalStreamed, BigGuyDistanceViewsEqualTheEagerTruths) {
-    expect_same_as_old({"bigguy.obj", Scheme::acc, false, ViewMode::contain, true, 20, 9, true,
-                        {{"frustum", 0}, {"frustum-disp", 0}, {"tcone", 5988}, {"ncone", 8799}, {"ptp", 10442},
-                         {"ptp-pcnt", 10442}}});
+    expect_same_as_old(
+        {"bigguy.obj",
+         Scheme::acc,
+         false,
+         ViewMode::contain,
+         true,
+         20,
+         9,
+         true,
+         {{"frustum", 0}, {"frustum-disp", 0}, {"tcone", 5988}, {"ncone", 8799}, {"ptp", 10442}, {"ptp-pcnt", 10442}}});
 }
 
 // Progress comes per block of views: increasing, ending at the view count, more than once for

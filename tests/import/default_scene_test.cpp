@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/import/builtin_scenes.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
+#include "patchcull/import/builtin_scenes.h"
+#include "patchcull/import/scene_poser.h"
 
 using namespace patchcull;
 
@@ -73,7 +73,8 @@ TEST(DefaultScene, CameraPathSeesTheGroupAndCutsSomePatches) {
     const PatchBatch batch = make_batch(patches);
     for (const Camera& camera : path) {
         std::vector<std::uint8_t> culled(patches.size());
-        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(camera.view_projection(), ClipDepth::zero_to_one), culled.data());
+        cull_frustum_scalar(batch.view(), nullptr,
+                            make_frustum_planes(camera.view_projection(), ClipDepth::zero_to_one), culled.data());
         const auto n = static_cast<std::size_t>(std::count(culled.begin(), culled.end(), 1));
         // Most of the scene is in view, but not all of it: frustum culling has work.
         EXPECT_GT(n, 0u);
@@ -93,7 +94,8 @@ TEST(DefaultScene, ModelSceneStandsOnTheGroundInView) {
     const PatchBatch batch = make_batch(patches);
     for (const Camera& camera : scene.camera_path(4, 1.0f)) {
         std::vector<std::uint8_t> culled(patches.size());
-        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(camera.view_projection(), ClipDepth::zero_to_one), culled.data());
+        cull_frustum_scalar(batch.view(), nullptr,
+                            make_frustum_planes(camera.view_projection(), ClipDepth::zero_to_one), culled.data());
         EXPECT_EQ(std::count(culled.begin(), culled.end(), 1), 0);  // the whole teapot is in view
     }
 }
@@ -267,7 +269,8 @@ Vec3 linear_part(const Mat4& m, Vec3 d) { return xyz(m * Vec4{d.x, d.y, d.z, 0})
 
 // Signed volume of a set of patches, 1/3 sum of P . (Pu x Pv) over an n x n midpoint grid per patch
 // (the divergence theorem; positive for a closed surface whose du x dv points outward).
-double patch_volume(const std::vector<BezierPatch>& patches, std::size_t first, std::size_t count, Vec3 centre, int n = 6) {
+double patch_volume(const std::vector<BezierPatch>& patches, std::size_t first, std::size_t count, Vec3 centre,
+                    int n = 6) {
     double v = 0;
     for (std::size_t p = first; p < first + count; ++p)
         for (int j = 0; j < n; ++j)
@@ -359,8 +362,8 @@ TEST(DefaultScene, MirroredInstancesArePosedRightSideOut) {
         {
             const Mat4& l = c.linear;
             auto a = [&](int r, int cc) { return double(l.at(r, cc)); };
-            det = a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
-                  a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
+            det = a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) -
+                  a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) + a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
         }
         // Outward normals map by the inverse transpose of the linear part.
         Mat4 inverse;
@@ -421,8 +424,10 @@ TEST(DefaultScene, MirroredInstancesArePosedRightSideOut) {
             const TangentPatches& tp_m = poser.tangents()[static_cast<std::size_t>(im)];
             for (float u : {0.0f, 0.3f, 1.0f})
                 for (float v : {0.0f, 0.6f, 1.0f}) {
-                    const Vec3 na = normal_map(evaluate_tangent_normal(tp_a, u, v)) * static_cast<float>(std::fabs(det));
-                    const Vec3 nm = mirrored ? evaluate_tangent_normal(tp_m, v, u) : evaluate_tangent_normal(tp_m, u, v);
+                    const Vec3 na =
+                        normal_map(evaluate_tangent_normal(tp_a, u, v)) * static_cast<float>(std::fabs(det));
+                    const Vec3 nm =
+                        mirrored ? evaluate_tangent_normal(tp_m, v, u) : evaluate_tangent_normal(tp_m, u, v);
                     ASSERT_LT(length(nm - na), 1e-3f * length(na) + 1e-9f) << c.name << " patch " << p;
                     // ... and the ACC normal agrees in direction with the patch's own du x dv.
                     const SurfacePoint sm = mirrored ? evaluate_surface(m, v, u) : evaluate_surface(m, u, v);

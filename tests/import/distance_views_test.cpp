@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/error.h"
+#include "patchcull/eval/cull_eval.h"
 #include "patchcull/import/model_loader.h"
 
 using namespace patchcull;

@@ -5,6 +5,7 @@
 // positions themselves were off by up to half a unit. Each test here fails on that code.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -12,14 +13,13 @@
 #include <map>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 #include "cli/cli_test_util.h"
 #include "patchcull/core/camera.h"
-#include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/frustum.h"
-#include "patchcull/import/obj.h"
+#include "patchcull/eval/cull_eval.h"
 #include "patchcull/import/model_loader.h"
+#include "patchcull/import/obj.h"
 
 using namespace patchcull;
 
@@ -85,13 +85,14 @@ TEST(FarOrigin, TranslatedBigGuyCullsAsAtTheOrigin) {
             const int views = mode == ViewMode::free ? 24 : 8;
             const auto reference = cull(base.rest, mode, views);
             for (double t : {1e5, 1e7}) {
-                const std::string path = patchcull::cli_test::write_file("bigguy_" + std::to_string(int(std::log10(t))) + ".obj", patchcull::cli_test::translated_bigguy(t));
+                const std::string path = patchcull::cli_test::write_file(
+                    "bigguy_" + std::to_string(int(std::log10(t))) + ".obj", patchcull::cli_test::translated_bigguy(t));
                 const LoadedModel far = load_model(path, scheme, 0);
                 EXPECT_NEAR(far.origin.x, t, 10.0);
                 const auto r = cull(far.rest, mode, views);
                 for (const auto& [name, ref] : reference) {
-                    const std::string what = std::string(scheme_name(scheme)) + " " + view_mode_name(mode) + " t=" +
-                                             std::to_string(t) + " " + name;
+                    const std::string what = std::string(scheme_name(scheme)) + " " + view_mode_name(mode) +
+                                             " t=" + std::to_string(t) + " " + name;
                     EXPECT_EQ(r.at(name).false_culls, 0u) << what;
                     EXPECT_NEAR(r.at(name).cull_rate, ref.cull_rate, 0.01) << what;
                 }
@@ -112,8 +113,10 @@ TEST(FarOrigin, WorldCameraLocalMatchesTheCameraAtTheOrigin) {
         const Camera cam = views.next();
         const Camera back = to_world(cam, origin).local(origin);
         std::vector<std::uint8_t> a(batch.size()), b(batch.size());
-        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(cam.view_projection(), ClipDepth::zero_to_one), a.data());
-        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(back.view_projection(), ClipDepth::zero_to_one), b.data());
+        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(cam.view_projection(), ClipDepth::zero_to_one),
+                            a.data());
+        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(back.view_projection(), ClipDepth::zero_to_one),
+                            b.data());
         std::size_t differ = 0;
         for (std::size_t i = 0; i < a.size(); ++i) differ += a[i] != b[i];
         // Eye and target come back to float rounding of numbers of BigGuy's size (an ulp or two).

@@ -4,10 +4,10 @@
 // shows the ground truth does catch a kernel that is not conservative.
 #include <gtest/gtest.h>
 
-#include "patchcull/import/animation.h"
-#include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/ground_truth.h"
+#include "patchcull/eval/cull_eval.h"
+#include "patchcull/import/animation.h"
 #include "patchcull/import/model_loader.h"
 
 using namespace patchcull;
@@ -92,7 +92,8 @@ TEST(FrustumProperty, GroundTruthCatchesAKernelThatIgnoresDisplacement) {
     std::uint64_t false_culls = 0;
     for (int v = 0; v < 200; ++v) {
         const Mat4 clip = views.next().view_projection();
-        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(clip, ClipDepth::zero_to_one), culled.data());  // margin dropped
+        cull_frustum_scalar(batch.view(), nullptr, make_frustum_planes(clip, ClipDepth::zero_to_one),
+                            culled.data());  // margin dropped
         for (std::size_t p = 0; p < n; ++p)
             if (culled[p] && any_point_in_clip_volume(clip, &samples[p * 289], 289)) ++false_culls;
     }

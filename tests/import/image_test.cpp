@@ -133,9 +133,9 @@ std::string decode_error(const std::vector<unsigned char>& png) {
 TEST(Image, ACorruptPngSaysWhatIsWrongWithIt) {
     // A dynamic-Huffman block whose 19 code-length codes are all 1 bit long: more codes of one
     // length than that length allows (stb_image's terse "bad sizes").
-    std::vector<unsigned char> bits = {1, 0, 1};          // final block, type 2 (dynamic)
-    bits.insert(bits.end(), 10, 0);                        // HLIT = 0, HDIST = 0
-    bits.insert(bits.end(), {1, 1, 1, 1});                 // HCLEN = 15: 19 code-length codes
+    std::vector<unsigned char> bits = {1, 0, 1};                      // final block, type 2 (dynamic)
+    bits.insert(bits.end(), 10, 0);                                   // HLIT = 0, HDIST = 0
+    bits.insert(bits.end(), {1, 1, 1, 1});                            // HCLEN = 15: 19 code-length codes
     for (int k = 0; k < 19; ++k) bits.insert(bits.end(), {1, 0, 0});  // each 1 bit long
     std::vector<unsigned char> deflate((bits.size() + 7) / 8, 0);
     for (std::size_t i = 0; i < bits.size(); ++i) deflate[i / 8] |= static_cast<unsigned char>(bits[i] << (i % 8));

@@ -41,77 +41,93 @@ struct Rng {
     std::size_t below(std::size_t n) { return n == 0 ? 0 : engine() % n; }
 };
 
-const char* const kHugeNumbers[] = {"1e39",        "-1e39",   "1e-50", "99999999999999999999", "-2147483649",
-                                    "4294967296",  "4294967297", "nan", "inf", "-0", "0x7fffffff", "1e308"};
-const char* const kHugeIndices[] = {"0", "-1", "999999999", "-999999999", "2147483648", "4294967295",
-                                    "18446744073709551617", "1//4294967296", "1/999999999/1", "-9223372036854775808"};
-const char kControlBytes[] = {'\0', '\x01', '\x07', '\x08', '\x0b', '\x0c', '\x1b', '\x7f', '\xff', '\xc3', '\xe2', '\r'};
+const char* const kHugeNumbers[] = {"1e39",        "-1e39",      "1e-50",      "99999999999999999999",
+                                    "-2147483649", "4294967296", "4294967297", "nan",
+                                    "inf",         "-0",         "0x7fffffff", "1e308"};
+const char* const kHugeIndices[] = {"0",
+                                    "-1",
+                                    "999999999",
+                                    "-999999999",
+                                    "2147483648",
+                                    "4294967295",
+                                    "18446744073709551617",
+                                    "1//4294967296",
+                                    "1/999999999/1",
+                                    "-9223372036854775808"};
+const char kControlBytes[] = {'\0',   '\x01', '\x07', '\x08', '\x0b', '\x0c',
+                              '\x1b', '\x7f', '\xff', '\xc3', '\xe2', '\r'};
 
 // One mutation of data; OBJ-aware ones replace whole tokens so that the parser gets past them.
 void mutate(Bytes& data, Rng& rng, bool text) {
     switch (rng.below(text ? 9 : 6)) {
-    case 0:  // flip one bit
-        if (!data.empty()) data[rng.below(data.size())] ^= static_cast<char>(1u << rng.below(8));
-        break;
-    case 1:  // truncate
-        data.resize(rng.below(data.size() + 1));
-        break;
-    case 2:  // insert a control byte or a piece of an invalid UTF-8 sequence
-        data.insert(rng.below(data.size() + 1), 1, kControlBytes[rng.below(sizeof kControlBytes)]);
-        break;
-    case 3:  // overwrite a byte with any value
-        if (!data.empty()) data[rng.below(data.size())] = static_cast<char>(rng.below(256));
-        break;
-    case 4: {  // duplicate a slice (repeated records, chunks)
-        const std::size_t at = rng.below(data.size() + 1), length = rng.below(std::min<std::size_t>(64, data.size() - at) + 1);
-        data.insert(at, data.substr(at, length));
-        break;
-    }
-    case 5: {  // overwrite 4 bytes with a big-endian huge value (PNG widths, heights, lengths)
-        if (data.size() < 4) break;
-        const std::size_t at = rng.below(data.size() - 3);
-        const std::uint32_t values[] = {0xFFFFFFFFu, 0x7FFFFFFFu, 0x01000000u, 0x00FFFFFFu, 0x80000000u, 0};
-        const std::uint32_t v = values[rng.below(std::size(values))];
-        for (int k = 0; k < 4; ++k) data[at + k] = static_cast<char>(v >> (24 - 8 * k));
-        break;
-    }
-    case 6: {  // replace a token with a huge or non-finite number, or a huge index
-        std::vector<std::size_t> starts;
-        for (std::size_t i = 0; i < data.size(); ++i)
-            if (data[i] != ' ' && data[i] != '\n' && (i == 0 || data[i - 1] == ' ')) starts.push_back(i);
-        if (starts.empty()) break;
-        const std::size_t at = starts[rng.below(starts.size())];
-        std::size_t end = at;
-        while (end < data.size() && data[end] != ' ' && data[end] != '\n') ++end;
-        const bool index = rng.below(2) == 0;
-        data.replace(at, end - at, index ? kHugeIndices[rng.below(std::size(kHugeIndices))]
-                                         : kHugeNumbers[rng.below(std::size(kHugeNumbers))]);
-        break;
-    }
-    case 7: {  // a long line without a newline, of garbage or of one token repeated
-        const std::size_t at = rng.below(data.size() + 1);
-        const Bytes unit = rng.below(2) == 0 ? Bytes("\x01\xff") : Bytes(" 1");
-        Bytes run;
-        for (int k = 0; k < 3000; ++k) run += unit;
-        data.insert(at, run);
-        break;
-    }
-    default: {  // a big face over the vertices read so far, or a tag line
-        const char* const lines[] = {"\nt crease 2/1/0 0 0 1\n", "\nt creese 2/1/0 0 1 1\n", "\nt corner 9/1/0 0 1 2 3 4 5 6 7 8 1\n",
-                                     "\nf 1//1 2//1 3//99\n", "\xEF\xBB\xBF", "\nvn 0 0 1\n"};
-        const std::size_t choice = rng.below(std::size(lines) + 1);
-        if (choice < std::size(lines)) {
-            data.insert(rng.below(data.size() + 1), lines[choice]);
-        } else {
-            Bytes face = "\nf";
-            for (int k = 1; k <= 2000; ++k) {
-                face += ' ';  // appended piecewise: GCC 12's -Wrestrict misreads " " + std::string
-                face += std::to_string(k);
-            }
-            data += face + "\n";
+        case 0:  // flip one bit
+            if (!data.empty()) data[rng.below(data.size())] ^= static_cast<char>(1u << rng.below(8));
+            break;
+        case 1:  // truncate
+            data.resize(rng.below(data.size() + 1));
+            break;
+        case 2:  // insert a control byte or a piece of an invalid UTF-8 sequence
+            data.insert(rng.below(data.size() + 1), 1, kControlBytes[rng.below(sizeof kControlBytes)]);
+            break;
+        case 3:  // overwrite a byte with any value
+            if (!data.empty()) data[rng.below(data.size())] = static_cast<char>(rng.below(256));
+            break;
+        case 4: {  // duplicate a slice (repeated records, chunks)
+            const std::size_t at = rng.below(data.size() + 1),
+                              length = rng.below(std::min<std::size_t>(64, data.size() - at) + 1);
+            data.insert(at, data.substr(at, length));
+            break;
         }
-        break;
-    }
+        case 5: {  // overwrite 4 bytes with a big-endian huge value (PNG widths, heights, lengths)
+            if (data.size() < 4) break;
+            const std::size_t at = rng.below(data.size() - 3);
+            const std::uint32_t values[] = {0xFFFFFFFFu, 0x7FFFFFFFu, 0x01000000u, 0x00FFFFFFu, 0x80000000u, 0};
+            const std::uint32_t v = values[rng.below(std::size(values))];
+            for (int k = 0; k < 4; ++k) data[at + k] = static_cast<char>(v >> (24 - 8 * k));
+            break;
+        }
+        case 6: {  // replace a token with a huge or non-finite number, or a huge index
+            std::vector<std::size_t> starts;
+            for (std::size_t i = 0; i < data.size(); ++i)
+                if (data[i] != ' ' && data[i] != '\n' && (i == 0 || data[i - 1] == ' ')) starts.push_back(i);
+            if (starts.empty()) break;
+            const std::size_t at = starts[rng.below(starts.size())];
+            std::size_t end = at;
+            while (end < data.size() && data[end] != ' ' && data[end] != '\n') ++end;
+            const bool index = rng.below(2) == 0;
+            data.replace(at, end - at,
+                         index ? kHugeIndices[rng.below(std::size(kHugeIndices))]
+                               : kHugeNumbers[rng.below(std::size(kHugeNumbers))]);
+            break;
+        }
+        case 7: {  // a long line without a newline, of garbage or of one token repeated
+            const std::size_t at = rng.below(data.size() + 1);
+            const Bytes unit = rng.below(2) == 0 ? Bytes("\x01\xff") : Bytes(" 1");
+            Bytes run;
+            for (int k = 0; k < 3000; ++k) run += unit;
+            data.insert(at, run);
+            break;
+        }
+        default: {  // a big face over the vertices read so far, or a tag line
+            const char* const lines[] = {"\nt crease 2/1/0 0 0 1\n",
+                                         "\nt creese 2/1/0 0 1 1\n",
+                                         "\nt corner 9/1/0 0 1 2 3 4 5 6 7 8 1\n",
+                                         "\nf 1//1 2//1 3//99\n",
+                                         "\xEF\xBB\xBF",
+                                         "\nvn 0 0 1\n"};
+            const std::size_t choice = rng.below(std::size(lines) + 1);
+            if (choice < std::size(lines)) {
+                data.insert(rng.below(data.size() + 1), lines[choice]);
+            } else {
+                Bytes face = "\nf";
+                for (int k = 1; k <= 2000; ++k) {
+                    face += ' ';  // appended piecewise: GCC 12's -Wrestrict misreads " " + std::string
+                    face += std::to_string(k);
+                }
+                data += face + "\n";
+            }
+            break;
+        }
     }
 }
 

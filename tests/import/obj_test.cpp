@@ -85,7 +85,8 @@ TEST(Obj, FaceIndexOutOfRangeIsAnError) {
 }
 
 TEST(Obj, OtherMalformedLines) {
-    EXPECT_EQ(error_of("v 0 0\n"), "mesh.obj:1: vertex has 2 values; expected 3 (x y z), 4 (x y z w), 6 (x y z r g b) or 7 (x y z r g b a)");
+    EXPECT_EQ(error_of("v 0 0\n"),
+              "mesh.obj:1: vertex has 2 values; expected 3 (x y z), 4 (x y z w), 6 (x y z r g b) or 7 (x y z r g b a)");
     EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nf 1 2\n"), "mesh.obj:3: face needs at least 3 vertices");
     EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nf 1 2 1\n"), "mesh.obj:3: face uses vertex 1 twice");
     EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 x 3\n"), "mesh.obj:4: malformed vertex index 'x'");
@@ -123,8 +124,10 @@ TEST(Obj, AcceptsVertexColoursAndPointRecords) {
     EXPECT_EQ(m.face_count(), 1u);
     EXPECT_EQ(error_of("v 0 0 0 1 nan 1\n"), "mesh.obj:1: non-finite coordinate 'nan'");
     // The count as found, not the minimum.
-    EXPECT_EQ(error_of("v 0 0 0 1 7\n"), "mesh.obj:1: vertex has 5 values; expected 3 (x y z), 4 (x y z w), 6 (x y z r g b) or 7 (x y z r g b a)");
-    EXPECT_EQ(error_of("v\n"), "mesh.obj:1: vertex has 0 values; expected 3 (x y z), 4 (x y z w), 6 (x y z r g b) or 7 (x y z r g b a)");
+    EXPECT_EQ(error_of("v 0 0 0 1 7\n"),
+              "mesh.obj:1: vertex has 5 values; expected 3 (x y z), 4 (x y z w), 6 (x y z r g b) or 7 (x y z r g b a)");
+    EXPECT_EQ(error_of("v\n"),
+              "mesh.obj:1: vertex has 0 values; expected 3 (x y z), 4 (x y z w), 6 (x y z r g b) or 7 (x y z r g b a)");
 }
 
 namespace {
@@ -165,28 +168,34 @@ TEST(Obj, UnknownAndUnsupportedTagsAreErrors) {
     EXPECT_EQ(error_of(std::string(kQuad) + "t vertexedit 1/0/0 0\n"),
               "mesh.obj:6: unsupported tag 'vertexedit' (hierarchical edits are not part of OpenSubdiv 3)");
     EXPECT_EQ(error_of(std::string(kQuad) + "t crease\n"),
-              "mesh.obj:6: malformed tag line (expected 't NAME ints/floats/strings arguments...', e.g. 't crease 2/1/0 v0 v1 sharpness')");
+              "mesh.obj:6: malformed tag line (expected 't NAME ints/floats/strings arguments...', e.g. 't crease "
+              "2/1/0 v0 v1 sharpness')");
 }
 
 TEST(Obj, TagArgumentCountsAreChecked) {
     const std::string q = kQuad;
-    EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1\n"), "mesh.obj:6: malformed 'crease' tag: 2 arguments for counts '2/1/0'");
-    EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1 2 3\n"), "mesh.obj:6: malformed 'crease' tag: 4 arguments for counts '2/1/0'");
+    EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1\n"),
+              "mesh.obj:6: malformed 'crease' tag: 2 arguments for counts '2/1/0'");
+    EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1 2 3\n"),
+              "mesh.obj:6: malformed 'crease' tag: 4 arguments for counts '2/1/0'");
     EXPECT_EQ(error_of(q + "t crease 3/1/0 0 1 2 1\n"),
               "mesh.obj:6: 'crease' tag over an odd number of vertices (3): OpenSubdiv's shape format lists a crease's "
               "edges as vertex pairs");
     EXPECT_EQ(error_of(q + "t crease 2/2/0 0 1 1 1\n"),
               "mesh.obj:6: 'crease' tag with 2 sharpness values: give one for all its edges, or one tag per edge");
-    EXPECT_EQ(error_of(q + "t crease 2/1/1 0 1 1 x\n"),
-              "mesh.obj:6: malformed 'crease' tag: expected 't crease 2/1/0 v0 v1 sharpness' (or n/1/0 with n vertices, "
-              "read as n/2 edges)");
+    EXPECT_EQ(
+        error_of(q + "t crease 2/1/1 0 1 1 x\n"),
+        "mesh.obj:6: malformed 'crease' tag: expected 't crease 2/1/0 v0 v1 sharpness' (or n/1/0 with n vertices, "
+        "read as n/2 edges)");
     EXPECT_EQ(error_of(q + "t crease 2/1 0 1 1\n"), "mesh.obj:6: malformed tag argument counts '2/1'");
     EXPECT_EQ(error_of(q + "t crease 2/1/0/0 0 1 1\n"), "mesh.obj:6: malformed tag argument counts '2/1/0/0'");
     EXPECT_EQ(error_of(q + "t crease 2/-1/0 0 1 1\n"), "mesh.obj:6: malformed tag argument counts '2/-1/0'");
-    EXPECT_EQ(error_of(q + "t corner 9223372036854775807/9223372036854775807/0 0 1\n"),
-              "mesh.obj:6: malformed 'corner' tag: 2 arguments for counts '9223372036854775807/9223372036854775807/'...");
-    EXPECT_EQ(error_of(q + "t corner 0/1/0 1\n"),
-              "mesh.obj:6: malformed 'corner' tag: expected 't corner 1/1/0 v sharpness' (or n/1/0 or n/n/0 for n vertices)");
+    EXPECT_EQ(
+        error_of(q + "t corner 9223372036854775807/9223372036854775807/0 0 1\n"),
+        "mesh.obj:6: malformed 'corner' tag: 2 arguments for counts '9223372036854775807/9223372036854775807/'...");
+    EXPECT_EQ(
+        error_of(q + "t corner 0/1/0 1\n"),
+        "mesh.obj:6: malformed 'corner' tag: expected 't corner 1/1/0 v sharpness' (or n/1/0 or n/n/0 for n vertices)");
     EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1 -1\n"), "mesh.obj:6: negative sharpness '-1'");
     // A sharpness is not a coordinate.
     EXPECT_EQ(error_of(q + "t crease 2/1/0 0 1 nan\n"), "mesh.obj:6: non-finite sharpness 'nan'");
@@ -194,7 +203,8 @@ TEST(Obj, TagArgumentCountsAreChecked) {
 }
 
 TEST(Obj, CreaseFromAVertexToItselfIsAnError) {
-    EXPECT_EQ(error_of(std::string(kQuad) + "t crease 2/1/0 2 2 1\n"), "mesh.obj:6: crease from vertex 2 to itself (0-based)");
+    EXPECT_EQ(error_of(std::string(kQuad) + "t crease 2/1/0 2 2 1\n"),
+              "mesh.obj:6: crease from vertex 2 to itself (0-based)");
 }
 
 TEST(Obj, CornerTagsWithSeveralVertices) {
@@ -204,8 +214,9 @@ TEST(Obj, CornerTagsWithSeveralVertices) {
     EXPECT_FLOAT_EQ(m.corners[1].sharpness, 10.0f);
     EXPECT_EQ(m.corners[3].v0, 3u);
     EXPECT_FLOAT_EQ(m.corners[3].sharpness, 2.0f);
-    EXPECT_EQ(error_of(std::string(kQuad) + "t corner 2/3/0 0 1 1 1 1\n"),
-              "mesh.obj:6: malformed 'corner' tag: expected 't corner 1/1/0 v sharpness' (or n/1/0 or n/n/0 for n vertices)");
+    EXPECT_EQ(
+        error_of(std::string(kQuad) + "t corner 2/3/0 0 1 1 1 1\n"),
+        "mesh.obj:6: malformed 'corner' tag: expected 't corner 1/1/0 v sharpness' (or n/1/0 or n/n/0 for n vertices)");
 }
 
 TEST(Obj, AcceptsAUtf8ByteOrderMark) {

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "patchcull/core/error.h"
-#include "patchcull/import/obj.h"
 #include "patchcull/import/model_loader.h"
+#include "patchcull/import/obj.h"
 #include "patchcull/import/subdivision.h"
 
 using namespace patchcull;
@@ -54,7 +54,8 @@ std::string grid_obj(int n) {
     std::string text;
     for (int j = 0; j <= n; ++j)
         for (int i = 0; i <= n; ++i)
-            text += "v " + std::to_string(i) + " " + std::to_string(j) + " " + std::to_string((i * 7 + j * 3) % 5 * 0.1) + "\n";
+            text += "v " + std::to_string(i) + " " + std::to_string(j) + " " +
+                    std::to_string((i * 7 + j * 3) % 5 * 0.1) + "\n";
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
             const int a = 1 + j * (n + 1) + i;
@@ -70,7 +71,8 @@ std::string tube_obj(int around, int rows) {
     for (int j = 0; j <= rows; ++j)
         for (int i = 0; i < around; ++i) {
             const double a = 6.283185307179586 * i / around;
-            text += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " " + std::to_string(j) + "\n";
+            text +=
+                "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " " + std::to_string(j) + "\n";
         }
     for (int j = 0; j < rows; ++j)
         for (int i = 0; i < around; ++i) {
@@ -131,8 +133,9 @@ TEST(ObjTags, BadOptionValuesNameTheLine) {
               "tags.obj:14: 'interpolateboundary' 3: expected 0 (none), 1 (edges and corners) or 2 (edges only)");
     EXPECT_EQ(parse_error(grid + "t interpolateboundary 1/0/0 1\nt interpolateboundary 1/0/0 2\n"),
               "tags.obj:15: 'interpolateboundary' tag given twice (first at line 14)");
-    EXPECT_EQ(parse_error(grid + "t interpolateboundary 0/1/0 1\n"),
-              "tags.obj:14: malformed 'interpolateboundary' tag: expected 't interpolateboundary 1/0/0 m' with m 0, 1 or 2");
+    EXPECT_EQ(
+        parse_error(grid + "t interpolateboundary 0/1/0 1\n"),
+        "tags.obj:14: malformed 'interpolateboundary' tag: expected 't interpolateboundary 1/0/0 m' with m 0, 1 or 2");
     EXPECT_EQ(parse_error(grid + "t creasemethod 0/0/1 smooth\n"),
               "tags.obj:14: 'creasemethod' tag 'smooth': expected normal or chaikin");
     EXPECT_EQ(parse_error(grid + "t smoothtriangles 1/0/0 1\n"),
@@ -141,7 +144,8 @@ TEST(ObjTags, BadOptionValuesNameTheLine) {
               "tags.obj:14: 'facevaryinginterpolateboundary' tag value 6: expected 0 to 5");
     EXPECT_EQ(parse_error(grid + "t facevaryingpropagatecorners 1/0/0 2\n"),
               "tags.obj:14: 'facevaryingpropagatecorners' tag value 2: expected 0 or 1");
-    EXPECT_EQ(parse_error(grid + "t hole 1/0/0 4\n"), "tags.obj:14: hole tag names face 4 (0-based); the file has 4 faces");
+    EXPECT_EQ(parse_error(grid + "t hole 1/0/0 4\n"),
+              "tags.obj:14: hole tag names face 4 (0-based); the file has 4 faces");
     EXPECT_EQ(parse_error(grid + "t hole 1/0/0 -1\n"), "tags.obj:14: hole face index -1 out of range (0-based)");
 }
 
@@ -202,7 +206,8 @@ TEST(ObjTags, HoleFacesProduceNoPatchesWithEitherScheme) {
     // Every face a hole: no surface, one line.
     ControlMesh all = parse(grid_obj(1) + "t hole 1/0/0 0\n");
     for (const Scheme scheme : {Scheme::acc, Scheme::osd})
-        EXPECT_EQ(build_error(all, scheme), "tags.obj: every face is a hole or at an uninterpolated boundary: no surface");
+        EXPECT_EQ(build_error(all, scheme),
+                  "tags.obj: every face is a hole or at an uninterpolated boundary: no surface");
 }
 
 TEST(ObjTags, AHoleOpensAClosedSolid) {
@@ -259,7 +264,8 @@ TEST(ObjTags, NoBoundaryInterpolationLeavesTheSameFacesOutWithBothSchemes) {
     // Creases sharpening every boundary edge infinitely keep the boundary faces in Far (crease
     // rules acc ignores): acc refuses, naming the tag's line and the osd scheme.
     std::string sharp = grid_obj(2) + "t interpolateboundary 1/0/0 0\n";
-    for (const auto& [a, b] : std::vector<std::pair<int, int>>{{0, 1}, {1, 2}, {2, 5}, {5, 8}, {8, 7}, {7, 6}, {6, 3}, {3, 0}})
+    for (const auto& [a, b] :
+         std::vector<std::pair<int, int>>{{0, 1}, {1, 2}, {2, 5}, {5, 8}, {8, 7}, {7, 6}, {6, 3}, {3, 0}})
         sharp += "t crease 2/1/0 " + std::to_string(a) + " " + std::to_string(b) + " 10\n";
     const ControlMesh sharpened = parse(sharp);
     EXPECT_EQ(base_faces(build_model(sharpened, Scheme::osd)).size(), 4u);
@@ -273,7 +279,8 @@ TEST(ObjTags, EdgesOnlyBoundariesAreHonouredOrRefused) {
     // corners sharp and refuses, naming the line and the osd scheme.
     const std::string grid = grid_obj(2);
     const ControlMesh corner = parse(grid), smooth = parse(grid + "t interpolateboundary 1/0/0 2\n");
-    EXPECT_FALSE(same_stencils(build_model(corner, Scheme::osd).patch_points, build_model(smooth, Scheme::osd).patch_points));
+    EXPECT_FALSE(
+        same_stencils(build_model(corner, Scheme::osd).patch_points, build_model(smooth, Scheme::osd).patch_points));
     const std::string e = build_error(smooth, Scheme::acc);
     EXPECT_EQ(e.rfind("tags.obj:14: ", 0), 0u) << e;
     EXPECT_NE(e.find("osd scheme"), std::string::npos) << e;
@@ -281,7 +288,8 @@ TEST(ObjTags, EdgesOnlyBoundariesAreHonouredOrRefused) {
     const std::string tube = tube_obj(6, 2);
     const ControlMesh tube_default = parse(tube), tube_edges = parse(tube + "t interpolateboundary 1/0/0 2\n");
     for (const Scheme scheme : {Scheme::acc, Scheme::osd})
-        EXPECT_TRUE(same_stencils(build_model(tube_default, scheme).patch_points, build_model(tube_edges, scheme).patch_points))
+        EXPECT_TRUE(
+            same_stencils(build_model(tube_default, scheme).patch_points, build_model(tube_edges, scheme).patch_points))
             << scheme_name(scheme);
 }
 
@@ -291,7 +299,8 @@ TEST(ObjTags, CreaseMethodAndTriangleRuleReachOpenSubdiv) {
     ASSERT_TRUE(chaikin.options.chaikin_creases);
     ControlMesh uniform = chaikin;
     uniform.options.chaikin_creases = false;
-    EXPECT_FALSE(same_stencils(build_model(chaikin, Scheme::osd).patch_points, build_model(uniform, Scheme::osd).patch_points));
+    EXPECT_FALSE(
+        same_stencils(build_model(chaikin, Scheme::osd).patch_points, build_model(uniform, Scheme::osd).patch_points));
 
     ControlMesh smooth = load_obj(shape("catmark_smoothtris1"));
     ASSERT_TRUE(smooth.options.smooth_triangles);

@@ -32,8 +32,8 @@
 
 #include "import/osd_topology.h"
 #include "patchcull/core/error.h"
-#include "patchcull/import/obj.h"
 #include "patchcull/core/patch.h"
+#include "patchcull/import/obj.h"
 #include "patchcull/import/subdivision.h"
 
 using namespace patchcull;
@@ -118,7 +118,8 @@ ControlMesh open_grid(int n) {
     m.name = "open_grid";
     for (int j = 0; j <= n; ++j)
         for (int i = 0; i <= n; ++i) {
-            const float x = static_cast<float>(i) / static_cast<float>(n), y = static_cast<float>(j) / static_cast<float>(n);
+            const float x = static_cast<float>(i) / static_cast<float>(n),
+                        y = static_cast<float>(j) / static_cast<float>(n);
             m.positions.push_back({x, y, 0.3f * std::sin(3 * x) * std::cos(2 * y)});
             m.texcoords.push_back({x, y});
         }
@@ -136,7 +137,8 @@ ControlMesh open_grid(int n) {
 ControlMesh open_ngon_fan() {
     ControlMesh m;
     m.name = "open_ngon_fan";
-    m.positions = {{0, 0, 0}, {1, 0, 0.1f}, {1.5f, 1, 0}, {0.5f, 1.7f, 0.2f}, {-0.6f, 1, 0}, {2, 0, 0}, {2.5f, 1, 0.3f}, {2.2f, 2, 0}};
+    m.positions = {{0, 0, 0},     {1, 0, 0.1f}, {1.5f, 1, 0},    {0.5f, 1.7f, 0.2f},
+                   {-0.6f, 1, 0}, {2, 0, 0},    {2.5f, 1, 0.3f}, {2.2f, 2, 0}};
     add_face(m, {0, 1, 2, 3, 4});  // pentagon
     add_face(m, {1, 5, 6, 2});     // quad
     add_face(m, {2, 6, 7});        // triangle
@@ -232,7 +234,8 @@ struct Reference {
 
         const int total = refiner->GetNumVerticesTotal();
         verts.resize(static_cast<std::size_t>(total + table->GetNumLocalPoints()));
-        for (std::size_t v = 0; v < m.positions.size(); ++v) verts[v] = {m.positions[v].x, m.positions[v].y, m.positions[v].z};
+        for (std::size_t v = 0; v < m.positions.size(); ++v)
+            verts[v] = {m.positions[v].x, m.positions[v].y, m.positions[v].z};
         Far::PrimvarRefinerReal<double> primvar(*refiner);
         DPoint* src = verts.data();
         for (int level = 1; level <= refiner->GetMaxLevel(); ++level) {
@@ -325,8 +328,8 @@ double expect_matches_far(const ControlMesh& mesh, int samples = 4000) {
         const Far::PatchParam param = ref.table->GetPatchParamTable()[static_cast<std::size_t>(s.patch)];
         double pu = u, pv = v;
         param.Normalize(pu, pv);
-        const SurfacePoint sp =
-            evaluate_surface(frame.patches[static_cast<std::size_t>(s.patch)], static_cast<float>(pu), static_cast<float>(pv));
+        const SurfacePoint sp = evaluate_surface(frame.patches[static_cast<std::size_t>(s.patch)],
+                                                 static_cast<float>(pu), static_cast<float>(pv));
         // Our derivatives are per patch parameter; Far scales its derivatives by 2^depth (for
         // non-quad base faces too, where a ptex sub-face counts as half the face's parameter
         // range, so this is not 1 / GetParamFraction() there).
@@ -345,8 +348,8 @@ double expect_matches_far(const ControlMesh& mesh, int samples = 4000) {
         if (!ok && ++failures <= 5)
             ADD_FAILURE() << mesh.name << ": patch " << s.patch << " ptex " << f << " (" << u << ", " << v
                           << ") boundary " << param.GetBoundary() << " depth " << param.GetDepth()
-                          << ": position error " << e << ", du error " << edu << ", dv error " << edv
-                          << " (tolerance " << tol << ")";
+                          << ": position error " << e << ", du error " << edu << ", dv error " << edv << " (tolerance "
+                          << tol << ")";
     };
     for (int k = 0; k < samples; ++k) check(face(rng), unit(rng), unit(rng));
     // Every patch at its corners, edge midpoints and centre (slightly inside, so PatchMap picks it).
@@ -370,7 +373,8 @@ std::vector<DPoint> far_uniform_level1(const ControlMesh& m, std::unique_ptr<Far
     refiner = reference_refiner(m);
     refiner->RefineUniform(Far::TopologyRefiner::UniformOptions(1));
     std::vector<DPoint> all(static_cast<std::size_t>(refiner->GetNumVerticesTotal()));
-    for (std::size_t v = 0; v < m.positions.size(); ++v) all[v] = {m.positions[v].x, m.positions[v].y, m.positions[v].z};
+    for (std::size_t v = 0; v < m.positions.size(); ++v)
+        all[v] = {m.positions[v].x, m.positions[v].y, m.positions[v].z};
     const DPoint* src = all.data();
     DPoint* dst = all.data() + m.positions.size();
     Far::PrimvarRefinerReal<double>(*refiner).Interpolate(1, src, dst);
@@ -379,8 +383,10 @@ std::vector<DPoint> far_uniform_level1(const ControlMesh& m, std::unique_ptr<Far
 
 std::string error_of(const ControlMesh& m, bool refine) {
     try {
-        if (refine) refine_uniform_once(m);
-        else build_osd_model(m);
+        if (refine)
+            refine_uniform_once(m);
+        else
+            build_osd_model(m);
     } catch (const Error& e) {
         return e.what();
     }
@@ -468,7 +474,8 @@ TEST(Osd, NormalsPointOutwardOnConvexMeshes) {
             for (int j = 0; j <= 4; ++j)
                 for (int i = 0; i <= 4; ++i) {
                     // Stay off the patch corners: at an extraordinary vertex du x dv may vanish.
-                    const float u = 0.05f + 0.9f * static_cast<float>(i) / 4, v = 0.05f + 0.9f * static_cast<float>(j) / 4;
+                    const float u = 0.05f + 0.9f * static_cast<float>(i) / 4,
+                                v = 0.05f + 0.9f * static_cast<float>(j) / 4;
                     const SurfacePoint s = evaluate_surface(patch, u, v);
                     ++total;
                     if (dot(s.normal, s.position - centre) <= 0) ++inward;
@@ -508,7 +515,8 @@ TEST(Osd, PatchesAreWatertightOnClosedMeshes) {
                                    static_cast<long>(std::floor(p.z / cell)));
         };
         const auto hash = [](const std::tuple<long, long, long>& c) {
-            return static_cast<std::size_t>(std::get<0>(c) * 73856093L ^ std::get<1>(c) * 19349663L ^ std::get<2>(c) * 83492791L);
+            return static_cast<std::size_t>(std::get<0>(c) * 73856093L ^ std::get<1>(c) * 19349663L ^
+                                            std::get<2>(c) * 83492791L);
         };
         std::unordered_multimap<std::tuple<long, long, long>, std::size_t, decltype(hash)> grid(samples.size(), hash);
         for (std::size_t i = 0; i < samples.size(); ++i) grid.emplace(cell_of(samples[i].p), i);
@@ -588,7 +596,8 @@ TEST(Osd, NonManifoldAndInvalidMeshesThrowNamingTheMesh) {
     fin.name = "fin.obj";
     fin.positions.push_back({0.5f, 0.5f, 1});
     fin.positions.push_back({0.5f, 0.0f, 1});
-    add_face(fin, {1, 4, static_cast<std::uint32_t>(fin.positions.size() - 2), static_cast<std::uint32_t>(fin.positions.size() - 1)});
+    add_face(fin, {1, 4, static_cast<std::uint32_t>(fin.positions.size() - 2),
+                   static_cast<std::uint32_t>(fin.positions.size() - 1)});
     fin.face_texcoords.clear();
     fin.texcoords.clear();
 
@@ -676,7 +685,8 @@ TEST(Refine, AllQuadsCountsAndOrientation) {
                 Vec3 n{};
                 const std::uint32_t b = m.face_offsets[face], sz = m.face_size(face);
                 for (std::uint32_t k = 0; k < sz; ++k) {
-                    const Vec3 p = m.positions[m.face_vertices[b + k]], q = m.positions[m.face_vertices[b + (k + 1) % sz]];
+                    const Vec3 p = m.positions[m.face_vertices[b + k]],
+                               q = m.positions[m.face_vertices[b + (k + 1) % sz]];
                     n += Vec3{(p.y - q.y) * (p.z + q.z), (p.z - q.z) * (p.x + q.x), (p.x - q.x) * (p.y + q.y)};
                 }
                 return n;
@@ -710,7 +720,9 @@ TEST(Refine, TexcoordsAreLinear) {
                 for (int rot = 0; rot < 4; ++rot) {
                     bool all = true;
                     for (int c = 0; c < 4; ++c) {
-                        const Vec2 got = r.mesh.texcoords[r.mesh.face_texcoords[4 * child + static_cast<std::size_t>((c + rot) % 4)]];
+                        const Vec2 got =
+                            r.mesh
+                                .texcoords[r.mesh.face_texcoords[4 * child + static_cast<std::size_t>((c + rot) % 4)]];
                         all = all && std::abs(got.x - expect[c].x) < 1e-6f && std::abs(got.y - expect[c].y) < 1e-6f;
                     }
                     matching_rotations += all;
@@ -728,9 +740,12 @@ TEST(Refine, CarriesCreasesAsFarDecrementsThem) {
     // (1.5 -> 0.5, 2.7 -> 1.7, 10 stays infinite; 0.5 -> 0 disappears).
     int infinite = 0, half = 0, one_seven = 0;
     for (const Crease& c : r.mesh.creases) {
-        if (c.sharpness >= 10) ++infinite;
-        else if (std::abs(c.sharpness - 0.5f) < 1e-5f) ++half;
-        else if (std::abs(c.sharpness - 1.7f) < 1e-5f) ++one_seven;
+        if (c.sharpness >= 10)
+            ++infinite;
+        else if (std::abs(c.sharpness - 0.5f) < 1e-5f)
+            ++half;
+        else if (std::abs(c.sharpness - 1.7f) < 1e-5f)
+            ++one_seven;
     }
     EXPECT_EQ(infinite, 4);
     EXPECT_EQ(half, 2);

@@ -8,10 +8,10 @@
 #include <cstring>
 #include <vector>
 
-#include "patchcull/import/builtin_scenes.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
+#include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/model_loader.h"
+#include "patchcull/import/scene_poser.h"
 
 using namespace patchcull;
 
@@ -51,7 +51,8 @@ void expect_tables_reproduce_pose(const Scene& scene, float t) {
             if (tb < 0) continue;
             // The block's rows, mapped (transposed for mirrored instances, as pose()).
             const Vec3* src = tangent_rows.data() + 24 * static_cast<std::size_t>(tb);
-            const TangentPatches& expected = reference.tangents()[static_cast<std::size_t>(reference.tangent_index()[next])];
+            const TangentPatches& expected =
+                reference.tangents()[static_cast<std::size_t>(reference.tangent_index()[next])];
             for (int k = 0; k < 12; ++k) {
                 Vec3 du, dv;
                 if (mirrored) {

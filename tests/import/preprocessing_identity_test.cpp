@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/import/obj.h"
 #include "patchcull/import/model_loader.h"
+#include "patchcull/import/obj.h"
 #include "patchcull/import/subdivision.h"
 
 using namespace patchcull;
@@ -136,7 +136,9 @@ ControlMesh cube_grid(int n) {
         if (v < 0) {
             v = static_cast<std::int64_t>(m.positions.size());
             // Slightly uneven spacing so that no weight meets a lucky cancellation.
-            const auto c = [n](int i) { return static_cast<float>(i) / static_cast<float>(n) - 0.5f + 0.01f * static_cast<float>(i % 3); };
+            const auto c = [n](int i) {
+                return static_cast<float>(i) / static_cast<float>(n) - 0.5f + 0.01f * static_cast<float>(i % 3);
+            };
             m.positions.push_back({c(x), c(y), c(z)});
         }
         return static_cast<std::uint32_t>(v);
@@ -154,8 +156,10 @@ ControlMesh cube_grid(int n) {
                         c[(axis + 2) % 3] = b + db[k];
                         q[k] = vertex(c[0], c[1], c[2]);
                     }
-                    if (side == 0) add_face(m, {q[3], q[2], q[1], q[0]});
-                    else add_face(m, {q[0], q[1], q[2], q[3]});
+                    if (side == 0)
+                        add_face(m, {q[3], q[2], q[1], q[0]});
+                    else
+                        add_face(m, {q[0], q[1], q[2], q[3]});
                 }
     return m;
 }
@@ -244,8 +248,8 @@ void expect_identical(const std::string& what, const SubdivisionModel& model, co
     EXPECT_EQ(got.frame, want.frame) << what << ": evaluated patches changed";
     EXPECT_EQ(got.split, want.split) << what << ": evaluated patches after one split changed";
     EXPECT_EQ(got.warnings, want.warnings) << what << ": warnings changed";
-    if (got.points != want.points || got.tangents != want.tangents || got.infos != want.infos || got.frame != want.frame ||
-        got.split != want.split || got.warnings != want.warnings)
+    if (got.points != want.points || got.tangents != want.tangents || got.infos != want.infos ||
+        got.frame != want.frame || got.split != want.split || got.warnings != want.warnings)
         print_actual(what, got);
 }
 
@@ -268,20 +272,30 @@ ControlMesh mesh_of(const std::string& name) {
 // Captured at 18c0849 (before the preprocessing speed and memory work).
 const Case kCases[] = {
     {"bigguy",
-     {0xd266c3255b0f0a21ull, 0xe538f67cd2b85797ull, 0xd6a2dd91032be23dull, 0xb662ca8e0b71c1e6ull, 0xd3ec6372b7c82122ull, 0xa8c7f832281a39c5ull},
-     {0xed8bf33812725076ull, 0x5f242d39c2422be4ull, 0x22a214bbb466c521ull, 0x3ee69bd2193b77f7ull, 0x8f19ed5eecd660f9ull, 0xa8c7f832281a39c5ull}},
+     {0xd266c3255b0f0a21ull, 0xe538f67cd2b85797ull, 0xd6a2dd91032be23dull, 0xb662ca8e0b71c1e6ull, 0xd3ec6372b7c82122ull,
+      0xa8c7f832281a39c5ull},
+     {0xed8bf33812725076ull, 0x5f242d39c2422be4ull, 0x22a214bbb466c521ull, 0x3ee69bd2193b77f7ull, 0x8f19ed5eecd660f9ull,
+      0xa8c7f832281a39c5ull}},
     {"monsterfrog",
-     {0x4f3f4ab105799148ull, 0xd29ba2ec0bce953full, 0xee58b1279e4e091cull, 0x0b545b0852b079ffull, 0x0093540531d39d3full, 0xa8c7f832281a39c5ull},
-     {0x01c747cfe225dca3ull, 0x5f242d39c2422be4ull, 0x3fd49bcbcc58b679ull, 0xb4520acbf1d5404eull, 0x2941ee7f1aaedc81ull, 0xa8c7f832281a39c5ull}},
+     {0x4f3f4ab105799148ull, 0xd29ba2ec0bce953full, 0xee58b1279e4e091cull, 0x0b545b0852b079ffull, 0x0093540531d39d3full,
+      0xa8c7f832281a39c5ull},
+     {0x01c747cfe225dca3ull, 0x5f242d39c2422be4ull, 0x3fd49bcbcc58b679ull, 0xb4520acbf1d5404eull, 0x2941ee7f1aaedc81ull,
+      0xa8c7f832281a39c5ull}},
     {"cube_grid",
-     {0x33a6f0c1c66c47c2ull, 0x6aa1b8584e41b991ull, 0xc5cf28d505bf87f5ull, 0x34689bc622a9e7e8ull, 0xe5b5ec48bc9c026full, 0xa8c7f832281a39c5ull},
-     {0x633bdbdac3369ff2ull, 0x5f242d39c2422be4ull, 0x85f82a5686f703caull, 0x92d6fa442db6c357ull, 0x58ba0b6e77de5132ull, 0xa8c7f832281a39c5ull}},
+     {0x33a6f0c1c66c47c2ull, 0x6aa1b8584e41b991ull, 0xc5cf28d505bf87f5ull, 0x34689bc622a9e7e8ull, 0xe5b5ec48bc9c026full,
+      0xa8c7f832281a39c5ull},
+     {0x633bdbdac3369ff2ull, 0x5f242d39c2422be4ull, 0x85f82a5686f703caull, 0x92d6fa442db6c357ull, 0x58ba0b6e77de5132ull,
+      0xa8c7f832281a39c5ull}},
     {"l_grid",
-     {0x0711db01da61e8f3ull, 0xec49e6ebe0ecf4cdull, 0x2cdc8c640560a1cdull, 0x9d108551b0c17d59ull, 0xe78988a1120a088eull, 0xf100f175872cd754ull},
-     {0xb082a40f888edb4aull, 0x5f242d39c2422be4ull, 0x534f903c2ce2ccceull, 0xb8fc21229b07c19aull, 0x4cc9a70cd520662cull, 0xa8c7f832281a39c5ull}},
+     {0x0711db01da61e8f3ull, 0xec49e6ebe0ecf4cdull, 0x2cdc8c640560a1cdull, 0x9d108551b0c17d59ull, 0xe78988a1120a088eull,
+      0xf100f175872cd754ull},
+     {0xb082a40f888edb4aull, 0x5f242d39c2422be4ull, 0x534f903c2ce2ccceull, 0xb8fc21229b07c19aull, 0x4cc9a70cd520662cull,
+      0xa8c7f832281a39c5ull}},
     {"prism_house",
-     {0x918930dee7684aaaull, 0xe59ef72159fb3418ull, 0x0ce3a5dfe51ed22cull, 0xd873569cfecef5f6ull, 0x1c2de2d0eb003c05ull, 0xa8c7f832281a39c5ull},
-     {0xdd917886284af23aull, 0x5f242d39c2422be4ull, 0x81ba40b6a100a55bull, 0x1bbc7b7b92b6972dull, 0x21bad3137af31471ull, 0xa8c7f832281a39c5ull}},
+     {0x918930dee7684aaaull, 0xe59ef72159fb3418ull, 0x0ce3a5dfe51ed22cull, 0xd873569cfecef5f6ull, 0x1c2de2d0eb003c05ull,
+      0xa8c7f832281a39c5ull},
+     {0xdd917886284af23aull, 0x5f242d39c2422be4ull, 0x81ba40b6a100a55bull, 0x1bbc7b7b92b6972dull, 0x21bad3137af31471ull,
+      0xa8c7f832281a39c5ull}},
 };
 
 TEST(PreprocessingIdentity, PatchesAreBitIdenticalToTheReference) {

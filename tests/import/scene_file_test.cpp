@@ -11,12 +11,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <memory>
 #include <iterator>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
-
 
 #include "patchcull/core/error.h"
 #include "patchcull/import/builtin_scenes.h"
@@ -131,14 +130,16 @@ TEST(SceneFile, DefaultJsonIsTheDefaultScene) {
     const Scene built = make_default_scene();
     EXPECT_EQ(file.name, "default");
     ASSERT_EQ(file.models.size(), built.models.size());
-    for (std::size_t m = 0; m < file.models.size(); ++m) EXPECT_EQ(file.models[m].rest.patches.size(), built.models[m].rest.patches.size());
+    for (std::size_t m = 0; m < file.models.size(); ++m)
+        EXPECT_EQ(file.models[m].rest.patches.size(), built.models[m].rest.patches.size());
     EXPECT_EQ(file.patch_count(), built.patch_count());
     ASSERT_EQ(file.instances.size(), built.instances.size());
     for (std::size_t i = 0; i < file.instances.size(); ++i) {
         const SceneInstance &a = file.instances[i], &b = built.instances[i];
         EXPECT_EQ(a.name, b.name);
         EXPECT_EQ(a.model, b.model);
-        for (int k = 0; k < 16; ++k) EXPECT_EQ(a.object_to_world.m[k], b.object_to_world.m[k]) << a.name << " element " << k;
+        for (int k = 0; k < 16; ++k)
+            EXPECT_EQ(a.object_to_world.m[k], b.object_to_world.m[k]) << a.name << " element " << k;
         EXPECT_EQ(a.time_offset, b.time_offset) << a.name;
         EXPECT_EQ(a.displaced, b.displaced);
         EXPECT_EQ(a.deforms, b.deforms);
@@ -186,7 +187,8 @@ TEST(SceneFile, DefaultJsonIsTheDefaultScene) {
 std::vector<Bounds> solids(const Scene& scene, std::initializer_list<const char*> prefixes) {
     std::vector<Bounds> out;
     for (const EnvironmentObject& o : scene.environment) {
-        if (std::none_of(prefixes.begin(), prefixes.end(), [&](const char* p) { return o.name.rfind(p, 0) == 0; })) continue;
+        if (std::none_of(prefixes.begin(), prefixes.end(), [&](const char* p) { return o.name.rfind(p, 0) == 0; }))
+            continue;
         std::vector<Vec3> points;
         for (std::uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t)
             for (int k = 0; k < 3; ++k) points.push_back(scene.occluder_vertices[scene.occluder_indices[3 * t + k]]);
@@ -258,7 +260,8 @@ TEST(SceneFile, ShippedCityAndBuildingFiles) {
         if (o.name.find("-floor") != std::string::npos) continue;
         std::vector<Vec3> points;
         for (std::uint32_t t = o.first_triangle; t < o.first_triangle + o.triangle_count; ++t)
-            for (int k = 0; k < 3; ++k) points.push_back(building.occluder_vertices[building.occluder_indices[3 * t + k]]);
+            for (int k = 0; k < 3; ++k)
+                points.push_back(building.occluder_vertices[building.occluder_indices[3 * t + k]]);
         walls.push_back(bounds_of(points));
     }
     std::size_t ceilings = 0;
@@ -268,7 +271,9 @@ TEST(SceneFile, ShippedCityAndBuildingFiles) {
     check_clear(building, walls);
     // The camera walks from the hall into the kitchen.
     const std::vector<Camera> cameras = building.camera_path(60, 1.5f);
-    auto in = [](Vec3 e, const Bounds& b) { return e.x >= b.min.x && e.x <= b.max.x && e.z >= b.min.z && e.z <= b.max.z; };
+    auto in = [](Vec3 e, const Bounds& b) {
+        return e.x >= b.min.x && e.x <= b.max.x && e.z >= b.min.z && e.z <= b.max.z;
+    };
     EXPECT_TRUE(in(cameras.front().eye, building.cells[0].box));
     EXPECT_TRUE(in(cameras.back().eye, building.cells[1].box));
 }
@@ -365,7 +370,8 @@ TEST(SceneFile, PathsAreRelativeToTheFile) {
     fs::current_path(cwd);
     EXPECT_EQ(s.models.size(), 2u);
     // Named as the file gives it, the model's error names the resolved path.
-    write_file(dir / "scenes" / "b.json", with(text, "../models/cube.obj\", \"transform\"", "missing.obj\", \"transform\""));
+    write_file(dir / "scenes" / "b.json",
+               with(text, "../models/cube.obj\", \"transform\"", "missing.obj\", \"transform\""));
     try {
         load_scene_file((dir / "scenes" / "b.json").string());
         ADD_FAILURE() << "no error";
@@ -383,7 +389,8 @@ TEST(SceneFile, FarFromTheOriginAndMirrored) {
     write_file(dir / "cube.obj", cube_obj());
     std::string text = with(valid_scene(), R"("obj": "cube.obj", "transform": {"position": [-3, 0, 3], "scale": 2})",
                             R"("obj": "far.obj", "one_sided": true)");
-    text = with(text, R"("position": [2, 0, 0], "yaw_degrees": 30)", R"("position": [2000, 0, 8000], "yaw_degrees": 30)");
+    text =
+        with(text, R"("position": [2, 0, 0], "yaw_degrees": 30)", R"("position": [2000, 0, 8000], "yaw_degrees": 30)");
     text = with(text, R"("min": [3, 0, 3], "max": [4, 1, 4])", R"("min": [3000, 0, 3000], "max": [3001, 1, 3001])");
     write_file(dir / "a.json", text);
     const Scene s = load_scene_file((dir / "a.json").string());
@@ -410,7 +417,8 @@ TEST(SceneFile, FarFromTheOriginAndMirrored) {
     const Scene c = load_scene_file((dir / "c.json").string());
     ASSERT_EQ(c.occluder_world.size(), c.occluder_vertices.size());
     double lo = 1e30;
-    for (std::uint32_t t = c.environment[2].first_triangle; t < c.environment[2].first_triangle + c.environment[2].triangle_count; ++t)
+    for (std::uint32_t t = c.environment[2].first_triangle;
+         t < c.environment[2].first_triangle + c.environment[2].triangle_count; ++t)
         for (int k = 0; k < 3; ++k) lo = std::min(lo, c.occluder_world[c.occluder_indices[3 * t + k]].x);
     EXPECT_EQ(lo, 1e5 + 0.25);
     write_file(dir / "far2.obj", cube_obj(1e9, 2));
@@ -425,14 +433,16 @@ TEST(SceneFile, FarFromTheOriginAndMirrored) {
             << e.what();
     }
     // A mirroring matrix keeps boxes outward: the triangles are flipped back.
-    text = with(valid_scene(), R"("box": {"min": [3, 0, 3], "max": [4, 1, 4]})",
-                R"("box": {"min": [3, 0, 3], "max": [4, 1, 4]}, "transform": [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])");
+    text = with(
+        valid_scene(), R"("box": {"min": [3, 0, 3], "max": [4, 1, 4]})",
+        R"("box": {"min": [3, 0, 3], "max": [4, 1, 4]}, "transform": [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1])");
     write_file(dir / "m.json", text);
     const Scene m = load_scene_file((dir / "m.json").string());
     double volume = 0;
     const EnvironmentObject& box = m.environment[1];
     for (std::uint32_t t = box.first_triangle; t < box.first_triangle + box.triangle_count; ++t) {
-        const Vec3 a = m.occluder_vertices[m.occluder_indices[3 * t]], c = m.occluder_vertices[m.occluder_indices[3 * t + 2]];
+        const Vec3 a = m.occluder_vertices[m.occluder_indices[3 * t]],
+                   c = m.occluder_vertices[m.occluder_indices[3 * t + 2]];
         const Vec3 bb = m.occluder_vertices[m.occluder_indices[3 * t + 1]];
         volume += dot(a, cross(bb, c)) / 6.0;
         EXPECT_LE(a.x, -3.0f);
@@ -462,32 +472,42 @@ TEST_F(SceneFileErrors, UnknownAndDuplicateKeys) {
            "objects[1]: duplicate key 'name'");
     expect(with(valid_scene(), "\"period_seconds\": 3", "\"period_seconds\": 3, \"period_seconds\": 4"),
            "animation: duplicate key 'period_seconds'");
-    expect(with(valid_scene(), R"([0, 2, 1], [0, 2, -1]]}])", R"([0, 2, 1], [0, 2, -1]], "cells": ["left", "right"]}])"),
-           "portals[0]: duplicate key 'cells'");
+    expect(
+        with(valid_scene(), R"([0, 2, 1], [0, 2, -1]]}])", R"([0, 2, 1], [0, 2, -1]], "cells": ["left", "right"]}])"),
+        "portals[0]: duplicate key 'cells'");
 }
 
 TEST_F(SceneFileErrors, WrongTypes) {
-    expect(with(valid_scene(), "\"transform\": [1, 0, 0, -2, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]", "\"transform\": [1, 0, 0]"),
+    expect(with(valid_scene(), "\"transform\": [1, 0, 0, -2, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]",
+                "\"transform\": [1, 0, 0]"),
            "objects[2].transform: expected 16 numbers (a row-major 4x4 matrix) or an object");
-    expect(with(valid_scene(), "\"yaw_degrees\": 30", "\"yaw_degrees\": \"30\""), "objects[1].transform.yaw_degrees: expected a number");
+    expect(with(valid_scene(), "\"yaw_degrees\": 30", "\"yaw_degrees\": \"30\""),
+           "objects[1].transform.yaw_degrees: expected a number");
     expect(with(valid_scene(), "\"model\": \"teapot\"", "\"model\": 3"), "objects[2].model: expected a string");
-    expect(with(valid_scene(), "\"displaced\": true", "\"displaced\": 1"), "objects[0].displaced: expected true or false");
-    expect(with(valid_scene(), "\"position\": [2, 0, 0]", "\"position\": [2, 0]"), "objects[1].transform.position: expected 3 numbers");
+    expect(with(valid_scene(), "\"displaced\": true", "\"displaced\": 1"),
+           "objects[0].displaced: expected true or false");
+    expect(with(valid_scene(), "\"position\": [2, 0, 0]", "\"position\": [2, 0]"),
+           "objects[1].transform.position: expected 3 numbers");
     expect(with(valid_scene(), "\"size\": 64", "\"size\": 64.5"), "displacement.size: expected an integer");
-    expect(with(valid_scene(), R"("portals": [{"cells": ["left", "right"], "corners": [[0, 0, -1], [0, 0, 1], [0, 2, 1], [0, 2, -1]]}])",
-                R"("portals": {"cells": 1})"),
-           "portals: expected an array");
-    expect(with(valid_scene(), "\"animation\": {\"period_seconds\": 3}", "\"animation\": [3]"), "animation: expected an object");
+    expect(
+        with(valid_scene(),
+             R"("portals": [{"cells": ["left", "right"], "corners": [[0, 0, -1], [0, 0, 1], [0, 2, 1], [0, 2, -1]]}])",
+             R"("portals": {"cells": 1})"),
+        "portals: expected an array");
+    expect(with(valid_scene(), "\"animation\": {\"period_seconds\": 3}", "\"animation\": [3]"),
+           "animation: expected an object");
 }
 
 TEST_F(SceneFileErrors, MissingAndEmpty) {
     expect(with(valid_scene(), "\"name\": \"t\", \"model\": \"teapot\", ", "\"name\": \"t\", "),
            "objects[2]: missing required key 'model'");
-    expect(with(valid_scene(), "\"camera\":", "\"kamera\":"),
-           "unknown key 'kamera' (expected name, objects, environment, displacement, animation, camera, cells, portals)");
+    expect(
+        with(valid_scene(), "\"camera\":", "\"kamera\":"),
+        "unknown key 'kamera' (expected name, objects, environment, displacement, animation, camera, cells, portals)");
     expect("{\"objects\": [], \"camera\": {}}", "objects: expected a non-empty array");
     expect("{\"camera\": {}}", "missing required key 'objects'");
-    expect(with(valid_scene(), "\"name\": \"a\", \"model\"", "\"name\": \"\", \"model\""), "objects[0].name: expected a non-empty string");
+    expect(with(valid_scene(), "\"name\": \"a\", \"model\"", "\"name\": \"\", \"model\""),
+           "objects[0].name: expected a non-empty string");
     expect(with(valid_scene(), "{\"orbit\": {\"target\": [0, 0.5, 0], \"distance\": 6, \"height\": 1}, ", "{"),
            "camera: expected exactly one of 'orbit' or 'walk'");
     expect(with(valid_scene(), "\"distance\": 6, ", ""), "camera.orbit: missing required key 'distance'");
@@ -496,29 +516,42 @@ TEST_F(SceneFileErrors, MissingAndEmpty) {
 TEST_F(SceneFileErrors, NumbersOutOfRange) {
     expect(with(valid_scene(), "\"scale\": 0.5", "\"scale\": -0.5"),
            "objects[1].transform.scale: expected a number > 0 and <= 1e+09, got -0.5");
-    expect(with(valid_scene(), "\"scale\": 0.5", "\"scale\": 0"), "objects[1].transform.scale: expected a number > 0 and <= 1e+09, got 0");
-    expect(with(valid_scene(), "\"height\": 1", "\"height\": 0"), "objects[0].transform.height: expected a number > 0 and <= 1e+09, got 0");
-    expect(with(valid_scene(), "\"yaw_degrees\": 30", "\"yaw_degrees\": 1e39"), "objects[1].transform.yaw_degrees: number 1e+39 does not fit a float");
+    expect(with(valid_scene(), "\"scale\": 0.5", "\"scale\": 0"),
+           "objects[1].transform.scale: expected a number > 0 and <= 1e+09, got 0");
+    expect(with(valid_scene(), "\"height\": 1", "\"height\": 0"),
+           "objects[0].transform.height: expected a number > 0 and <= 1e+09, got 0");
+    expect(with(valid_scene(), "\"yaw_degrees\": 30", "\"yaw_degrees\": 1e39"),
+           "objects[1].transform.yaw_degrees: number 1e+39 does not fit a float");
     // nlohmann-json refuses a number beyond a double while parsing, without a position.
-    expect(with(valid_scene(), "\"yaw_degrees\": 30", "\"yaw_degrees\": 1e999"), "invalid JSON: number overflow parsing '1e999'");
+    expect(with(valid_scene(), "\"yaw_degrees\": 30", "\"yaw_degrees\": 1e999"),
+           "invalid JSON: number overflow parsing '1e999'");
     expect(with(valid_scene(), "\"time_offset\": 0.5", "\"time_offset\": 1e7"),
            "objects[1].animation.time_offset: expected a number >= -1e+06 and <= 1e+06, got 1e+07");
-    expect(with(valid_scene(), "\"size\": 64", "\"size\": 100000"), "displacement.size: expected an integer between 1 and 4096");
-    expect(with(valid_scene(), "\"size\": 64", "\"size\": 0"), "displacement.size: expected an integer between 1 and 4096");
-    expect(with(valid_scene(), "\"size\": 64", "\"size\": -3"), "displacement.size: expected an integer between 1 and 4096");
+    expect(with(valid_scene(), "\"size\": 64", "\"size\": 100000"),
+           "displacement.size: expected an integer between 1 and 4096");
+    expect(with(valid_scene(), "\"size\": 64", "\"size\": 0"),
+           "displacement.size: expected an integer between 1 and 4096");
+    expect(with(valid_scene(), "\"size\": 64", "\"size\": -3"),
+           "displacement.size: expected an integer between 1 and 4096");
     expect(with(valid_scene(), "\"size\": 64", "\"size\": 18446744073709551615"),
            "displacement.size: expected an integer between 1 and 4096");
     expect(with(valid_scene(), "\"z_far\": 40", "\"z_far\": 0.05"), "camera.z_far: must be greater than z_near");
 }
 
 TEST_F(SceneFileErrors, TransformsAndDegenerateInputs) {
-    expect(with(valid_scene(), "\"height\": 1}", "\"height\": 1, \"scale\": 2}"), "objects[0].transform: give 'height' or 'scale', not both");
-    expect(with(valid_scene(), "0, 0, 0, 1]}", "0, 0, 1, 1]}"), "objects[2].transform: the last row must be 0 0 0 1 (an affine matrix)");
-    expect(with(valid_scene(), "[1, 0, 0, -2, 0, 1, 0, 0", "[1, 0, 0, -2, 0, 0, 0, 0"), "objects[2].transform: the matrix is singular (a zero scale)");
-    expect_prefix(with(valid_scene(), "\"scale\": 0.5", "\"scale\": 1e-9"), "objects[1].transform: the placed model is ");
-    EXPECT_NE(load_error(dir_, with(valid_scene(), "\"scale\": 0.5", "\"scale\": 1e-9"))
-                  .find("e-09 units across; patchcull takes meshes of at least 1e-06 units across (the kernels work in float)"),
-              std::string::npos);
+    expect(with(valid_scene(), "\"height\": 1}", "\"height\": 1, \"scale\": 2}"),
+           "objects[0].transform: give 'height' or 'scale', not both");
+    expect(with(valid_scene(), "0, 0, 0, 1]}", "0, 0, 1, 1]}"),
+           "objects[2].transform: the last row must be 0 0 0 1 (an affine matrix)");
+    expect(with(valid_scene(), "[1, 0, 0, -2, 0, 1, 0, 0", "[1, 0, 0, -2, 0, 0, 0, 0"),
+           "objects[2].transform: the matrix is singular (a zero scale)");
+    expect_prefix(with(valid_scene(), "\"scale\": 0.5", "\"scale\": 1e-9"),
+                  "objects[1].transform: the placed model is ");
+    EXPECT_NE(
+        load_error(dir_, with(valid_scene(), "\"scale\": 0.5", "\"scale\": 1e-9"))
+            .find(
+                "e-09 units across; patchcull takes meshes of at least 1e-06 units across (the kernels work in float)"),
+        std::string::npos);
     expect(with(valid_scene(), "\"position\": [2, 0, 0]", "\"position\": [2, 0, 3e11]"),
            "objects[1].transform.position[2]: expected a number >= -536870912 and <= 536870912, got 3e+11");
     // kMaxSceneCoordinate (2^29): beyond it a double world position is coarser than the floats
@@ -528,7 +561,8 @@ TEST_F(SceneFileErrors, TransformsAndDegenerateInputs) {
     // Cells and portals are world positions (double) within kMaxSceneCoordinate.
     expect(with(valid_scene(), "\"min\": [0, 0, -5], \"max\": [5, 3, 5]", "\"min\": [0, 0, -5], \"max\": [6e8, 3, 5]"),
            "cells[1].max[0]: expected a number >= -536870912 and <= 536870912, got 6e+08");
-    const std::string huge = with(valid_scene(), "[1, 0, 0, -2, 0, 1, 0, 0, 0, 0, 1, 0", "[5e11, 0, 0, -2, 0, 5e11, 0, 0, 0, 0, 5e11, 0");
+    const std::string huge =
+        with(valid_scene(), "[1, 0, 0, -2, 0, 1, 0, 0, 0, 0, 1, 0", "[5e11, 0, 0, -2, 0, 5e11, 0, 0, 0, 0, 5e11, 0");
     expect_prefix(huge, "objects[2].transform: the placed model reaches ");
     EXPECT_NE(load_error(dir_, huge)
                   .find("e+11; scene files take world coordinates up to 536870912 (2^29: beyond it a double world "
@@ -536,21 +570,27 @@ TEST_F(SceneFileErrors, TransformsAndDegenerateInputs) {
               std::string::npos);
     expect(with(valid_scene(), "\"max\": [4, 1, 4]", "\"max\": [4, 0, 4]"),
            "environment[1].box: max must be greater than min on every axis (a flat or empty box)");
-    expect(with(valid_scene(), "[5, 0, 5], [5, 0, -5]]", "[-5, 0, -5], [-5, 0, -5]]"), "environment[0].quad: the corners span no area");
+    expect(with(valid_scene(), "[5, 0, 5], [5, 0, -5]]", "[-5, 0, -5], [-5, 0, -5]]"),
+           "environment[0].quad: the corners span no area");
     expect(with(valid_scene(), "\"name\": \"box\", \"box\"", "\"name\": \"box\", \"quad\": [], \"box\""),
            "environment[1]: expected exactly one of 'box', 'quad' or 'obj'");
 }
 
 TEST_F(SceneFileErrors, NamesAndReferences) {
-    expect(with(valid_scene(), "\"name\": \"b\"", "\"name\": \"a\""), "objects[1].name: duplicate object name 'a' (also objects[0])");
+    expect(with(valid_scene(), "\"name\": \"b\"", "\"name\": \"a\""),
+           "objects[1].name: duplicate object name 'a' (also objects[0])");
     expect(with(valid_scene(), "\"name\": \"box\"", "\"name\": \"ground\""),
            "environment[1].name: duplicate environment name 'ground' (also environment[0])");
-    expect(with(valid_scene(), "\"objects\": [\"b\"]", "\"objects\": [\"c\"]"), "cells[1].objects[0]: no object named 'c'");
+    expect(with(valid_scene(), "\"objects\": [\"b\"]", "\"objects\": [\"c\"]"),
+           "cells[1].objects[0]: no object named 'c'");
     expect(with(valid_scene(), "\"environment\": [\"box\"]", "\"environment\": [\"box\", \"box\"]"),
            "cells[1].environment[1]: 'box' is listed twice");
-    expect(with(valid_scene(), "[\"left\", \"right\"]", "[\"left\", \"up\"]"), "portals[0].cells[1]: no cell named 'up'");
-    expect(with(valid_scene(), "[\"left\", \"right\"]", "[\"left\", \"left\"]"), "portals[0].cells: a portal joins two different cells");
-    expect(with(valid_scene(), "\"scheme\": \"acc\"", "\"scheme\": \"loop\""), "objects[1].scheme: unknown scheme 'loop' (acc or osd)");
+    expect(with(valid_scene(), "[\"left\", \"right\"]", "[\"left\", \"up\"]"),
+           "portals[0].cells[1]: no cell named 'up'");
+    expect(with(valid_scene(), "[\"left\", \"right\"]", "[\"left\", \"left\"]"),
+           "portals[0].cells: a portal joins two different cells");
+    expect(with(valid_scene(), "\"scheme\": \"acc\"", "\"scheme\": \"loop\""),
+           "objects[1].scheme: unknown scheme 'loop' (acc or osd)");
     expect(with(valid_scene(), "\"displacement\": {\"map\": \"procedural\", \"scale\": 0.02, \"size\": 64},", ""),
            "objects[0].displaced: true, but the scene has no displacement map (\"displacement\")");
 }
@@ -566,7 +606,8 @@ TEST_F(SceneFileErrors, WalkCamera) {
     EXPECT_EQ(cams[2].target.z, cams[2].eye.z - 1);
     expect(with(valid_scene(), orbit, with(walk, "[0, 0, -1]", "[0, -2, 0]")),
            "camera.walk.direction: expected a direction that is not zero or vertical");
-    expect(with(valid_scene(), orbit, with(walk, "\"step\": [0, 0, -0.1], ", "")), "camera.walk: missing required key 'step'");
+    expect(with(valid_scene(), orbit, with(walk, "\"step\": [0, 0, -0.1], ", "")),
+           "camera.walk: missing required key 'step'");
 }
 
 TEST_F(SceneFileErrors, UnreadableFilesAndModels) {
@@ -587,11 +628,13 @@ TEST_F(SceneFileErrors, UnreadableFilesAndModels) {
     write_file(dir_ / "huge.obj", cube_obj(0, 1e12));
     expect(with(valid_scene(), "\"model\": \"teapot\"", "\"model\": \"huge.obj\""),
            "objects[2].model: " + (dir_ / "huge.obj").string() +
-               ": the mesh is 1e+12 units across; patchcull takes meshes up to 2e+11 units across (the kernels work in float)");
+               ": the mesh is 1e+12 units across; patchcull takes meshes up to 2e+11 units across (the kernels work in "
+               "float)");
     write_file(dir_ / "bad.obj", "v 0 0 0\nv 1 0 nan\n");
     expect(with(valid_scene(), "\"obj\": \"cube.obj\"", "\"obj\": \"bad.obj\""),
            "environment[2].obj: " + (dir_ / "bad.obj").string() + ":2: non-finite coordinate 'nan'");
-    expect(with(valid_scene(), "\"map\": \"procedural\", \"scale\": 0.02, \"size\": 64", "\"map\": \"h.png\", \"scale\": 0.02"),
+    expect(with(valid_scene(), "\"map\": \"procedural\", \"scale\": 0.02, \"size\": 64",
+                "\"map\": \"h.png\", \"scale\": 0.02"),
            "displacement.map: " + (dir_ / "h.png").string() + ": cannot read image: cannot open file");
 }
 
@@ -602,9 +645,26 @@ TEST(SceneFile, MutantsLoadOrFailWithOneLine) {
     const TempDir dir("mutants");
     write_file(dir / "cube.obj", cube_obj());
     const std::string base = valid_scene();
-    const char* const tokens[] = {"1e39", "-1e39", "1e-50", "nan", "-0", "0", "-1", "1e308", "99999999999999999999",
-                                  "\"\"", "[]", "{}", "null", "true", "\"teapot\"", "\"../cube.obj\"", "\"/dev/zero\"",
-                                  "[0, 0, 0]", "\"\\u0001\"", "\"\xff\""};
+    const char* const tokens[] = {"1e39",
+                                  "-1e39",
+                                  "1e-50",
+                                  "nan",
+                                  "-0",
+                                  "0",
+                                  "-1",
+                                  "1e308",
+                                  "99999999999999999999",
+                                  "\"\"",
+                                  "[]",
+                                  "{}",
+                                  "null",
+                                  "true",
+                                  "\"teapot\"",
+                                  "\"../cube.obj\"",
+                                  "\"/dev/zero\"",
+                                  "[0, 0, 0]",
+                                  "\"\\u0001\"",
+                                  "\"\xff\""};
     std::mt19937 rng(2024);
     auto below = [&](std::size_t n) { return n == 0 ? std::size_t{0} : static_cast<std::size_t>(rng() % n); };
     int loaded = 0, failed = 0;
@@ -613,53 +673,59 @@ TEST(SceneFile, MutantsLoadOrFailWithOneLine) {
         const int edits = below(4) == 0 ? 2 : 1;
         for (int e = 0; e < edits; ++e) {
             switch (below(10)) {
-            case 6:
-            case 7:
-            case 8:
-            case 9: {  // replace a number with another number (often still a valid scene)
-                std::vector<std::size_t> starts;
-                for (std::size_t i = 1; i < text.size(); ++i)
-                    if ((text[i] >= '0' && text[i] <= '9') && !(text[i - 1] >= '0' && text[i - 1] <= '9') && text[i - 1] != '.' &&
-                        text[i - 1] != '-' && text[i - 1] != 'e')
-                        starts.push_back(i);
-                if (starts.empty()) break;
-                const std::size_t at = starts[below(starts.size())];
-                std::size_t end = at;
-                while (end < text.size() && (std::isdigit(static_cast<unsigned char>(text[end])) || text[end] == '.' || text[end] == 'e')) ++end;
-                const char* const numbers[] = {"0", "1", "2", "0.5", "3.25", "7", "1e-3", "1e5", "45", "0.01"};
-                text.replace(at, end - at, numbers[below(std::size(numbers))]);
-                break;
-            }
-            case 0:  // flip a bit
-                text[below(text.size())] ^= static_cast<char>(1u << below(8));
-                break;
-            case 1:  // truncate
-                text.resize(below(text.size() + 1));
-                break;
-            case 2: {  // replace a number, string or literal with another token
-                std::vector<std::size_t> starts;
-                for (std::size_t i = 1; i < text.size(); ++i)
-                    if ((text[i - 1] == ' ' || text[i - 1] == '[') && text[i] != ' ') starts.push_back(i);
-                if (starts.empty()) break;
-                const std::size_t at = starts[below(starts.size())];
-                std::size_t end = at;
-                while (end < text.size() && text[end] != ',' && text[end] != ']' && text[end] != '}' && text[end] != '\n') ++end;
-                text.replace(at, end - at, tokens[below(std::size(tokens))]);
-                break;
-            }
-            case 3: {  // duplicate a slice
-                const std::size_t at = below(text.size() + 1), n = below(std::min<std::size_t>(80, text.size() - at) + 1);
-                text.insert(at, text.substr(at, n));
-                break;
-            }
-            case 4: {  // delete a slice
-                const std::size_t at = below(text.size() + 1), n = below(std::min<std::size_t>(40, text.size() - at) + 1);
-                text.erase(at, n);
-                break;
-            }
-            default:  // insert a control byte or a piece of invalid UTF-8
-                text.insert(below(text.size() + 1), 1, "\x01\x1b\xff\xc3\x7f\t"[below(6)]);
-                break;
+                case 6:
+                case 7:
+                case 8:
+                case 9: {  // replace a number with another number (often still a valid scene)
+                    std::vector<std::size_t> starts;
+                    for (std::size_t i = 1; i < text.size(); ++i)
+                        if ((text[i] >= '0' && text[i] <= '9') && !(text[i - 1] >= '0' && text[i - 1] <= '9') &&
+                            text[i - 1] != '.' && text[i - 1] != '-' && text[i - 1] != 'e')
+                            starts.push_back(i);
+                    if (starts.empty()) break;
+                    const std::size_t at = starts[below(starts.size())];
+                    std::size_t end = at;
+                    while (end < text.size() && (std::isdigit(static_cast<unsigned char>(text[end])) ||
+                                                 text[end] == '.' || text[end] == 'e'))
+                        ++end;
+                    const char* const numbers[] = {"0", "1", "2", "0.5", "3.25", "7", "1e-3", "1e5", "45", "0.01"};
+                    text.replace(at, end - at, numbers[below(std::size(numbers))]);
+                    break;
+                }
+                case 0:  // flip a bit
+                    text[below(text.size())] ^= static_cast<char>(1u << below(8));
+                    break;
+                case 1:  // truncate
+                    text.resize(below(text.size() + 1));
+                    break;
+                case 2: {  // replace a number, string or literal with another token
+                    std::vector<std::size_t> starts;
+                    for (std::size_t i = 1; i < text.size(); ++i)
+                        if ((text[i - 1] == ' ' || text[i - 1] == '[') && text[i] != ' ') starts.push_back(i);
+                    if (starts.empty()) break;
+                    const std::size_t at = starts[below(starts.size())];
+                    std::size_t end = at;
+                    while (end < text.size() && text[end] != ',' && text[end] != ']' && text[end] != '}' &&
+                           text[end] != '\n')
+                        ++end;
+                    text.replace(at, end - at, tokens[below(std::size(tokens))]);
+                    break;
+                }
+                case 3: {  // duplicate a slice
+                    const std::size_t at = below(text.size() + 1),
+                                      n = below(std::min<std::size_t>(80, text.size() - at) + 1);
+                    text.insert(at, text.substr(at, n));
+                    break;
+                }
+                case 4: {  // delete a slice
+                    const std::size_t at = below(text.size() + 1),
+                                      n = below(std::min<std::size_t>(40, text.size() - at) + 1);
+                    text.erase(at, n);
+                    break;
+                }
+                default:  // insert a control byte or a piece of invalid UTF-8
+                    text.insert(below(text.size() + 1), 1, "\x01\x1b\xff\xc3\x7f\t"[below(6)]);
+                    break;
             }
         }
         const fs::path path = dir / "m.json";

@@ -11,7 +11,6 @@
 #include <fstream>
 #include <string>
 
-
 #include "patchcull/core/error.h"
 #include "patchcull/import/scene_file.h"
 #include "patchcull/import/scene_poser.h"
@@ -94,14 +93,16 @@ TEST(SceneMotion, AMovingObjectIsRefusedAtTheFirstFrameBeyondTheLimit) {
 TEST(SceneMotion, ATimeOffsetThatPlacesAnObjectBeyondTheLimitIsNamed) {
     TempDir dir(test_name());
     // Near 1e4 at frame 0: the loader checks the placement at rest; the time offset moves it.
-    const Scene scene = load_text(dir, scene_text(R"({"deform": false, "time_offset": 1e6, "velocity": [0.01, 0, 0]})", kOrbit));
+    const Scene scene =
+        load_text(dir, scene_text(R"({"deform": false, "time_offset": 1e6, "velocity": [0.01, 0, 0]})", kOrbit));
     const std::string e = motion_error(scene, 1);
     EXPECT_NE(e.find("a.json: objects[1].animation.time_offset: the moving model ('monsterfrog#0') reaches x = "),
               std::string::npos)
         << e;
     EXPECT_NE(e.find(" at frame 0 (time 0 s)"), std::string::npos) << e;
     // A time offset that keeps it within the limit (velocity x offset = 5000): accepted.
-    const Scene near = load_text(dir, scene_text(R"({"time_offset": 5e5, "velocity": [0.01, 0, 0]})", kOrbit), "b.json");
+    const Scene near =
+        load_text(dir, scene_text(R"({"time_offset": 5e5, "velocity": [0.01, 0, 0]})", kOrbit), "b.json");
     EXPECT_EQ(motion_error(near, 100), "");
     // A static object with any time offset does not move.
     const Scene still = load_text(dir, scene_text(R"({"time_offset": 1e6})", kOrbit), "c.json");
@@ -127,9 +128,11 @@ TEST(SceneMotion, CamerasAreCheckedAtEveryFrame) {
               std::string::npos)
         << e;
     // An orbit whose distance reaches beyond the limit (accepted by the loader up to 2e11).
-    const Scene orbit = load_text(dir, scene_text("{}", R"({"orbit": {"distance": 1e5, "start_degrees": 90}})"), "c.json");
+    const Scene orbit =
+        load_text(dir, scene_text("{}", R"({"orbit": {"distance": 1e5, "start_degrees": 90}})"), "c.json");
     e = motion_error(orbit, 1);
-    EXPECT_NE(e.find("a.json: camera.orbit.distance: the camera's eye reaches x = 100000 at frame 0"), std::string::npos)
+    EXPECT_NE(e.find("a.json: camera.orbit.distance: the camera's eye reaches x = 100000 at frame 0"),
+              std::string::npos)
         << e;
     // An orbit of radius 8000 around 0: every coordinate of its eye stays within 8000.
     const Scene turning =
@@ -167,17 +170,19 @@ TEST(SceneFileNames, DefaultNamesAreUniqueAcrossSchemesAndPaths) {
     // One stem from two files: the names say the files as written.
     std::string cube;
     for (int i = 0; i < 8; ++i)
-        cube += "v " + std::to_string(i & 1) + " " + std::to_string((i >> 1) & 1) + " " + std::to_string((i >> 2) & 1) + "\n";
+        cube += "v " + std::to_string(i & 1) + " " + std::to_string((i >> 1) & 1) + " " + std::to_string((i >> 2) & 1) +
+                "\n";
     cube += "f 1 5 7 3\nf 2 4 8 6\nf 1 2 6 5\nf 3 7 8 4\nf 1 3 4 2\nf 5 6 8 7\n";
     for (const char* sub : {"a", "b"}) {
         fs::create_directories(dir.path / sub);
         std::ofstream(dir.path / sub / "cube.obj") << cube;
     }
-    s = load_text(dir, R"({"objects": [{"model": "a/cube.obj"}, {"model": "b/cube.obj", "transform": {"position": [2, 0, 0]}},
+    s = load_text(
+        dir, R"({"objects": [{"model": "a/cube.obj"}, {"model": "b/cube.obj", "transform": {"position": [2, 0, 0]}},
                                        {"model": "./a/cube.obj", "transform": {"position": [4, 0, 0]}},
                                        {"model": "bigguy"}],
                             "camera": {"orbit": {"distance": 4}}})",
-                  "b.json");
+        "b.json");
     ASSERT_EQ(s.instances.size(), 4u);
     EXPECT_EQ(s.models.size(), 3u);
     EXPECT_EQ(s.instances[0].name, "a/cube.obj#0");
@@ -185,7 +190,8 @@ TEST(SceneFileNames, DefaultNamesAreUniqueAcrossSchemesAndPaths) {
     EXPECT_EQ(s.instances[2].name, "a/cube.obj#1");  // the same file, spelt differently
     EXPECT_EQ(s.instances[3].name, "bigguy#0");      // a stem of one model keeps the short name
     // One model, one scheme: the short names, as before.
-    s = load_text(dir, R"({"objects": [{"model": "bigguy"}, {"model": "bigguy", "scheme": "acc"}, {"model": "monsterfrog"}],
+    s = load_text(dir,
+                  R"({"objects": [{"model": "bigguy"}, {"model": "bigguy", "scheme": "acc"}, {"model": "monsterfrog"}],
                             "camera": {"orbit": {"distance": 4}}})",
                   "c.json");
     EXPECT_EQ(s.instances[0].name, "bigguy#0");
@@ -212,10 +218,12 @@ TEST(SceneMotion, TheSceneLimitAndTheOneFrameReach) {
     const Scene far = load_text(dir, scene_text(R"({"time_offset": 1e6, "velocity": [1, 0, 0]})", kOrbit));
     EXPECT_EQ(motion_error(far, 200, kMaxSceneCoordinate), "");
     std::string e = motion_error(far, 1);
-    EXPECT_NE(e.find("objects[1].animation.time_offset: the moving model ('monsterfrog#0') reaches x = 999999 at frame "
-                     "0 (time 0 s); this command draws a scene in one float frame, at its first camera's grid point (0, 0, 0), "
-                     "and takes what lies within 8192 of it"),
-              std::string::npos)
+    EXPECT_NE(
+        e.find(
+            "objects[1].animation.time_offset: the moving model ('monsterfrog#0') reaches x = 999999 at frame "
+            "0 (time 0 s); this command draws a scene in one float frame, at its first camera's grid point (0, 0, 0), "
+            "and takes what lies within 8192 of it"),
+        std::string::npos)
         << e;
     // 1e6 units per second from 5e8 (time offset 500 s): beyond 2^29 after 36.87 s.
     const Scene fast = load_text(dir, scene_text(R"({"time_offset": 500, "velocity": [1e6, 0, 0]})", kOrbit), "b.json");
@@ -226,17 +234,21 @@ TEST(SceneMotion, TheSceneLimitAndTheOneFrameReach) {
     EXPECT_EQ(f, 443);  // (2^29 - 5e8) / 1e6 s = 36.87 s: frame 443 (36.92 s)
     EXPECT_EQ(motion_error(fast, f, kMaxSceneCoordinate), "");
     e = motion_error(fast, f + 1, kMaxSceneCoordinate);
-    EXPECT_NE(e.find("objects[1].animation.velocity: the moving model ('monsterfrog#0') reaches x = 5.36"), std::string::npos) << e;
+    EXPECT_NE(e.find("objects[1].animation.velocity: the moving model ('monsterfrog#0') reaches x = 5.36"),
+              std::string::npos)
+        << e;
     EXPECT_NE(e.find(" at frame 443 (time 36.9167 s); scenes take world coordinates up to 536870912 (2^29)"),
               std::string::npos)
         << e;
     // Static placements beyond the reach are named by their JSON path.
     const Scene placed = load_text(
-        dir, R"({"objects": [{"model": "bigguy", "transform": {"position": [3e5, 0, 0]}}], "camera": {"orbit": {"distance": 4}}})",
+        dir,
+        R"({"objects": [{"model": "bigguy", "transform": {"position": [3e5, 0, 0]}}], "camera": {"orbit": {"distance": 4}}})",
         "c.json");
     EXPECT_EQ(motion_error(placed, 1, kMaxSceneCoordinate), "");
-    EXPECT_NE(motion_error(placed, 1).find("a.json: objects[0].transform: the placed model ('bigguy#0') reaches x = 299"),
-              std::string::npos)
+    EXPECT_NE(
+        motion_error(placed, 1).find("a.json: objects[0].transform: the placed model ('bigguy#0') reaches x = 299"),
+        std::string::npos)
         << motion_error(placed, 1);
 }
 
@@ -248,9 +260,11 @@ TEST(SceneMotion, OneFrameCommandsDrawAtTheirFirstCamera) {
     TempDir dir(test_name());
     const std::string near = R"({"time_offset": 1e6, "velocity": [1, 0, 0]})";
     const std::string camera = R"({"orbit": {"target": [1e6, 0.5, -1], "distance": 4, "height": 1}})";
-    Scene scene = load_text(dir, R"({"objects": [{"model": "bigguy", "transform": {"position": [1e6, 0, 0], "height": 1}},
+    Scene scene = load_text(dir,
+                            R"({"objects": [{"model": "bigguy", "transform": {"position": [1e6, 0, 0], "height": 1}},
                            {"model": "monsterfrog", "transform": {"position": [0, 0, -2], "height": 1},
-                            "animation": )" + near + R"(}],
+                            "animation": )" +
+                                near + R"(}],
         "environment": [{"name": "wall", "box": {"min": [1e6, 0, -3], "max": [1000001, 1, -2.5]}}],
         "cells": [{"name": "c", "min": [999990, -1, -10], "max": [1000010, 5, 10]}],
         "camera": )" + camera + "}");
@@ -270,11 +284,13 @@ TEST(SceneMotion, OneFrameCommandsDrawAtTheirFirstCamera) {
         place_scene_at_first_camera(fast, "c.json", 24, kSecondsPerFrame);
         ADD_FAILURE() << "a run 9000 units from its frame was taken";
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("c.json: objects[1].animation.velocity: the moving model ('monsterfrog#0') reaches x = "),
+        EXPECT_NE(std::string(e.what()).find(
+                      "c.json: objects[1].animation.velocity: the moving model ('monsterfrog#0') reaches x = "),
                   std::string::npos)
             << e.what();
-        EXPECT_NE(std::string(e.what()).find("at frame 11 (time 0.916667 s); this command draws a scene in one float frame"),
-                  std::string::npos)
+        EXPECT_NE(
+            std::string(e.what()).find("at frame 11 (time 0.916667 s); this command draws a scene in one float frame"),
+            std::string::npos)
             << e.what();
     }
 }
@@ -319,7 +335,8 @@ TEST(SceneFrames, InstancesAreComposedInDoubleAndRoundedOnce) {
 TEST(SceneFrames, RebasedScenesPoseNearTheirFrame) {
     TempDir dir(test_name());
     // A BigGuy and a quad 1e6 out, an orbit camera around them.
-    const Scene world = load_text(dir, R"({"objects": [{"model": "bigguy", "transform": {"position": [1000000.3, 0, 0], "height": 1},
+    const Scene world =
+        load_text(dir, R"({"objects": [{"model": "bigguy", "transform": {"position": [1000000.3, 0, 0], "height": 1},
                                                         "animation": {"deform": false, "velocity": [1, 0, 0]}}],
         "environment": [{"quad": [[999990.1, 0, -5], [999990.1, 0, 5], [1000010.1, 0, 5], [1000010.1, 0, -5]]}],
         "camera": {"orbit": {"target": [1000000.3, 0.5, 0], "distance": 3, "height": 0.5}}})");

@@ -4,8 +4,8 @@
 // degenerate objects), over camera paths and adversarial cameras (eyes inside boxes, boxes
 // straddling the near plane), for every method and variant: frustum, bvh, bvh+backface; plane
 // masking, plane coherence and meta-BVs on and off; AABB alone or followed by the sphere or OBB;
-// clusters, normal masks (1, 2, 3 and 8 sectors) and per-triangle tests. The object-level tests of G. Zachmann's lecture "Advanced Visibility
-// Computations" and the patch clusters built from Loop, Niessner & Eisenacher's tangent
+// clusters, normal masks (1, 2, 3 and 8 sectors) and per-triangle tests. The object-level tests of G. Zachmann's
+// lecture "Advanced Visibility Computations" and the patch clusters built from Loop, Niessner & Eisenacher's tangent
 // control planes ("Effective Back-Patch Culling for Hardware Tessellation").
 //
 // Ground truth, independent of the kernels (double precision, ground_truth.h):
@@ -24,7 +24,6 @@
 //   exactly their complement.
 #include <gtest/gtest.h>
 
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -35,12 +34,12 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/import/builtin_scenes.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/ground_truth.h"
+#include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/scene_file.h"
 #include "patchcull/import/scene_object_level.h"
+#include "patchcull/import/scene_poser.h"
 #include "temp_dir.h"
 
 using namespace patchcull;
@@ -89,13 +88,16 @@ std::vector<Config> all_configs() {
     add("bvh+backface clusters", ObjectCullMethod::bvh_backface, true, true, false);
     add("bvh+backface clusters masking=off coherence=off meta=on", ObjectCullMethod::bvh_backface, false, false, true);
     add("bvh+backface masks", ObjectCullMethod::bvh_backface, true, true, false, TriangleBackface::normal_masks, 1);
-    add("bvh+backface masks sectors=3", ObjectCullMethod::bvh_backface, true, true, true, TriangleBackface::normal_masks, 3);
-    add("bvh+backface masks sectors=8", ObjectCullMethod::bvh_backface, true, true, false, TriangleBackface::normal_masks, 8);
+    add("bvh+backface masks sectors=3", ObjectCullMethod::bvh_backface, true, true, true,
+        TriangleBackface::normal_masks, 3);
+    add("bvh+backface masks sectors=8", ObjectCullMethod::bvh_backface, true, true, false,
+        TriangleBackface::normal_masks, 8);
     add("bvh+backface triangles", ObjectCullMethod::bvh_backface, true, true, false, TriangleBackface::per_triangle);
     // The sphere and the OBB after the AABB (--object-volume).
     add("frustum volume=sphere", ObjectCullMethod::frustum, true, true, false, TriangleBackface::clusters, 1,
         ObjectVolume::sphere);
-    add("bvh volume=obb meta=on", ObjectCullMethod::bvh, true, true, true, TriangleBackface::clusters, 1, ObjectVolume::obb);
+    add("bvh volume=obb meta=on", ObjectCullMethod::bvh, true, true, true, TriangleBackface::clusters, 1,
+        ObjectVolume::obb);
     add("bvh+backface volume=obb masks sectors=2", ObjectCullMethod::bvh_backface, true, true, false,
         TriangleBackface::normal_masks, 2, ObjectVolume::obb);
     return out;
@@ -137,18 +139,25 @@ bool triangle_meets_clip_volume(const Mat4& m, Vec3 p0, Vec3 p1, Vec3 p2) {
     auto clip = [&](Vec3 p) {
         H h;
         for (int r = 0; r < 4; ++r)
-            h.v[r] = double(m.at(r, 0)) * p.x + double(m.at(r, 1)) * p.y + double(m.at(r, 2)) * p.z + double(m.at(r, 3));
+            h.v[r] =
+                double(m.at(r, 0)) * p.x + double(m.at(r, 1)) * p.y + double(m.at(r, 2)) * p.z + double(m.at(r, 3));
         return h;
     };
     std::vector<H> poly = {clip(p0), clip(p1), clip(p2)}, next;
     auto plane = [](int k, const H& h) {
         switch (k) {
-            case 0: return h.v[3] + h.v[0];
-            case 1: return h.v[3] - h.v[0];
-            case 2: return h.v[3] + h.v[1];
-            case 3: return h.v[3] - h.v[1];
-            case 4: return h.v[2];
-            default: return h.v[3] - h.v[2];
+            case 0:
+                return h.v[3] + h.v[0];
+            case 1:
+                return h.v[3] - h.v[0];
+            case 2:
+                return h.v[3] + h.v[1];
+            case 3:
+                return h.v[3] - h.v[1];
+            case 4:
+                return h.v[2];
+            default:
+                return h.v[3] - h.v[2];
         }
     };
     for (int k = 0; k < 6 && !poly.empty(); ++k) {
@@ -202,8 +211,14 @@ class FrameTruth {
 public:
     FrameTruth(const Scene& scene, const ScenePoser& poser, const std::vector<BezierPatch>& pose, const Camera& camera,
                const std::vector<std::size_t>& instance_first, float time_seconds, bool world_float_truth)
-        : scene_(scene), poser_(poser), pose_(pose), camera_(camera), instance_first_(instance_first),
-          world_to_clip_(camera.view_projection()), time_(time_seconds), world_float_truth_(world_float_truth) {
+        : scene_(scene),
+          poser_(poser),
+          pose_(pose),
+          camera_(camera),
+          instance_first_(instance_first),
+          world_to_clip_(camera.view_projection()),
+          time_(time_seconds),
+          world_float_truth_(world_float_truth) {
         eye_[0] = camera.eye.x, eye_[1] = camera.eye.y, eye_[2] = camera.eye.z;
         double c[3];
         eye_offset_ = 0;
@@ -276,7 +291,8 @@ public:
             if (any_plane_faces_eye(planes, kGroundTruthGrid * kGroundTruthGrid, camera_.eye)) memo = 0;
         }
         std::size_t i = static_cast<std::size_t>(std::upper_bound(instance_first_.begin(), instance_first_.end(), p) -
-                                                  instance_first_.begin()) - 1;
+                                                 instance_first_.begin()) -
+                        1;
         const SceneInstance& instance = scene_.instances[i];
         if (!instance.deforms || !scene_.models[instance.model].subdiv) {
             const Mat4 m = instance_to_world(instance, time_);
@@ -507,7 +523,8 @@ void check_scene_into(const Scene& base, const std::vector<Camera>& cameras, con
                     std::size_t kept = 0;
                     for (std::size_t m = o.span.first; m < o.span.first + o.span.count; ++m)
                         kept += culled_index(spans, m) ? 0 : 1;
-                    EXPECT_EQ(kept, 0u) << what << ": " << o.name << " back-face culled whole but members are not in the spans";
+                    EXPECT_EQ(kept, 0u) << what << ": " << o.name
+                                        << " back-face culled whole but members are not in the spans";
                 }
                 if (config.options.method != ObjectCullMethod::bvh_backface) {
                     EXPECT_EQ(v, ObjectVerdict::visible) << what;
@@ -526,10 +543,9 @@ void check_scene_into(const Scene& base, const std::vector<Camera>& cameras, con
                     // A normal mask marks the classes that face away along every view ray of its
                     // (sub-)frustum: it also culls front-facing triangles that no view ray meets
                     // (backface.h), which have no pixel either.
-                    const bool back =
-                        o.triangles ? truth.triangle_back_facing(m, scene.occluder_indices) ||
-                                          (masks && !truth.triangle_in_view(m, scene.occluder_indices))
-                                    : truth.patch_back_facing(m);
+                    const bool back = o.triangles ? truth.triangle_back_facing(m, scene.occluder_indices) ||
+                                                        (masks && !truth.triangle_in_view(m, scene.occluder_indices))
+                                                  : truth.patch_back_facing(m);
                     if (!back && facing++ == 0) first_facing = m;
                 }
                 EXPECT_EQ(facing, 0u) << what << ": " << o.name << ": " << facing << " of " << culled_members
@@ -548,11 +564,13 @@ void check_scene_into(const Scene& base, const std::vector<Camera>& cameras, con
                     if (r.verdicts[i] != ObjectVerdict::visible) continue;
                     const CullableObject& o = culler.object(i);
                     if (&config == &configs.front())
-                        totals.truth_in_view += (o.triangles ? truth.environment_outside(i - instances, scene.occluder_indices)
-                                                             : truth.instance_outside(i))
-                                                    ? 0
-                                                    : 1;
-                    if (o.triangles || !culler.has_clusters(i) || config.options.method != ObjectCullMethod::bvh_backface)
+                        totals.truth_in_view +=
+                            (o.triangles ? truth.environment_outside(i - instances, scene.occluder_indices)
+                                         : truth.instance_outside(i))
+                                ? 0
+                                : 1;
+                    if (o.triangles || !culler.has_clusters(i) ||
+                        config.options.method != ObjectCullMethod::bvh_backface)
                         continue;
                     std::size_t sampled = 0;
                     for (std::size_t m = o.span.first; m < o.span.first + o.span.count && sampled < 16; m += 37)
@@ -579,7 +597,8 @@ void check_scene_into(const Scene& base, const std::vector<Camera>& cameras, con
         for (const auto& [key, set] : verdict_sets)
             for (std::size_t i = 0; i < objects && !plain.empty(); ++i) {
                 if (plain[i] == ObjectVerdict::frustum) {
-                    EXPECT_EQ(set[i], ObjectVerdict::frustum) << "camera " << k << ": set " << key << " kept object " << i;
+                    EXPECT_EQ(set[i], ObjectVerdict::frustum)
+                        << "camera " << k << ": set " << key << " kept object " << i;
                 }
             }
         ++totals.checked_frames;
@@ -702,7 +721,8 @@ TEST(SceneObjectLevelTruth, EyeInsideABuildingCullsItAsBackFacing) {
     const std::vector<BezierPatch>& pose = poser.pose(0);
     SceneObjectLevel level(scene, {true});
     for (const Config& c : all_configs()) {
-        const ObjectCullResult& r = level.cull(pose, poser.displacement_ranges(), 0, camera, kViewportHeight, c.options);
+        const ObjectCullResult& r =
+            level.cull(pose, poser.displacement_ranges(), 0, camera, kViewportHeight, c.options);
         const ObjectVerdict v = r.verdicts[scene.instances.size() + index];
         // Normal masks cull only the faces whose every view ray meets their back (the faces behind
         // the eye are not marked): the building stays in, partly culled.
@@ -730,7 +750,7 @@ TEST(SceneObjectLevelTruth, DefaultScene) {
         const Totals t = check_scene(scene, cameras, times);
         EXPECT_EQ(t.checked_frames, cameras.size());
         EXPECT_GT(t.truth_in_view, 0u);
-    EXPECT_GT(t.truth_in_view, 0u);
+        EXPECT_GT(t.truth_in_view, 0u);
         EXPECT_GT(t.frustum, 0u) << scheme_name(scheme);
         EXPECT_GT(t.backface_triangles, 0u) << scheme_name(scheme);
     }
@@ -843,16 +863,16 @@ TEST(SceneObjectLevelTruth, FarFromTheOriginAgainstTheDrawnPatches) {
 TEST(SceneObjectLevelTruth, DegenerateObjects) {
     Scene scene = make_model_scene(load_model(shipped_model_path("bigguy.obj"), Scheme::acc, 0));
     add_environment_object(scene, "nothing", {}, {}, true);
-    add_environment_object(scene, "flat", {{-1, 0.5f, -1}, {-1, 0.5f, 1}, {1, 0.5f, 1}, {1, 0.5f, -1}}, {0, 1, 2, 0, 2, 3},
-                           true);
+    add_environment_object(scene, "flat", {{-1, 0.5f, -1}, {-1, 0.5f, 1}, {1, 0.5f, 1}, {1, 0.5f, -1}},
+                           {0, 1, 2, 0, 2, 3}, true);
     add_environment_object(scene, "sliver", {{0.5f, 0, 0.5f}, {0.5f, 0, 0.5f}, {0.6f, 1, 0.5f}}, {0, 1, 2}, true);
     add_environment_box(scene, "speck", {0.7f, 0.7f, 0.7f}, {0.7f + 1e-5f, 0.7f + 1e-5f, 0.7f + 1e-5f});
     std::vector<Camera> cameras;
     std::vector<float> times;
     path_cameras(scene, 72, 12, cameras, times);
     cameras.push_back(make_camera({0.0f, 0.5001f, 3.0f}, {0.0f, 0.5001f, 0.0f}));  // edge-on to the flat quad
-    cameras.push_back(make_camera({0.0f, 0.2f, 0.0f}, {0.0f, 3.0f, 0.1f}));       // under it, looking up
-    cameras.push_back(make_camera({0.0f, 3.0f, 0.1f}, {0.0f, 0.0f, 0.0f}));       // above it, looking down
+    cameras.push_back(make_camera({0.0f, 0.2f, 0.0f}, {0.0f, 3.0f, 0.1f}));        // under it, looking up
+    cameras.push_back(make_camera({0.0f, 3.0f, 0.1f}, {0.0f, 0.0f, 0.0f}));        // above it, looking down
     while (times.size() < cameras.size()) times.push_back(0.0f);
     const Totals t = check_scene(scene, cameras, times);
     EXPECT_EQ(t.checked_frames, cameras.size());
@@ -860,7 +880,6 @@ TEST(SceneObjectLevelTruth, DegenerateObjects) {
     // The zero-triangle object is frustum-culled every time (an empty box), with an empty span.
     EXPECT_GE(t.frustum, cameras.size());
 }
-
 
 // A rigid character placed with a mirroring transform (det < 0, allowed for scene-file objects:
 // a 16-number matrix need only be affine and invertible). Its world patches are the mirror

@@ -25,21 +25,23 @@ TEST(SceneOcclusion, BoxOccludersAreTheClosedBoxes) {
     const Scene city = make_city_scene(Scheme::acc, p);
     const std::vector<std::size_t> boxes = box_environment_objects(city);
     ASSERT_EQ(boxes.size(), 6u);  // the buildings, not the ground quad
-    for (std::size_t e : boxes) EXPECT_EQ(city.environment[e].name.rfind("building#", 0), 0u) << city.environment[e].name;
+    for (std::size_t e : boxes)
+        EXPECT_EQ(city.environment[e].name.rfind("building#", 0), 0u) << city.environment[e].name;
 
     Scene scene;
     add_environment_box(scene, "box", {0, 0, 0}, {1, 2, 3});
     // A box without its top: its two top triangles left out.
     std::vector<Vec3> v;
     for (int c = 0; c < 8; ++c) v.push_back({(c & 4) ? 1.0f : 0.0f, (c & 2) ? 1.0f : 0.0f, (c & 1) ? 1.0f : 0.0f});
-    add_environment_object(scene, "open", v, {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3},
+    add_environment_object(scene, "open", v,
+                           {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3},
                            true);
     // A flat box and a quad.
     add_environment_box(scene, "flat", {0, 0, 0}, {1, 0, 1});
     add_environment_object(scene, "quad", {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}}, {0, 1, 2, 0, 2, 3}, true);
     // 12 triangles on the corners but one cutting through the inside.
-    add_environment_object(scene, "diagonal", v, {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1, 2, 3, 7, 2, 7, 6,
-                                                  0, 2, 6, 0, 6, 4, 1, 5, 7, 0, 7, 3},
+    add_environment_object(scene, "diagonal", v, {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
+                                                  2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 0, 7, 3},
                            true);
     const std::vector<std::size_t> found = box_environment_objects(scene);
     ASSERT_EQ(found.size(), 1u);

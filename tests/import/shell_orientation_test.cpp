@@ -70,7 +70,8 @@ constexpr std::uint32_t kSphere = 54, kTorus = 32;
 }  // namespace
 
 TEST(ShellOrientation, TwoSpheresOneReversedBothFaceOut) {
-    expect_shells_face_out("two_spheres.obj", {{0, kSphere, {-1.5f, 0, 0}, +1}, {kSphere, kSphere, {1.5f, 0, 0}, +1}}, "");
+    expect_shells_face_out("two_spheres.obj", {{0, kSphere, {-1.5f, 0, 0}, +1}, {kSphere, kSphere, {1.5f, 0, 0}, +1}},
+                           "");
     expect_shells_face_out("two_spheres_one_reversed.obj",
                            {{0, kSphere, {-1.5f, 0, 0}, +1}, {kSphere, kSphere, {1.5f, 0, 0}, +1}},
                            "1 of 2 closed shells oriented inward");
@@ -83,10 +84,10 @@ TEST(ShellOrientation, HollowSolidsCavityFacesIntoIt) {
 
 TEST(ShellOrientation, NestedSpheresAlternate) {
     // The outer written inside out, the middle (a cavity) and the inner (an island) outward.
-    expect_shells_face_out("nested_spheres.obj",
-                           {{0, kSphere, {0, 0, 0}, +1}, {kSphere, kSphere, {0, 0, 0.1f}, -1},
-                            {2 * kSphere, kSphere, {0.1f, 0, 0}, +1}},
-                           "2 of 3 closed shells oriented inward");
+    expect_shells_face_out(
+        "nested_spheres.obj",
+        {{0, kSphere, {0, 0, 0}, +1}, {kSphere, kSphere, {0, 0, 0.1f}, -1}, {2 * kSphere, kSphere, {0.1f, 0, 0}, +1}},
+        "2 of 3 closed shells oriented inward");
 }
 
 TEST(ShellOrientation, TwoToriOneReversedBothFaceOut) {

@@ -7,8 +7,8 @@
 #include <cmath>
 #include <filesystem>
 
-#include "patchcull/eval/cull_eval.h"
 #include "patchcull/core/error.h"
+#include "patchcull/eval/cull_eval.h"
 #include "patchcull/import/model_loader.h"
 
 using namespace patchcull;

@@ -3,16 +3,14 @@
 // displaced patch, {oobb, caf} x {full, acon, con} (patchcull/core/displaced_bounds.h), by the frustum
 // and by occlusion inside the object, over views that contain the whole object.
 //
-// The run (eval_gl/displaced_eval.h), per view (camera.h, contain mode): the displaced model is rendered unculled (GPU, the renderer's
-// TES displaces along the unit normal of the patch's own derivatives, as the bounds assume); its
-// depth buffer gives the CPU Hi-Z pyramid (hiz.h), which is what Niessner & Loop §3's pipeline converges
-// to on a static view (its visible set stable); each bound is then tested against the frustum and
-// that pyramid (cull_displaced_occlusion). A patch culled although its id is in the unculled id
-// buffer is a false cull.
-// Next to these converged-depth rates, the running pipeline's (temporal coherence, Niessner & Loop §3):
-// per view and combination, CullPipeline::render_frame (frustum + occlusion; the displaced patches
-// tested by DisplacedPass against the pipeline's own Hi-Z, built from the patches the previous
-// frame found visible) from a first frame until its visible set is stable (at most 8 frames), its
+// The run (eval_gl/displaced_eval.h), per view (camera.h, contain mode): the displaced model is rendered unculled (GPU,
+// the renderer's TES displaces along the unit normal of the patch's own derivatives, as the bounds assume); its depth
+// buffer gives the CPU Hi-Z pyramid (hiz.h), which is what Niessner & Loop §3's pipeline converges to on a static view
+// (its visible set stable); each bound is then tested against the frustum and that pyramid (cull_displaced_occlusion).
+// A patch culled although its id is in the unculled id buffer is a false cull. Next to these converged-depth rates, the
+// running pipeline's (temporal coherence, Niessner & Loop §3): per view and combination, CullPipeline::render_frame
+// (frustum + occlusion; the displaced patches tested by DisplacedPass against the pipeline's own Hi-Z, built from the
+// patches the previous frame found visible) from a first frame until its visible set is stable (at most 8 frames), its
 // last frame compared with the unculled render (render_reference: a false cull is judged per
 // patch). Output (--json):
 //   {"model","clip_depth","patches","views","displace","displace_scale","size","tess","seed",
@@ -78,11 +76,12 @@ int run_displaced_eval(const DisplacedEvalOptions& o) {
         std::printf("%s: %zu patches, %d whole-object views at %dx%d, level %d, displacement %s (scale %g)\n",
                     model.name.c_str(), r.patches, o.views, width, height, o.tess, o.displace.c_str(), map.scale);
         for (const eval_gl::DisplacedEvalRow& row : r.rows)
-            std::printf("  %-4s %-4s  cull rate %6.2f%%  false culls %zu   running pipeline %6.2f%% (%.1f frames), "
-                        "false culls %zu\n",
-                        displaced_bound_name(row.bound), normal_cone_name(row.cone), 100 * row.rate_sum / o.views,
-                        row.false_culls, 100 * row.pipeline_rate_sum / o.views, row.pipeline_frames_sum / o.views,
-                        row.pipeline_false_culls);
+            std::printf(
+                "  %-4s %-4s  cull rate %6.2f%%  false culls %zu   running pipeline %6.2f%% (%.1f frames), "
+                "false culls %zu\n",
+                displaced_bound_name(row.bound), normal_cone_name(row.cone), 100 * row.rate_sum / o.views,
+                row.false_culls, 100 * row.pipeline_rate_sum / o.views, row.pipeline_frames_sum / o.views,
+                row.pipeline_false_culls);
     }
     return r.false_culls() > 0 ? 1 : 0;  // a false cull breaks the conservative promise, as in `render --verify`
 }

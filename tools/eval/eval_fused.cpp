@@ -145,7 +145,8 @@ int run_fused_eval(const FusedEvalOptions& o) {
             std::printf("  plan %-4s %10.1f us/frame  x%.3f\n", row["plan"].get<std::string>().c_str(),
                         row["seconds"].get<double>() * 1e6, row["ratio_to_best"].get<double>());
         std::printf("  model     %10.1f us/frame  x%.3f (profiling %.1f us, agreement %.2f)\n",
-                    r.model_seconds / frames * 1e6, ratio(r.model_seconds), r.profile_seconds / frames * 1e6, agreement);
+                    r.model_seconds / frames * 1e6, ratio(r.model_seconds), r.profile_seconds / frames * 1e6,
+                    agreement);
         std::printf("  oracle    %10.1f us/frame  x%.3f\n", r.oracle_seconds / frames * 1e6, ratio(r.oracle_seconds));
         std::printf("  separate  %10.1f us/frame  x%.3f\n", r.separate_seconds / frames * 1e6,
                     ratio(r.separate_seconds));

@@ -8,7 +8,7 @@
 namespace patchcull::cli {
 
 struct FusedEvalOptions {
-    std::string scene;          ///< "city", "building", "default", a scene file or a model
+    std::string scene;  ///< "city", "building", "default", a scene file or a model
     std::string scheme = "acc";
     int frames = 24;
     std::string size = "640x360";

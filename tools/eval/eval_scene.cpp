@@ -131,8 +131,8 @@ int run_scene_eval(const SceneEvalOptions& o) {
     } else {
         std::printf("%s: %zu characters, %zu patches, %d frames at %dx%d, tess %d\n", r.scene.c_str(), r.characters,
                     r.patches, o.frames, width, height, o.tess);
-        std::printf("%-18s %9s %10s %9s %8s %7s %9s %7s %6s\n", "method", "objects", "patches", "queries", "multi", "waits",
-                    "frame ms", "ratio", "false");
+        std::printf("%-18s %9s %10s %9s %8s %7s %9s %7s %6s\n", "method", "objects", "patches", "queries", "multi",
+                    "waits", "frame ms", "ratio", "false");
         for (const eval_gl::SceneEvalRow& row : r.rows)
             std::printf("%-18s %9.1f %10.0f %9.1f %8.1f %7d %9.2f %7.2f %6d\n", row.name.c_str(), row.objects_culled,
                         row.patches_culled, row.queries, row.multiqueries, int(row.wait_frames), row.ms_frame,

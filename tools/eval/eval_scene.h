@@ -11,17 +11,17 @@
 namespace patchcull::cli {
 
 struct SceneEvalOptions {
-    std::string scene;            ///< "city", "building", "default" or a scene file
+    std::string scene;  ///< "city", "building", "default" or a scene file
     std::string scheme = "acc";
     int frames = 24;
     std::string size = "640x360";
     int tess = 8;
-    std::string methods;          ///< comma list of method names; empty: every one the scene allows
-    int batch = 16;               ///< b: batched and CHC++'s I-queue
-    float sigma = 1.4f;           ///< CHC++ tight bounding volumes
+    std::string methods;  ///< comma list of method names; empty: every one the scene allows
+    int batch = 16;       ///< b: batched and CHC++'s I-queue
+    float sigma = 1.4f;   ///< CHC++ tight bounding volumes
     int max_tight_boxes = static_cast<int>(kDefaultMaxTightBoxes);
-    float c1 = 0.1f;              ///< CHC++ multiquery cost per object
-    int visible_interval = 1;     ///< CHC++: previously visible objects queried every n frames
+    float c1 = 0.1f;           ///< CHC++ multiquery cost per object
+    int visible_interval = 1;  ///< CHC++: previously visible objects queried every n frames
     bool json = false;
 };
 

@@ -74,8 +74,8 @@ int run_temporal_eval(const TemporalEvalOptions& o) {
     EvalProgress progress("eval temporal", "frames", o.json);
     const eval_gl::TemporalEvalResult r = eval_gl::run_temporal_eval(std::move(model), run, progress.hooks());
     if (r.unstable_views > 0)
-        print_warnings({"eval temporal: " + std::to_string(r.unstable_views) + " views had no stable visible set after " +
-                        std::to_string(eval_gl::kTemporalConvergeFrames) +
+        print_warnings({"eval temporal: " + std::to_string(r.unstable_views) +
+                        " views had no stable visible set after " + std::to_string(eval_gl::kTemporalConvergeFrames) +
                         " frames (their last frame counts as converged)"});
     if (o.json) {
         nlohmann::json rows = nlohmann::json::array();
@@ -96,8 +96,8 @@ int run_temporal_eval(const TemporalEvalOptions& o) {
         out["false_culls"] = r.false_culls;
         std::cout << out.dump() << "\n";
     } else {
-        std::printf("%s (%s): %zu patches, %d frames per speed at %dx%d, level %d, cull occlusion\n",
-                    r.model.c_str(), r.scheme.c_str(), r.patches, o.frames, run.width, run.height, o.tess);
+        std::printf("%s (%s): %zu patches, %d frames per speed at %dx%d, level %d, cull occlusion\n", r.model.c_str(),
+                    r.scheme.c_str(), r.patches, o.frames, run.width, run.height, o.tess);
         std::printf("  %9s  %9s  %9s  %9s  %6s  (mean over frames 1..%d)\n", "deg/frame", "occluded", "converged",
                     "frustum", "false", o.frames - 1);
         for (const eval_gl::TemporalSpeedRow& row : r.speeds)

@@ -23,11 +23,16 @@ void ViewerControls::leave_path(ViewerCameraMode mode, const Camera& path_camera
 }
 
 void ViewerControls::key(ViewerKey k, const Camera& path_camera) {
-    if (is_movement_key(k)) held_.insert(k);
-    else if (k == ViewerKey::reset_camera) reset();
-    else if (k == ViewerKey::screenshot) screenshot_ = true;
-    else if (k == ViewerKey::quit) quit_ = true;
-    else apply_settings_key(s_, k);
+    if (is_movement_key(k))
+        held_.insert(k);
+    else if (k == ViewerKey::reset_camera)
+        reset();
+    else if (k == ViewerKey::screenshot)
+        screenshot_ = true;
+    else if (k == ViewerKey::quit)
+        quit_ = true;
+    else
+        apply_settings_key(s_, k);
     sync(path_camera);
 }
 
@@ -38,14 +43,18 @@ void ViewerControls::reset() {
 
 void ViewerControls::drag(bool left, float dx, float dy, const Camera& path_camera) {
     leave_path(left ? ViewerCameraMode::orbit : ViewerCameraMode::fly, path_camera);
-    if (s_.camera == ViewerCameraMode::orbit) camera_.orbit(dx, dy);
-    else camera_.look(dx, dy);
+    if (s_.camera == ViewerCameraMode::orbit)
+        camera_.orbit(dx, dy);
+    else
+        camera_.look(dx, dy);
 }
 
 void ViewerControls::wheel(float steps, const Camera& path_camera) {
     leave_path(ViewerCameraMode::orbit, path_camera);
-    if (s_.camera == ViewerCameraMode::orbit) camera_.zoom(steps);
-    else camera_.move(0, 0, steps * 0.2f, 1.0f);  // fly: a step is 0.2 s of a held key
+    if (s_.camera == ViewerCameraMode::orbit)
+        camera_.zoom(steps);
+    else
+        camera_.move(0, 0, steps * 0.2f, 1.0f);  // fly: a step is 0.2 s of a held key
 }
 
 void ViewerControls::move(float seconds, const Camera& path_camera) {

@@ -110,8 +110,9 @@ PanelActions view_section(ViewerSettings& s) {
     int view = static_cast<int>(s.view);
     if (combo("view [v]", view, views, 3)) s.view = static_cast<ViewerView>(view);
     if (s.view != ViewerView::colour)
-        ImGui::TextWrapped("green visible, yellow newly visible, blue frustum, magenta back-patch, red occlusion, "
-                           "cyan object level, grey occluders");
+        ImGui::TextWrapped(
+            "green visible, yellow newly visible, blue frustum, magenta back-patch, red occlusion, "
+            "cyan object level, grey occluders");
     static const char* const cameras[] = {"path", "orbit", "fly"};
     int camera = static_cast<int>(s.camera);
     if (combo("camera [c]", camera, cameras, 3)) s.camera = static_cast<ViewerCameraMode>(camera);
@@ -160,13 +161,15 @@ PanelActions ViewerPanel::draw(ViewerSettings& settings, const PanelInfo& info) 
         if (ImGui::CollapsingHeader("Frame", ImGuiTreeNodeFlags_DefaultOpen)) stats_section(info);
         if (ImGui::CollapsingHeader("Culling", ImGuiTreeNodeFlags_DefaultOpen)) culling_section(settings, info);
         if (ImGui::CollapsingHeader("Tessellation and displacement")) scene_section(settings);
-        if (ImGui::CollapsingHeader("View and camera", ImGuiTreeNodeFlags_DefaultOpen)) actions = view_section(settings);
+        if (ImGui::CollapsingHeader("View and camera", ImGuiTreeNodeFlags_DefaultOpen))
+            actions = view_section(settings);
         if (ImGui::CollapsingHeader("Keys and mouse"))
-            ImGui::TextWrapped("orbit: left-drag, wheel zoom, W/S zoom, A/D/Q/E turn; fly: right-drag look, "
-                               "WASD move, Q/E down/up; c camera mode (orbit, fly, path), r reset; 1 2 3 "
-                               "frustum / back-patch / occlusion, 4 auto, b back-patch test, g aggressive, "
-                               "+/- tess level, x displacement, v view, space pause, p or F12 screenshot, "
-                               "h hide this panel, Esc quit");
+            ImGui::TextWrapped(
+                "orbit: left-drag, wheel zoom, W/S zoom, A/D/Q/E turn; fly: right-drag look, "
+                "WASD move, Q/E down/up; c camera mode (orbit, fly, path), r reset; 1 2 3 "
+                "frustum / back-patch / occlusion, 4 auto, b back-patch test, g aggressive, "
+                "+/- tess level, x displacement, v view, space pause, p or F12 screenshot, "
+                "h hide this panel, Esc quit");
         if (!info.message.empty()) ImGui::TextWrapped("%s", info.message.c_str());
         ImGui::PopItemWidth();
     }

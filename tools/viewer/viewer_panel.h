@@ -17,14 +17,14 @@ namespace patchcull::cli {
 /// What the panel shows besides the settings.
 struct PanelInfo {
     std::string scene_name;
-    std::string renderer;     ///< GL_RENDERER
-    bool one_sided = true;    ///< false: back-patch culling is not conservative on the scene
+    std::string renderer;       ///< GL_RENDERER
+    bool one_sided = true;      ///< false: back-patch culling is not conservative on the scene
     bool object_level = false;  ///< the object level ran (objects below is meaningful)
     int frame = 0;
-    double fps = 0;           ///< frames per wall-clock second, smoothed
+    double fps = 0;  ///< frames per wall-clock second, smoothed
     const gl::FrameStats* stats = nullptr;
     const ObjectCullStats* objects = nullptr;
-    std::string message;      ///< the last screenshot written, or a warning
+    std::string message;  ///< the last screenshot written, or a warning
 };
 
 /// Buttons pressed in the panel this frame.

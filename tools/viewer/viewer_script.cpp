@@ -19,8 +19,10 @@ std::string printable(const std::string& text) {
     static const char* hex = "0123456789abcdef";
     std::string out;
     for (unsigned char c : text.substr(0, 80)) {
-        if (c >= 0x20 && c < 0x7f) out += static_cast<char>(c);
-        else out += std::string("\\x") + hex[c >> 4] + hex[c & 15];
+        if (c >= 0x20 && c < 0x7f)
+            out += static_cast<char>(c);
+        else
+            out += std::string("\\x") + hex[c >> 4] + hex[c & 15];
     }
     return text.size() > 80 ? out + "..." : out;
 }
@@ -61,14 +63,16 @@ ViewerScript parse_viewer_script(const std::string& text, const std::string& pat
             fail("frame " + std::to_string(e.frame) + " comes after frame " + std::to_string(last_frame) +
                  " (events must be in frame order)");
         last_frame = e.frame;
-        if (f.size() < 2) fail("expected an event after the frame number (orbit, look, zoom, key, set, screenshot, quit)");
+        if (f.size() < 2)
+            fail("expected an event after the frame number (orbit, look, zoom, key, set, screenshot, quit)");
         const std::string& kind = f[1];
         auto expect_fields = [&](std::size_t n, const char* usage) {
             if (f.size() != n) fail(kind + ": expected '" + usage + "'");
         };
         auto number = [&](const std::string& t, const char* what) {
             float v = 0;
-            if (!parse_float(t, v)) fail(kind + ": " + what + " must be a number in -1e6..1e6, got '" + printable(t) + "'");
+            if (!parse_float(t, v))
+                fail(kind + ": " + what + " must be a number in -1e6..1e6, got '" + printable(t) + "'");
             return v;
         };
         if (kind == "orbit" || kind == "look") {

@@ -41,14 +41,29 @@ bool parse_whole(const std::string& text, T& out) {
 
 const std::vector<std::pair<const char*, ViewerKey>>& key_table() {
     static const std::vector<std::pair<const char*, ViewerKey>> table = {
-        {"1", ViewerKey::toggle_frustum},   {"2", ViewerKey::toggle_backpatch}, {"3", ViewerKey::toggle_occlusion},
-        {"4", ViewerKey::toggle_auto},      {"b", ViewerKey::next_backpatch},   {"g", ViewerKey::toggle_aggressive},
-        {"v", ViewerKey::next_view},        {"c", ViewerKey::next_camera},      {"r", ViewerKey::reset_camera},
-        {"h", ViewerKey::toggle_panel},     {"x", ViewerKey::toggle_displace},  {"plus", ViewerKey::tess_up},
-        {"minus", ViewerKey::tess_down},    {"space", ViewerKey::pause},        {"p", ViewerKey::screenshot},
-        {"f12", ViewerKey::screenshot},     {"escape", ViewerKey::quit},        {"w", ViewerKey::forward},
-        {"s", ViewerKey::back},             {"a", ViewerKey::left},             {"d", ViewerKey::right},
-        {"e", ViewerKey::up},               {"q", ViewerKey::down},
+        {"1", ViewerKey::toggle_frustum},
+        {"2", ViewerKey::toggle_backpatch},
+        {"3", ViewerKey::toggle_occlusion},
+        {"4", ViewerKey::toggle_auto},
+        {"b", ViewerKey::next_backpatch},
+        {"g", ViewerKey::toggle_aggressive},
+        {"v", ViewerKey::next_view},
+        {"c", ViewerKey::next_camera},
+        {"r", ViewerKey::reset_camera},
+        {"h", ViewerKey::toggle_panel},
+        {"x", ViewerKey::toggle_displace},
+        {"plus", ViewerKey::tess_up},
+        {"minus", ViewerKey::tess_down},
+        {"space", ViewerKey::pause},
+        {"p", ViewerKey::screenshot},
+        {"f12", ViewerKey::screenshot},
+        {"escape", ViewerKey::quit},
+        {"w", ViewerKey::forward},
+        {"s", ViewerKey::back},
+        {"a", ViewerKey::left},
+        {"d", ViewerKey::right},
+        {"e", ViewerKey::up},
+        {"q", ViewerKey::down},
     };
     return table;
 }
@@ -71,21 +86,27 @@ std::string apply_setting(ViewerSettings& settings, const std::string& name, con
         return set_choice(settings.backpatch_method, name, value, methods);
     }
     if (name == "bound")
-        return set_choice(settings.bound, name, value, {{"caf", DisplacedBoundKind::caf}, {"oobb", DisplacedBoundKind::oobb}});
+        return set_choice(settings.bound, name, value,
+                          {{"caf", DisplacedBoundKind::caf}, {"oobb", DisplacedBoundKind::oobb}});
     if (name == "cone")
-        return set_choice(settings.cone, name, value,
-                          {{"full", NormalConeKind::full}, {"acon", NormalConeKind::acon}, {"con", NormalConeKind::con}});
+        return set_choice(
+            settings.cone, name, value,
+            {{"full", NormalConeKind::full}, {"acon", NormalConeKind::acon}, {"con", NormalConeKind::con}});
     if (name == "objects")
         return set_choice(settings.objects, name, value,
-                          {{"none", std::string("none")}, {"frustum", std::string("frustum")}, {"bvh", std::string("bvh")},
+                          {{"none", std::string("none")},
+                           {"frustum", std::string("frustum")},
+                           {"bvh", std::string("bvh")},
                            {"bvh+backface", std::string("bvh+backface")}});
     if (name == "view")
         return set_choice(settings.view, name, value,
-                          {{"colour", ViewerView::colour}, {"status", ViewerView::status},
+                          {{"colour", ViewerView::colour},
+                           {"status", ViewerView::status},
                            {"status-second", ViewerView::status_second}});
     if (name == "camera")
-        return set_choice(settings.camera, name, value,
-                          {{"path", ViewerCameraMode::path}, {"orbit", ViewerCameraMode::orbit}, {"fly", ViewerCameraMode::fly}});
+        return set_choice(
+            settings.camera, name, value,
+            {{"path", ViewerCameraMode::path}, {"orbit", ViewerCameraMode::orbit}, {"fly", ViewerCameraMode::fly}});
     if (name == "tess") {
         int level = 0;
         if (!parse_whole(value, level) || level < 1 || level > 64)
@@ -127,35 +148,56 @@ bool is_movement_key(ViewerKey key) {
 
 bool apply_settings_key(ViewerSettings& s, ViewerKey key) {
     switch (key) {
-    case ViewerKey::toggle_frustum: s.frustum = !s.frustum; return true;
-    case ViewerKey::toggle_backpatch: s.backpatch = !s.backpatch; return true;
-    case ViewerKey::toggle_occlusion: s.occlusion = !s.occlusion; return true;
-    case ViewerKey::toggle_auto: s.cull_auto = !s.cull_auto; return true;
-    case ViewerKey::next_backpatch: {  // the next of gl::gpu_backpatch_methods, round
-        const std::vector<gl::BackpatchMethod> ids = gl::gpu_backpatch_methods();
-        const std::size_t n = ids.size();
-        std::size_t at = 0;
-        while (at < n && ids[at] != s.backpatch_method) ++at;
-        s.backpatch_method = ids[(at + 1) % n];
-        return true;
-    }
-    case ViewerKey::toggle_aggressive: s.aggressive = !s.aggressive; return true;
-    case ViewerKey::next_view:
-        s.view = s.view == ViewerView::colour   ? ViewerView::status
-                 : s.view == ViewerView::status ? ViewerView::status_second
-                                                : ViewerView::colour;
-        return true;
-    case ViewerKey::next_camera:
-        s.camera = s.camera == ViewerCameraMode::orbit ? ViewerCameraMode::fly
-                   : s.camera == ViewerCameraMode::fly ? ViewerCameraMode::path
-                                                       : ViewerCameraMode::orbit;
-        return true;
-    case ViewerKey::toggle_panel: s.panel = !s.panel; return true;
-    case ViewerKey::toggle_displace: s.displace = !s.displace; return true;
-    case ViewerKey::tess_up: s.tess = s.tess < 64 ? s.tess + 1 : 64; return true;
-    case ViewerKey::tess_down: s.tess = s.tess > 1 ? s.tess - 1 : 1; return true;
-    case ViewerKey::pause: s.paused = !s.paused; return true;
-    default: return false;
+        case ViewerKey::toggle_frustum:
+            s.frustum = !s.frustum;
+            return true;
+        case ViewerKey::toggle_backpatch:
+            s.backpatch = !s.backpatch;
+            return true;
+        case ViewerKey::toggle_occlusion:
+            s.occlusion = !s.occlusion;
+            return true;
+        case ViewerKey::toggle_auto:
+            s.cull_auto = !s.cull_auto;
+            return true;
+        case ViewerKey::next_backpatch: {  // the next of gl::gpu_backpatch_methods, round
+            const std::vector<gl::BackpatchMethod> ids = gl::gpu_backpatch_methods();
+            const std::size_t n = ids.size();
+            std::size_t at = 0;
+            while (at < n && ids[at] != s.backpatch_method) ++at;
+            s.backpatch_method = ids[(at + 1) % n];
+            return true;
+        }
+        case ViewerKey::toggle_aggressive:
+            s.aggressive = !s.aggressive;
+            return true;
+        case ViewerKey::next_view:
+            s.view = s.view == ViewerView::colour   ? ViewerView::status
+                     : s.view == ViewerView::status ? ViewerView::status_second
+                                                    : ViewerView::colour;
+            return true;
+        case ViewerKey::next_camera:
+            s.camera = s.camera == ViewerCameraMode::orbit ? ViewerCameraMode::fly
+                       : s.camera == ViewerCameraMode::fly ? ViewerCameraMode::path
+                                                           : ViewerCameraMode::orbit;
+            return true;
+        case ViewerKey::toggle_panel:
+            s.panel = !s.panel;
+            return true;
+        case ViewerKey::toggle_displace:
+            s.displace = !s.displace;
+            return true;
+        case ViewerKey::tess_up:
+            s.tess = s.tess < 64 ? s.tess + 1 : 64;
+            return true;
+        case ViewerKey::tess_down:
+            s.tess = s.tess > 1 ? s.tess - 1 : 1;
+            return true;
+        case ViewerKey::pause:
+            s.paused = !s.paused;
+            return true;
+        default:
+            return false;
     }
 }
 

@@ -29,9 +29,9 @@ struct ViewerSettings {
     bool aggressive = false;  ///< skip the second pass (not conservative, Niessner & Loop §3.1)
     int tess = 8;             ///< 1..64
     bool adaptive_tess = false;
-    bool displace = false;          ///< the scene's (or --displace's) map applied; else none
-    float displace_scale = 0.02f;   ///< world units of a full height step, (0, 1]
-    std::string objects = "none";   ///< object level: none, frustum, bvh, bvh+backface
+    bool displace = false;         ///< the scene's (or --displace's) map applied; else none
+    float displace_scale = 0.02f;  ///< world units of a full height step, (0, 1]
+    std::string objects = "none";  ///< object level: none, frustum, bvh, bvh+backface
     ViewerView view = ViewerView::colour;
     ViewerCameraMode camera = ViewerCameraMode::orbit;
     bool paused = false;  ///< animation stopped (the pipeline still runs every frame)
@@ -64,7 +64,12 @@ enum class ViewerKey {
     pause,              ///< space
     screenshot,         ///< p or f12
     quit,               ///< escape
-    forward, back, left, right, up, down,  ///< w s a d e q (held: fly moves; orbit: zoom / turn)
+    forward,
+    back,
+    left,
+    right,
+    up,
+    down,  ///< w s a d e q (held: fly moves; orbit: zoom / turn)
 };
 /// Script and README names ("1", "b", "space", "plus", "f12", "w", ...); false when unknown.
 bool parse_viewer_key(const std::string& name, ViewerKey& key);
@@ -82,7 +87,7 @@ gl::CullMode settings_cull_mode(const ViewerSettings& settings);
 /// Sets the three toggles from a cull mode.
 void set_cull_toggles(ViewerSettings& settings, gl::CullMode mode);
 
-const char* viewer_view_name(ViewerView view);  ///< "colour", "status", "status-second"
+const char* viewer_view_name(ViewerView view);               ///< "colour", "status", "status-second"
 const char* viewer_camera_mode_name(ViewerCameraMode mode);  ///< "path", "orbit", "fly"
 
 }  // namespace patchcull::cli

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "object_level_options.h"
-#include "patchcull/import/scene_poser.h"
 #include "patchcull/gl/gl_pipeline.h"
+#include "patchcull/import/scene_poser.h"
 #include "viewer_settings.h"
 
 namespace patchcull::cli {

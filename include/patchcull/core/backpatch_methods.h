@@ -33,8 +33,8 @@ using BackpatchKernel = void (*)(const PatchBatchView& patches, const CullView& 
                                  std::uint8_t* culled);
 
 struct BackpatchMethodInfo {
-    std::string name;               ///< the CLI's name, e.g. "tcone": lower case, unique
-    std::string summary;            ///< one line for help text and docs
+    std::string name;                  ///< the CLI's name, e.g. "tcone": lower case, unique
+    std::string summary;               ///< one line for help text and docs
     BackpatchKernel scalar = nullptr;  ///< the reference kernel (required)
     BackpatchKernel simd = nullptr;    ///< the same decisions, faster (nullptr: scalar is used)
     /// True when the fused kernel and the fused GPU pass can run it as their back-patch stage

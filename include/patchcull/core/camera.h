@@ -26,7 +26,7 @@ struct Camera {
     float fovy_radians = 1.0471976f;  ///< 60 degrees
     float aspect = 1.0f;
     float z_near = 0.1f;
-    float z_far = 100.0f;                       ///< ignored by ClipDepth::reversed_infinite
+    float z_far = 100.0f;                      ///< ignored by ClipDepth::reversed_infinite
     ClipDepth depth = ClipDepth::zero_to_one;  ///< the convention projection() is written in
 
     Mat4 view() const { return look_at(eye, target, up); }
@@ -84,7 +84,6 @@ private:
 
 /// frames cameras on a circle around the object, turning degrees_per_frame each frame, for
 /// temporal tests; the whole object stays in view.
-std::vector<Camera> orbit_sequence(const Bounds& object, int frames, float degrees_per_frame,
-                                   float aspect = 1.0f);
+std::vector<Camera> orbit_sequence(const Bounds& object, int frames, float degrees_per_frame, float aspect = 1.0f);
 
 }  // namespace patchcull

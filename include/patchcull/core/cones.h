@@ -13,9 +13,9 @@
 namespace patchcull {
 
 struct NormalCone {
-    Vec3 axis;           ///< unit
-    float cos_angle = 0; ///< cos(alpha)
-    float sin_angle = 1; ///< sin(alpha)
+    Vec3 axis;            ///< unit
+    float cos_angle = 0;  ///< cos(alpha)
+    float sin_angle = 1;  ///< sin(alpha)
     bool valid = false;
 };
 

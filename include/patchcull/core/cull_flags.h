@@ -20,10 +20,10 @@ namespace patchcull {
 #define PATCHCULL_FLAG_CONST const uint
 #endif
 
-PATCHCULL_FLAG_CONST kCullFrustum = 1u;      // outside the view frustum (CullTest::frustum)
-PATCHCULL_FLAG_CONST kCullBackPatch = 2u;    // facing away from the eye (CullTest::backpatch)
-PATCHCULL_FLAG_CONST kCullOcclusion = 4u;    // behind the Hi-Z pyramid (CullTest::occlusion)
-PATCHCULL_FLAG_CONST kCullObject = 8u;       // culled with its object, before any patch test
+PATCHCULL_FLAG_CONST kCullFrustum = 1u;    // outside the view frustum (CullTest::frustum)
+PATCHCULL_FLAG_CONST kCullBackPatch = 2u;  // facing away from the eye (CullTest::backpatch)
+PATCHCULL_FLAG_CONST kCullOcclusion = 4u;  // behind the Hi-Z pyramid (CullTest::occlusion)
+PATCHCULL_FLAG_CONST kCullObject = 8u;     // culled with its object, before any patch test
 PATCHCULL_FLAG_CONST kCullReasonMask = 0xFFu;
 PATCHCULL_FLAG_CONST kStatusVisible = 0x100u;
 PATCHCULL_FLAG_CONST kStatusNewlyVisible = 0x200u;
@@ -40,7 +40,8 @@ constexpr std::uint32_t cull_test_flag(CullTest test) { return 1u << static_cast
 constexpr const char* cull_test_name(CullTest test) {
     return test == CullTest::frustum ? "frustum" : test == CullTest::backpatch ? "backpatch" : "occlusion";
 }
-static_assert(cull_test_flag(CullTest::frustum) == kCullFrustum && cull_test_flag(CullTest::backpatch) == kCullBackPatch &&
+static_assert(cull_test_flag(CullTest::frustum) == kCullFrustum &&
+              cull_test_flag(CullTest::backpatch) == kCullBackPatch &&
               cull_test_flag(CullTest::occlusion) == kCullOcclusion);
 }  // namespace patchcull
 #endif

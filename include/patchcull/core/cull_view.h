@@ -19,7 +19,7 @@ struct CullView {
     /// singular, and then has_eye is false and no test that needs the eye may cull.
     Vec3 eye{0, 0, 0};
     bool has_eye = false;
-    float alpha = 0;      ///< clip_space_eye_alpha(projection): the eye's clip-space z (backpatch.h)
+    float alpha = 0;  ///< clip_space_eye_alpha(projection): the eye's clip-space z (backpatch.h)
     /// ptp_orientation_sign(object_to_clip, alpha): -1 or 1, or 0 when ptp may cull nothing.
     int orientation = 0;
 };

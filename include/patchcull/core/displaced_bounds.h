@@ -151,15 +151,15 @@ inline constexpr float kDisplacedDepthSafety = 0x1p-20f;
 
 /// Per-frame constants of the bounds: build once per view with make_displaced_cull_view.
 struct DisplacedCullView {
-    Mat4 object_to_view;   ///< V = [L | T]
-    Mat4 projection;       ///< glFrustum form (see the header), as to_depth_key(projection, depth)
+    Mat4 object_to_view;        ///< V = [L | T]
+    Mat4 projection;            ///< glFrustum form (see the header), as to_depth_key(projection, depth)
     FrustumPlanes view_planes;  ///< clip planes over view-space points (make_frustum_planes(projection, depth))
     ClipDepth depth = ClipDepth::zero_to_one;  ///< the projection's convention
-    float key_near = 0, key_far = 1;  ///< depth keys of the near and far planes (key_far = +inf: none)
-    Vec3 axis_unit[3];     ///< rows of L normalised (view x, y, z directions in object space)
-    float axis_length[3];  ///< |rows of L|
-    float abs_row_z[4];    ///< |V(2, c)|, for the projectability margin
-    bool valid = false;    ///< finite matrices, projection of the required form, L rows non-zero
+    float key_near = 0, key_far = 1;           ///< depth keys of the near and far planes (key_far = +inf: none)
+    Vec3 axis_unit[3];                         ///< rows of L normalised (view x, y, z directions in object space)
+    float axis_length[3];                      ///< |rows of L|
+    float abs_row_z[4];                        ///< |V(2, c)|, for the projectability margin
+    bool valid = false;                        ///< finite matrices, projection of the required form, L rows non-zero
 };
 
 /// Prepares the per-frame constants. object_to_view = view * model (any affine matrix with
@@ -174,17 +174,17 @@ DisplacedCullView make_displaced_cull_view(const CullView& view);
 
 /// Status of a computed bound.
 enum DisplacedBoundStatus : std::uint8_t {
-    kDisplacedBoundProjected = 0,    ///< in front of the eye: ndc rectangle and depths are valid
-    kDisplacedBoundOutsidePlane = 1, ///< reaches t <= 0, and lies outside one clip plane: culled
-    kDisplacedBoundUnprojectable = 2,///< reaches t <= 0 and meets every clip plane's inside
-    kDisplacedBoundInvalid = 3,      ///< non-finite input or output, weight <= 0, invalid view
+    kDisplacedBoundProjected = 0,      ///< in front of the eye: ndc rectangle and depths are valid
+    kDisplacedBoundOutsidePlane = 1,   ///< reaches t <= 0, and lies outside one clip plane: culled
+    kDisplacedBoundUnprojectable = 2,  ///< reaches t <= 0 and meets every clip plane's inside
+    kDisplacedBoundInvalid = 3,        ///< non-finite input or output, weight <= 0, invalid view
 };
 
 /// Screen-space summary of a displaced patch's bound (caf or oobb).
 struct DisplacedBound {
     float ndc_xmin = -1, ndc_xmax = 1, ndc_ymin = -1, ndc_ymax = 1;  ///< valid when projected
-    float depth_near = 0;  ///< depth key of the bound's nearest point (the CAF front plane); projected only
-    float depth_far = 1;   ///< depth key of its farthest point (CAF: the back plane); projected only
+    float depth_near = 0;             ///< depth key of the bound's nearest point (the CAF front plane); projected only
+    float depth_far = 1;              ///< depth key of its farthest point (CAF: the back plane); projected only
     float key_near = 0, key_far = 1;  ///< the view's clip depth range in keys (DisplacedCullView)
     std::uint8_t status = kDisplacedBoundInvalid;
 };
@@ -211,19 +211,17 @@ std::uint8_t displaced_bound_hiz_decision(const DisplacedBound& bound, const HiZ
 
 /// Batch: bounds of every patch. ranges: patches.count entries or null (no displacement);
 /// out: patches.count entries.
-void compute_displaced_bounds(const PatchBatchView& patches, const DisplacementRange* ranges,
-                              DisplacedBoundKind kind, NormalConeKind cone, const DisplacedCullView& view,
-                              DisplacedBound* out);
+void compute_displaced_bounds(const PatchBatchView& patches, const DisplacementRange* ranges, DisplacedBoundKind kind,
+                              NormalConeKind cone, const DisplacedCullView& view, DisplacedBound* out);
 
 /// Batch frustum kernel: culled[i] = 1 when patch i's bound is outside the view volume, else 0.
-void cull_displaced_frustum(const PatchBatchView& patches, const DisplacementRange* ranges,
-                            DisplacedBoundKind kind, NormalConeKind cone, const DisplacedCullView& view,
-                            std::uint8_t* culled);
+void cull_displaced_frustum(const PatchBatchView& patches, const DisplacementRange* ranges, DisplacedBoundKind kind,
+                            NormalConeKind cone, const DisplacedCullView& view, std::uint8_t* culled);
 
 /// Batch frustum + occlusion kernel: decision[i] is a HiZDecision. The screen is the pyramid's
 /// depth buffer.
-void cull_displaced_occlusion(const PatchBatchView& patches, const DisplacementRange* ranges,
-                              DisplacedBoundKind kind, NormalConeKind cone, const DisplacedCullView& view,
-                              const HiZPyramid& hiz, std::uint8_t* decision);
+void cull_displaced_occlusion(const PatchBatchView& patches, const DisplacementRange* ranges, DisplacedBoundKind kind,
+                              NormalConeKind cone, const DisplacedCullView& view, const HiZPyramid& hiz,
+                              std::uint8_t* decision);
 
 }  // namespace patchcull

@@ -115,18 +115,18 @@ struct FrustumVerdict {
 /// frustum kernel, scalar reference.
 struct CullView;  // cull_view.h
 
-void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement,
-                         const FrustumPlanes& planes, std::uint8_t* culled);
+void cull_frustum_scalar(const PatchBatchView& patches, const float* max_displacement, const FrustumPlanes& planes,
+                         std::uint8_t* culled);
 /// frustum kernel, SIMD (Highway, best instruction set chosen once at run time).
-void cull_frustum_simd(const PatchBatchView& patches, const float* max_displacement,
-                       const FrustumPlanes& planes, std::uint8_t* culled);
+void cull_frustum_simd(const PatchBatchView& patches, const float* max_displacement, const FrustumPlanes& planes,
+                       std::uint8_t* culled);
 
 /// frustum-disp kernel (Sathe), scalar reference.
-void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement,
-                              const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled);
+void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement, const Mat4& object_to_clip,
+                              ClipDepth depth, std::uint8_t* culled);
 /// frustum-disp kernel, SIMD.
-void cull_frustum_disp_simd(const PatchBatchView& patches, const float* max_displacement,
-                            const Mat4& object_to_clip, ClipDepth depth, std::uint8_t* culled);
+void cull_frustum_disp_simd(const PatchBatchView& patches, const float* max_displacement, const Mat4& object_to_clip,
+                            ClipDepth depth, std::uint8_t* culled);
 
 /// Name of the instruction set the SIMD kernels dispatch to on this machine (e.g. "AVX2").
 const char* simd_target_name();

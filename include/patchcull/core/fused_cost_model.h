@@ -48,9 +48,9 @@ inline constexpr unsigned kAllFusedStages = 7u;  ///< frustum | backpatch | occl
 class FusedCostModel {
 public:
     struct Config {
-        int profile_interval = 16;   ///< frames between an object's profiling runs (>= 1)
-        double rate_weight = 0.5;    ///< weight of a new observation of P(S) (exponential average)
-        double cost_weight = 0.25;   ///< weight of a new profiling run's stage costs
+        int profile_interval = 16;  ///< frames between an object's profiling runs (>= 1)
+        double rate_weight = 0.5;   ///< weight of a new observation of P(S) (exponential average)
+        double cost_weight = 0.25;  ///< weight of a new profiling run's stage costs
         double draw_seconds_per_patch = std::numeric_limits<double>::infinity();
     };
     static constexpr double kUnmeasuredStageSeconds = 1e-7;

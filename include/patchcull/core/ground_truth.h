@@ -126,10 +126,10 @@ private:
     int grid_;
     std::size_t per_patch_;
     const DisplacementMap* displacement_;
-    std::vector<Vec3> points_;          ///< clip: capacity * per_patch_
+    std::vector<Vec3> points_;           ///< clip: capacity * per_patch_
     std::vector<SampleSphere> spheres_;  ///< clip: capacity
-    std::vector<PlaneD> planes_;        ///< facing: capacity * per_patch_
-    std::vector<std::uint8_t> ready_;   ///< per slot: bit 0 points, bit 1 planes
+    std::vector<PlaneD> planes_;         ///< facing: capacity * per_patch_
+    std::vector<std::uint8_t> ready_;    ///< per slot: bit 0 points, bit 1 planes
     std::uint64_t samplings_ = 0;
 };
 

@@ -47,7 +47,8 @@
 // 1. Frustum: exactly cull_frustum_scalar without displacement (frustum.h; the kernels call it,
 //    or cull_frustum_simd, whose decisions are identical). Culled -> kHiZFrustumCulled.
 // 2. Clip-space control points: for each control point P_k (object space, homogeneous) and row r of
-//    M = to_depth_key(object_to_clip) (row z gives the depth key), c_r = fma(M(r,3), W, fma(M(r,2), Z, fma(M(r,1), Y, M(r,0) * X))).
+//    M = to_depth_key(object_to_clip) (row z gives the depth key), c_r = fma(M(r,3), W, fma(M(r,2), Z, fma(M(r,1), Y,
+//    M(r,0) * X))).
 // 3. Projectable: every control point has w_k > 2^-20 * s_k, with
 //    s_k = fma(|M(3,3)|, |W|, fma(|M(3,2)|, |Z|, fma(|M(3,1)|, |Y|, |M(3,0)| * |X|))).
 //    s_k bounds the terms of w_k, and the rounding error of the computed w_k is below 2^-22 s_k, so
@@ -217,8 +218,8 @@ struct PatchScreenBounds {
 };
 /// object_to_clip's depth convention is depth (clip_space.h); zmin is the smallest depth key of the
 /// control points (the window depth with glDepthRange(0, 1), negated for reversed conventions).
-bool patch_screen_bounds(const PatchBatchView& patches, std::size_t index, const Mat4& object_to_clip,
-                         ClipDepth depth, int width, int height, PatchScreenBounds& out);
+bool patch_screen_bounds(const PatchBatchView& patches, std::size_t index, const Mat4& object_to_clip, ClipDepth depth,
+                         int width, int height, PatchScreenBounds& out);
 
 /// Per-patch decision bytes written by the kernels.
 enum HiZDecision : std::uint8_t {

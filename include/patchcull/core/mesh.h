@@ -48,8 +48,8 @@ enum class BoundaryInterpolation : std::uint8_t {
 /// weights at triangles.
 struct SubdivisionOptions {
     BoundaryInterpolation boundary = BoundaryInterpolation::edge_and_corner;
-    bool chaikin_creases = false;   ///< Sdc CREASE_CHAIKIN ("t creasemethod 0/0/1 chaikin")
-    bool smooth_triangles = false;  ///< Sdc TRI_SUB_SMOOTH ("t smoothtriangles 0/0/1 smooth")
+    bool chaikin_creases = false;     ///< Sdc CREASE_CHAIKIN ("t creasemethod 0/0/1 chaikin")
+    bool smooth_triangles = false;    ///< Sdc TRI_SUB_SMOOTH ("t smoothtriangles 0/0/1 smooth")
     std::uint32_t boundary_line = 0;  ///< line of the interpolateboundary tag (0: none, or not from a file)
 };
 

@@ -137,7 +137,9 @@ struct CacheAlignedAllocator {
     T* allocate(std::size_t n) { return static_cast<T*>(allocate_batch_storage(n * sizeof(T))); }
     void deallocate(T* p, std::size_t n) { free_batch_storage(p, n * sizeof(T)); }
     template <class U>
-    bool operator==(const CacheAlignedAllocator<U>&) const { return true; }
+    bool operator==(const CacheAlignedAllocator<U>&) const {
+        return true;
+    }
 };
 using AlignedFloats = std::vector<float, CacheAlignedAllocator<float>>;
 }  // namespace detail

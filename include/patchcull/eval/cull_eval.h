@@ -47,7 +47,7 @@ struct CullEvalOptions {
     /// evaluate_cull throws patchcull::Error naming the bound for a range outside its contract.
     std::optional<DistanceViews> distance;
     std::vector<std::string> methods{"frustum", "frustum-disp"};
-    int ground_truth_grid = 17;   ///< samples per side for false-cull checks, 1..1024
+    int ground_truth_grid = 17;  ///< samples per side for false-cull checks, 1..1024
     float aspect = 1.0f;
     /// Called on the calling thread after each block of views with the views done so far
     /// (increasing, the last call with views), between blocks, never inside a kernel or the

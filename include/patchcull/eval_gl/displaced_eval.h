@@ -21,7 +21,7 @@ struct DisplacedEvalOptions {
     int views = 100;         ///< whole-object views (ViewGenerator, contain mode), at least 1
     std::uint64_t seed = 1;  ///< the view generator's
     int width = 512, height = 512;
-    int tess = 8;  ///< uniform tessellation level
+    int tess = 8;                                   ///< uniform tessellation level
     ClipDepth clip_depth = ClipDepth::zero_to_one;  ///< drawn and culled in it
 };
 
@@ -29,8 +29,8 @@ struct DisplacedEvalOptions {
 struct DisplacedEvalRow {
     DisplacedBoundKind bound = DisplacedBoundKind::oobb;
     NormalConeKind cone = NormalConeKind::full;
-    double rate_sum = 0;  ///< culled fraction against the converged depth's Hi-Z
-    std::size_t false_culls = 0;  ///< culled although in the unculled id buffer
+    double rate_sum = 0;             ///< culled fraction against the converged depth's Hi-Z
+    std::size_t false_culls = 0;     ///< culled although in the unculled id buffer
     double pipeline_rate_sum = 0;    ///< the running pipeline's culled fraction (frustum + occlusion)
     double pipeline_frames_sum = 0;  ///< frames converge_frame ran
     std::size_t pipeline_false_culls = 0;

@@ -15,18 +15,18 @@
 namespace patchcull::eval_gl {
 
 struct SceneEvalOptions {
-    int frames = 24;  ///< of the scene's camera path, at least 1
+    int frames = 24;                         ///< of the scene's camera path, at least 1
     float seconds_per_frame = 1.0f / 12.0f;  ///< animation time between two frames
     int width = 640, height = 360;
     int tess = 8;  ///< uniform tessellation level
     /// Method names (rows) in the order asked; empty: every one the scene allows. "none" is
     /// always run, first; a repeated name runs once.
     std::vector<std::string> methods;
-    int batch = 16;     ///< b: batched and CHC++'s I-queue
+    int batch = 16;      ///< b: batched and CHC++'s I-queue
     float sigma = 1.4f;  ///< CHC++ tight bounding volumes' area factor
     int max_tight_boxes = static_cast<int>(kDefaultMaxTightBoxes);
-    float c1 = 0.1f;            ///< CHC++ multiquery cost per object
-    int visible_interval = 1;   ///< CHC++: previously visible objects queried every n frames
+    float c1 = 0.1f;           ///< CHC++ multiquery cost per object
+    int visible_interval = 1;  ///< CHC++: previously visible objects queried every n frames
 };
 
 /// One method's row: per-frame means over the path, except wait_frames and false_culls (totals).

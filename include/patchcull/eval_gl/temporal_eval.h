@@ -18,10 +18,10 @@ namespace patchcull::eval_gl {
 inline constexpr int kTemporalConvergeFrames = 8;
 
 struct TemporalEvalOptions {
-    int width = 512, height = 512;           ///< framebuffer size
+    int width = 512, height = 512;            ///< framebuffer size
     std::vector<double> speeds{0, 2, 5, 10};  ///< degrees per frame, each in [0, 180]
-    int frames = 36;                         ///< per speed, at least 2 (frame 0 primes the statuses)
-    int tess = 8;                            ///< uniform tessellation level
+    int frames = 36;                          ///< per speed, at least 2 (frame 0 primes the statuses)
+    int tess = 8;                             ///< uniform tessellation level
 };
 
 struct TemporalSpeedRow {

@@ -30,9 +30,9 @@
 #include <utility>
 #include <vector>
 
-#include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/core/math.h"
 #include "patchcull/core/patch.h"
+#include "patchcull/gl/gl_pipeline.h"
 
 namespace patchcull::gl {
 
@@ -70,11 +70,11 @@ public:
     /// One object's decision for a frame.
     struct Decision {
         bool cull = true;
-        bool probe = false;               ///< culled to measure its rate (or the costs)
-        double tess_factor = 0;           ///< t at its centroid
-        double break_even = kUnknown;     ///< x at t (NaN until the costs are measured; +inf when tess(t) <= 0)
-        double cull_rate = kUnknown;      ///< the average used (NaN until measured)
-        std::string reason;               ///< "rate 0.41 > break-even 0.18", "probe: ...", ...
+        bool probe = false;            ///< culled to measure its rate (or the costs)
+        double tess_factor = 0;        ///< t at its centroid
+        double break_even = kUnknown;  ///< x at t (NaN until the costs are measured; +inf when tess(t) <= 0)
+        double cull_rate = kUnknown;   ///< the average used (NaN until measured)
+        std::string reason;            ///< "rate 0.41 > break-even 0.18", "probe: ...", ...
     };
 
     /// objects: disjoint ranges of a set of patch_count patches (their cull fields are ignored).

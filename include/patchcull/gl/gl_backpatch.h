@@ -71,10 +71,10 @@
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/backpatch_methods.h"
 #include "patchcull/core/cull_view.h"
-#include "patchcull/gl/gl_passes.h"
-#include "patchcull/gl/gl_renderer.h"
 #include "patchcull/core/math.h"
 #include "patchcull/core/patch.h"
+#include "patchcull/gl/gl_passes.h"
+#include "patchcull/gl/gl_renderer.h"
 
 namespace patchcull::gl {
 

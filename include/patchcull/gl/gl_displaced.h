@@ -57,9 +57,9 @@
 
 #include "patchcull/core/displaced_bounds.h"
 #include "patchcull/core/displacement.h"
-#include "patchcull/gl/gl_renderer.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/patch.h"
+#include "patchcull/gl/gl_renderer.h"
 
 namespace patchcull::gl {
 

@@ -51,9 +51,9 @@
 #include <string>
 #include <vector>
 
+#include "patchcull/core/mesh.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_renderer.h"
-#include "patchcull/core/mesh.h"
 
 namespace patchcull::gl {
 
@@ -74,8 +74,8 @@ struct QueryOptions {
     bool front_to_back = true;
     /// b: batched's batch and CHC++'s I-queue size (>= 1).
     unsigned batch_size = 16;
-    bool multiqueries = true;      ///< CHC++: the I-queue issued as multiqueries
-    bool tight_bounds = true;      ///< CHC++: objects queried with their tight boxes (FrameObjects)
+    bool multiqueries = true;  ///< CHC++: the I-queue issued as multiqueries
+    bool tight_bounds = true;  ///< CHC++: objects queried with their tight boxes (FrameObjects)
     /// CHC++: a previously visible object is queried every visible_interval frames (its phase
     /// random), assumed visible in between (>= 1; 1: every frame).
     unsigned visible_interval = 1;
@@ -91,22 +91,22 @@ struct QueryOptions {
 /// What one frame of queries did.
 struct QueryStats {
     std::uint32_t objects = 0;
-    std::uint32_t frustum_culled = 0;    ///< objects outside the frustum (their box, or an ancestor's)
-    std::uint32_t occlusion_culled = 0;  ///< objects left out by a query (conservative ones)
-    std::uint32_t drawn = 0;             ///< objects drawn
-    std::uint32_t queries = 0;           ///< query objects issued (a multiquery counts once)
-    std::uint32_t multiqueries = 0;      ///< of queries: over more than one node
-    std::uint32_t multiquery_passed = 0; ///< multiqueries that passed samples (re-issued singly)
-    std::uint32_t proxy_boxes = 0;       ///< boxes drawn under queries
-    std::uint32_t waits = 0;             ///< results read before they were available (the CPU stalled)
-    std::uint32_t unqueryable = 0;       ///< boxes reaching in front of the near plane (counted visible)
+    std::uint32_t frustum_culled = 0;     ///< objects outside the frustum (their box, or an ancestor's)
+    std::uint32_t occlusion_culled = 0;   ///< objects left out by a query (conservative ones)
+    std::uint32_t drawn = 0;              ///< objects drawn
+    std::uint32_t queries = 0;            ///< query objects issued (a multiquery counts once)
+    std::uint32_t multiqueries = 0;       ///< of queries: over more than one node
+    std::uint32_t multiquery_passed = 0;  ///< multiqueries that passed samples (re-issued singly)
+    std::uint32_t proxy_boxes = 0;        ///< boxes drawn under queries
+    std::uint32_t waits = 0;              ///< results read before they were available (the CPU stalled)
+    std::uint32_t unqueryable = 0;        ///< boxes reaching in front of the near plane (counted visible)
 };
 
 /// The objects of one frame (object order = PipelineParams::objects' order).
 struct FrameObjects {
-    Mat4 world_to_clip;  ///< projection * view, in the renderer's clip depth convention
+    Mat4 world_to_clip;                        ///< projection * view, in the renderer's clip depth convention
     ClipDepth depth = ClipDepth::zero_to_one;  ///< world_to_clip's convention (RenderParams::depth)
-    Vec3 eye;            ///< world space
+    Vec3 eye;                                  ///< world space
     /// World box of each object, holding everything it draws this frame.
     const Bounds* boxes = nullptr;
     std::size_t count = 0;

@@ -97,8 +97,8 @@ namespace patchcull::gl {
 
 /// Back-patch methods are registered in core/backpatch_methods.h (their GPU passes in
 /// gl_backpatch_passes.h); these names are the same entities, for code written against gl::.
-using patchcull::BackpatchMethod;
 using patchcull::backpatch_method_name;
+using patchcull::BackpatchMethod;
 using patchcull::parse_backpatch_method;
 
 /// The text of a GLSL header shipped for an engine's own shaders, embedded in the library:

@@ -34,9 +34,9 @@
 
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/patch.h"
 #include "patchcull/gl/gl_passes.h"
 #include "patchcull/gl/gl_renderer.h"
-#include "patchcull/core/patch.h"
 
 namespace patchcull::gl {
 
@@ -51,7 +51,7 @@ const char* timing_method_name(TimingMethod method);  ///< "automatic", "wall-cl
 
 /// Parameters of one frame of the culling pipeline.
 struct FrameParams {
-    RenderParams render;         ///< camera, size, tessellation (use_cull_flags is ignored)
+    RenderParams render;  ///< camera, size, tessellation (use_cull_flags is ignored)
     CullMode cull = CullMode::all;
     /// Niessner & Loop §3.1: skip the second pass (newly visible patches appear one frame late). NOT
     /// conservative for the current frame: its image can miss patches that became visible; the
@@ -124,7 +124,7 @@ struct PipelineParams {
     /// The back-patch test: any method with a GPU pass (gl_backpatch_passes.h; the built-in ones
     /// are Loop, Niessner & Eisenacher's). A method without one: render_frame throws Error.
     BackpatchMethod backpatch = BackpatchMethod::tcone;
-    PtpRule ptp_rule = PtpRule::ncnt;                    ///< rule of ptp (ignored by the cones)
+    PtpRule ptp_rule = PtpRule::ncnt;  ///< rule of ptp (ignored by the cones)
     /// Bound and cone of displaced patches (Niessner & Loop §4.2; used when the set has
     /// displacement_ranges and a displacement map is set).
     DisplacedBoundKind bound = DisplacedBoundKind::caf;
@@ -167,19 +167,19 @@ struct PipelineParams {
 /// the next frame).
 struct FrameStats {
     std::size_t patches = 0;
-    std::size_t object_culled = 0;   ///< in PipelineParams::object_culled, or of objects the ObjectPass left out
+    std::size_t object_culled = 0;     ///< in PipelineParams::object_culled, or of objects the ObjectPass left out
     std::size_t objects_left_out = 0;  ///< objects the ObjectPass did not draw (0 without one)
-    bool two_pass = false;           ///< the mode includes occlusion (Niessner & Loop §3's pipeline)
+    bool two_pass = false;             ///< the mode includes occlusion (Niessner & Loop §3's pipeline)
     // Every pass issues all patches to the TCS (Niessner & Loop §6.3's RT_0 cost per pass); "drawn" =
     // tessellated (levels > 0), the others get levels 0 there.
     std::size_t pass1_drawn = 0;     ///< patches drawn (tessellated) in the first pass
     std::size_t pass2_drawn = 0;     ///< ... in the second pass (newly visible; 0 when aggressive)
     std::size_t frustum_culled = 0;  ///< by a frustum test (a displaced patch's bound included)
     std::size_t backpatch_culled = 0;
-    std::size_t occlusion_culled = 0;  ///< by a Hi-Z test (control points, or a displaced bound)
+    std::size_t occlusion_culled = 0;            ///< by a Hi-Z test (control points, or a displaced bound)
     std::size_t displaced_occlusion_culled = 0;  ///< of occlusion_culled: displaced patches
-    std::size_t visible = 0;         ///< passed every test of the mode
-    std::size_t newly_visible = 0;   ///< passed, and were not tagged visible before (not drawn in pass 1)
+    std::size_t visible = 0;                     ///< passed every test of the mode
+    std::size_t newly_visible = 0;               ///< passed, and were not tagged visible before (not drawn in pass 1)
     /// Per-pass times in milliseconds. Two-pass: pass1 (clear, occluders, patches tagged visible),
     /// hiz (build), cull (the whole flag chain), pass2 (newly visible). One pass (no occlusion):
     /// cull first, then pass1 draws the patches that passed; hiz = pass2 = 0.

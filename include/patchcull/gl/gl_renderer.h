@@ -118,9 +118,9 @@ struct RenderParams {
     ClipDepth depth = ClipDepth::zero_to_one;
     int width = 256;
     int height = 256;
-    int tess_level = 8;           ///< uniform tessellation level (adaptive: the maximum), clamped to [1, 64]
-    bool use_cull_flags = true;   ///< false: ignore the flags and draw every patch (the reference)
-    bool displace = true;         ///< displace the surface when a displacement map is set
+    int tess_level = 8;          ///< uniform tessellation level (adaptive: the maximum), clamped to [1, 64]
+    bool use_cull_flags = true;  ///< false: ignore the flags and draw every patch (the reference)
+    bool displace = true;        ///< displace the surface when a displacement map is set
     /// Adaptive tessellation by distance (Niessner & Loop §6.3): each edge gets
     /// clamp(tess_level * tess_reference_distance / d, 1, tess_level), d = distance from the eye to
     /// the midpoint of the edge's two corner points; interior levels the max of opposite edges.
@@ -281,8 +281,8 @@ public:
 
     // ---- what a frame drew, for verification (waits for the GPU) -----------------------------
     /// One byte per patch: 1 when the last render(), or a draw_selected() since the last
-    /// begin_frame(), tessellated it (levels > 0 in the TCS, in any pass), else 0 (culled). This, not the id buffer, is what a false cull
-    /// is judged on: a drawn patch that loses a depth tie is absent from the id buffer.
+    /// begin_frame(), tessellated it (levels > 0 in the TCS, in any pass), else 0 (culled). This, not the id buffer, is
+    /// what a false cull is judged on: a drawn patch that loses a depth tie is absent from the id buffer.
     std::vector<std::uint8_t> read_drawn_patches() const;
     /// The front set of the last render: redraws the patches (params must be the last render's:
     /// camera, size, tessellation, use_cull_flags, discard_back_facing) with depth test GL_EQUAL
@@ -295,11 +295,11 @@ public:
     // ---- read-back of the last render (waits for the GPU; image order, row 0 = top) ----------
     int width() const;
     int height() const;
-    std::vector<std::uint32_t> read_ids() const;     ///< patch index + 1, 0 = background
-    std::vector<float> read_depth() const;           ///< window depth in [0,1], background 1 (0 reversed)
+    std::vector<std::uint32_t> read_ids() const;  ///< patch index + 1, 0 = background
+    std::vector<float> read_depth() const;        ///< window depth in [0,1], background 1 (0 reversed)
     /// The depth buffer with row 0 = bottom, hiz.h's order: what HiZPyramid::build takes as it is.
     std::vector<float> read_depth_bottom_up() const;
-    std::vector<std::uint8_t> read_color() const;    ///< RGBA8, 4 bytes per pixel
+    std::vector<std::uint8_t> read_color() const;  ///< RGBA8, 4 bytes per pixel
     /// Writes the colour image of the last render as a PNG. Throws patchcull::Error("PATH: cannot
     /// write PNG") on failure.
     void write_color_png(const std::string& path) const;

@@ -52,17 +52,17 @@ void add_environment_box(Scene& scene, std::string name, Vec3 lo, Vec3 hi);
 
 /// Parameters of the `city` scene. Lengths in character heights (a BigGuy is 1 high).
 struct CityParams {
-    int blocks_x = 6, blocks_z = 6;  ///< blocks (one box building each), 1..64 per axis
-    float block_size = 8;            ///< side of a block's square footprint
-    float street_width = 4;          ///< streets run between the blocks and around the grid
+    int blocks_x = 6, blocks_z = 6;         ///< blocks (one box building each), 1..64 per axis
+    float block_size = 8;                   ///< side of a block's square footprint
+    float street_width = 4;                 ///< streets run between the blocks and around the grid
     float min_height = 3, max_height = 14;  ///< building heights, uniform in between
-    int characters = 220;            ///< BigGuys and MonsterFrogs (alternating), 0..5000
-    float rigid_fraction = 0.25f;    ///< share of characters that do not deform
-    float walking_fraction = 0.35f;  ///< share that walk along their street (velocity)
-    float walk_seconds = 10;         ///< walkers stay in their street and out of the camera's corridor this long
-    int phases = 6;                  ///< distinct animation time offsets (1..64), k * 0.37 s
-    unsigned seed = 11;              ///< placement, heights and choices (std::mt19937)
-    int camera_street = -1;          ///< index of the z street the camera walks; -1: the middle one
+    int characters = 220;                   ///< BigGuys and MonsterFrogs (alternating), 0..5000
+    float rigid_fraction = 0.25f;           ///< share of characters that do not deform
+    float walking_fraction = 0.35f;         ///< share that walk along their street (velocity)
+    float walk_seconds = 10;                ///< walkers stay in their street and out of the camera's corridor this long
+    int phases = 6;                         ///< distinct animation time offsets (1..64), k * 0.37 s
+    unsigned seed = 11;                     ///< placement, heights and choices (std::mt19937)
+    int camera_street = -1;                 ///< index of the z street the camera walks; -1: the middle one
 };
 
 /// The built-in `city` scene: a blocks_x x blocks_z grid of box buildings (heights
@@ -76,8 +76,8 @@ struct CityParams {
 /// shares one deformation per model and phase). Over [0, walk_seconds] no character comes within
 /// its animated reach (over one animation period, any yaw) plus 0.1 of a building on x or z,
 /// leaves the grid, or enters the camera's corridor (0.3 either side of its line); characters
-/// start apart, a fifth of them in the camera's street. The camera walks down the middle of z street camera_street (streets 0..blocks_x
-/// from -x) from the grid's +z edge towards -z at eye height 0.8 (a character is 1 high), 0.15
+/// start apart, a fifth of them in the camera's street. The camera walks down the middle of z street camera_street
+/// (streets 0..blocks_x from -x) from the grid's +z edge towards -z at eye height 0.8 (a character is 1 high), 0.15
 /// units per frame, looking down the street (60 degrees): buildings hide the parallel streets,
 /// the characters behind the camera are outside the view. Names: "bigguy#k" / "monsterfrog#k"
 /// (counted per model). The default makes 220 characters, about 300k ACC patches.
@@ -87,11 +87,11 @@ Scene make_city_scene(Scheme scheme = Scheme::acc, const CityParams& params = {}
 
 /// Parameters of the `building` scene.
 struct BuildingParams {
-    int rooms_x = 3, rooms_z = 3;     ///< a grid of square rooms, 1..16 per axis
-    float room_size = 6;              ///< inner side of a room (wall centre to wall centre)
+    int rooms_x = 3, rooms_z = 3;  ///< a grid of square rooms, 1..16 per axis
+    float room_size = 6;           ///< inner side of a room (wall centre to wall centre)
     float wall_height = 2.5f;
     float wall_thickness = 0.2f;
-    int characters_per_room = 10;     ///< 0..64, placed at random in each room (fewer where they do not fit)
+    int characters_per_room = 10;  ///< 0..64, placed at random in each room (fewer where they do not fit)
     unsigned seed = 5;
 };
 

@@ -11,18 +11,18 @@
 namespace patchcull {
 
 struct LoadedModel {
-    std::string name;                        ///< path or "teapot"
+    std::string name;  ///< path or "teapot"
     /// World position of the local frame the patches live in (ControlMesh::origin; 0 for the
     /// teapot): a world-space camera must be moved into that frame (WorldCamera::local).
     DVec3 origin;
     std::optional<SubdivisionModel> subdiv;  ///< absent for the built-in teapot (already Bezier)
     int split_levels = 0;
-    PatchFrame rest;                         ///< patches at rest, after split_levels splits
+    PatchFrame rest;  ///< patches at rest, after split_levels splits
     std::vector<std::string> warnings;
     /// A closed surface whose every shell faces out of the solid (orient_outward: inside-out
-    /// shells were reversed at load, a flat or undecided one is not closed): drawn one-sided (RenderParams::discard_back_facing), and
-    /// back-patch culling is conservative for it. False for open meshes and the teapot (its lid
-    /// sits loose in the rim).
+    /// shells were reversed at load, a flat or undecided one is not closed): drawn one-sided
+    /// (RenderParams::discard_back_facing), and back-patch culling is conservative for it. False for open meshes and
+    /// the teapot (its lid sits loose in the rim).
     bool closed = false;
 };
 

@@ -101,9 +101,9 @@ struct CameraPath {
     float z_near = 0.05f;
     float z_far = 50;
     bool walk = false;
-    Vec3 walk_start{0, 0, 0};      ///< eye at frame 0 (walk)
-    Vec3 walk_step{0, 0, 0};       ///< eye movement per frame (walk)
-    Vec3 walk_direction{0, 0, -1}; ///< look direction, any non-zero length (walk)
+    Vec3 walk_start{0, 0, 0};       ///< eye at frame 0 (walk)
+    Vec3 walk_step{0, 0, 0};        ///< eye movement per frame (walk)
+    Vec3 walk_direction{0, 0, -1};  ///< look direction, any non-zero length (walk)
 };
 
 /// A cell of a cell-and-portal scene (a room of the `building` scene; read by the portal
@@ -112,8 +112,8 @@ struct CameraPath {
 /// in at least one box.
 struct SceneCell {
     std::string name;
-    Bounds box;                             ///< world-space box of the cell
-    std::vector<std::size_t> instances;     ///< indices into Scene::instances standing in the cell
+    Bounds box;                          ///< world-space box of the cell
+    std::vector<std::size_t> instances;  ///< indices into Scene::instances standing in the cell
     /// Indices into Scene::environment of the objects that bound or fill the cell: its floor,
     /// ceiling and wall pieces (a wall between two cells is listed in both).
     std::vector<std::size_t> environment;

@@ -28,10 +28,10 @@
 
 #include "patchcull/core/camera.h"
 #include "patchcull/import/scene_model.h"
+#include "patchcull/import/scene_object_level.h"
 #include "patchcull/objects/object_culling.h"
 #include "patchcull/objects/occlusion_horizon.h"
 #include "patchcull/objects/portal_culling.h"
-#include "patchcull/import/scene_object_level.h"
 #include "patchcull/objects/tight_bounds.h"
 
 namespace patchcull {
@@ -50,8 +50,8 @@ bool parse_scene_occlusion_method(const std::string& text, SceneOcclusionMethod&
 
 /// Counts of one frame.
 struct SceneOcclusionStats {
-    std::size_t objects_tested = 0;  ///< objects the object level left
-    std::size_t objects_culled = 0;  ///< of those, hidden by the method
+    std::size_t objects_tested = 0;                        ///< objects the object level left
+    std::size_t objects_culled = 0;                        ///< of those, hidden by the method
     std::size_t patches_culled = 0, triangles_culled = 0;  ///< in the hidden objects
     HorizonStats horizon;
     PortalStats portals;
@@ -110,7 +110,8 @@ class SceneTightBounds {
 public:
     /// pose: a pose of every instance (ScenePoser::pose), ranges: its displacement ranges (empty:
     /// undisplaced).
-    SceneTightBounds(const Scene& scene, const std::vector<BezierPatch>& pose, const std::vector<DisplacementRange>& ranges);
+    SceneTightBounds(const Scene& scene, const std::vector<BezierPatch>& pose,
+                     const std::vector<DisplacementRange>& ranges);
     /// Refits to a pose of the same scene and selects each instance's boxes (TightBounds::select
     /// with sigma and max_boxes).
     void update(const std::vector<BezierPatch>& pose, const std::vector<DisplacementRange>& ranges, float sigma,

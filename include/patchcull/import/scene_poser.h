@@ -108,11 +108,11 @@ private:
     const Scene* scene_;
     std::vector<Vec3> positions_;
     PatchFrame frame_;
-    std::vector<std::size_t> first_patch_;    ///< per instance: its first patch in pose()'s output
-    std::vector<std::size_t> first_tangent_;  ///< per instance: its first entry of tangents()
-    std::vector<std::size_t> order_;          ///< instances sorted by (model, effective time)
-    std::vector<float> times_;                ///< per instance: effective time (rest: -inf)
-    std::vector<std::size_t> tangent_counts_; ///< per model: patches with tangent patches
+    std::vector<std::size_t> first_patch_;     ///< per instance: its first patch in pose()'s output
+    std::vector<std::size_t> first_tangent_;   ///< per instance: its first entry of tangents()
+    std::vector<std::size_t> order_;           ///< instances sorted by (model, effective time)
+    std::vector<float> times_;                 ///< per instance: effective time (rest: -inf)
+    std::vector<std::size_t> tangent_counts_;  ///< per model: patches with tangent patches
     std::vector<BezierPatch> patches_;
     std::vector<std::int32_t> tangent_index_;
     std::vector<TangentPatches> tangents_;

@@ -56,9 +56,9 @@ struct PatchInfo {
     /// Texture coordinates at the patch corners (u,v) = (0,0), (1,0), (0,1), (1,1). The texture
     /// parameterization is bilinear over the patch domain (Sathe's pre-processing step).
     Vec2 uv[4] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
-    std::uint32_t base_face = 0;     ///< control-mesh face the patch comes from
-    bool extraordinary = false;      ///< acc: touches an extraordinary vertex; osd: end-cap patch
-    std::int32_t tangent_index = -1; ///< row block in SubdivisionModel::tangent_points, or -1
+    std::uint32_t base_face = 0;      ///< control-mesh face the patch comes from
+    bool extraordinary = false;       ///< acc: touches an extraordinary vertex; osd: end-cap patch
+    std::int32_t tangent_index = -1;  ///< row block in SubdivisionModel::tangent_points, or -1
     /// Refinement depth of the patch's domain (osd: Far::PatchParam::GetDepth(), which counts an
     /// n-gon's quadrangulation so that a depth-d patch spans 2^-d of a base edge in every face;
     /// acc: 0). Adaptive refinement puts patches of different depths side by side; the renderer
@@ -70,9 +70,9 @@ struct PatchInfo {
 struct SubdivisionModel {
     std::string name;
     Scheme scheme = Scheme::acc;
-    ControlMesh mesh;                ///< the control mesh; animation deforms mesh.positions
-    PointStencils patch_points;      ///< 16 rows per patch, control point 4*j + i (patch.h)
-    PointStencils tangent_points;    ///< 24 rows per tangent block: 12 du rows, then 12 dv rows
+    ControlMesh mesh;              ///< the control mesh; animation deforms mesh.positions
+    PointStencils patch_points;    ///< 16 rows per patch, control point 4*j + i (patch.h)
+    PointStencils tangent_points;  ///< 24 rows per tangent block: 12 du rows, then 12 dv rows
     std::vector<PatchInfo> patches;
 
     std::size_t patch_count() const { return patches.size(); }
@@ -113,8 +113,8 @@ struct PatchFrame {
 /// copy of the same size), then applies split_levels uniform 1-to-4 splits (Loop, Niessner & Eisenacher's
 /// MonsterFrog with 5168 patches is 1292 quads after one split). Child texture coordinates are
 /// the bilinear interpolation of the parent's.
-void evaluate_patches(const SubdivisionModel& model, const std::vector<Vec3>& positions,
-                      int split_levels, PatchFrame& out);
+void evaluate_patches(const SubdivisionModel& model, const std::vector<Vec3>& positions, int split_levels,
+                      PatchFrame& out);
 
 // Scheme back ends (src/import/acc.cpp, src/import/osd.cpp); build_model dispatches to them.
 SubdivisionModel build_acc_model(const ControlMesh& mesh);
@@ -124,8 +124,8 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh);
 /// original vertices: refined positions = stencils.apply(original positions). Texture
 /// coordinates are refined linearly (face-varying, linear interpolation everywhere).
 struct RefinedMesh {
-    ControlMesh mesh;          ///< all-quad mesh; positions already evaluated at rest
-    PointStencils stencils;    ///< one row per refined vertex
+    ControlMesh mesh;        ///< all-quad mesh; positions already evaluated at rest
+    PointStencils stencils;  ///< one row per refined vertex
 };
 RefinedMesh refine_uniform_once(const ControlMesh& mesh);
 

@@ -117,9 +117,9 @@ struct BackMask {
 /// a 1e-12 relative margin, in double precision. The test is exact for the cones: n . v is
 /// bilinear, so n = sum a_i n_i and v = sum b_j v_j (a, b >= 0) give n . v = sum a_i b_j
 /// n_i . v_j > 0, and a corner pair with n_i . v_j <= 0 is itself a normal of the (grown) class
-/// facing a ray of the sub-frustum, so the test loses nothing beyond the growth and the margin. n . v > 0 is n . (p - eye) > 0: back-facing at every point on the ray.
-/// An orthographic world_to_clip (projection centre at infinity) uses its one view direction.
-/// A matrix that is singular, non-finite, or whose frustum corners lie behind its centre marks
+/// facing a ray of the sub-frustum, so the test loses nothing beyond the growth and the margin. n . v > 0 is n . (p -
+/// eye) > 0: back-facing at every point on the ray. An orthographic world_to_clip (projection centre at infinity) uses
+/// its one view direction. A matrix that is singular, non-finite, or whose frustum corners lie behind its centre marks
 /// nothing (conservative).
 ///
 /// Which primitives may use a mask: a triangle's facing is one number for its whole plane, so a
@@ -130,8 +130,8 @@ struct BackMask {
 /// the sub-frustum (e.g. their bounding box's projection inside the sector, in front of the eye).
 /// Contracts: 1 <= sectors, 0 <= sector_x, sector_y < sectors, else throws patchcull::Error.
 /// out.bits is resized (the only allocation).
-void make_back_mask(const NormalMaskGrid& grid, const Mat4& world_to_clip, ClipDepth depth, int sector_x,
-                    int sector_y, int sectors, BackMask& out);
+void make_back_mask(const NormalMaskGrid& grid, const Mat4& world_to_clip, ClipDepth depth, int sector_x, int sector_y,
+                    int sectors, BackMask& out);
 
 /// The screen sector (sy * sectors + sx) into which point p projects, computed in double: p must
 /// be in front of the eye (clip w > 0) and project into [-1, 1]^2 in NDC, else -1. A point on a
@@ -144,7 +144,6 @@ void cull_by_normal_mask_scalar(const std::uint16_t* classes, std::size_t n, con
                                 std::uint8_t* culled);
 /// The same lookup with a SIMD gather of 32-bit mask words (Highway; identical results). Whether
 /// the gather pays is measured in bench/backface_bench.cpp.
-void cull_by_normal_mask_simd(const std::uint16_t* classes, std::size_t n, const BackMask& mask,
-                              std::uint8_t* culled);
+void cull_by_normal_mask_simd(const std::uint16_t* classes, std::size_t n, const BackMask& mask, std::uint8_t* culled);
 
 }  // namespace patchcull

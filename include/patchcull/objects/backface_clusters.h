@@ -68,8 +68,8 @@ struct BackfaceCluster {
 /// (the lecture's practice). Triangles with two equal vertices (zero area, never drawn) are
 /// skipped as planes but counted as members. first/count are set to the arguments.
 /// Contracts: indices covers the range; count >= 1. Never throws.
-BackfaceCluster make_triangle_cluster(const Vec3* vertices, const std::uint32_t* indices,
-                                      std::uint32_t first_triangle, std::uint32_t count);
+BackfaceCluster make_triangle_cluster(const Vec3* vertices, const std::uint32_t* indices, std::uint32_t first_triangle,
+                                      std::uint32_t count);
 
 /// d of the triangle range for local coordinates c (as make_triangle_cluster computes it, before
 /// rounding to float): for tests of the choice of c.
@@ -134,9 +134,9 @@ inline const BackfaceCluster& cluster_leaf(const ClusterHierarchy& h, std::size_
 /// hundreds of cluster tests (0.01 - 0.1): with tC / r >= 1 BigGuy's patches merge into clusters
 /// that cull little (bench/backface_bench.cpp, backface/hierarchy/bigguy_acc_*).
 struct ClusterBuildOptions {
-    double tc_over_r = 4.0;                ///< tC / r of merge_pays
-    std::uint32_t max_leaf = 64;           ///< members per leaf at most (>= 1)
-    double max_leaf_normal_angle = 0.5236; ///< radians (30 deg): a leaf's normals stay within it of its seed's
+    double tc_over_r = 4.0;                 ///< tC / r of merge_pays
+    std::uint32_t max_leaf = 64;            ///< members per leaf at most (>= 1)
+    double max_leaf_normal_angle = 0.5236;  ///< radians (30 deg): a leaf's normals stay within it of its seed's
     Bounds viewpoints{{1, 1, 1}, {0, 0, 0}};
 };
 
@@ -196,8 +196,8 @@ Bounds near_field_viewpoints(const Bounds& box);
 /// at most options.max_leaf members; returns the merged clusters in range order (first/count
 /// exact; bounds relaxed as merge_clusters makes them: recompute each from its members for
 /// leaves). Never throws except bad_alloc.
-std::vector<BackfaceCluster> merge_into_leaves(const std::vector<BackfaceCluster>& units, const ClusterBuildOptions& options,
-                                               const Bounds& default_viewpoints);
+std::vector<BackfaceCluster> merge_into_leaves(const std::vector<BackfaceCluster>& units,
+                                               const ClusterBuildOptions& options, const Bounds& default_viewpoints);
 
 /// The hierarchy over leaves given in range order (their first/count adjacent and increasing):
 /// adjacent nodes merged bottom-up by the largest gain while merge_pays holds (tC / r and the
@@ -228,9 +228,9 @@ BackfaceCluster make_patch_cluster(const BezierPatch* patches, std::uint32_t fir
 /// Patch clusters of one object, built once at rest in the object's space: every patch a unit,
 /// adjacent units (input order) merged into leaves by merge_into_leaves (merge_pays, at most
 /// max_leaf patches; max_leaf_normal_angle is not used), each leaf recomputed from its patches'
-/// control planes; then the hierarchy as for triangles (build_cluster_hierarchy). For an object moving rigidly, test each frame with the eye moved into object
-/// space (inverse of the rigid transform). indices and triangle_order stay empty.
-/// Contracts: max_leaf >= 1, else throws patchcull::Error.
+/// control planes; then the hierarchy as for triangles (build_cluster_hierarchy). For an object moving rigidly, test
+/// each frame with the eye moved into object space (inverse of the rigid transform). indices and triangle_order stay
+/// empty. Contracts: max_leaf >= 1, else throws patchcull::Error.
 ClusterHierarchy build_patch_clusters(const BezierPatch* patches, std::size_t n, const ClusterBuildOptions& options);
 /// The same with default options except tc_over_r and max_leaf.
 ClusterHierarchy build_patch_clusters(const BezierPatch* patches, std::size_t n, double tc_over_r,

@@ -21,9 +21,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "patchcull/objects/bounding_volumes.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/mesh.h"
+#include "patchcull/objects/bounding_volumes.h"
 
 namespace patchcull {
 
@@ -81,8 +81,8 @@ public:
 private:
     struct Node {
         Bounds box;
-        std::uint32_t first = 0;  ///< leaf: first slot; inner: index of the left child (right = +1)
-        std::uint32_t count = 0;  ///< leaf: objects (1..4); inner: 0
+        std::uint32_t first = 0;                     ///< leaf: first slot; inner: index of the left child (right = +1)
+        std::uint32_t count = 0;                     ///< leaf: objects (1..4); inner: 0
         std::uint32_t slot_begin = 0, slot_end = 0;  ///< slots of every object in the subtree
     };
     struct StackEntry {

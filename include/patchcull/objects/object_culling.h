@@ -24,13 +24,13 @@
 #include <string>
 #include <vector>
 
-#include "patchcull/objects/backface.h"
-#include "patchcull/objects/backface_clusters.h"
-#include "patchcull/objects/bounding_volumes.h"
 #include "patchcull/core/clip_space.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/math.h"
 #include "patchcull/core/mesh.h"
+#include "patchcull/objects/backface.h"
+#include "patchcull/objects/backface_clusters.h"
+#include "patchcull/objects/bounding_volumes.h"
 #include "patchcull/objects/object_bvh.h"
 
 namespace patchcull {
@@ -121,18 +121,18 @@ struct ObjectCullOptions {
 
 /// Counts of one frame (render --json "objects").
 struct ObjectCullStats {
-    std::size_t total = 0;            ///< objects
-    std::size_t frustum_culled = 0;   ///< objects culled whole by the frustum test
-    std::size_t backface_culled = 0;  ///< objects whose every cluster is back-facing
-    std::size_t detail_culled = 0;    ///< objects culled by detail culling
-    std::uint32_t plane_tests = 0;    ///< frustum planes evaluated (nodes and objects)
-    std::uint32_t bvh_nodes_visited = 0;  ///< BVH nodes tested (the flat list: objects tested)
-    std::uint32_t cluster_tests = 0;      ///< back-face cluster tests (hierarchies: nodes tested)
-    std::size_t triangle_tests = 0;       ///< per-triangle tests or normal-mask lookups
-    std::uint32_t meta_rejected = 0;      ///< objects rejected by the meta-BVs
-    std::uint32_t volume_rejected = 0;    ///< objects the sphere / OBB rejected after the AABB
-    std::size_t patches_culled = 0;       ///< patches in culled spans (no patch test runs on them)
-    std::size_t triangles_culled = 0;     ///< triangles in culled spans
+    std::size_t total = 0;                    ///< objects
+    std::size_t frustum_culled = 0;           ///< objects culled whole by the frustum test
+    std::size_t backface_culled = 0;          ///< objects whose every cluster is back-facing
+    std::size_t detail_culled = 0;            ///< objects culled by detail culling
+    std::uint32_t plane_tests = 0;            ///< frustum planes evaluated (nodes and objects)
+    std::uint32_t bvh_nodes_visited = 0;      ///< BVH nodes tested (the flat list: objects tested)
+    std::uint32_t cluster_tests = 0;          ///< back-face cluster tests (hierarchies: nodes tested)
+    std::size_t triangle_tests = 0;           ///< per-triangle tests or normal-mask lookups
+    std::uint32_t meta_rejected = 0;          ///< objects rejected by the meta-BVs
+    std::uint32_t volume_rejected = 0;        ///< objects the sphere / OBB rejected after the AABB
+    std::size_t patches_culled = 0;           ///< patches in culled spans (no patch test runs on them)
+    std::size_t triangles_culled = 0;         ///< triangles in culled spans
     std::size_t backface_patches_culled = 0;  ///< of patches_culled: in back-facing clusters
 };
 
@@ -187,8 +187,8 @@ private:
     std::vector<std::uint16_t> triangle_classes_;
     std::vector<BackMask> masks_;  // [0]: the frustum; then sectors x sectors
     std::vector<std::uint8_t> triangle_culled_;
-    std::size_t cull_triangles_individually(std::size_t object, const ObjectFrame& frame, const ObjectCullOptions& options,
-                                     std::vector<IndexSpan>& culled);
+    std::size_t cull_triangles_individually(std::size_t object, const ObjectFrame& frame,
+                                            const ObjectCullOptions& options, std::vector<IndexSpan>& culled);
     ObjectCullResult result_;
 };
 

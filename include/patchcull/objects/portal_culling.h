@@ -124,7 +124,7 @@ private:
     struct Portal {
         std::uint32_t cell_a = 0, cell_b = 0;
         Point corners[4];
-        Point normal;  ///< unit, right-handed with the corner order
+        Point normal;       ///< unit, right-handed with the corner order
         double offset = 0;  ///< plane: dot(normal, p) + offset = 0 (through the corners' centroid)
     };
     struct Reach {
@@ -151,8 +151,8 @@ private:
     double margin_ = 0, near_portal_ = 0;
 
     // Per frame.
-    bool cull_ = false;    ///< false: nothing is culled (no traverse yet, eye in no cell, bad input)
-    bool capped_ = false;  ///< a cap was hit: only the view frustum culls
+    bool cull_ = false;          ///< false: nothing is culled (no traverse yet, eye in no cell, bad input)
+    bool capped_ = false;        ///< a cap was hit: only the view frustum culls
     std::vector<Plane> planes_;  ///< planes_[0, view_planes_) the widened view frustum, then reaches'
     std::uint32_t view_planes_ = 0;
     Plane near_far_[2];

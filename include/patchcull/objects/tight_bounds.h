@@ -96,7 +96,7 @@ private:
     double split_increase(const Node& node) const;
 
     std::size_t piece_count_ = 0;
-    std::vector<Node> nodes_;               ///< nodes_[0] the root; children after their parent
+    std::vector<Node> nodes_;                ///< nodes_[0] the root; children after their parent
     std::vector<std::uint32_t> slot_piece_;  ///< piece index of each leaf slot
 };
 

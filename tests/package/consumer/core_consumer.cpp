@@ -23,7 +23,8 @@ bool sample_inside(const pc::BezierPatch& patch, const pc::Mat4& clip) {
         for (int i = 0; i <= 16; ++i) {
             const pc::Vec3 p = pc::evaluate_position(patch, i / 16.0f, j / 16.0f);
             float c[4];
-            for (int r = 0; r < 4; ++r) c[r] = clip.at(r, 0) * p.x + clip.at(r, 1) * p.y + clip.at(r, 2) * p.z + clip.at(r, 3);
+            for (int r = 0; r < 4; ++r)
+                c[r] = clip.at(r, 0) * p.x + clip.at(r, 1) * p.y + clip.at(r, 2) * p.z + clip.at(r, 3);
             if (c[3] > 0 && -c[3] <= c[0] && c[0] <= c[3] && -c[3] <= c[1] && c[1] <= c[3] && 0 <= c[2] && c[2] <= c[3])
                 return true;
         }
@@ -66,7 +67,7 @@ int main() {
             culled += scalar[p];
             if (scalar[p] && sample_inside(patches[p], clip)) ++wrong;
         }
-        const bool count_ok = view.expect_none ? culled == 0
+        const bool count_ok = view.expect_none  ? culled == 0
                               : view.expect_all ? culled == patches.size()
                                                 : culled > 0 && culled < patches.size();
         check(count_ok && wrong == 0 && scalar == simd,

@@ -29,9 +29,9 @@ int main() {
         const std::string path = std::string(CONSUMER_GLSL_DIR) + "/" + name;
         const std::string installed = read_file(path);
         const std::string_view embedded = patchcull::gl::shipped_glsl(name);
-        check(!installed.empty() && installed == embedded,
-              path + " (" + std::to_string(installed.size()) + " bytes) is shipped_glsl(\"" + name + "\") (" +
-                  std::to_string(embedded.size()) + " bytes)");
+        check(!installed.empty() && installed == embedded, path + " (" + std::to_string(installed.size()) +
+                                                               " bytes) is shipped_glsl(\"" + name + "\") (" +
+                                                               std::to_string(embedded.size()) + " bytes)");
     }
     check(patchcull::gl::shared::kBindingControlPoints == 0u, "shared.h: kBindingControlPoints is binding 0");
     try {
