@@ -33,7 +33,7 @@ using patchcull::kStatusVisible;
 
 // Shader storage buffer binding points (std430).
 PATCHCULL_CONST uint kBindingControlPoints = 0u;  // vec4 cp[16 * patch_count]: patch p's point k at 16p+k
-PATCHCULL_CONST uint kBindingCullFlags = 1u;      // uint flags[patch_count]: 0 = draw, nonzero = culled
+PATCHCULL_CONST uint kBindingCullFlags = 1u;      // uint flags[patch_count]: the flag word (cull reason bits 0-7: 0 = drawn; statuses)
 PATCHCULL_CONST uint kBindingMaxDisplacement = 2u; // float max_disp[patch_count], >= 0 (cull margin)
 PATCHCULL_CONST uint kBindingPatchTexcoords = 3u;  // vec2 uv[4 * patch_count]: corner texcoords (patch.h order)
 PATCHCULL_CONST uint kBindingPlaneValues = 4u;     // float values[6 * patch_count]: frustum diagnostics

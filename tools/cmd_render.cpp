@@ -126,9 +126,9 @@ Runner add_render_command(CLI::App& app) {
     };
     auto state = std::make_shared<State>();
     CLI::App* command = app.add_subcommand("render", "Render an animated camera path with the GPU cull pipeline");
-    add_text_option(
-        *command, "MODEL", state->model,
-        "OBJ control mesh, 'teapot', a built-in scene ('default', 'city', 'building') or a scene file (.json)");
+    add_text_option(*command, "MODEL", state->model,
+                    "OBJ control mesh, 'teapot', 'bigguy', 'monsterfrog', a built-in scene ('default', 'city', "
+                    "'building') or a scene file (.json)");
     add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 1, 1000, "number of frames");

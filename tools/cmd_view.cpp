@@ -61,9 +61,9 @@ Runner add_view_command(CLI::App& app) {
     };
     auto state = std::make_shared<State>();
     CLI::App* command = app.add_subcommand("view", "Show the GPU cull pipeline in a window (GLFW, Dear ImGui panel)");
-    add_text_option(
-        *command, "MODEL", state->model,
-        "OBJ control mesh, 'teapot', a built-in scene ('default', 'city', 'building') or a scene file (.json)");
+    add_text_option(*command, "MODEL", state->model,
+                    "OBJ control mesh, 'teapot', 'bigguy', 'monsterfrog', a built-in scene ('default', 'city', "
+                    "'building') or a scene file (.json)");
     add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 0, 1000000,

@@ -14,7 +14,9 @@ void print_warnings(const std::vector<std::string>& warnings) {
 }
 
 void add_model_options(CLI::App& command, ModelOptions& options, bool with_displacement) {
-    add_text_option(command, "MODEL", options.model, "OBJ control mesh, or 'teapot' for the built-in Utah teapot")
+    add_text_option(
+        command, "MODEL", options.model,
+        "OBJ control mesh, 'teapot' (the built-in Utah teapot), or a shipped model: 'bigguy', 'monsterfrog'")
         ->required();
     add_choice_option(command, "--scheme", options.scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
     add_int_option(command, "--split", options.split, 0, 4, "uniform 1-to-4 patch splits");

@@ -1,14 +1,15 @@
 // Multi-core range splitting over oneTBB (patchcull/core/parallel.h).
 #include "patchcull/core/parallel.h"
 
+#include <algorithm>
+
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
 
 namespace patchcull {
 
-void parallel_for_ranges(std::size_t count, std::size_t grain,
-                         const std::function<void(std::size_t, std::size_t)>& body) {
+void parallel_for_ranges(std::size_t count, std::size_t grain, RangeBody body) {
     if (count == 0) return;
     if (grain == 0) grain = 1;
     const std::size_t chunks = (count + grain - 1) / grain;

@@ -1,5 +1,9 @@
 // OpenGL contexts (patchcull/gl/gl_context.h: GlContext): headless EGL, or a GLFW window.
 //
+// GLFW is loaded at run time (dlopen libglfw.so.3) by create_window, so patchcull::gl links no
+// GLFW: an engine with its own SDL, EGL or GLFW context does not get it. A program that links
+// GLFW itself (the CLI's viewer, for Dear ImGui's backend) shares the same loaded library.
+//
 // libepoxy dispatches EGL and GL; it loads libEGL.so.1 and libOpenGL.so.0 / libGL.so.1 at run
 // time, and aborts the process when they are missing, so create_headless() dlopen()s them first
 // and throws a one-line patchcull::Error instead. EGL extension entry points come from
@@ -18,6 +22,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "patchcull/core/error.h"
@@ -26,10 +31,30 @@
 
 namespace patchcull::gl {
 
+// The GLFW functions create_window's contexts use, from libglfw.so.3 (GLFW's declarations give
+// their types).
+struct GlfwApi {
+    decltype(&::glfwInit) init = nullptr;
+    decltype(&::glfwTerminate) terminate = nullptr;
+    decltype(&::glfwSetErrorCallback) set_error_callback = nullptr;
+    decltype(&::glfwWindowHint) window_hint = nullptr;
+    decltype(&::glfwCreateWindow) create_window = nullptr;
+    decltype(&::glfwDestroyWindow) destroy_window = nullptr;
+    decltype(&::glfwMakeContextCurrent) make_context_current = nullptr;
+    decltype(&::glfwSwapInterval) swap_interval = nullptr;
+    decltype(&::glfwPollEvents) poll_events = nullptr;
+    decltype(&::glfwGetKey) get_key = nullptr;
+    decltype(&::glfwSetWindowShouldClose) set_window_should_close = nullptr;
+    decltype(&::glfwWindowShouldClose) window_should_close = nullptr;
+    decltype(&::glfwSwapBuffers) swap_buffers = nullptr;
+    decltype(&::glfwGetFramebufferSize) get_framebuffer_size = nullptr;
+};
+
 struct GlContext::Impl {
     EGLDisplay display = EGL_NO_DISPLAY;
     EGLContext context = EGL_NO_CONTEXT;
-    GLFWwindow* window = nullptr;  // a window context instead of EGL
+    GLFWwindow* window = nullptr;   // a window context instead of EGL
+    const GlfwApi* glfw = nullptr;  // the loaded GLFW of a window context
     std::string renderer, vendor, version, platform;
     bool software = false;
     ~Impl();
@@ -136,14 +161,45 @@ std::string try_candidate(const Candidate& c, PFNEGLGETPLATFORMDISPLAYEXTPROC ge
 // The last GLFW error, for one-line messages (GLFW reports through a callback).
 std::string g_glfw_error;
 
+// Loads GLFW once; throws a one-line Error when the library or one of its functions is missing.
+const GlfwApi& glfw_api() {
+    static const GlfwApi api = [] {
+        void* library = nullptr;
+        for (const char* name : {"libglfw.so.3", "libglfw.so"})
+            if (!library) library = dlopen(name, RTLD_NOW | RTLD_GLOBAL);
+        if (!library) throw Error("GLFW: cannot load libglfw.so.3 (Debian: libglfw3) for a window context");
+        GlfwApi a;
+        auto load = [library](auto& function, const char* name) {
+            function = reinterpret_cast<std::remove_reference_t<decltype(function)>>(dlsym(library, name));
+            if (!function) throw Error(std::string("GLFW: libglfw.so.3 has no ") + name);
+        };
+        load(a.init, "glfwInit");
+        load(a.terminate, "glfwTerminate");
+        load(a.set_error_callback, "glfwSetErrorCallback");
+        load(a.window_hint, "glfwWindowHint");
+        load(a.create_window, "glfwCreateWindow");
+        load(a.destroy_window, "glfwDestroyWindow");
+        load(a.make_context_current, "glfwMakeContextCurrent");
+        load(a.swap_interval, "glfwSwapInterval");
+        load(a.poll_events, "glfwPollEvents");
+        load(a.get_key, "glfwGetKey");
+        load(a.set_window_should_close, "glfwSetWindowShouldClose");
+        load(a.window_should_close, "glfwWindowShouldClose");
+        load(a.swap_buffers, "glfwSwapBuffers");
+        load(a.get_framebuffer_size, "glfwGetFramebufferSize");
+        return a;
+    }();
+    return api;
+}
+
 void remember_glfw_error(int code, const char* description) {
     g_glfw_error = description ? description : "error " + std::to_string(code);
 }
 
 GlContext::Impl::~Impl() {
     if (window) {
-        glfwDestroyWindow(window);
-        glfwTerminate();  // one window context at a time (create_window)
+        glfw->destroy_window(window);
+        glfw->terminate();  // one window context at a time (create_window)
         return;
     }
     if (context != EGL_NO_CONTEXT) {
@@ -202,24 +258,26 @@ GlContext GlContext::create_headless() {
 
 GlContext GlContext::create_window(int width, int height, const std::string& title) {
     if (width < 1 || height < 1) throw Error("GLFW: window size must be positive");
-    glfwSetErrorCallback(remember_glfw_error);
+    const GlfwApi& glfw = glfw_api();
+    glfw.set_error_callback(remember_glfw_error);
     g_glfw_error.clear();
-    if (!glfwInit()) throw Error("GLFW: cannot start: " + g_glfw_error + " (no X display? run under xvfb-run)");
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
-    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);  // the renderer's framebuffer has a fixed size
-    GLFWwindow* window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+    if (!glfw.init()) throw Error("GLFW: cannot start: " + g_glfw_error + " (no X display? run under xvfb-run)");
+    glfw.window_hint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+    glfw.window_hint(GLFW_CONTEXT_VERSION_MINOR, 5);
+    glfw.window_hint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfw.window_hint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfw.window_hint(GLFW_RESIZABLE, GLFW_FALSE);  // the renderer's framebuffer has a fixed size
+    GLFWwindow* window = glfw.create_window(width, height, title.c_str(), nullptr, nullptr);
     if (!window) {
         const std::string why = g_glfw_error;
-        glfwTerminate();
+        glfw.terminate();
         throw Error("GLFW: no OpenGL 4.5 core window: " + why);
     }
-    glfwMakeContextCurrent(window);
-    glfwSwapInterval(0);  // measure frames, not the display's refresh
+    glfw.make_context_current(window);
+    glfw.swap_interval(0);  // measure frames, not the display's refresh
     auto impl = std::make_unique<Impl>();
     impl->window = window;
+    impl->glfw = &glfw;
     if (epoxy_gl_version() < 45) throw Error("GLFW: the window's context is not OpenGL 4.5");
     auto str = [](GLenum e) {
         const GLubyte* v = glGetString(e);
@@ -242,7 +300,7 @@ GlContext::~GlContext() = default;
 
 void GlContext::make_current() const {
     if (impl_->window) {
-        glfwMakeContextCurrent(impl_->window);
+        impl_->glfw->make_context_current(impl_->window);
         return;
     }
     if (!eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, impl_->context))
@@ -254,19 +312,21 @@ GLFWwindow* GlContext::glfw_window() const { return impl_->window; }
 
 bool GlContext::window_open() const {
     if (!impl_->window) return true;
-    glfwPollEvents();
-    if (glfwGetKey(impl_->window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(impl_->window, GLFW_TRUE);
-    return !glfwWindowShouldClose(impl_->window);
+    const GlfwApi& glfw = *impl_->glfw;
+    glfw.poll_events();
+    if (glfw.get_key(impl_->window, GLFW_KEY_ESCAPE) == GLFW_PRESS)
+        glfw.set_window_should_close(impl_->window, GLFW_TRUE);
+    return !glfw.window_should_close(impl_->window);
 }
 
 void GlContext::swap_buffers() const {
-    if (impl_->window) glfwSwapBuffers(impl_->window);
+    if (impl_->window) impl_->glfw->swap_buffers(impl_->window);
 }
 
 void GlContext::write_window_png(const std::string& path) const {
     if (!impl_->window) throw Error(path + ": cannot write a window screenshot: the context has no window");
     int width = 0, height = 0;
-    glfwGetFramebufferSize(impl_->window, &width, &height);
+    impl_->glfw->get_framebuffer_size(impl_->window, &width, &height);
     std::vector<std::uint8_t> rgba(static_cast<std::size_t>(width) * height * 4);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
     glReadBuffer(GL_BACK);

@@ -95,7 +95,11 @@ struct StencilPoser::Impl {
     }
 };
 
-StencilPoser::StencilPoser(const GlContext& ctx) : impl_((ctx.make_current(), std::make_unique<Impl>())) {
+StencilPoser::StencilPoser(const GlContext& ctx) : StencilPoser((ctx.make_current(), CurrentContext{})) {}
+
+StencilPoser::StencilPoser(CurrentContext) : impl_(std::make_unique<Impl>()) {
+    if (glGetString(GL_VERSION) == nullptr || epoxy_gl_version() < 45)
+        throw Error("GL: StencilPoser needs a current OpenGL 4.5 core context");
     Impl& m = *impl_;
     m.program = detail::link_program({{"pose_stencils.comp.glsl", GL_COMPUTE_SHADER}}, "pose_stencils");
     m.count_location = glGetUniformLocation(m.program, "u_patch_count");

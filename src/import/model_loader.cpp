@@ -47,7 +47,7 @@ LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels)
         split_in_place(model.rest, split_levels, spec);
         return model;
     }
-    ControlMesh mesh = load_obj(spec);
+    ControlMesh mesh = load_obj(resolve_model_path(spec));
     // Orientation from geometry, shell by shell (mesh.h): inside-out shells are reversed, a flat or
     // undecided mesh is two-sided.
     const SurfaceOrientation orientation = orient_outward(mesh);
@@ -116,14 +116,30 @@ Bounds patch_bounds(const PatchFrame& frame) {
 }
 
 std::string shipped_model_path(const std::string& file_name) {
-    if (const char* dir = std::getenv("PATCHCULL_DATA_DIR")) return std::string(dir) + "/models/" + file_name;
-    // The source tree's data/ while it exists (builds and tests), else the configured install
-    // prefix's share/patchcull, so an installed library finds its models after the source is gone.
+    const char* dir = std::getenv("PATCHCULL_DATA_DIR");
+    if (dir && *dir) return std::string(dir) + "/models/" + file_name;  // empty: unset
+    // The source tree's data/ while it exists (builds and tests); else the share/patchcull beside
+    // the running program's prefix (an installed CLI, wherever the prefix was moved); else the
+    // configured install prefix's, so an installed library finds its models after the source is gone.
     const std::string source = std::string(PATCHCULL_DATA_DIR) + "/models/" + file_name;
     std::error_code error;
     if (std::filesystem::exists(source, error)) return source;
+    const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
+    if (!error) {
+        const std::string beside =
+            (program.parent_path().parent_path() / "share/patchcull/models" / file_name).string();
+        if (std::filesystem::exists(beside, error)) return beside;
+    }
     const std::string installed = std::string(PATCHCULL_INSTALLED_DATA_DIR) + "/models/" + file_name;
     return std::filesystem::exists(installed, error) ? installed : source;
+}
+
+std::string resolve_model_path(const std::string& spec) {
+    std::error_code error;
+    if (spec.empty() || std::filesystem::exists(spec, error)) return spec;
+    for (const char* name : kShippedModels)
+        if (spec == name) return shipped_model_path(spec + ".obj");
+    return spec;
 }
 
 }  // namespace patchcull

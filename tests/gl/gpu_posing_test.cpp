@@ -46,14 +46,16 @@ StencilTableView view_of(const PointStencils& s) {
 
 // A StencilPoser over the scene's tables (ScenePoser::gpu_tables), as tools/frame_poser.cpp
 // makes it.
-StencilPoser make_poser(ScenePoser& poser) {
+StencilPoser make_poser(ScenePoser& poser, bool on_current_context = false) {
     std::vector<PosingModel> models;
     for (const PoseModelTables& t : poser.gpu_tables())
         models.push_back({view_of(*t.patch_points), view_of(*t.tangent_points), t.tangent_index, t.vertex_count});
     std::vector<std::uint32_t> instance_models;
     for (const SceneInstance& i : poser.scene().instances)
         instance_models.push_back(static_cast<std::uint32_t>(i.model));
-    StencilPoser gpu(test::context());
+    test::context().make_current();
+    StencilPoser gpu =
+        on_current_context ? StencilPoser(StencilPoser::CurrentContext{}) : StencilPoser(test::context());
     gpu.set_tables(models, instance_models);
     return gpu;
 }
@@ -148,6 +150,28 @@ TEST(GpuPosing, TeapotPosesThroughIdentityRows) {
     Scene scene = make_model_scene(load_model("teapot", Scheme::acc, 0));
     scene.instances[0].velocity = {0.1f, 0, 0};
     expect_identical_poses(scene, {0.0f, 0.5f}, false);
+}
+
+// The poser made on the caller's current context (no GlContext) writes the same buffers.
+TEST(GpuPosing, OnTheCallersCurrentContext) {
+    Scene scene = make_model_scene(load_model("teapot", Scheme::acc, 0));  // no tangents to size
+    scene.instances[0].velocity = {0.1f, 0, 0};
+    ScenePoser a(scene), b(scene);
+    StencilPoser own = make_poser(a), current = make_poser(b, true);
+    PatchRenderer ra(test::context()), rb(test::context());
+    ra.set_patches(a.pose(0.0f));
+    rb.set_patches(b.pose(0.0f));
+    gpu_pose(own, a, 0.25f, ra);
+    gpu_pose(current, b, 0.25f, rb);
+    const std::size_t bytes = ra.patch_count() * sizeof(BezierPatch);
+    std::vector<std::uint8_t> pa(bytes), pb(bytes);
+    glGetNamedBufferSubData(ra.patch_buffer(), 0, static_cast<GLsizeiptr>(bytes), pa.data());
+    glGetNamedBufferSubData(rb.patch_buffer(), 0, static_cast<GLsizeiptr>(bytes), pb.data());
+    EXPECT_EQ(pa, pb);
+    std::vector<std::uint8_t> rest(bytes);
+    const std::vector<BezierPatch>& at_rest = a.pose(0.0f);
+    std::memcpy(rest.data(), at_rest.data(), bytes);
+    EXPECT_NE(pa, rest) << "the pose at 0.25 s moved the teapot";
 }
 
 TEST(GpuPosing, SplitModelsAreRefused) {

@@ -25,8 +25,10 @@ namespace {
 
 std::atomic<std::int64_t> g_live_bytes{0};
 std::atomic<std::int64_t> g_peak_bytes{0};
+std::atomic<std::int64_t> g_allocations{0};
 
 void count_allocation(void* p) {
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
     const auto size = static_cast<std::int64_t>(malloc_usable_size(p));
     const std::int64_t live = g_live_bytes.fetch_add(size, std::memory_order_relaxed) + size;
     std::int64_t peak = g_peak_bytes.load(std::memory_order_relaxed);
@@ -107,4 +109,30 @@ TEST(CullEvalMemory, PeakHeapGrowsByHundredsOfBytesPerPatchNotByTheSamples) {
         EXPECT_GT(m.culled, static_cast<std::uint64_t>(n) / 10) << m.name;
         EXPECT_EQ(m.false_culls, 0u) << m.name;
     }
+}
+
+// parallel_for_ranges takes its body by reference (RangeBody): a call with a lambda that captures
+// more than a std::function keeps inline allocates nothing through operator new, and the ranges
+// cover [0, count) once, starting at multiples of the grain.
+TEST(ParallelForRanges, CoversEveryIndexOnceAndAllocatesNothing) {
+    constexpr std::size_t kCount = 100003, kGrain = 64;
+    std::vector<std::atomic<int>> hits(kCount);
+    std::atomic<int> misaligned{0};
+    const double a = 1, b = 2, c = 3, d = 4;  // captured by reference with hits: a large closure
+    auto body = [&](std::size_t first, std::size_t last) {
+        if (first % kGrain != 0) misaligned.fetch_add(1);
+        for (std::size_t i = first; i < last; ++i) hits[i].fetch_add(static_cast<int>(a + b + c + d) - 9);
+    };
+    patchcull::parallel_for_ranges(kCount, kGrain, body);  // warm-up: oneTBB starts its workers
+    for (auto& h : hits) h.store(0);
+    const std::int64_t before = g_allocations.load();
+    patchcull::parallel_for_ranges(kCount, kGrain, body);
+    patchcull::parallel_for_ranges(kCount, kGrain, [&](std::size_t first, std::size_t last) { body(first, last); });
+    const std::int64_t allocations = g_allocations.load() - before;
+    EXPECT_EQ(allocations, 0);
+    EXPECT_EQ(misaligned.load(), 0);
+    for (std::size_t i = 0; i < kCount; ++i) ASSERT_EQ(hits[i].load(), 2) << i;
+    patchcull::parallel_for_ranges(0, kGrain, body);  // nothing to do
+    patchcull::parallel_for_ranges(5, 0, body);       // grain 0 counts as 1
+    for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(hits[i].load(), 3) << i;
 }

@@ -45,10 +45,11 @@ public:
 
     /// Opens a window of width x height pixels with an OpenGL 4.5 core context, current on the
     /// calling thread: the same renderer and cull pipeline as create_headless, shown on screen
-    /// (PatchRenderer::blit_color_to_window, swap_buffers). GLFW 3 on X11; without a screen, run
-    /// under a virtual X server (`xvfb-run -a -s "-screen 0 1280x1024x24" ...`, llvmpipe). At most
-    /// one window context at a time. Throws patchcull::Error with one line ("GLFW: ...") when
-    /// there is no X display or no 4.5 core context.
+    /// (PatchRenderer::blit_color_to_window, swap_buffers). GLFW 3 on X11, loaded at run time
+    /// (libglfw.so.3: patchcull::gl does not link GLFW); without a screen, run under a virtual X
+    /// server (`xvfb-run -a -s "-screen 0 1280x1024x24" ...`, llvmpipe). At most one window
+    /// context at a time. Throws patchcull::Error with one line ("GLFW: ...") when libglfw.so.3 is
+    /// missing, there is no X display or no 4.5 core context.
     static GlContext create_window(int width, int height, const std::string& title);
 
     /// Makes this context current on the calling thread (needed only after another context was).

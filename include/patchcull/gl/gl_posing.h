@@ -78,6 +78,11 @@ public:
     /// ("GL: shader pose_stencils.comp.glsl: ...") when the driver rejects it (it needs double
     /// precision, core since GL 4.0).
     explicit StencilPoser(const GlContext& ctx);
+    /// The same on the OpenGL 4.5 context current on the calling thread (the caller's own: GLFW,
+    /// SDL, EGL, an engine's), as the passes (gl_passes.h) take it; the caller owns the buffers
+    /// pose() writes. Throws Error when no 4.5 context is current.
+    struct CurrentContext {};
+    explicit StencilPoser(CurrentContext);
     StencilPoser(StencilPoser&&) noexcept;
     StencilPoser& operator=(StencilPoser&&) noexcept;
     StencilPoser(const StencilPoser&) = delete;

@@ -1,4 +1,5 @@
-// patchcull/import/model_loader.h: loading a model by name for tools: an OBJ path or "teapot".
+// patchcull/import/model_loader.h: loading a model by name for tools: an OBJ path, "teapot", or a
+// shipped model's name ("bigguy", "monsterfrog").
 #pragma once
 
 #include <optional>
@@ -37,8 +38,9 @@ inline constexpr double kMaxMeshExtent = 2e11;
 /// everything (the views lost the object). A smaller mesh is refused with one line.
 inline constexpr double kMinMeshDiagonal = 1e-6;
 
-/// Loads spec ("teapot" or an OBJ path), builds patches with scheme (ignored for the teapot) and
-/// applies split_levels 1-to-4 splits. Throws patchcull::Error naming the file and line.
+/// Loads spec ("teapot", an OBJ path, or a shipped model's name: resolve_model_path), builds
+/// patches with scheme (ignored for the teapot) and applies split_levels 1-to-4 splits. Throws
+/// patchcull::Error naming the file and line.
 LoadedModel load_model(const std::string& spec, Scheme scheme, int split_levels);
 
 /// Re-evaluates the model's patches for animated control-mesh positions (the teapot is static:
@@ -53,8 +55,16 @@ std::vector<DisplacementRange> displacement_ranges(const PatchFrame& frame, cons
 Bounds patch_bounds(const PatchFrame& frame);
 
 /// Path of a model shipped with patchcull (data/models/NAME), e.g. "bigguy.obj": under
-/// $PATCHCULL_DATA_DIR when set, else the source tree's data/ while it exists, else the data
-/// installed under the configured prefix (share/patchcull/models). Does not check the file exists.
+/// $PATCHCULL_DATA_DIR when set and not empty, else the source tree's data/ while it exists, else
+/// share/patchcull/models beside the running program's prefix (PREFIX/bin/.. of an installed CLI,
+/// wherever the prefix was moved), else the data installed under the configured prefix. Does not
+/// check the file exists.
 std::string shipped_model_path(const std::string& file_name);
+
+/// The models shipped with patchcull, by name: data/models/NAME.obj.
+inline constexpr const char* kShippedModels[] = {"bigguy", "monsterfrog"};
+/// The OBJ path of spec: spec itself when a file of that name exists or it names no shipped model,
+/// else shipped_model_path(spec + ".obj") ("bigguy" -> .../models/bigguy.obj).
+std::string resolve_model_path(const std::string& spec);
 
 }  // namespace patchcull
