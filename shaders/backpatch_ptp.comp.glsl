@@ -1,5 +1,5 @@
 // ptp back-patch cull pass (BackpatchPtpPass, src/gl/backpatch_ptp_pass.cpp; Loop, Niessner &
-// Eisenacher §3-6): the GPU twin of cull_ptp_scalar (include/patchcull/core/backpatch.h, src/core/ptp.cpp)
+// Eisenacher §3-6): the GPU twin of cull_ptp_scalar (include/patchcull/core/backpatch.h, src/core/backpatch_ptp.cpp)
 // with Loop, Niessner & Eisenacher §6's parallel scheme:
 // kPtpLanes = 16 invocations per patch, kPtpPatchesPerGroup = 8 patches per work group.
 //
@@ -62,7 +62,7 @@ shared float s_t[kPtpPatchesPerGroup][64];
 shared float s_thr[kPtpPatchesPerGroup][64];
 shared uint s_count[kPtpPatchesPerGroup][kPtpLanes];
 
-// a*b - c*d as fma(a, b, -(c*d)) (ptp.cpp's minor2).
+// a*b - c*d as fma(a, b, -(c*d)) (backpatch_ptp.cpp's minor2).
 float pc_minor2(float a, float b, float c, float d) {
     precise float q = c * d;
     precise float r = pc_fma(a, b, -q);
@@ -81,7 +81,7 @@ void main() {
     // Inactive slots (past the range, culled earlier, displaced) still take part in every barrier.
     const bool in_range = index < ptp.patch_count && !pc_chain_culled(p) && pc_margin(p, ptp.has_margins) == 0.0;
 
-    // 1. Clip transform of control point `lane`: v = r.x X; v = fma(r.y, Y, v); ... (ptp.cpp step 1).
+    // 1. Clip transform of control point `lane`: v = r.x X; v = fma(r.y, Y, v); ... (backpatch_ptp.cpp step 1).
     {
         const vec4 P = in_range ? control_points[16u * p + lane] : vec4(0.0);
         precise float o[3];
@@ -99,7 +99,7 @@ void main() {
     }
     sync_shared();
 
-    // 2. Minors of the schedule's pairs (a, b), as the minors of (a, b - a) (ptp.cpp step 2).
+    // 2. Minors of the schedule's pairs (a, b), as the minors of (a, b - a) (backpatch_ptp.cpp step 2).
     for (uint q = lane; q < kPtpPairCount; q += kPtpLanes) {
         const uint pair = kPtpPairs[q];
         const uint a = pair & 0xFFu, b = pair >> 8;
@@ -113,7 +113,7 @@ void main() {
     }
     sync_shared();
 
-    // Margin scales of the patch (ptp.cpp's rounding_margins), computed by every lane alike.
+    // Margin scales of the patch (backpatch_ptp.cpp's rounding_margins), computed by every lane alike.
     bool finite;
     precise float g1, g2;
     uint collapsed = 0u;

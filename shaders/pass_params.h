@@ -108,7 +108,7 @@ PC_PARAMS(BackpatchConeParams, kUniformPassParams) {
 
 // backpatch_ptp.comp.glsl (BackpatchPtpPass).
 PC_PARAMS(BackpatchPtpParams, kUniformPassParams) {
-    PC_VEC4(rows[3]);                  // rows x, y, w of s * object_to_clip (ptp.cpp: s = sign(alpha) sign(det))
+    PC_VEC4(rows[3]);                  // rows x, y, w of s * object_to_clip (backpatch_ptp.cpp: s = sign(alpha) sign(det))
     PC_UINT(first_patch);
     PC_UINT(patch_count);
     PC_UINT(has_margins);

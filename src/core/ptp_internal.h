@@ -1,4 +1,4 @@
-// Shared by the ptp kernels (ptp.cpp, ptp_simd.cpp); private to patchcull.
+// Shared by the ptp kernels (backpatch_ptp.cpp, backpatch_ptp_simd.cpp); private to patchcull.
 #pragma once
 
 #include "patchcull/core/math.h"
@@ -6,7 +6,7 @@
 
 namespace patchcull::ptp_detail {
 
-/// Rows x, y, w of s * object_to_clip with s = sign(alpha) * sign(det object_to_clip) (ptp.cpp
+/// Rows x, y, w of s * object_to_clip with s = sign(alpha) * sign(det object_to_clip) (backpatch_ptp.cpp
 /// explains why), r[row][column].
 struct PtpClipRows {
     float r[3][4];

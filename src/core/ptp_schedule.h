@@ -1,4 +1,4 @@
-// The ptp kernels' evaluation schedule (private to patchcull; shared by ptp.cpp and ptp_simd.cpp so
+// The ptp kernels' evaluation schedule (private to patchcull; shared by backpatch_ptp.cpp and backpatch_ptp_simd.cpp so
 // both do the same operations in the same order), derived at compile time from the generated
 // table src/core/ptp_table.inc.
 //
@@ -211,7 +211,7 @@ inline constexpr int kStepCount = kTermCount - 4;
 // float control points X (M the float rows of s * object_to_clip) and the exact rational weights.
 // Without it, distant nearly edge-on patches were culled with a tangent plane facing the eye by
 // ~1e-5 rad (docs/RESULTS.md, Finding 1). Per patch (the same operations, in this order, in
-// ptp.cpp, ptp_simd.cpp and backpatch_ptp.comp.glsl, so all three agree bit for bit):
+// backpatch_ptp.cpp, backpatch_ptp_simd.cpp and backpatch_ptp.comp.glsl, so all three agree bit for bit):
 //   Mc = max_k |X_k.c| (c = x, y, z, w), finite = (Mx + My) + (Mz + Mw) <= FLT_MAX
 //   R  = max over rows i of fma chain |r_i0| Mx + |r_i1| My + |r_i2| Mz + |r_i3| Mw
 //        (>= sum_c |r_ic| |X_k.c| for every point k: R bounds |P| and P's rounding scale)

@@ -5,7 +5,7 @@
 //
 // Per-triangle test, operation order (shared with backface_simd.cpp; every product feeds an
 // explicit fma or is a lone multiply used only as an fma operand, so GCC's default
-// -ffp-contract=fast cannot fuse anything differently in the two versions, see ptp.cpp):
+// -ffp-contract=fast cannot fuse anything differently in the two versions, see backpatch_ptp.cpp):
 //   e1 = p1 - p0, e2 = p2 - p0, w = eye - p0                           (9 subtractions)
 //   n.x = fma(e1.y, e2.z, -(e1.z * e2.y)), n.y, n.z cyclically
 //   s = n.x * w.x;  s = fma(n.y, w.y, s);  s = fma(n.z, w.z, s)

@@ -236,7 +236,8 @@ enum HiZDecision : std::uint8_t {
 /// coordinate is never culled (step 1 keeps it, step 3 finds it not projectable).
 void cull_occlusion_scalar(const PatchBatchView& patches, const Mat4& object_to_clip, ClipDepth depth,
                            const HiZPyramid& hiz, std::uint8_t* decision);
-/// Same decisions, steps 1-6 in SIMD (Highway, target chosen once at run time).
+/// Same decisions, steps 1-6 in SIMD (Highway, target chosen once at run time): the fused kernel's
+/// {frustum, occlusion} plan (fused_cull.h; defined in src/core/fused_cull_simd.cpp).
 void cull_occlusion_simd(const PatchBatchView& patches, const Mat4& object_to_clip, ClipDepth depth,
                          const HiZPyramid& hiz, std::uint8_t* decision);
 

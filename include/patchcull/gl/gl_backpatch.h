@@ -110,7 +110,7 @@ public:
     void cull_ncone(Vec3 eye, std::vector<std::uint8_t>* culled = nullptr, std::vector<float>* cones = nullptr);
     /// cull_ptp_scalar on the GPU (object_to_clip = projection * view (* model), alpha =
     /// clip_space_eye_alpha(projection)). planes (optional): the 64 control plane z values per
-    /// patch as ptp_control_planes_z computes them (times the orientation sign s of ptp.cpp),
+    /// patch as ptp_control_planes_z computes them (times the orientation sign s of backpatch_ptp.cpp),
     /// t[64p + d]; margins (optional): their rounding-error margins thr[64p + d] as the CPU's
     /// ptp_rounding_margins computes them (a patch with a non-finite coordinate: unspecified);
     /// neither is written when nothing may be culled (alpha or det zero or not finite: all flags

@@ -295,7 +295,7 @@ public:
     BackpatchPtpPass& operator=(BackpatchPtpPass&&) noexcept;
     ~BackpatchPtpPass();
     /// plane_values (optional, diagnostics): >= 128 floats per patch; a tested patch p gets its 64
-    /// control plane z values (times the orientation sign, ptp.cpp) at 128p + 8 jv + iu and their
+    /// control plane z values (times the orientation sign, backpatch_ptp.cpp) at 128p + 8 jv + iu and their
     /// 64 rounding-error margins at 128p + 64 + 8 jv + iu. Returns false when nothing ran.
     bool run(const PatchBuffers& patches, const Mat4& object_to_clip, float alpha, PtpRule rule,
              std::uint32_t plane_values = 0);

@@ -5,13 +5,13 @@
 //
 // Lanes are patches, groups and partial-group padding as in simd_groups-inl.h.
 //
-// The operations and their order are the scalar reference's (ptp.cpp), fully unrolled at compile
+// The operations and their order are the scalar reference's (backpatch_ptp.cpp), fully unrolled at compile
 // time over the schedule of ptp_schedule.h (pair indices, third points, weights and destination
 // groups are constants, so the stack arrays of points and minors are addressed with constant
 // offsets): MulAdd <-> std::fma, NegMulAdd(a, b, c) <-> std::fma(-a, b, c), MulSub(a, b, c) <->
 // std::fma(a, b, -c) (exact on every target, simd_groups-inl.h), every other product and sum
 // separately rounded, and no Mul feeding a plain Add/Sub (GCC would contract that into an fma on
-// FMA targets only; see ptp.cpp).
+// FMA targets only; see backpatch_ptp.cpp).
 
 #include <cmath>
 #include <cstddef>
@@ -25,7 +25,7 @@
 #include "patchcull/core/backpatch.h"
 
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "core/ptp_simd.cpp"
+#define HWY_TARGET_INCLUDE "core/backpatch_ptp_simd.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
@@ -49,7 +49,7 @@ using simd_groups::MF;
 using simd_groups::NegFma;
 using simd_groups::VF;
 
-// a*b - c*e as fma(a, b, -(c*e)), like minor2 in ptp.cpp. (A plain Sub(Mul, Mul) would not do:
+// a*b - c*e as fma(a, b, -(c*e)), like minor2 in backpatch_ptp.cpp. (A plain Sub(Mul, Mul) would not do:
 // GCC contracts it into an fma on FMA targets, but not on the others.)
 HWY_INLINE VF Minor(DF d, VF a, VF b, VF c, VF e) { return FmaSub(d, a, b, hn::Mul(c, e)); }
 
@@ -58,7 +58,7 @@ HWY_INLINE void Unroll(std::index_sequence<I...>, F&& f) {
     (f(std::integral_constant<std::size_t, I>{}), ...);
 }
 
-// The rounding-error margins' per-patch scales (ptp.cpp's rounding_margins, same operations in
+// The rounding-error margins' per-patch scales (backpatch_ptp.cpp's rounding_margins, same operations in
 // the same order): g1, g2, the collapsed-edge masks and whether every coordinate is finite.
 struct MarginScales {
     VF g1, g2;

@@ -1,5 +1,5 @@
 // Parametric tangent plane (ptp) back-patch cull kernel, scalar reference (patchcull/core/backpatch.h,
-// Loop, Niessner & Eisenacher §3-6). The SIMD kernel (ptp_simd.cpp) does the same operations in
+// Loop, Niessner & Eisenacher §3-6). The SIMD kernel (backpatch_ptp_simd.cpp) does the same operations in
 // the same order; the schedule both follow, and the FLOP count before/after sharing minors, is in
 // ptp_schedule.h.
 //
