@@ -513,6 +513,37 @@ std::array<double, 4> to_clip(const Mat4& m, const std::array<double, 3>& p) {
     return c;
 }
 
+// A Gregory patch whose 12 boundary points lie just outside one side of make_scene's frustum
+// (side 0..3: left, right, bottom, top) or far behind its depth layer (side 4), and whose 8 face
+// points are pulled well inside (towards the eye for side 4): its surface bulges into view, so a
+// test that ignored the face points would cull it.
+std::array<Vec4, 20> bulging_gregory(std::mt19937& rng, const Scene& s, int side) {
+    std::uniform_real_distribution<float> u(-1, 1), unit(0, 1);
+    const float half_h = std::tan(0.5f), half_w = half_h * float(W) / float(H);  // make_scene's fovy 1.0
+    const float d = side == 4 ? 20 + 10 * unit(rng) : 2 + 10 * unit(rng);
+    const float size = 0.1f * d * (0.2f + unit(rng));
+    Vec3 corner{0.5f * half_w * d * u(rng), 0.5f * half_h * d * u(rng), -d}, pull{0, 0, 0};
+    if (side == 0) corner.x = -half_w * d * 1.02f - size, pull = {0.4f * d, 0, 0};
+    if (side == 1) corner.x = half_w * d * 1.02f, pull = {-0.4f * d, 0, 0};
+    if (side == 2) corner.y = -half_h * d * 1.02f - size, pull = {0, 0.4f * d, 0};
+    if (side == 3) corner.y = half_h * d * 1.02f, pull = {0, -0.4f * d, 0};
+    if (side == 4) pull = {0, 0, 0.85f * d};
+    BezierPatch b;
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            const Vec3 pv = corner + Vec3{size * i / 3.0f, size * j / 3.0f, 0.1f * size * u(rng)};
+            const Vec4 w4 = s.to_world * Vec4{pv.x, pv.y, pv.z, 1};
+            b.cp[4 * j + i] = {w4.x, w4.y, w4.z, 1};
+        }
+    std::array<Vec4, 20> g = gregory_of(b, &rng, 0.05f * size);
+    for (int f : {3, 4, 8, 9, 13, 14, 18, 19}) {
+        const float k = 0.7f + 0.3f * unit(rng);
+        const Vec4 dw = s.to_world * Vec4{k * pull.x, k * pull.y, k * pull.z, 0};
+        g[f] = {g[f].x + dw.x, g[f].y + dw.y, g[f].z + dw.z, 1};
+    }
+    return g;
+}
+
 TEST(PatchSource, GregoryNeverCullsAVisibleSampleAndCullsWhatIsOutside) {
     for (ClipDepth depth : {ClipDepth::zero_to_one, ClipDepth::reversed}) {
         const Scene s = make_scene(51 + static_cast<std::uint32_t>(depth), depth);
@@ -526,6 +557,7 @@ TEST(PatchSource, GregoryNeverCullsAVisibleSampleAndCullsWhatIsOutside) {
             const Vec3 c0 = cartesian(b.cp[0]), c15 = cartesian(b.cp[15]);
             patches.push_back(gregory_of(b, &rng, 0.3f * length(c15 - c0)));
         }
+        for (int i = 0; i < 300; ++i) patches.push_back(bulging_gregory(rng, s, i % 5));
         for (const Layout& layout : {Layout{3, 13, 1, true}, Layout{4, 20, 4, false}}) {
             SCOPED_TRACE(layout_name(layout));
             const Source src = make_source(patches, layout, PatchBasis::gregory);
