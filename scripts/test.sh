@@ -4,9 +4,10 @@
 # campaign over the input loaders (scripts/fuzz.sh, clang), then builds everything in Release with
 # warnings as errors (PATCHCULL_WERROR) and runs the whole suite, two tests at a time (ctest's
 # summary line comes before the phases' times).
-# The sanitizer tree is the kernels' (the core suite, no GL: the CLI and GL suites run in Release)
-# and compiles the SIMD kernels for the wide targets and the portable one only (AVX2, AVX-512,
-# EMU128; the Release build has all five): their group tails are where a stray load would be.
+# Each suite is built once: the core suite (the kernels, with every SIMD target Highway compiles)
+# in the sanitizer tree alone, at -O1 with line tables (the speed AddressSanitizer recommends,
+# assertions on); the import, CLI, GL and tools suites in Release. The CPU-only package test
+# checks the sanitizer tree (PATCHCULL_WITH_GL=OFF) rather than building the CPU layers again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS="$(nproc)"
@@ -20,9 +21,9 @@ end_phase() {
 ./scripts/install-deps.sh
 
 echo "== core tests under ASan + UBSan =="
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DPATCHCULL_SANITIZE=ON -DPATCHCULL_WITH_GL=OFF \
-  -DPATCHCULL_BUILD_BENCHMARKS=OFF -DPATCHCULL_BUILD_EXAMPLES=OFF -DPATCHCULL_BUILD_TOOLS=OFF \
-  -DPATCHCULL_WIDE_SIMD_TARGETS_ONLY=ON >/dev/null
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-O1 -g1" -DPATCHCULL_SANITIZE=ON \
+  -DPATCHCULL_WITH_GL=OFF -DPATCHCULL_BUILD_BENCHMARKS=OFF -DPATCHCULL_BUILD_EXAMPLES=OFF \
+  -DPATCHCULL_BUILD_TOOLS=OFF >/dev/null
 cmake --build build-asan -j"$JOBS" --target patchcull_core_tests
 ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j"$JOBS" -L core --output-on-failure
 end_phase "sanitizer build and core suite"
@@ -32,7 +33,8 @@ echo "== fuzz campaign (libFuzzer, clang: OBJ reader and PNG loader, 20 s each) 
 end_phase "fuzz campaign"
 
 echo "== full suite (Release) =="
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPATCHCULL_WERROR=ON >/dev/null
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPATCHCULL_WERROR=ON -DPATCHCULL_SKIP_TEST_SUITES=core \
+  -DPATCHCULL_PACKAGE_CPU_BUILD_DIR="$PWD/build-asan" >/dev/null
 cmake --build build -j"$JOBS"
 end_phase "Release build"
 status=0

@@ -2,6 +2,7 @@
 #include "patchcull/import/model_loader.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -115,9 +116,20 @@ Bounds patch_bounds(const PatchFrame& frame) {
     return b;
 }
 
+namespace {
+std::atomic<const char*> package_data_dir{nullptr};
+}  // namespace
+
+bool detail::register_package_data_dir(const char* dir) {
+    if (dir && *dir) package_data_dir.store(dir, std::memory_order_relaxed);
+    return true;
+}
+
 std::string shipped_model_path(const std::string& file_name) {
     const char* dir = std::getenv("PATCHCULL_DATA_DIR");
     if (dir && *dir) return std::string(dir) + "/models/" + file_name;  // empty: unset
+    if (const char* package = package_data_dir.load(std::memory_order_relaxed))
+        return std::string(package) + "/models/" + file_name;
     // The source tree's data/ while it exists (builds and tests); else the share/patchcull beside
     // the running program's prefix (an installed CLI, wherever the prefix was moved); else the
     // configured install prefix's, so an installed library finds its models after the source is gone.

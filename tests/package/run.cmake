@@ -2,13 +2,15 @@
 #
 #   cmake -DMODE=install -DBUILD_DIR=... -DWORK=... -DSOURCE_DIR=... -DCXX=... -DNEXT_MINOR=... -P run.cmake
 #     installs the build BUILD_DIR into WORK/prefix (cmake --install), checks the layout, that no
-#     PATCHCULL_* definition reaches a consumer, then configures, builds and runs
+#     PATCHCULL_* definition of the build reaches a consumer, moves the prefix to WORK/moved/prefix
+#     (the installed CLI resolves `cull bigguy` there), then configures, builds and runs
 #     tests/package/consumer with find_package(patchcull 0.2 CONFIG): with patchcull::import and
 #     patchcull::gl (core_consumer, import_consumer, gl_consumer), and with COMPONENTS core alone
 #     (the kernels), which must search for no GL, OpenSubdiv or stb package;
 #     find_package(patchcull NEXT_MINOR) must refuse the package (version file).
 #   cmake -DMODE=cpu -DCPU_BUILD_DIR=... -DWORK=... -DSOURCE_DIR=... -DCXX=... -P run.cmake
-#     configures SOURCE_DIR with PATCHCULL_WITH_GL=OFF and find_package(OpenGL/glfw3) disabled
+#     configures SOURCE_DIR in CPU_BUILD_DIR (a new tree, or one configured before: its build type
+#     and sanitizers kept) with PATCHCULL_WITH_GL=OFF and find_package(OpenGL/glfw3) disabled
 #     (a REQUIRED search for them is then an error), checks that nothing of GL was searched for
 #     and no GL target exists while the core tests do, builds and installs the CPU layers alone
 #     (CPU_BUILD_DIR is kept between runs: incremental), runs core_consumer and import_consumer
@@ -70,8 +72,13 @@ function(build_consumer name prefix consumer_gl consumer_import)
   run("${name}: build" ${CMAKE_COMMAND} --build "${dir}" -j2)
   run("${name}: core_consumer" "${dir}/core_consumer")
   if(consumer_import)
-    # The installed data, as a program moved away from the source tree finds it.
-    run("${name}: import_consumer" ${CMAKE_COMMAND} -E env "PATCHCULL_DATA_DIR=${prefix}/share/patchcull"
+    # A shipped model by name: from the package the consumer was built against (wherever its
+    # prefix is; not from the source tree, which still exists), then from the folder the
+    # environment names instead.
+    run("${name}: import_consumer (package data)" ${CMAKE_COMMAND} -E env --unset=PATCHCULL_DATA_DIR
+        "${dir}/import_consumer")
+    file(COPY "${prefix}/share/patchcull/models/bigguy.obj" DESTINATION "${dir}/env_data/models")
+    run("${name}: import_consumer (PATCHCULL_DATA_DIR)" ${CMAKE_COMMAND} -E env "PATCHCULL_DATA_DIR=${dir}/env_data"
         "${dir}/import_consumer")
   elseif(NOT consumer_gl)
     expect_no_model_search("${name}" "${dir}/CMakeCache.txt")
@@ -107,6 +114,14 @@ if(MODE STREQUAL "install")
       message(FATAL_ERROR "install: ${file} passes the build's settings to consumers: ${leaks}")
     endif()
   endforeach()
+  # A relocatable package: moved after installing, it still serves its consumers (and its CLI)
+  # the data beside it.
+  set(moved "${WORK}/moved/prefix")
+  file(MAKE_DIRECTORY "${WORK}/moved")
+  file(RENAME "${prefix}" "${moved}")
+  set(prefix "${moved}")
+  run("moved CLI: cull bigguy" ${CMAKE_COMMAND} -E env --unset=PATCHCULL_DATA_DIR "${prefix}/bin/patchcull" cull bigguy
+      --views 2)
   build_consumer(consumer "${prefix}" ON ON)
   # The kernels alone: no GL, OpenSubdiv or stb package searched for.
   build_consumer(consumer_kernels_only "${prefix}" OFF OFF)
@@ -121,11 +136,22 @@ if(MODE STREQUAL "install")
   message(STATUS "[find_package(patchcull ${NEXT_MINOR}) refused] ${err}")
 elseif(MODE STREQUAL "cpu")
   file(REMOVE_RECURSE "${WORK}")
-  # Build type None (no -O, no -g): the check is about packaging, and unoptimised the core
-  # library compiles in about half the time (its first run compiles it all; later ones only
-  # what changed).
+  # A tree configured before (scripts/test.sh's sanitizer tree) keeps its build type and flags;
+  # a new one is of build type None (no -O, no -g): the check is about packaging, and unoptimised
+  # the core library compiles in about half the time (its first run compiles it all; later ones
+  # only what changed).
+  set(cpu_build_type -DCMAKE_BUILD_TYPE=None)
+  set(consumer_link_flags)
+  if(EXISTS "${CPU_BUILD_DIR}/CMakeCache.txt")
+    set(cpu_build_type)
+    # Libraries built with the sanitizers need them on the consumers' link line too.
+    file(STRINGS "${CPU_BUILD_DIR}/CMakeCache.txt" sanitized REGEX "^PATCHCULL_SANITIZE:BOOL=ON$")
+    if(sanitized)
+      set(consumer_link_flags "-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined")
+    endif()
+  endif()
   run("cpu-only: configure" ${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${CPU_BUILD_DIR}"
-      -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_COMPILER=${CXX} -DPATCHCULL_WITH_GL=OFF
+      ${cpu_build_type} -DCMAKE_CXX_COMPILER=${CXX} -DPATCHCULL_WITH_GL=OFF
       -DPATCHCULL_BUILD_TESTS=ON -DPATCHCULL_BUILD_BENCHMARKS=ON -DPATCHCULL_BUILD_TOOLS=ON
       -DPATCHCULL_BUILD_EXAMPLES=ON -DPATCHCULL_BUILD_FUZZERS=OFF
       -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON)
@@ -151,7 +177,7 @@ elseif(MODE STREQUAL "cpu")
   expect_no_files("cpu-only: install" "${prefix}/lib/libpatchcull_gl.a" "${prefix}/include/patchcull/gl"
     "${prefix}/include/patchcull/glsl" "${prefix}/lib/cmake/patchcull/patchcullGLTargets.cmake")
   build_consumer(consumer_cpu "${prefix}" OFF ON
-    -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON)
+    -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON ${consumer_link_flags})
   # A package without GL refuses COMPONENTS gl, and says why.
   execute_process(COMMAND ${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/package/consumer" -B "${WORK}/consumer_cpu_gl"
                   -DCMAKE_CXX_COMPILER=${CXX} "-DCMAKE_PREFIX_PATH=${prefix}" -DCONSUMER_GL=ON

@@ -55,11 +55,26 @@ std::vector<DisplacementRange> displacement_ranges(const PatchFrame& frame, cons
 Bounds patch_bounds(const PatchFrame& frame);
 
 /// Path of a model shipped with patchcull (data/models/NAME), e.g. "bigguy.obj": under
-/// $PATCHCULL_DATA_DIR when set and not empty, else the source tree's data/ while it exists, else
-/// share/patchcull/models beside the running program's prefix (PREFIX/bin/.. of an installed CLI,
-/// wherever the prefix was moved), else the data installed under the configured prefix. Does not
-/// check the file exists.
+/// $PATCHCULL_DATA_DIR when set and not empty; else under the installed package's data folder a
+/// program was built against (find_package(patchcull) defines it for patchcull::import's
+/// consumers, relative to where the package was found: see package_data_dir_registered below);
+/// else the source tree's data/ while it exists; else share/patchcull/models beside the running
+/// program's prefix (PREFIX/bin/.. of an installed CLI, wherever the prefix was moved); else the
+/// data installed under the configured prefix. Does not check the file exists.
 std::string shipped_model_path(const std::string& file_name);
+
+namespace detail {
+/// Makes dir (a package's share/patchcull) the data folder shipped_model_path prefers after
+/// $PATCHCULL_DATA_DIR; returns true. Called at static initialisation by the line below.
+bool register_package_data_dir(const char* dir);
+#ifdef PATCHCULL_PACKAGE_DATA_DIR
+/// Set by the installed package's patchcullConfig.cmake on patchcull::import (the package's own
+/// share/patchcull, found relative to the config file): a program built against an installed
+/// package finds that package's models wherever its prefix is, and not a source tree's. Calls
+/// from other static initialisers may run before this one.
+inline const bool package_data_dir_registered = register_package_data_dir(PATCHCULL_PACKAGE_DATA_DIR);
+#endif
+}  // namespace detail
 
 /// The models shipped with patchcull, by name: data/models/NAME.obj.
 inline constexpr const char* kShippedModels[] = {"bigguy", "monsterfrog"};
