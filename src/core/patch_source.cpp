@@ -3,6 +3,8 @@
 #include "patchcull/core/patch_source.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cstring>
 #include <string>
 
@@ -27,6 +29,12 @@ constexpr std::uint32_t real_slots(unsigned mask) {
     return slots;
 }
 
+constexpr std::array<std::uint32_t, 16> kRealSlots = [] {
+    std::array<std::uint32_t, 16> t{};
+    for (unsigned m = 0; m < 16; ++m) t[m] = real_slots(m);
+    return t;
+}();
+
 std::string basis_name(PatchBasis basis) {
     switch (basis) {
         case PatchBasis::bezier:
@@ -46,71 +54,74 @@ inline void load_point(const char* base, std::size_t stride, std::size_t i, floa
     if constexpr (C == 3) out[3] = 1.0f;
 }
 
-// One direction of the B-spline -> Bezier change of basis on 4 points of C components (lo / hi:
-// boundary at the first / last end, where the phantom point b0 = 2 b1 - b2 (b3 = 2 b2 - b1) makes
-// the end point b1 (b2) and the phantom drops out, so it is never read).
-template <int C>
-inline void bspline_to_bezier(const float* b0, const float* b1, const float* b2, const float* b3, bool lo, bool hi,
-                              float* e0, float* e1, float* e2, float* e3) {
+// One direction of the B-spline -> Bezier change of basis on the 16 lanes of 4 points, in place:
+// b0..b3 become the Bezier points e0..e3. lo[j] / hi[j] (0 or all ones): lane j has a boundary at the
+// first / last end, where the phantom point b0 = 2 b1 - b2 (b3 = 2 b2 - b1) makes the end point b1
+// (b2): the phantom drops out, and its slot (zero here) is never read into the result.
+inline void bspline_to_bezier(float* __restrict b0, float* __restrict b1, float* __restrict b2, float* __restrict b3,
+                              const std::uint32_t* __restrict lo, const std::uint32_t* __restrict hi) {
     constexpr float kSixth = 1.0f / 6.0f, kThird = 1.0f / 3.0f;
-    for (int c = 0; c < C; ++c) {
-        e0[c] = lo ? b1[c] : (b0[c] + 4.0f * b1[c] + b2[c]) * kSixth;
-        e1[c] = (2.0f * b1[c] + b2[c]) * kThird;
-        e2[c] = (b1[c] + 2.0f * b2[c]) * kThird;
-        e3[c] = hi ? b2[c] : (b1[c] + 4.0f * b2[c] + b3[c]) * kSixth;
+    // Selects as bit masks (all ones: take the boundary point), so that the loop vectorizes.
+    const auto select = [](std::uint32_t m, float a, float b) {
+        return std::bit_cast<float>((std::bit_cast<std::uint32_t>(a) & m) | (std::bit_cast<std::uint32_t>(b) & ~m));
+    };
+    for (std::size_t j = 0; j < kLanes; ++j) {
+        const float p0 = b0[j], p1 = b1[j], p2 = b2[j], p3 = b3[j];
+        b0[j] = select(lo[j], p1, (p0 + 4.0f * p1 + p2) * kSixth);
+        b1[j] = (2.0f * p1 + p2) * kThird;
+        b2[j] = (p1 + 2.0f * p2) * kThird;
+        b3[j] = select(hi[j], p2, (p1 + 4.0f * p2 + p3) * kSixth);
     }
 }
 
-template <int C>
-void gather_bezier_points(const PatchSourceView& s, std::size_t first, std::size_t n, float* block) {
+// The points of patches [first, first + n) as they are, lane j = patch first + j; a point whose
+// slot bit is clear in slots(j) (a B-spline phantom) is written as (0, 0, 0, w = 1 or 0).
+template <int C, class Slots>
+void gather_raw(const PatchSourceView& s, std::size_t first, std::size_t n, float* block, const Slots& slots) {
     const char* base = static_cast<const char*>(s.points.data) + s.points.offset_bytes;
     const std::size_t stride = s.points.stride_bytes;
     for (std::size_t j = 0; j < n; ++j) {
         const std::size_t p = first + j;
         const std::uint32_t* idx = s.indices ? s.indices + kPatchPoints * p : nullptr;
+        const std::uint32_t real = slots(p);
         for (int k = 0; k < kPatchPoints; ++k) {
-            float v[4];
-            load_point<C>(base, stride, idx ? idx[k] : kPatchPoints * p + static_cast<std::size_t>(k), v);
+            float v[4] = {0.0f, 0.0f, 0.0f, C == 3 ? 1.0f : 0.0f};
+            if ((real >> k) & 1u)
+                load_point<C>(base, stride, idx ? idx[k] : kPatchPoints * p + static_cast<std::size_t>(k), v);
             for (int c = 0; c < 4; ++c) block[static_cast<std::size_t>(4 * k + c) * kLanes + j] = v[c];
         }
     }
 }
 
-// Bezier points of B-spline patch p, out[k][c] (k = 4 j + i).
 template <int C>
-void bspline_patch(const PatchSourceView& s, std::size_t p, float out[16][4]) {
-    const char* base = static_cast<const char*>(s.points.data) + s.points.offset_bytes;
-    const std::size_t stride = s.points.stride_bytes;
-    const std::uint32_t* idx = s.indices ? s.indices + kPatchPoints * p : nullptr;
-    const unsigned mask = s.boundary_mask ? s.boundary_mask[p] & 15u : 0u;
-    const std::uint32_t slots = real_slots(mask);
-    float grid[16][4];
-    for (int k = 0; k < kPatchPoints; ++k) {
-        if (slots & (1u << k)) {
-            load_point<C>(base, stride, idx ? idx[k] : kPatchPoints * p + static_cast<std::size_t>(k), grid[k]);
-        } else {
-            for (float& v : grid[k]) v = 0.0f;  // phantom: never reaches the result
-        }
-    }
-    // Along u within each row (columns 0 / 3 phantom: bits 3 / 1), then along v (rows 0 / 3: bits 0 / 2).
-    float rows[16][4];
-    for (int r = 0; r < 4; ++r)
-        bspline_to_bezier<C>(grid[4 * r], grid[4 * r + 1], grid[4 * r + 2], grid[4 * r + 3], mask & 8u, mask & 2u,
-                             rows[4 * r], rows[4 * r + 1], rows[4 * r + 2], rows[4 * r + 3]);
-    for (int i = 0; i < 4; ++i)
-        bspline_to_bezier<C>(rows[i], rows[4 + i], rows[8 + i], rows[12 + i], mask & 1u, mask & 4u, out[i], out[4 + i],
-                             out[8 + i], out[12 + i]);
-    if constexpr (C == 3)
-        for (int k = 0; k < kPatchPoints; ++k) out[k][3] = 1.0f;
+void gather_bezier_points(const PatchSourceView& s, std::size_t first, std::size_t n, float* block) {
+    gather_raw<C>(s, first, n, block, [](std::size_t) { return 0xFFFFu; });
 }
 
+// B-spline patches: their points gathered as they are (phantoms zero), then converted to Bezier
+// form lane-parallel: along u within each row (columns 0 / 3 phantom: mask bits 3 / 1), then along
+// v (rows 0 / 3: bits 0 / 2). With 3 components w stays 1 (the exact result).
 template <int C>
 void gather_bspline(const PatchSourceView& s, std::size_t first, std::size_t n, float* block) {
-    for (std::size_t j = 0; j < n; ++j) {
-        float cp[16][4];
-        bspline_patch<C>(s, first + j, cp);
-        for (int k = 0; k < kPatchPoints; ++k)
-            for (int c = 0; c < 4; ++c) block[static_cast<std::size_t>(4 * k + c) * kLanes + j] = cp[k][c];
+    const std::uint8_t* mask = s.boundary_mask;
+    gather_raw<C>(s, first, n, block, [&](std::size_t p) { return mask ? kRealSlots[mask[p] & 15u] : 0xFFFFu; });
+    for (int a = 0; a < 4 * kPatchPoints; ++a)  // lanes past n: zero, converted to zero
+        std::fill(block + static_cast<std::size_t>(a) * kLanes + n, block + static_cast<std::size_t>(a + 1) * kLanes,
+                  0.0f);
+    std::uint32_t u0[kLanes] = {}, u1[kLanes] = {}, v0[kLanes] = {}, v1[kLanes] = {};
+    if (mask)
+        for (std::size_t j = 0; j < n; ++j) {
+            const unsigned m = mask[first + j];
+            v0[j] = 0u - (m & 1u);
+            u1[j] = 0u - ((m >> 1) & 1u);
+            v1[j] = 0u - ((m >> 2) & 1u);
+            u0[j] = 0u - ((m >> 3) & 1u);
+        }
+    const auto at = [&](int k, int c) { return block + static_cast<std::size_t>(4 * k + c) * kLanes; };
+    for (int c = 0; c < C; ++c) {
+        for (int r = 0; r < 4; ++r)
+            bspline_to_bezier(at(4 * r, c), at(4 * r + 1, c), at(4 * r + 2, c), at(4 * r + 3, c), u0, u1);
+        for (int i = 0; i < 4; ++i) bspline_to_bezier(at(i, c), at(4 + i, c), at(8 + i, c), at(12 + i, c), v0, v1);
     }
 }
 
@@ -155,14 +166,14 @@ void check_patch_source(const PatchSourceView& s, const char* what) {
         for (std::size_t i = 0; i < total; ++i) largest = std::max(largest, s.indices[i]);
     } else {
         for (std::size_t p = 0; p < s.count; ++p) {
-            const std::uint32_t slots = real_slots(s.boundary_mask[p]);
+            const std::uint32_t slots = kRealSlots[s.boundary_mask[p]];
             for (std::size_t k = 0; k < per_patch; ++k)
                 largest = std::max(largest, (slots >> k) & 1u ? s.indices[per_patch * p + k] : 0u);
         }
     }
     if (largest < pts.point_count) return;
     for (std::size_t p = 0; p < s.count; ++p) {
-        const std::uint32_t slots = s.boundary_mask ? real_slots(s.boundary_mask[p]) : 0xFFFFFFFFu;
+        const std::uint32_t slots = s.boundary_mask ? kRealSlots[s.boundary_mask[p]] : 0xFFFFFFFFu;
         for (std::size_t k = 0; k < per_patch; ++k) {
             const std::uint32_t index = s.indices[per_patch * p + k];
             if (((slots >> k) & 1u) && index >= pts.point_count)
