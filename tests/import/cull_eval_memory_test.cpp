@@ -17,7 +17,10 @@
 #include <new>
 #include <vector>
 
+#include "patchcull/core/camera.h"
+#include "patchcull/core/cull_view.h"
 #include "patchcull/core/parallel.h"
+#include "patchcull/core/parallel_cull.h"
 #include "patchcull/core/teapot.h"
 #include "patchcull/eval/cull_eval.h"
 
@@ -135,4 +138,45 @@ TEST(ParallelForRanges, CoversEveryIndexOnceAndAllocatesNothing) {
     patchcull::parallel_for_ranges(0, kGrain, body);  // nothing to do
     patchcull::parallel_for_ranges(5, 0, body);       // grain 0 counts as 1
     for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(hits[i].load(), 3) << i;
+}
+
+// The parallel kernel entries (parallel_cull.h) allocate nothing through operator new per call,
+// warm oneTBB aside: every kernel over four ranges of a batch, into the caller's arrays.
+TEST(ParallelCull, EntriesAllocateNothing) {
+    using namespace patchcull;
+    std::vector<BezierPatch> patches;
+    const std::vector<BezierPatch> teapot = teapot_patches();
+    for (std::size_t i = 0; patches.size() < 4 * kParallelGrain; ++i) {
+        BezierPatch p = teapot[i % teapot.size()];
+        for (Vec4& c : p.cp) c.x += 3.0f * static_cast<float>(i / teapot.size() % 9) - 12.0f;
+        patches.push_back(p);
+    }
+    const PatchBatch batch = make_batch(patches);
+    Camera cam;
+    cam.eye = {0, -10, 2};
+    cam.target = {0, 0, 1};
+    cam.up = {0, 0, 1};
+    const CullView view = make_cull_view(cam.view(), cam.projection(), cam.depth, cam.eye);
+    std::vector<float> depth(64 * 64, 1.0f);
+    HiZPyramid hiz;
+    hiz.build(depth.data(), 64, 64, cam.depth);
+    const FusedCullSetup setup = make_fused_setup(view, BackPatchCone::tcone, &hiz);
+    std::vector<std::uint8_t> out(batch.size());
+    std::size_t culled = 0;
+    auto run_all = [&] {
+        cull_frustum_parallel(batch.view(), nullptr, view, out.data());
+        cull_frustum_disp_parallel(batch.view(), nullptr, view, out.data());
+        for (BackpatchMethod id : {BackpatchMethod::tcone, BackpatchMethod::ncone, BackpatchMethod::ptp}) {
+            cull_backpatch_parallel(id, batch.view(), view, {}, out.data());
+            for (std::uint8_t c : out) culled += c != 0;
+        }
+        cull_occlusion_parallel(batch.view(), view, hiz, out.data());
+        cull_fused_parallel(batch.view(), setup, FusedPlan{}, out.data());
+    };
+    run_all();  // warm-up: oneTBB starts its workers
+    culled = 0;
+    const std::int64_t before = g_allocations.load();
+    run_all();
+    EXPECT_EQ(g_allocations.load() - before, 0);
+    EXPECT_GT(culled, 0u);  // the kernels ran over real work
 }
