@@ -16,12 +16,15 @@
 //   range per thread (scripts/kernel_scaling.sh prints the speedup table).
 // layout_prefetch/frustum/<plain|blocked>/N/D: prefetch distance D patches (0 = off), one
 //   thread: the sweep that chose the default distances.
+// entry/<kernel>/<plain|blocked>/<1_thread|all_threads>/N: the parallel entries (parallel_cull.h)
+//   at 1450, 65536 and 1M patches, default prefetching, in a oneTBB arena of one thread or of all.
 //
 // Run (docs/PERFORMANCE.md, "Batches at the memory roof"):
 //   build/bench/patchcull_bench --benchmark_filter='^(roof|layout)/' --benchmark_repetitions=3
 //       --benchmark_min_time=0.2 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 #include <immintrin.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -33,10 +36,13 @@
 
 #include "cull_bench_loop.h"
 #include "patchcull/core/backpatch.h"
+#include "patchcull/core/backpatch_methods.h"
+#include "patchcull/core/cull_view.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/fused_cull.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/parallel.h"
+#include "patchcull/core/parallel_cull.h"
 #include "patchcull/core/patch.h"
 
 using namespace patchcull;
@@ -135,6 +141,7 @@ struct Workload {
     float alpha = 0;  // clip_space_eye_alpha of the projection (ptp)
     HiZPyramid hiz;
     FusedCullSetup fused;  // plan FBH (frustum, tcone, Hi-Z), the default FusedPlan
+    CullView view;         // the same view for the parallel entries
     std::vector<std::uint8_t> culled;
 };
 
@@ -187,6 +194,7 @@ Workload& workload(std::size_t n) {
     w.planes = make_frustum_planes(w.object_to_clip, ClipDepth::zero_to_one);
     w.hiz = make_pyramid();
     w.fused = make_fused_setup(w.object_to_clip, ClipDepth::zero_to_one, w.eye, BackPatchCone::tcone, &w.hiz);
+    w.view = make_cull_view(look_at(w.eye, {0, 0, 0}, {0, 1, 0}), proj, ClipDepth::zero_to_one, w.eye);
     w.culled.assign(n, 0);
     return w;
 }
@@ -318,6 +326,49 @@ void bm_prefetch(benchmark::State& state, Kernel k, bool blocked) {
     state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * n * kBytesPerPatch));
 }
 
+void run_entry(const Workload& w, Kernel k, const PatchBatchView& v, std::uint8_t* out) {
+    switch (k) {
+        case Kernel::kFrustum:
+            cull_frustum_parallel(v, w.disp.data(), w.view, out);
+            break;
+        case Kernel::kFrustumDisp:
+            cull_frustum_disp_parallel(v, w.disp.data(), w.view, out);
+            break;
+        case Kernel::kTcone:
+            cull_backpatch_parallel(BackpatchMethod::tcone, v, w.view, {}, out);
+            break;
+        case Kernel::kNcone:
+            cull_backpatch_parallel(BackpatchMethod::ncone, v, w.view, {}, out);
+            break;
+        case Kernel::kPtp:
+            cull_backpatch_parallel(BackpatchMethod::ptp, v, w.view, {}, out);
+            break;
+        case Kernel::kOcclusion:
+            cull_occlusion_parallel(v, w.view, w.hiz, out);
+            break;
+        case Kernel::kFused:
+            cull_fused_parallel(v, w.fused, FusedPlan{}, out);
+            break;
+    }
+}
+
+// A parallel entry in an arena of one thread or of every core (an engine's own arena).
+void bm_entry(benchmark::State& state, Kernel k, bool blocked, bool all_threads) {
+    const std::size_t n = static_cast<std::size_t>(state.range(0));
+    Workload& w = workload(n);
+    const PatchBatchView all = blocked ? w.blocked.view() : w.plain.view();
+    tbb::task_arena arena(all_threads ? tbb::task_arena::automatic : 1);
+    std::uint8_t* culled = w.culled.data();
+    for (auto _ : state) {
+        arena.execute([&] { run_entry(w, k, all, culled); });
+        benchmark::DoNotOptimize(culled);
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));
+    state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * n * kBytesPerPatch));
+    state.counters["threads"] = arena.max_concurrency();
+}
+
 int register_all() {
     for (bool mt : {false, true}) {
         auto* b = benchmark::RegisterBenchmark(mt ? "roof/sum/all_threads" : "roof/sum/1_thread",
@@ -334,6 +385,17 @@ int register_all() {
                 auto* b =
                     benchmark::RegisterBenchmark(name.c_str(), [=](benchmark::State& s) { bm_layout(s, k, l, mt); });
                 for (std::int64_t n : kSizes) b->Arg(n);
+                b->UseRealTime()->Unit(benchmark::kMicrosecond);
+            }
+    for (Kernel k : {Kernel::kFrustum, Kernel::kFrustumDisp, Kernel::kTcone, Kernel::kNcone, Kernel::kPtp,
+                     Kernel::kOcclusion, Kernel::kFused})
+        for (bool blocked : {false, true})
+            for (bool mt : {false, true}) {
+                const std::string name = std::string("entry/") + kernel_name(k) + "/" +
+                                         (blocked ? "blocked" : "plain") + "/" + (mt ? "all_threads" : "1_thread");
+                auto* b = benchmark::RegisterBenchmark(name.c_str(),
+                                                       [=](benchmark::State& s) { bm_entry(s, k, blocked, mt); });
+                for (std::int64_t n : {1450, 65536, 1 << 20}) b->Arg(n);
                 b->UseRealTime()->Unit(benchmark::kMicrosecond);
             }
     for (Kernel k : {Kernel::kFrustum, Kernel::kFrustumDisp, Kernel::kTcone, Kernel::kNcone, Kernel::kPtp,

@@ -217,7 +217,12 @@ std::size_t blocked_prefetch_distance();
 /// a weight of patch is <= 0 (NaN and +Inf pass: the kernels never cull them).
 void check_patch_weights(const BezierPatch& patch, std::size_t index);
 
-/// Builds a batch from an array of patches (check_patch_weights on each).
+/// Builds a batch from an array of patches (check_patch_weights on each), in the plain layout.
+/// The layout is the caller's choice, measured (docs/PERFORMANCE.md, "Batches at the memory roof",
+/// frustum, one thread, default prefetching): for batches that fit the L2 both layouts run alike;
+/// beyond it the memory-bound frustum kernels run 1.6x faster on PatchBlocks at 65536 patches and
+/// 1.2x at 1M; the compute-bound kernels (back-patch, occlusion, fused) gain nothing (fused loses
+/// up to 1.2x). Copy to PatchBlocks once for a large batch culled by frustum every frame.
 PatchBatch make_batch(const std::vector<BezierPatch>& patches);
 
 /// A plain copy of `patches` (either layout), patch for patch.
