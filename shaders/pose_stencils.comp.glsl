@@ -29,8 +29,11 @@ layout(local_size_x = 256) in;
 #define PC_CONTROL_POINTS writeonly
 #define PC_PATCH_TANGENTS writeonly
 #include "patch_buffers.h"
+// The posed control meshes: StencilPoser's own buffer (packed Vec3: base 0, stride 3) or the
+// caller's (gl_posing.h's GpuVertices, bound whole: float3 or float4 at any 4-byte-aligned stride
+// and offset; w is not read). Vertex v's x y z are vertices[u_vertex_base + v * u_vertex_stride + 0..2].
 layout(std430, binding = kBindingPoseVertices) readonly buffer Vertices {
-    float vertices[];  // posed control meshes, x y z per vertex (packed Vec3)
+    float vertices[];
 };
 struct Instance {
     mat4 to_world;     // column-major, as Mat4
@@ -54,13 +57,15 @@ layout(std430, binding = kBindingPoseTerms) readonly buffer Terms {
 
 uniform uint u_patch_count;
 uniform uint u_tangent_count;  // entries of tangent_table
+uniform uint u_vertex_base;    // floats before vertex 0 in vertices[]
+uniform uint u_vertex_stride;  // floats from one vertex to the next (>= 3)
 
 vec3 stencil_row(uint row, uint first_vertex) {
     precise dvec3 s = dvec3(0.0lf);
     const uint end = offsets[row + 1u];
     for (uint k = offsets[row]; k < end; ++k) {
         const uvec2 t = terms[k];
-        const uint v = 3u * (first_vertex + t.x);
+        const uint v = u_vertex_base + u_vertex_stride * (first_vertex + t.x);
         const double w = double(uintBitsToFloat(t.y));
         s.x += w * double(vertices[v]);
         s.y += w * double(vertices[v + 1u]);

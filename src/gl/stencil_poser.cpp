@@ -68,7 +68,7 @@ void append_table(const StencilTableView& t, std::uint32_t vertex_count, std::si
 
 struct StencilPoser::Impl {
     GLuint program = 0;
-    GLint count_location = -1, tangent_count_location = -1;
+    GLint count_location = -1, tangent_count_location = -1, vertex_base_location = -1, vertex_stride_location = -1;
     GLuint offsets = 0, terms = 0, patch_table = 0, vertices = 0, instances = 0, tangent_table = 0;
     std::size_t tangent_count = 0;                              // entries of tangent_table
     std::size_t vertices_capacity = 0, instances_capacity = 0;  // bytes of the per-frame buffers
@@ -87,6 +87,12 @@ struct StencilPoser::Impl {
         glDeleteBuffers(6, buffers);
     }
 
+    struct Dispatch {
+        GLuint vertex_buffer;
+        GLuint vertex_base, vertex_stride;  // in floats
+    };
+    void run(const Dispatch& d, GLuint patch_buffer, GLuint tangent_buffer);
+
     // Makes buffer hold at least size bytes (grows by doubling; never shrinks).
     void reserve(GLuint buffer, std::size_t& capacity, std::size_t size) {
         if (size <= capacity && capacity > 0) return;
@@ -104,6 +110,8 @@ StencilPoser::StencilPoser(CurrentContext) : impl_(std::make_unique<Impl>()) {
     m.program = detail::link_program({{"pose_stencils.comp.glsl", GL_COMPUTE_SHADER}}, "pose_stencils");
     m.count_location = glGetUniformLocation(m.program, "u_patch_count");
     m.tangent_count_location = glGetUniformLocation(m.program, "u_tangent_count");
+    m.vertex_base_location = glGetUniformLocation(m.program, "u_vertex_base");
+    m.vertex_stride_location = glGetUniformLocation(m.program, "u_vertex_stride");
     GLuint buffers[6];
     glCreateBuffers(6, buffers);
     m.offsets = buffers[0];
@@ -192,9 +200,12 @@ void StencilPoser::set_tables(const std::vector<PosingModel>& models,
     detail::check_gl("StencilPoser::set_tables");
 }
 
-void StencilPoser::pose(const std::vector<Vec3>& vertices, const std::vector<PosingInstance>& instances,
-                        std::uint32_t patch_buffer, std::uint32_t tangent_buffer) {
-    Impl& m = *impl_;
+namespace {
+
+// Checks the instance count and the output buffers, and fills m.staging (throws when an instance's
+// vertices run past vertex_count).
+void prepare(StencilPoser::Impl& m, std::size_t vertex_count, const std::vector<PosingInstance>& instances,
+             GLuint patch_buffer, GLuint tangent_buffer) {
     if (instances.size() != m.instance_models.size())
         throw Error("GL: StencilPoser::pose: " + std::to_string(instances.size()) + " instances for tables of " +
                     std::to_string(m.instance_models.size()));
@@ -208,9 +219,9 @@ void StencilPoser::pose(const std::vector<Vec3>& vertices, const std::vector<Pos
     for (std::size_t i = 0; i < instances.size(); ++i) {
         const PosingInstance& in = instances[i];
         const std::uint32_t model = m.instance_models[i];
-        if (in.first_vertex > vertices.size() || m.model_vertex_counts[model] > vertices.size() - in.first_vertex)
+        if (in.first_vertex > vertex_count || m.model_vertex_counts[model] > vertex_count - in.first_vertex)
             throw Error("GL: StencilPoser::pose: instance " + std::to_string(i) + "'s vertices run past the " +
-                        std::to_string(vertices.size()) + " given");
+                        std::to_string(vertex_count) + " given");
         GpuInstance& out = m.staging[i];
         std::copy_n(in.to_world.m, 16, out.to_world);
         out.first_vertex = static_cast<std::uint32_t>(in.first_vertex);
@@ -218,36 +229,97 @@ void StencilPoser::pose(const std::vector<Vec3>& vertices, const std::vector<Pos
         out.mirrored = in.mirrored ? 1u : 0u;
         out.first_row = m.model_first_row[model];
     }
-    detail::check_gl("(pending before StencilPoser::pose)");
-    const std::size_t vertex_bytes = vertices.size() * sizeof(Vec3);
-    const std::size_t instance_bytes = m.staging.size() * sizeof(GpuInstance);
-    m.reserve(m.vertices, m.vertices_capacity, vertex_bytes);
-    m.reserve(m.instances, m.instances_capacity, instance_bytes);
-    if (vertex_bytes) glNamedBufferSubData(m.vertices, 0, static_cast<GLsizeiptr>(vertex_bytes), vertices.data());
-    if (instance_bytes) glNamedBufferSubData(m.instances, 0, static_cast<GLsizeiptr>(instance_bytes), m.staging.data());
-    m.last_bytes = vertex_bytes + instance_bytes;
-    if (m.count == 0) return;
-    glUseProgram(m.program);
-    glUniform1ui(m.count_location, static_cast<GLuint>(m.count));
-    glUniform1ui(m.tangent_count_location, static_cast<GLuint>(m.tangent_count));
+}
+
+}  // namespace
+
+// Uploads the instances and runs the pass over the vertices at d.
+void StencilPoser::Impl::run(const Dispatch& d, GLuint patch_buffer, GLuint tangent_buffer) {
+    const std::size_t instance_bytes = staging.size() * sizeof(GpuInstance);
+    reserve(instances, instances_capacity, instance_bytes);
+    if (instance_bytes) glNamedBufferSubData(instances, 0, static_cast<GLsizeiptr>(instance_bytes), staging.data());
+    last_bytes += instance_bytes;
+    if (count == 0) return;
+    glUseProgram(program);
+    glUniform1ui(count_location, static_cast<GLuint>(count));
+    glUniform1ui(tangent_count_location, static_cast<GLuint>(tangent_count));
+    glUniform1ui(vertex_base_location, d.vertex_base);
+    glUniform1ui(vertex_stride_location, d.vertex_stride);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOutPoints, patch_buffer);
     // Without tangents nothing is written at kOutTangents; a buffer of ours keeps the binding valid.
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOutTangents, m.tangents ? tangent_buffer : m.instances);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertices, m.vertices);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kInstances, m.instances);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPatchTable, m.patch_table);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOffsets, m.offsets);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTerms, m.terms);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTangentTable, m.tangent_table);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOutTangents, tangents ? tangent_buffer : instances);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kVertices, d.vertex_buffer);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kInstances, instances);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kPatchTable, patch_table);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kOffsets, offsets);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTerms, terms);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTangentTable, tangent_table);
     // 16 invocations per patch and 24 per tangent block; more than 65535 groups go into a second
     // dimension (the shader flattens gl_GlobalInvocationID).
-    const std::uint64_t rows = m.count * kPointRows + m.tangent_count * kTangentRows;
+    const std::uint64_t rows = count * kPointRows + tangent_count * kTangentRows;
     const std::uint64_t groups = (rows + kGroupSize - 1) / kGroupSize;
     const std::uint64_t x = std::min<std::uint64_t>(groups, 65535);
     const std::uint64_t y = (groups + x - 1) / x;
     glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT);
     glUseProgram(0);
+}
+
+void StencilPoser::pose(const std::vector<Vec3>& vertices, const std::vector<PosingInstance>& instances,
+                        std::uint32_t patch_buffer, std::uint32_t tangent_buffer) {
+    Impl& m = *impl_;
+    prepare(m, vertices.size(), instances, patch_buffer, tangent_buffer);
+    detail::check_gl("(pending before StencilPoser::pose)");
+    const std::size_t vertex_bytes = vertices.size() * sizeof(Vec3);
+    m.reserve(m.vertices, m.vertices_capacity, vertex_bytes);
+    if (vertex_bytes) glNamedBufferSubData(m.vertices, 0, static_cast<GLsizeiptr>(vertex_bytes), vertices.data());
+    m.last_bytes = vertex_bytes;
+    static_assert(sizeof(Vec3) == 12, "packed x y z");
+    m.run({m.vertices, 0, 3}, patch_buffer, tangent_buffer);
+    detail::check_gl("StencilPoser::pose");
+}
+
+void StencilPoser::pose(const GpuVertices& vertices, const std::vector<PosingInstance>& instances,
+                        std::uint32_t patch_buffer, std::uint32_t tangent_buffer) {
+    Impl& m = *impl_;
+    const auto fail = [&](const std::string& why) {
+        throw Error("GL: StencilPoser::pose: vertex buffer " + std::to_string(vertices.buffer) + ": " + why);
+    };
+    const std::size_t components =
+        vertices.components == 3 || vertices.components == 4 ? static_cast<std::size_t>(vertices.components) : 0;
+    if (components == 0) fail(std::to_string(vertices.components) + " components (3 or 4 floats a vertex)");
+    if (vertices.offset_bytes % 4 != 0)
+        fail("offset " + std::to_string(vertices.offset_bytes) + " bytes is not a multiple of 4");
+    if (vertices.stride_bytes % 4 != 0)
+        fail("stride " + std::to_string(vertices.stride_bytes) + " bytes is not a multiple of 4");
+    if (vertices.stride_bytes < 4 * components)
+        fail("stride " + std::to_string(vertices.stride_bytes) + " bytes is smaller than its " +
+             std::to_string(components) + " floats");
+    if (vertices.buffer != 0 && (vertices.buffer == patch_buffer || (m.tangents && vertices.buffer == tangent_buffer)))
+        fail("is also an output buffer of the pass");
+    // The shader indexes floats with uint: every float read must lie below 2^32 floats (16 GiB).
+    constexpr std::size_t kMaxFloats = 0xFFFFFFFFu;
+    if (vertices.count > 0) {
+        if (!glIsBuffer(vertices.buffer)) fail("is not a buffer object of the current context");
+        const std::size_t size = buffer_size(vertices.buffer);
+        const std::size_t first = vertices.offset_bytes, last = 4 * components;
+        if (first > size || last > size - first || vertices.count - 1 > (size - first - last) / vertices.stride_bytes)
+            fail(std::to_string(size) + " bytes do not hold " + std::to_string(vertices.count) + " vertices of " +
+                 std::to_string(components) + " floats at offset " + std::to_string(vertices.offset_bytes) +
+                 ", stride " + std::to_string(vertices.stride_bytes));
+        if ((first + (vertices.count - 1) * vertices.stride_bytes + last) / 4 > kMaxFloats ||
+            vertices.stride_bytes / 4 > kMaxFloats)
+            fail("reads past 16 GiB (the pass indexes 32-bit floats with 32-bit indices)");
+    }
+    prepare(m, vertices.count, instances, patch_buffer, tangent_buffer);
+    detail::check_gl("(pending before StencilPoser::pose)");
+    // A compute shader's storage writes to the vertices (skinning) just before are seen.
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    m.last_bytes = 0;
+    // No vertices: nothing reads them, and a buffer of ours keeps the binding valid.
+    const GLuint buffer = vertices.count > 0 ? vertices.buffer : m.vertices;
+    m.run({buffer, static_cast<GLuint>(vertices.offset_bytes / 4), static_cast<GLuint>(vertices.stride_bytes / 4)},
+          patch_buffer, tangent_buffer);
     detail::check_gl("StencilPoser::pose");
 }
 

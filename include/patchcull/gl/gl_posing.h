@@ -3,7 +3,8 @@
 // Both subdivision schemes make every Bezier control point (and every ACC tangent vector) a fixed
 // linear combination of control-mesh vertices: a stencil row (subdivision.h's PointStencils).
 // StencilPoser uploads those tables once, and per frame only the posed control meshes (12 bytes
-// per vertex) and each instance's transform (80 bytes); one compute pass
+// per vertex; nothing when they are already in a GL buffer: GpuVertices) and each instance's
+// transform (80 bytes); one compute pass
 // (shaders/pose_stencils.comp.glsl) then writes the control points and the tangent vectors
 // straight into the caller's buffers (PatchRenderer::patch_buffer() and tangent_buffer()), in
 // gl_passes.h's layouts. What changes per frame on the CPU is the animation of the control
@@ -21,12 +22,25 @@
 // scene_poser.h here); ScenePoser::gpu_tables / gpu_meshes (scene_poser.h) produce them for a Scene.
 //
 // Threads and lifetime as gl_renderer.h: create, use and destroy on the context's thread.
-// State contract of pose(): it binds its program and its buffers at shader storage bindings 0, 10
-// (the outputs, shared.h's kBindingControlPoints and kBindingPatchTangents) and 13-18 (its inputs),
-// leaves no program in use, and ends with glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT |
-// GL_BUFFER_UPDATE_BARRIER_BIT | GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT) so the following cull passes,
-// draws and read-backs see its writes. It does not wait for the GPU. After set_tables it allocates
-// no GL storage while the per-frame sizes stay the same (buffers grow, never shrink).
+// Vertices come either from a CPU array (uploaded into the poser's own buffer) or straight from a
+// GL buffer of the caller's (GpuVertices: float3 or float4 positions at any byte stride and
+// offset, e.g. an engine's skinning output), read in place: no copy, no CPU round trip, and the
+// output is bit-identical to the CPU-array path for the same positions.
+// State contract of pose(): it binds its program and, at shader storage bindings, the outputs at 0
+// and 10 (shared.h's kBindingControlPoints and kBindingPatchTangents; without tangents a buffer of
+// its own at 10), the vertices at 17 (kBindingPoseVertices: its own buffer, or the caller's
+// GpuVertices::buffer whole, glBindBufferBase) and its own inputs at 18-22 (kBindingPoseInstances,
+// kBindingPosePatchTable, kBindingPoseOffsets, kBindingPoseTerms, kBindingPoseTangentTable). It
+// leaves those bindings as it set them and no program in use, and changes no other state (no
+// vertex array, framebuffer or uniform buffer binding). The GpuVertices overload issues
+// glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT) before its dispatch, so a compute shader's storage
+// writes to the vertex buffer just before pose() are seen without a barrier of the caller's
+// (writes through glBufferSubData, copies or transform feedback need none). Every pose() ends with
+// glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT |
+// GL_VERTEX_ATTRIB_ARRAY_BARRIER_BIT) so the following cull passes, draws and read-backs see its
+// writes. It does not wait for the GPU. After set_tables it allocates no GL storage while the
+// per-frame sizes stay the same (buffers grow, never shrink; the GpuVertices overload uploads only
+// the instances).
 #pragma once
 
 #include <cstddef>
@@ -70,6 +84,23 @@ struct PosingInstance {
     bool mirrored = false;
 };
 
+/// Posed control-mesh vertices already in a GL buffer of the caller's (an engine's skinning
+/// output): vertex v's position is the first 3 floats at byte offset_bytes + v * stride_bytes of
+/// buffer (x, y, z; with components == 4 the fourth float, w, is not read: positions, not
+/// homogeneous points). pose() reads them in place. Requirements (else pose() throws
+/// patchcull::Error): buffer is a buffer object of the current context, not one of pose()'s output
+/// buffers; components is 3 or 4; offset_bytes and stride_bytes are multiples of 4 and
+/// stride_bytes >= 4 * components; the buffer holds offset_bytes + (count - 1) * stride_bytes +
+/// 4 * components bytes (count > 0). The buffer must not be mapped (unless persistently) while
+/// the pass runs.
+struct GpuVertices {
+    std::uint32_t buffer = 0;
+    std::size_t offset_bytes = 0;
+    std::size_t stride_bytes = 12;
+    int components = 3;
+    std::size_t count = 0;  // vertices in the buffer: instances index [0, count)
+};
+
 /// The posing pass and its tables (caller-owned GL objects, made once; nothing per frame but the
 /// vertex and instance uploads).
 class StencilPoser {
@@ -111,7 +142,14 @@ public:
     /// small (patch_buffer: 256 bytes per patch; tangent_buffer: 384 bytes per patch).
     void pose(const std::vector<Vec3>& vertices, const std::vector<PosingInstance>& instances,
               std::uint32_t patch_buffer, std::uint32_t tangent_buffer);
-    /// Bytes the last pose() uploaded (vertices and instances), and the bytes set_tables uploaded.
+    /// The same with the vertices read from the caller's GL buffer (GpuVertices; instance i's at
+    /// vertices instances[i].first_vertex on), no copy: the written buffers are bit-identical to
+    /// the vector overload's for the same positions. Throws patchcull::Error as that overload, and
+    /// when `vertices` breaks GpuVertices' requirements (one line naming the requirement).
+    void pose(const GpuVertices& vertices, const std::vector<PosingInstance>& instances, std::uint32_t patch_buffer,
+              std::uint32_t tangent_buffer);
+    /// Bytes the last pose() uploaded (vertices and instances; the instances alone for
+    /// GpuVertices), and the bytes set_tables uploaded.
     std::size_t last_upload_bytes() const;
     std::size_t table_bytes() const;
 
