@@ -34,7 +34,9 @@ inline void check_gl(const char* where) {
     throw Error("GL: error " + hex(e) + " after " + where);
 }
 
+// The first line of a driver's info log (which may end in NUL padding), "(...)" when more follow.
 inline std::string first_line(std::string log) {
+    log.resize(std::min(log.find('\0'), log.size()));
     while (!log.empty() && (log.back() == '\n' || log.back() == '\r' || log.back() == ' ')) log.pop_back();
     const std::size_t nl = log.find('\n');
     if (nl != std::string::npos) log = log.substr(0, nl) + " (...)";
@@ -62,7 +64,7 @@ inline GLuint compile_shader(const char* name, GLenum stage, const std::string& 
         std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
         glGetShaderInfoLog(s, len, nullptr, log.data());
         glDeleteShader(s);
-        throw Error(std::string("GL: shader ") + name + ": " + first_line(log.c_str()));
+        throw Error(std::string("GL: shader ") + name + ": " + first_line(std::move(log)));
     }
     return s;
 }
@@ -92,7 +94,7 @@ inline GLuint link_program(const std::vector<std::pair<const char*, GLenum>>& st
         std::string log(static_cast<std::size_t>(std::max(len, 1)), '\0');
         glGetProgramInfoLog(program, len, nullptr, log.data());
         glDeleteProgram(program);
-        throw Error(std::string("GL: program ") + label + ": " + first_line(log.c_str()));
+        throw Error(std::string("GL: program ") + label + ": " + first_line(std::move(log)));
     }
     return program;
 }

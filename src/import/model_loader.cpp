@@ -133,13 +133,12 @@ std::string shipped_model_path(const std::string& file_name) {
     // The source tree's data/ while it exists (builds and tests); else the share/patchcull beside
     // the running program's prefix (an installed CLI, wherever the prefix was moved); else the
     // configured install prefix's, so an installed library finds its models after the source is gone.
-    const std::string source = std::string(PATCHCULL_DATA_DIR) + "/models/" + file_name;
+    std::string source = std::string(PATCHCULL_DATA_DIR) + "/models/" + file_name;
     std::error_code error;
     if (std::filesystem::exists(source, error)) return source;
     const std::filesystem::path program = std::filesystem::read_symlink("/proc/self/exe", error);
     if (!error) {
-        const std::string beside =
-            (program.parent_path().parent_path() / "share/patchcull/models" / file_name).string();
+        std::string beside = (program.parent_path().parent_path() / "share/patchcull/models" / file_name).string();
         if (std::filesystem::exists(beside, error)) return beside;
     }
     const std::string installed = std::string(PATCHCULL_INSTALLED_DATA_DIR) + "/models/" + file_name;

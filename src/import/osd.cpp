@@ -280,8 +280,8 @@ SubdivisionModel build_osd_model(const ControlMesh& mesh) {
         const int first = ptex.GetFaceId(static_cast<int>(f));
         const int count = mesh.face_size(f) == 4 ? 1 : static_cast<int>(mesh.face_size(f));
         for (int k = 0; k < count; ++k) {
-            ptex_face[static_cast<std::size_t>(first + k)] = f;
-            ptex_sub[static_cast<std::size_t>(first + k)] = k;
+            ptex_face[static_cast<std::size_t>(first) + static_cast<std::size_t>(k)] = f;
+            ptex_sub[static_cast<std::size_t>(first) + static_cast<std::size_t>(k)] = k;
         }
     }
 

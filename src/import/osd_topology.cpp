@@ -141,7 +141,7 @@ void check_manifold(const ControlMesh& mesh, const OSD::TopologyLevel& base) {
     for (int v = 0; v < base.GetNumVertices(); ++v) {
         // An unused vertex (no faces) is harmless: no stencil refers to it.
         const auto vf = base.GetVertexFaces(v);
-        if (vf.size() == 0 || !base.IsVertexNonManifold(v)) continue;
+        if (vf.empty() || !base.IsVertexNonManifold(v)) continue;
         throw Error(detail::vertex_fan_message(mesh, static_cast<std::size_t>(*std::min_element(vf.begin(), vf.end())),
                                                static_cast<std::uint32_t>(v)));
     }

@@ -77,6 +77,7 @@ void add_triangles(Scene& scene, std::string name, const std::vector<Vec3>& vert
 
 void add_box(Scene& scene, std::string name, Vec3 lo, Vec3 hi) {
     std::vector<Vec3> vertices;
+    vertices.reserve(8);
     for (int i = 0; i < 8; ++i)
         vertices.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
     // Faces as corner quads (bit 0 = x, bit 1 = y, bit 2 = z), each counter-clockwise seen from
