@@ -47,7 +47,7 @@ bool instance_displaced(const std::vector<DisplacementRange>& ranges, const gl::
 
 }  // namespace
 
-FusedEvalResult run_fused_eval(Scene scene, const FusedEvalOptions& o, const RunProgress& progress) {
+FusedEvalResult run_fused_eval(const Scene& scene, const FusedEvalOptions& o, const RunProgress& progress) {
     const int width = o.width, height = o.height;
     const BackPatchCone cone = o.cone;
     const bool one_sided = scene_is_one_sided(scene);
@@ -178,7 +178,7 @@ FusedEvalResult run_fused_eval(Scene scene, const FusedEvalOptions& o, const Run
             });
         }
         model.next_frame();
-        progress.done(static_cast<std::uint64_t>(f + 1));
+        progress.done(static_cast<std::uint64_t>(f) + 1);
     }
     return r;
 }

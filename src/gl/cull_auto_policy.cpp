@@ -34,7 +34,7 @@ bool CullAutoPolicy::Costs::known() const {
     return !std::isnan(issue_ms) && !std::isnan(cull_ms) && !std::isnan(tess_unit_ms) && !std::isnan(hiz_ms);
 }
 
-CullAutoPolicy::CullAutoPolicy(std::vector<ObjectRange> objects, std::size_t patch_count, Config config)
+CullAutoPolicy::CullAutoPolicy(const std::vector<ObjectRange>& objects, std::size_t patch_count, Config config)
     : config_(config), patch_count_(patch_count) {
     if (config.probe_interval < 1) throw Error("cull auto: probe_interval must be >= 1");
     if (config.max_probe_interval < config.probe_interval)

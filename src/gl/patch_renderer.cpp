@@ -17,11 +17,6 @@
 
 namespace patchcull::gl {
 
-static_assert(kCullFrustum == sh::kCullFrustum && kCullBackPatch == sh::kCullBackPatch &&
-              kCullOcclusion == sh::kCullOcclusion && kCullReasonMask == sh::kCullReasonMask);
-static_assert(kStatusVisible == sh::kStatusVisible && kStatusNewlyVisible == sh::kStatusNewlyVisible);
-static_assert(kIdOccluderBit == sh::kIdOccluderBit);
-
 PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl>()) {
     ctx.make_current();
     if (epoxy_gl_version() < 45) throw Error("GL: PatchRenderer needs OpenGL 4.5 (context has " + ctx.version() + ")");

@@ -326,7 +326,9 @@ Scene make_building_scene(Scheme scheme, const BuildingParams& params) {
     const float xmin = -0.5f * nx * R, zmin = -0.5f * nz * R;
     auto wall_x = [&](int k) { return xmin + k * R; };  // x of wall line k (0..nx)
     auto wall_z = [&](int l) { return zmin + l * R; };
-    auto room = [&](int i, int j) { return static_cast<std::size_t>(j * nx + i); };
+    auto room = [&](int i, int j) {
+        return static_cast<std::size_t>(j) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
+    };
 
     for (int j = 0; j < nz; ++j)
         for (int i = 0; i < nx; ++i) {

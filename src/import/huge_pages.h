@@ -24,6 +24,7 @@ inline void advise_huge_pages(void* data, std::size_t bytes) {
     if (!data || bytes < 2 * kHuge) return;
     const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
     const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
+    // An address computed from the allocation's own. NOLINTNEXTLINE(performance-no-int-to-ptr)
     if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
 #else
     (void)data;

@@ -127,7 +127,7 @@ struct Reader {
 
     std::string string(const json& j, const std::string& path) const {
         if (!j.is_string()) fail(path, "expected a string");
-        const std::string s = j.get<std::string>();
+        std::string s = j.get<std::string>();
         if (s.empty()) fail(path, "expected a non-empty string");
         return s;
     }
@@ -212,7 +212,7 @@ Placement read_transform(const Reader& r, const json& j, const std::string& path
         double t[3];
         for (int row = 0; row < 4; ++row)
             for (int col = 0; col < 4; ++col) {
-                const std::size_t k = static_cast<std::size_t>(4 * row + col);
+                const std::size_t k = 4 * static_cast<std::size_t>(row) + static_cast<std::size_t>(col);
                 m.at(row, col) = r.number(j[k], index(path, k), -FLT_MAX, FLT_MAX);
                 if (col == 3 && row < 3) t[row] = j[k].get<double>();
             }

@@ -238,7 +238,8 @@ void OcclusionHorizon::insert(const Bounds& occluder) {
         if (a > b) continue;
         float& low = low_[col];
         float& high = high_[col];
-        if (low > high) {  // nothing covered yet
+        // The first and last branches act alike for different reasons; the overlap test goes between.
+        if (low > high) {  // NOLINT(bugprone-branch-clone): nothing covered yet
             low = a, high = b;
         } else if (a <= high && b >= low) {  // overlap or touch: every point of the union is covered
             low = std::min(low, a), high = std::max(high, b);

@@ -81,7 +81,7 @@ int run_fused_eval(const FusedEvalOptions& o) {
     run.profile_interval = o.profile_interval;
     run.clip_depth = parse_clip_depth_option(o.clip_depth);
     EvalProgress progress("eval fused", "frames", o.json);
-    const eval_gl::FusedEvalResult r = eval_gl::run_fused_eval(std::move(scene), run, progress.hooks());
+    const eval_gl::FusedEvalResult r = eval_gl::run_fused_eval(scene, run, progress.hooks());
     for (const eval_gl::FusedFalseCull& c : r.first_false_culls) print_false_cull(c);
 
     const double frames = static_cast<double>(o.frames);

@@ -61,6 +61,6 @@ struct FusedEvalResult {
 /// each the minimum of repeats runs: every fixed plan, the cost model's choice (its profiling
 /// runs included), the fastest plan (oracle) and the separate SIMD kernels. scene: as loaded and
 /// placed (place_scene_at_first_camera). Progress: one unit per frame. Needs an OpenGL 4.5 context.
-FusedEvalResult run_fused_eval(Scene scene, const FusedEvalOptions& options, const RunProgress& progress = {});
+FusedEvalResult run_fused_eval(const Scene& scene, const FusedEvalOptions& options, const RunProgress& progress = {});
 
 }  // namespace patchcull::eval_gl

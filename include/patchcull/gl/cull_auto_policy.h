@@ -79,8 +79,8 @@ public:
 
     /// objects: disjoint ranges of a set of patch_count patches (their cull fields are ignored).
     /// Throws patchcull::Error when a range leaves the set or the config is out of range.
-    CullAutoPolicy(std::vector<ObjectRange> objects, std::size_t patch_count, Config config);
-    CullAutoPolicy(std::vector<ObjectRange> objects, std::size_t patch_count)
+    CullAutoPolicy(const std::vector<ObjectRange>& objects, std::size_t patch_count, Config config);
+    CullAutoPolicy(const std::vector<ObjectRange>& objects, std::size_t patch_count)
         : CullAutoPolicy(std::move(objects), patch_count, Config{}) {}
 
     /// Decides the next frame, given each object's tessellation factor (object_tess_factors).
