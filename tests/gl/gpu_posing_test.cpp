@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,7 @@
 #include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/model_loader.h"
 #include "patchcull/import/scene_poser.h"
+#include "shared.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;
@@ -172,6 +174,154 @@ TEST(GpuPosing, OnTheCallersCurrentContext) {
     const std::vector<BezierPatch>& at_rest = a.pose(0.0f);
     std::memcpy(rest.data(), at_rest.data(), bytes);
     EXPECT_NE(pa, rest) << "the pose at 0.25 s moved the teapot";
+}
+
+namespace {
+
+// The posed control meshes written into a buffer of the caller's, as an engine's skinning output
+// would hold them: x y z at `stride` bytes from `offset`; everything else (a float4 layout's w, the
+// padding) is NaN bytes, which the pass must never read.
+std::vector<std::uint8_t> interleave(const std::vector<Vec3>& vertices, std::size_t stride, std::size_t offset) {
+    std::vector<std::uint8_t> bytes(offset + vertices.size() * stride + 4, 0xFF);
+    for (std::size_t v = 0; v < vertices.size(); ++v) std::memcpy(&bytes[offset + v * stride], &vertices[v], 12);
+    return bytes;
+}
+
+std::vector<std::uint8_t> read_bytes(std::uint32_t buffer, std::size_t bytes) {
+    std::vector<std::uint8_t> out(bytes);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(bytes), out.data());
+    return out;
+}
+
+// Poses `scene` at each time through the vector overload and through GpuVertices over the same
+// positions in a caller buffer of the given layout, on the caller's current context with the
+// caller's output buffers; the written patch and tangent buffers must be equal byte for byte (and
+// the patches equal ScenePoser::pose()'s).
+void expect_gpu_vertices_like_vector(const Scene& scene, int components, std::size_t stride, std::size_t offset) {
+    SCOPED_TRACE(scene.name + ": " + std::to_string(components) + " floats, stride " + std::to_string(stride) +
+                 ", offset " + std::to_string(offset));
+    ScenePoser cpu(scene), gpu_side(scene);
+    StencilPoser gpu = make_poser(gpu_side, true);  // the caller's current context
+    const std::size_t patch_bytes = gpu.patch_count() * sizeof(BezierPatch);
+    const std::size_t tangent_bytes = gpu.patch_count() * 24 * sizeof(Vec4);
+    test::ScratchBuffer pa(patch_bytes), pb(patch_bytes), ta(tangent_bytes), tb(tangent_bytes);
+    std::uint32_t caller_vertices = 0;
+    glCreateBuffers(1, &caller_vertices);
+    for (float t : kTimes) {
+        const PoseMeshes& meshes = gpu_side.gpu_meshes(t);
+        std::vector<PosingInstance> instances;
+        for (std::size_t i = 0; i < meshes.first_vertex.size(); ++i)
+            instances.push_back({meshes.first_vertex[i], meshes.to_world[i], meshes.mirrored[i] != 0});
+        const std::vector<std::uint8_t> bytes = interleave(meshes.vertices, stride, offset);
+        glNamedBufferData(caller_vertices, static_cast<GLsizeiptr>(bytes.size()), bytes.data(), GL_STREAM_DRAW);
+        gpu.pose(meshes.vertices, instances, pa.name(), ta.name());
+        const GpuVertices in{caller_vertices, offset, stride, components, meshes.vertices.size()};
+        gpu.pose(in, instances, pb.name(), tb.name());
+        EXPECT_EQ(gpu.last_upload_bytes(), instances.size() * 80) << "only the instances go up";
+        GLint bound = 0, program = -1;
+        glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, shared::kBindingPoseVertices, &bound);
+        glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+        EXPECT_EQ(static_cast<std::uint32_t>(bound), caller_vertices) << "the state contract: left bound";
+        EXPECT_EQ(program, 0);
+        const std::vector<std::uint8_t> a = read_bytes(pa.name(), patch_bytes), b = read_bytes(pb.name(), patch_bytes);
+        EXPECT_TRUE(a == b) << "t=" << t << ": patch buffers differ";
+        const std::vector<BezierPatch>& posed = cpu.pose(t);
+        ASSERT_EQ(posed.size() * sizeof(BezierPatch), patch_bytes);
+        EXPECT_EQ(std::memcmp(b.data(), posed.data(), patch_bytes), 0) << "t=" << t << ": differs from the CPU pose";
+        if (gpu.has_tangents()) {
+            EXPECT_TRUE(read_bytes(ta.name(), tangent_bytes) == read_bytes(tb.name(), tangent_bytes))
+                << "t=" << t << ": tangent buffers differ";
+            const std::vector<Vec4> expected = tangent_layout(cpu, posed.size());
+            EXPECT_EQ(std::memcmp(read_bytes(tb.name(), tangent_bytes).data(), expected.data(), tangent_bytes), 0)
+                << "t=" << t << ": tangent vectors differ from the CPU pose";
+        }
+    }
+    glDeleteBuffers(1, &caller_vertices);
+}
+
+// One line, naming what is wrong.
+void expect_one_line(const std::function<void()>& f, const std::string& needle) {
+    try {
+        f();
+        ADD_FAILURE() << "no error (expected one about " << needle << ")";
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find(needle), std::string::npos) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+}
+
+}  // namespace
+
+// Float3 at an odd stride and offset (28 bytes from byte 8) and float4 (16 bytes, w never read),
+// both schemes (acc with tangents, a mirrored, a walking and a rigid instance).
+TEST(GpuPosing, CallerVertexBufferFloat3OddStride) {
+    expect_gpu_vertices_like_vector(varied_default_scene(Scheme::acc), 3, 28, 8);
+    expect_gpu_vertices_like_vector(varied_default_scene(Scheme::osd), 3, 28, 8);
+}
+
+TEST(GpuPosing, CallerVertexBufferFloat4) {
+    expect_gpu_vertices_like_vector(varied_default_scene(Scheme::acc), 4, 16, 0);
+    expect_gpu_vertices_like_vector(varied_default_scene(Scheme::acc), 4, 20, 12);
+}
+
+TEST(GpuPosing, CallerVertexBufferIsChecked) {
+    test::context().make_current();
+    StencilPoser gpu(StencilPoser::CurrentContext{});
+    std::vector<std::uint32_t> offs(17);
+    for (std::uint32_t r = 0; r <= 16; ++r) offs[r] = r;
+    const std::vector<std::uint32_t> indices(16, 3);
+    const std::vector<float> weights(16, 1.0f);
+    const PosingModel model{{offs.data(), 16, indices.data(), weights.data()}, {}, {-1}, 4};
+    gpu.set_tables({model}, {0, 0});
+    test::ScratchBuffer out(2 * sizeof(BezierPatch));
+    // 8 vertices of float3 at stride 28 from byte 8: 8 + 7 * 28 + 12 = 216 bytes.
+    test::ScratchBuffer vertices(216);
+    PosingInstance first, second;
+    second.first_vertex = 4;
+    const std::vector<PosingInstance> two{first, second};
+    const GpuVertices good{vertices.name(), 8, 28, 3, 8};
+    auto with = [&](auto change) {
+        GpuVertices v = good;
+        change(v);
+        return [&gpu, &two, &out, v] { gpu.pose(v, two, out.name(), 0); };
+    };
+    expect_one_line(with([](GpuVertices& v) { v.components = 2; }), "2 components");
+    expect_one_line(with([](GpuVertices& v) { v.components = 5; }), "5 components");
+    expect_one_line(with([](GpuVertices& v) { v.offset_bytes = 6; }), "offset 6 bytes is not a multiple of 4");
+    expect_one_line(with([](GpuVertices& v) { v.stride_bytes = 26; }), "stride 26 bytes is not a multiple of 4");
+    expect_one_line(with([](GpuVertices& v) { v.stride_bytes = 8; }), "stride 8 bytes is smaller");
+    expect_one_line(with([](GpuVertices& v) {
+                        v.components = 4;
+                        v.stride_bytes = 12;
+                    }),
+                    "stride 12 bytes is smaller than its 4 floats");
+    expect_one_line(with([](GpuVertices& v) { v.offset_bytes = 12; }), "216 bytes do not hold 8 vertices");
+    expect_one_line(with([](GpuVertices& v) { v.components = 4; }), "216 bytes do not hold 8 vertices");  // +4
+    expect_one_line(with([](GpuVertices& v) { v.offset_bytes = 1u << 20; }), "do not hold");
+    expect_one_line(with([](GpuVertices& v) { v.buffer = 0; }), "is not a buffer object");
+    expect_one_line(with([&](GpuVertices& v) { v.buffer = out.name(); }), "is also an output buffer");
+    expect_one_line(with([](GpuVertices& v) { v.count = 7; }), "vertices run past the 7 given");
+    expect_one_line([&] { gpu.pose(good, {first}, out.name(), 0); }, "1 instances for tables of 2");
+    // The good layout poses: vertex 3 of each instance, (1, 2, 3) and (4, 5, 6).
+    std::vector<float> floats(216 / 4, -1.0f);
+    floats[(8 + 3 * 28) / 4 + 0] = 1;
+    floats[(8 + 3 * 28) / 4 + 1] = 2;
+    floats[(8 + 3 * 28) / 4 + 2] = 3;
+    floats[(8 + 7 * 28) / 4 + 0] = 4;
+    floats[(8 + 7 * 28) / 4 + 1] = 5;
+    floats[(8 + 7 * 28) / 4 + 2] = 6;
+    glNamedBufferSubData(vertices.name(), 0, 216, floats.data());
+    gpu.pose(good, two, out.name(), 0);
+    const std::vector<float> back = out.read_floats(2 * 64);
+    for (int k = 0; k < 32; ++k) {
+        const float base = k < 16 ? 0.0f : 3.0f;
+        EXPECT_EQ(back[4 * k], base + 1);
+        EXPECT_EQ(back[4 * k + 1], base + 2);
+        EXPECT_EQ(back[4 * k + 2], base + 3);
+        EXPECT_EQ(back[4 * k + 3], 1.0f);
+    }
 }
 
 TEST(GpuPosing, SplitModelsAreRefused) {
