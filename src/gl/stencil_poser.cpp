@@ -310,6 +310,13 @@ void StencilPoser::pose(const GpuVertices& vertices, const std::vector<PosingIns
         if ((first + (vertices.count - 1) * vertices.stride_bytes + last) / 4 > kMaxFloats ||
             vertices.stride_bytes / 4 > kMaxFloats)
             fail("reads past 16 GiB (the pass indexes 32-bit floats with 32-bit indices)");
+        // The pass reads a storage block: the driver bounds its size.
+        GLint64 max_block = 0;
+        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+        const std::size_t end = first + (vertices.count - 1) * vertices.stride_bytes + last;
+        if (max_block > 0 && end > static_cast<std::size_t>(max_block))
+            fail("the vertices end at byte " + std::to_string(end) + ", past GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                 std::to_string(max_block) + ")");
     }
     prepare(m, vertices.count, instances, patch_buffer, tangent_buffer);
     detail::check_gl("(pending before StencilPoser::pose)");

@@ -91,7 +91,8 @@ struct PosingInstance {
 /// patchcull::Error): buffer is a buffer object of the current context, not one of pose()'s output
 /// buffers; components is 3 or 4; offset_bytes and stride_bytes are multiples of 4 and
 /// stride_bytes >= 4 * components; the buffer holds offset_bytes + (count - 1) * stride_bytes +
-/// 4 * components bytes (count > 0). The buffer must not be mapped (unless persistently) while
+/// 4 * components bytes (count > 0), and those end within GL_MAX_SHADER_STORAGE_BLOCK_SIZE (the
+/// pass reads the buffer as one storage block from byte 0). The buffer must not be mapped (unless persistently) while
 /// the pass runs.
 struct GpuVertices {
     std::uint32_t buffer = 0;
