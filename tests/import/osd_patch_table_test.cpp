@@ -5,14 +5,16 @@
 // sharp creases, corners, holes, boundaries under each interpolation rule, triangles) and the
 // shipped bigguy, adaptively refined to levels 1-4 with Gregory-basis (Far's default) and
 // B-spline-basis end caps. The vertex buffer holds every refined level and the local points,
-// float3 or float4 at odd strides and offsets, at the origin and translated by thousands of
-// units (the camera translated with it).
+// float3 or float4 at odd strides and offsets.
 // (a) Each array's source describes the surface PatchTable::EvaluateBasis gives: the B-spline
 //     arrays' Bezier conversion and the Gregory arrays' 20 points (evaluated by the definition in
-//     core/patch_source.h) agree with Far at a grid of (s, t) on every patch.
+//     core/patch_source.h) agree with Far at a grid of (s, t) on every patch, with the buffer at
+//     the origin and translated by thousands of units.
 // (b) No patch is culled that has a dense sample (Far's positions, normals from Far's
 //     derivatives) inside the frustum, in front of a synthetic depth layer or facing the eye, in
-//     every ClipDepth convention; and every kind of cull happens (the checks can fail).
+//     every ClipDepth convention, the object at the origin and placed thousands of units out
+//     with the camera (camera-relative, as docs/ENGINE.md asks; see check_cases); and every kind
+//     of cull happens, Gregory end caps included (the checks can fail).
 #include <gtest/gtest.h>
 
 #include <algorithm>
