@@ -217,7 +217,7 @@ void prepare_output_dir(const std::string& flag, const std::string& dir, const s
 namespace patchcull::cli {
 
 std::string parse_error_message(const CLI::ParseError& error) {
-    const std::string what = error.what();
+    std::string what = error.what();
     // CLI11 (ArgumentMismatch::AtMost): "NAME: At Most N required but received M", thrown for every
     // option whose values, over all its occurrences, outnumber what it takes.
     static const std::string kAtMost = ": At Most ", kReceived = " required but received ";

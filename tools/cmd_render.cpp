@@ -230,8 +230,10 @@ Runner add_render_command(CLI::App& app) {
         for (Camera& c : cameras) c.depth = clip_depth;  // drawn, culled and verified in it
         const std::vector<eval_gl::SceneObject> objects = eval_gl::scene_objects(scene);
         std::vector<gl::ObjectRange> ranges;
+        ranges.reserve(objects.size());
         for (const eval_gl::SceneObject& o : objects) ranges.push_back(o.range);
         std::vector<std::string> names;
+        names.reserve(objects.size());
         for (const eval_gl::SceneObject& o : objects) names.push_back(o.name);
         gl::CullAutoPolicy policy(ranges, scene.patch_count());
 

@@ -42,6 +42,7 @@ FramePoser::FramePoser(const gl::GlContext& context, ScenePoser& poser, gl::Patc
     }
     const std::vector<PoseModelTables>& tables = *tables_or_null;
     std::vector<gl::PosingModel> models;
+    models.reserve(tables.size());
     for (const PoseModelTables& t : tables)
         models.push_back({table_view(*t.patch_points), table_view(*t.tangent_points), t.tangent_index, t.vertex_count});
     std::vector<std::uint32_t> instance_models;

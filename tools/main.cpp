@@ -11,7 +11,9 @@
 #include "patchcull/core/error.h"
 #include "patchcull/version.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_cli(int argc, char** argv) {
     using namespace patchcull::cli;
     CLI::App app{"patchcull: conservative culling of bicubic patches before hardware tessellation"};
     app.require_subcommand(0, 1);
@@ -48,4 +50,18 @@ int main(int argc, char** argv) {
         std::cerr << "patchcull: internal error: " << patchcull::printable_line(e.what()) << "\n";
         return 3;
     }
+}
+
+}  // namespace
+
+// Whatever escapes the commands' own handling (building the parser included) is still one line.
+int main(int argc, char** argv) {
+    try {
+        return run_cli(argc, argv);
+    } catch (const std::exception& e) {
+        std::cerr << "patchcull: internal error: " << patchcull::printable_line(e.what()) << "\n";
+    } catch (...) {
+        std::cerr << "patchcull: internal error: an unknown exception\n";
+    }
+    return 3;
 }

@@ -20,9 +20,9 @@ Scene load_scene(const std::string& model, const std::string& scheme_text, int s
     const bool file = model.size() > 5 && model.compare(model.size() - 5, 5, ".json") == 0;
     if ((builtin || file) && split != 0)
         throw Error("--split: not available for a scene (" + model + "); it splits a single model");
-    const Scene scene = builtin ? make_builtin_scene(model, scheme)
-                        : file  ? load_scene_file(model)
-                                : make_model_scene(load_model(model, scheme, split));
+    Scene scene = builtin ? make_builtin_scene(model, scheme)
+                  : file  ? load_scene_file(model)
+                          : make_model_scene(load_model(model, scheme, split));
     for (const LoadedModel& m : scene.models) print_warnings(m.warnings);
     return scene;
 }

@@ -49,7 +49,11 @@ ViewerScript parse_viewer_script(const std::string& text, const std::string& pat
     int line_number = 0, last_frame = 0;
     while (std::getline(in, raw)) {
         ++line_number;
-        auto fail = [&](const std::string& why) { throw Error(path + ":" + std::to_string(line_number) + ": " + why); };
+        auto fail = [&](const std::string& why) {
+            std::string message = path;
+            message.append(":").append(std::to_string(line_number)).append(": ").append(why);
+            throw Error(message);
+        };
         const std::string line = raw.substr(0, raw.find('#'));
         std::istringstream fields(line);
         std::vector<std::string> f;

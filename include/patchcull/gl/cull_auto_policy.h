@@ -81,7 +81,7 @@ public:
     /// Throws patchcull::Error when a range leaves the set or the config is out of range.
     CullAutoPolicy(const std::vector<ObjectRange>& objects, std::size_t patch_count, Config config);
     CullAutoPolicy(const std::vector<ObjectRange>& objects, std::size_t patch_count)
-        : CullAutoPolicy(std::move(objects), patch_count, Config{}) {}
+        : CullAutoPolicy(objects, patch_count, Config{}) {}
 
     /// Decides the next frame, given each object's tessellation factor (object_tess_factors).
     /// Throws std::logic_error when the previous decision was not observed or the sizes differ.
