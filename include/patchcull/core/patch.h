@@ -218,11 +218,13 @@ std::size_t blocked_prefetch_distance();
 void check_patch_weights(const BezierPatch& patch, std::size_t index);
 
 /// Builds a batch from an array of patches (check_patch_weights on each), in the plain layout.
-/// The layout is the caller's choice, measured (docs/PERFORMANCE.md, "Batches at the memory roof",
-/// frustum, one thread, default prefetching): for batches that fit the L2 both layouts run alike;
-/// beyond it the memory-bound frustum kernels run 1.6x faster on PatchBlocks at 65536 patches and
-/// 1.2x at 1M; the compute-bound kernels (back-patch, occlusion, fused) gain nothing (fused loses
-/// up to 1.2x). Copy to PatchBlocks once for a large batch culled by frustum every frame.
+/// The layout is the caller's choice, measured (docs/PERFORMANCE.md, "The parallel entries at three
+/// sizes" and "Batches at the memory roof"): at 1450 patches both run alike; beyond the L2 the
+/// blocked layout (PatchBlocks) is faster for every kernel on an AMD EPYC with AVX2 (one thread,
+/// 65536 / 1M patches: frustum 2.2x / 3.1x, tcone 1.5x / 2.3x, occlusion 1.5x / 2.0x, fused
+/// 1.6x / 2.1x), and for the memory-bound frustum kernels on a Sapphire Rapids with AVX-512
+/// (1.6x / 1.2x; the compute-bound kernels there gained nothing). Copy a large batch to
+/// PatchBlocks once when it is culled every frame.
 PatchBatch make_batch(const std::vector<BezierPatch>& patches);
 
 /// A plain copy of `patches` (either layout), patch for patch.
