@@ -16,22 +16,9 @@ namespace {
 
 constexpr std::size_t kLanes = kBlockPatches;
 
-// The slots of a 4 x 4 B-spline grid that are real points under OpenSubdiv's boundary mask
-// (bit 0: row 0 phantom, bit 1: column 3, bit 2: row 3, bit 3: column 0): bit k set for slot k.
-constexpr std::uint32_t real_slots(unsigned mask) {
-    std::uint32_t slots = 0;
-    for (int k = 0; k < 16; ++k) {
-        const int row = k / 4, col = k % 4;
-        const bool phantom = ((mask & 1u) && row == 0) || ((mask & 2u) && col == 3) || ((mask & 4u) && row == 3) ||
-                             ((mask & 8u) && col == 0);
-        if (!phantom) slots |= 1u << k;
-    }
-    return slots;
-}
-
 constexpr std::array<std::uint32_t, 16> kRealSlots = [] {
     std::array<std::uint32_t, 16> t{};
-    for (unsigned m = 0; m < 16; ++m) t[m] = real_slots(m);
+    for (unsigned m = 0; m < 16; ++m) t[m] = bspline_real_slots(m);
     return t;
 }();
 

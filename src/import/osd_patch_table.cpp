@@ -22,13 +22,6 @@ namespace {
 
 namespace Far = OpenSubdiv::Far;
 
-// The slots of a 4 x 4 B-spline grid that are read under a boundary mask (patch_source.h).
-bool slot_is_read(unsigned mask, int k) {
-    const int row = k / 4, col = k % 4;
-    return !(((mask & 1u) && row == 0) || ((mask & 2u) && col == 3) || ((mask & 4u) && row == 3) ||
-             ((mask & 8u) && col == 0));
-}
-
 std::string type_name(Far::PatchDescriptor::Type type) {
     switch (type) {
         case Far::PatchDescriptor::NON_PATCH:
@@ -103,8 +96,9 @@ OsdPatchTableSource::OsdPatchTableSource(const Far::PatchTable& table, const Poi
                             std::to_string(mask) + ", beyond a quad's 4 edges");
             masks_[first + static_cast<std::size_t>(p)] = static_cast<std::uint8_t>(mask);
             any_boundary = any_boundary || mask != 0;
+            const std::uint32_t read = regular ? bspline_real_slots(mask) : ~0u;
             for (int k = 0; k < per_patch; ++k) {
-                if (regular && !slot_is_read(mask, k)) continue;
+                if (!((read >> k) & 1u)) continue;
                 const Far::Index index = cvs[p * per_patch + k];
                 if (index < 0)
                     throw Error("OsdPatchTableSource: patch " + std::to_string(first + static_cast<std::size_t>(p)) +

@@ -71,6 +71,20 @@ enum class PatchBasis : std::uint8_t { bezier, bspline, gregory };
 /// Control points per patch of a basis: 16, or 20 for gregory.
 constexpr int patch_source_points(PatchBasis basis) { return basis == PatchBasis::gregory ? 20 : 16; }
 
+/// The slots of a 4 x 4 B-spline grid that hold real points under OpenSubdiv's boundary mask
+/// (bit 0: row 0 is phantom, bit 1: column 3, bit 2: row 3, bit 3: column 0): bit k set when
+/// slot k (row k / 4, column k % 4) is read. Phantom slots are never read.
+constexpr std::uint32_t bspline_real_slots(unsigned boundary_mask) {
+    std::uint32_t slots = 0;
+    for (int k = 0; k < 16; ++k) {
+        const int row = k / 4, col = k % 4;
+        const bool phantom = ((boundary_mask & 1u) && row == 0) || ((boundary_mask & 2u) && col == 3) ||
+                             ((boundary_mask & 4u) && row == 3) || ((boundary_mask & 8u) && col == 0);
+        if (!phantom) slots |= 1u << k;
+    }
+    return slots;
+}
+
 /// count patches of one basis over the caller's memory (see the top of this header).
 struct PatchSourceView {
     PointLayout points;
