@@ -8,6 +8,7 @@
 // patches (any w != 1) are never culled. A link of the flag chain (flag_chain.h): patches culled
 // earlier are skipped, and so are displaced ones (margin > 0: a displaced surface is not bounded by
 // the base patch's normals, Loop, Niessner & Eisenacher §8); a culled patch gets kCullBackPatch.
+// With PC_PATCH_SOURCE the 16 points come from the caller's patch source (patch_source.h).
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
@@ -20,6 +21,7 @@
 #define u_zero cones.zero
 #include "backpatch_cones.h"
 #include "flag_chain.h"
+#include "patch_source.h"
 
 #ifdef PATCHCULL_NCONE
 #define PC_PASS_CONE pc_normal_cone
@@ -38,7 +40,12 @@ void main() {
     if (gl_GlobalInvocationID.x >= cones.patch_count || pc_chain_culled(p)) return;
     if (pc_margin(p, cones.has_margins) > 0.0) return;
     vec4 P[16];
+#ifdef PC_PATCH_SOURCE
+    if (!pc_gather_source(p)) return;
+    for (uint k = 0u; k < 16u; ++k) P[k] = pc_source_points[k];
+#else
     for (int k = 0; k < 16; ++k) P[k] = control_points[16u * p + uint(k)];
+#endif
     const PcCone cone = PC_PASS_CONE(P);
     const PcSphere sphere = pc_sphere_of_points(P);
     if (pc_is_polynomial(P) && pc_back_facing(cone, sphere, cones.eye.xyz)) pc_chain_cull(p, kCullBackPatch);

@@ -23,7 +23,8 @@
 // A link of the flag chain (flag_chain.h): patches culled earlier and displaced ones (margin > 0)
 // take part in the barriers but are neither counted nor written; a culled patch gets
 // kCullBackPatch. The 64 t and then the 64 thr go to kBindingPtpPlanes (128 floats per patch) on
-// request (tests). The host skips the dispatch (and clears the flags) when ptp_clip_rows would
+// request (tests). With PC_PATCH_SOURCE the points come from the caller's patch source
+// (patch_source.h). The host skips the dispatch (and clears the flags) when ptp_clip_rows would
 // return false (alpha or det(object_to_clip) zero or not finite).
 #version 450 core
 #include "shared.h"
@@ -35,6 +36,7 @@
 #include "exact_fma.h"
 #include "ptp_schedule.h"
 #include "flag_chain.h"
+#include "patch_source.h"
 
 layout(local_size_x = kPtpLanes, local_size_y = kPtpPatchesPerGroup) in;
 
@@ -79,11 +81,22 @@ void main() {
     const uint index = gl_WorkGroupID.x * kPtpPatchesPerGroup + slot;
     const uint p = ptp.first_patch + index;
     // Inactive slots (past the range, culled earlier, displaced) still take part in every barrier.
+#ifdef PC_PATCH_SOURCE
+    // Every lane gathers the whole patch (a B-spline point's conversion needs its neighbours) and
+    // takes point `lane`; a patch with an index past the points is inactive.
+    bool in_range = index < ptp.patch_count && !pc_chain_culled(p) && pc_margin(p, ptp.has_margins) == 0.0;
+    if (in_range) in_range = pc_gather_source(p);
+#else
     const bool in_range = index < ptp.patch_count && !pc_chain_culled(p) && pc_margin(p, ptp.has_margins) == 0.0;
+#endif
 
     // 1. Clip transform of control point `lane`: v = r.x X; v = fma(r.y, Y, v); ... (backpatch_ptp.cpp step 1).
     {
+#ifdef PC_PATCH_SOURCE
+        const vec4 P = in_range ? pc_source_points[lane] : vec4(0.0);
+#else
         const vec4 P = in_range ? control_points[16u * p + lane] : vec4(0.0);
+#endif
         precise float o[3];
         for (int r = 0; r < 3; ++r) {
             const vec4 row = u_rows[r];

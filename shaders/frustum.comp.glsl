@@ -3,6 +3,9 @@
 // operation by operation, so the decisions are identical (the test itself is shaders/frustum_test.h,
 // shared with occlusion.comp.glsl). A link of the flag chain (gl_passes.h): a patch that an earlier
 // pass of the frame culled is left as it is; otherwise a culled patch gets the reason kCullFrustum.
+// With PC_PATCH_SOURCE the points come from the caller's patch source (patch_source.h: Bezier or
+// converted B-spline points, or with PC_PATCH_SOURCE_GREGORY a Gregory patch's 20 points, all
+// tested as cull_frustum over a PatchSourceView tests them).
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
@@ -13,8 +16,14 @@
 #include "patch_buffers.h"
 #include "exact_fma.h"
 #include "flag_chain.h"
+#include "patch_source.h"
 
 layout(local_size_x = kCullGroupSize) in;
+
+#ifdef PC_PATCH_SOURCE
+#define PC_PATCH_POINT(p, k) pc_source_points[k]
+#define PC_PATCH_POINT_COUNT PC_SOURCE_POINTS
+#endif
 
 // frustum_test.h's names.
 #define u_clip_rows frustum.clip_rows
@@ -25,6 +34,9 @@ layout(local_size_x = kCullGroupSize) in;
 void main() {
     const uint p = frustum.first_patch + gl_GlobalInvocationID.x;
     if (gl_GlobalInvocationID.x >= frustum.patch_count || pc_chain_culled(p)) return;
+#ifdef PC_PATCH_SOURCE
+    if (!pc_gather_source(p)) return;
+#endif
     const float d = pc_margin(p, frustum.has_margins);
     float mx[6];
     if (pc_frustum_culled(p, frustum.has_margins != 0u, d, mx)) pc_chain_cull(p, kCullFrustum);

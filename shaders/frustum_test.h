@@ -16,7 +16,14 @@
 // control_points[] (patch_buffers.h, PC_CONTROL_POINTS) and the names u_clip_rows (vec4[4], FrustumPlanes::clip_rows)
 // , u_plane_normal_length (vec4[2]: FrustumPlanes::normal_length[q] at [q >> 2][q & 3]) and
 // u_plane_depth (vec4: FrustumPlanes::near_w, far_w, far_limit), #defines
-// onto its parameter block (pass_params.h).
+// onto its parameter block (pass_params.h). A pass over a patch source (patch_source.h) defines
+// PC_PATCH_POINT(p, k) and PC_PATCH_POINT_COUNT before including this file: the tests then read
+// the gathered points (16 Bezier points, or a Gregory patch's 20) instead of control_points[].
+
+#ifndef PC_PATCH_POINT
+#define PC_PATCH_POINT(p, k) control_points[16u * (p) + (k)]
+#define PC_PATCH_POINT_COUNT 16u
+#endif
 
 // Plane values of clip-space point c (before margins).
 void pc_frustum_plane_values(const vec4 c, out float v[6]) {
@@ -63,8 +70,8 @@ bool pc_frustum_culled(uint p, bool with_margins, float d, out float mx[6]) {
         m[q] = uintBitsToFloat(0xFF800000u);  // -infinity
     }
     bool non_finite = false;
-    for (uint k = 0u; k < 16u; ++k) {
-        const vec4 point = control_points[16u * p + k];
+    for (uint k = 0u; k < PC_PATCH_POINT_COUNT; ++k) {
+        const vec4 point = PC_PATCH_POINT(p, k);
         float v[6];
         pc_frustum_plane_values(pc_clip_point(point), v);
         for (int q = 0; q < 6; ++q) {

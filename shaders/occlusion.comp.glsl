@@ -8,6 +8,9 @@
 // as the CPU kernel, the frustum test (frustum_test.h, with the margin; when with_frustum) and
 // steps 2-9 against the pyramid, only for patches whose margin is 0 (a displaced patch needs the
 // bound of displaced.comp.glsl). Reasons kCullFrustum / kCullOcclusion.
+// With PC_PATCH_SOURCE the points come from the caller's patch source (patch_source.h); with
+// PC_PATCH_SOURCE_GREGORY all 20 points of a Gregory patch are tested, and a point whose NDC
+// coordinate is NaN leaves the patch visible (patch_source_cull.cpp's gregory_occluded).
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
@@ -17,8 +20,14 @@
 #include "patch_buffers.h"
 #include "exact_fma.h"
 #include "flag_chain.h"
+#include "patch_source.h"
 
 layout(local_size_x = kCullGroupSize) in;
+
+#ifdef PC_PATCH_SOURCE
+#define PC_PATCH_POINT(p, k) pc_source_points[k]
+#define PC_PATCH_POINT_COUNT PC_SOURCE_POINTS
+#endif
 
 layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 
@@ -32,13 +41,22 @@ layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 #include "frustum_test.h"
 #include "hiz_box_test.h"
 
+#ifdef PC_PATCH_SOURCE_GREGORY
+// True when v is NaN (a test of the bits, which no compiler folds away).
+bool pc_is_nan(float v) { return (floatBitsToUint(v) & 0x7FFFFFFFu) > 0x7F800000u; }
+#endif
+
 // Steps 2-9 for patch p: true when the patch lies behind the pyramid.
 bool hiz_occluded(uint p) {
     HiZPointBox box;
-    for (uint k = 0u; k < 16u; ++k) {
-        const vec4 P = control_points[16u * p + k];
+    for (uint k = 0u; k < PC_PATCH_POINT_COUNT; ++k) {
+        const vec4 P = PC_PATCH_POINT(p, k);
         // Step 2 (pc_clip_point, frustum_test.h), steps 3-4 (hiz_add_point, hiz_box_test.h).
-        if (!hiz_add_point(P, pc_clip_point(P), u_clip_rows[3], k == 0u, box)) return false;
+        const vec4 c = pc_clip_point(P);
+        if (!hiz_add_point(P, c, u_clip_rows[3], k == 0u, box)) return false;
+#ifdef PC_PATCH_SOURCE_GREGORY
+        if (pc_is_nan(hiz_div(c.x, c.w)) || pc_is_nan(hiz_div(c.y, c.w)) || pc_is_nan(hiz_div(c.z, c.w))) return false;
+#endif
     }
     return hiz_box_occluded(box.nxmin, box.nxmax, box.nymin, box.nymax, box.zmin);  // steps 5-9
 }
@@ -46,6 +64,9 @@ bool hiz_occluded(uint p) {
 void main() {
     const uint p = occlusion.first_patch + gl_GlobalInvocationID.x;
     if (gl_GlobalInvocationID.x >= occlusion.patch_count || pc_chain_culled(p)) return;
+#ifdef PC_PATCH_SOURCE
+    if (!pc_gather_source(p)) return;
+#endif
     const float d = pc_margin(p, occlusion.has_margins);
     if (occlusion.with_frustum != 0u) {
         float mx[6];

@@ -169,6 +169,27 @@ PC_PARAMS(FusedCullParams, kUniformPassParams) {
     PC_FLOAT(zero);                    // 0.0 at run time (see BackpatchConeParams::zero)
 } PC_END(fused);
 
+// patch_source.h: the caller's control points of a pass compiled with PC_PATCH_SOURCE, at
+// kUniformPatchSource beside the pass's own block (GpuPatchSource of gl_passes.h). The shader's
+// patch p (an index of the flag buffer) is source patch p + patch_delta (mod 2^32). Declared in
+// GLSL only with PC_PATCH_SOURCE.
+#if defined(__cplusplus) || defined(PC_PATCH_SOURCE)
+PC_PARAMS(PatchSourceParams, kUniformPatchSource) {
+    PC_UINT(vertex_base);              // GpuPatchSource::offset_bytes / 4: x of point i at vertex_base + i vertex_stride
+    PC_UINT(vertex_stride);            // stride_bytes / 4
+    PC_UINT(components);               // 3 (w = 1) or 4
+    PC_UINT(point_count);              // an index >= point_count is not read (the patch is not culled)
+    PC_UINT(basis);                    // kSourceBasisBezier, kSourceBasisBspline or kSourceBasisGregory
+    PC_UINT(has_indices);              // 0: patch s reads points n s .. n s + n - 1
+    PC_UINT(index_base);               // indices_offset_bytes / 4: patch s's slot k at index_base + n s + k
+    PC_UINT(has_masks);                // bspline: the boundary-mask buffer is bound
+    PC_UINT(mask_base);                // masks_offset_bytes: patch s's mask is byte mask_base + s
+    PC_UINT(patch_delta);              // source_first - first
+    PC_UINT(pad0);
+    PC_UINT(pad1);
+} PC_END(pc_source);
+#endif
+
 #undef PC_PARAMS
 #undef PC_END
 #undef PC_VEC4

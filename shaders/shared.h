@@ -74,9 +74,17 @@ PATCHCULL_CONST uint kBindingPosePatchTable = 19u;
 PATCHCULL_CONST uint kBindingPoseOffsets = 20u;
 PATCHCULL_CONST uint kBindingPoseTerms = 21u;
 PATCHCULL_CONST uint kBindingPoseTangentTable = 22u;
+// Passes over the caller's own control points (gl_passes.h's GpuPatchSource; shaders/patch_source.h):
+// the vertex buffer read as float[], the index buffer (uint per slot), the boundary masks (one
+// byte per patch, read as packed uint words).
+PATCHCULL_CONST uint kBindingSourceVertices = 23u;
+PATCHCULL_CONST uint kBindingSourceIndices = 24u;
+PATCHCULL_CONST uint kBindingSourceMasks = 25u;
 
 // Uniform buffer binding of the passes' parameter blocks (pass_params.h; one pass runs at a time).
 PATCHCULL_CONST uint kUniformPassParams = 0u;
+// ... and of the patch-source block (pass_params.h's PatchSourceParams) of the passes run on a GpuPatchSource.
+PATCHCULL_CONST uint kUniformPatchSource = 1u;
 
 // Texture units.
 PATCHCULL_CONST uint kTextureUnitDisplacement = 0u;  // R32F height map, GL_REPEAT, bilinear
@@ -186,6 +194,23 @@ PATCHCULL_CONST uint kDisplacedBoundCaf = 1u;
 PATCHCULL_CONST uint kDisplacedConeFull = 0u;
 PATCHCULL_CONST uint kDisplacedConeAcon = 1u;
 PATCHCULL_CONST uint kDisplacedConeCon = 2u;
+
+// ---- Patch sources (GpuPatchSource of gl_passes.h: shaders/patch_source.h) ----------------------
+// The basis (PatchSourceParams::basis; core/patch_source.h's PatchBasis, in its order).
+PATCHCULL_CONST uint kSourceBasisBezier = 0u;
+PATCHCULL_CONST uint kSourceBasisBspline = 1u;
+PATCHCULL_CONST uint kSourceBasisGregory = 2u;
+// The slots of a 4 x 4 B-spline grid that a boundary edge makes phantom (bspline_real_slots of
+// core/patch_source.h: bit k for slot k = 4 row + column): mask bit 0 row 0, bit 1 column 3, bit 2
+// row 3, bit 3 column 0.
+PATCHCULL_CONST uint kBsplinePhantomRow0 = 0x000Fu;
+PATCHCULL_CONST uint kBsplinePhantomColumn3 = 0x8888u;
+PATCHCULL_CONST uint kBsplinePhantomRow3 = 0xF000u;
+PATCHCULL_CONST uint kBsplinePhantomColumn0 = 0x1111u;
+// The B-spline -> Bezier change of basis' constants as float bits: 1.0f / 6.0f and 1.0f / 3.0f
+// (patch_source.cpp's kSixth, kThird).
+PATCHCULL_CONST uint kBsplineSixthBits = 0x3E2AAAABu;
+PATCHCULL_CONST uint kBsplineThirdBits = 0x3EAAAAABu;
 
 #ifdef __cplusplus
 }  // namespace patchcull::gl::shared

@@ -52,4 +52,27 @@ bool BackpatchPtpPass::run(const PatchBuffers& patches, const Mat4& object_to_cl
     return true;
 }
 
+bool BackpatchPtpPass::run(const GpuPatchSource& source, const Mat4& object_to_clip, float alpha, PtpRule rule,
+                           std::uint32_t plane_values) {
+    detail::begin_pass("BackpatchPtpPass");
+    const pp::PatchSourceParams source_params = detail::check_patch_source("BackpatchPtpPass", impl_->context, source);
+    if (plane_values)
+        detail::check_buffer_size("BackpatchPtpPass", "plane-value", plane_values,
+                                  (source.first + source.count) * 128 * sizeof(float));
+    if (source.basis == PatchBasis::gregory) return false;  // never back-patch culled
+    pp::BackpatchPtpParams params;
+    if (!ptp_rows(object_to_clip, alpha, params.rows)) return false;
+    if (source.count == 0) return true;
+    params.has_margins = source.margins ? 1u : 0u;
+    params.pcnt = rule == PtpRule::pcnt ? 1u : 0u;
+    params.write_planes = plane_values ? 1u : 0u;
+    params.zero = 0.0f;
+    glUseProgram(impl_->context.program("backpatch_ptp.comp.glsl", detail::patch_source_defines(source)));
+    detail::bind_patch_source(*impl_, source, source_params);
+    if (plane_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingPtpPlanes, plane_values);
+    detail::dispatch_patches(impl_->block, params, source.first, source.count, shared::kPtpPatchesPerGroup);
+    detail::finish_pass("BackpatchPtpPass");
+    return true;
+}
+
 }  // namespace patchcull::gl

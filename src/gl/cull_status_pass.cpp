@@ -13,7 +13,7 @@ struct CullStatusPass::Impl {
 
     void run(const PatchBuffers& patches, pp::uint mode, GLuint counters, std::size_t offset) {
         detail::begin_pass("CullStatusPass");
-        detail::check_patch_buffers("CullStatusPass", patches);
+        detail::check_patch_buffers("CullStatusPass", patches, /*with_points=*/false);
         if (counters)
             detail::check_buffer_size("CullStatusPass", "counter", counters, offset + shared::kCounterCount * 4);
         if (patches.count == 0) return;

@@ -34,4 +34,26 @@ void FrustumPass::run(const PatchBuffers& patches, const CullView& view, std::ui
     run(patches, view.planes, plane_values);
 }
 
+void FrustumPass::run(const GpuPatchSource& source, const FrustumPlanes& planes, std::uint32_t plane_values) {
+    detail::begin_pass("FrustumPass");
+    const pp::PatchSourceParams source_params = detail::check_patch_source("FrustumPass", impl_->context, source);
+    if (plane_values)
+        detail::check_buffer_size("FrustumPass", "plane-value", plane_values,
+                                  (source.first + source.count) * 6 * sizeof(float));
+    if (source.count == 0) return;
+    pp::FrustumParams params;
+    detail::store_planes(planes, params.clip_rows, params.plane_normal_length, params.plane_depth);
+    params.has_margins = source.margins ? 1u : 0u;
+    params.write_plane_values = plane_values ? 1u : 0u;
+    glUseProgram(impl_->context.program("frustum.comp.glsl", detail::patch_source_defines(source)));
+    detail::bind_patch_source(*impl_, source, source_params);
+    if (plane_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingPlaneValues, plane_values);
+    detail::dispatch_patches(impl_->block, params, source.first, source.count, shared::kCullGroupSize);
+    detail::finish_pass("FrustumPass");
+}
+
+void FrustumPass::run(const GpuPatchSource& source, const CullView& view, std::uint32_t plane_values) {
+    run(source, view.planes, plane_values);
+}
+
 }  // namespace patchcull::gl

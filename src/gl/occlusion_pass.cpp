@@ -8,6 +8,31 @@ struct OcclusionPass::Impl : detail::PassState {
     using PassState::PassState;
 };
 
+namespace {
+
+void check_hiz(const HiZTexture& hiz, ClipDepth depth) {
+    if (!glIsTexture(hiz.texture) || hiz.width < 1 || hiz.height < 1)
+        throw Error("GL: OcclusionPass: no Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
+    if (hiz.reversed != is_reversed(depth))
+        throw Error(std::string("GL: OcclusionPass: the matrix is declared ") + clip_depth_name(depth) +
+                    " but the Hi-Z pyramid was built from a " + (hiz.reversed ? "reversed" : "forward") +
+                    " depth buffer (HiZBuildPass::run's convention)");
+}
+
+pp::OcclusionParams make_params(const FrustumPlanes& planes, const HiZTexture& hiz, bool has_margins,
+                                bool with_frustum) {
+    pp::OcclusionParams params;
+    detail::store_planes(planes, params.clip_rows, params.plane_normal_length, params.plane_depth);
+    params.has_margins = has_margins ? 1u : 0u;
+    params.with_frustum = with_frustum ? 1u : 0u;
+    params.screen_width = hiz.width;
+    params.screen_height = hiz.height;
+    params.hiz_levels = HiZPyramid::level_count(hiz.width, hiz.height);
+    return params;
+}
+
+}  // namespace
+
 OcclusionPass::OcclusionPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
 OcclusionPass::OcclusionPass(OcclusionPass&&) noexcept = default;
 OcclusionPass& OcclusionPass::operator=(OcclusionPass&&) noexcept = default;
@@ -17,21 +42,10 @@ void OcclusionPass::run(const PatchBuffers& patches, const Mat4& any_object_to_c
                         const HiZTexture& hiz, bool with_frustum) {
     detail::begin_pass("OcclusionPass");
     detail::check_patch_buffers("OcclusionPass", patches);
-    if (!glIsTexture(hiz.texture) || hiz.width < 1 || hiz.height < 1)
-        throw Error("GL: OcclusionPass: no Hi-Z pyramid (create_hiz_texture, HiZBuildPass)");
-    if (hiz.reversed != is_reversed(depth))
-        throw Error(std::string("GL: OcclusionPass: the matrix is declared ") + clip_depth_name(depth) +
-                    " but the Hi-Z pyramid was built from a " + (hiz.reversed ? "reversed" : "forward") +
-                    " depth buffer (HiZBuildPass::run's convention)");
+    check_hiz(hiz, depth);
     const FrustumPlanes planes = make_frustum_planes(any_object_to_clip, depth);  // refuses a contradiction
     if (patches.count == 0) return;
-    pp::OcclusionParams params;
-    detail::store_planes(planes, params.clip_rows, params.plane_normal_length, params.plane_depth);
-    params.has_margins = patches.margins ? 1u : 0u;
-    params.with_frustum = with_frustum ? 1u : 0u;
-    params.screen_width = hiz.width;
-    params.screen_height = hiz.height;
-    params.hiz_levels = HiZPyramid::level_count(hiz.width, hiz.height);
+    pp::OcclusionParams params = make_params(planes, hiz, patches.margins != 0, with_frustum);
     glUseProgram(impl_->context.program("occlusion.comp.glsl"));
     detail::bind_patch_buffers(patches);
     glBindTextureUnit(shared::kTextureUnitHiZ, hiz.texture);
@@ -41,6 +55,25 @@ void OcclusionPass::run(const PatchBuffers& patches, const Mat4& any_object_to_c
 
 void OcclusionPass::run(const PatchBuffers& patches, const CullView& view, const HiZTexture& hiz, bool with_frustum) {
     run(patches, view.object_to_clip, view.depth, hiz, with_frustum);
+}
+
+void OcclusionPass::run(const GpuPatchSource& source, const Mat4& any_object_to_clip, ClipDepth depth,
+                        const HiZTexture& hiz, bool with_frustum) {
+    detail::begin_pass("OcclusionPass");
+    const pp::PatchSourceParams source_params = detail::check_patch_source("OcclusionPass", impl_->context, source);
+    check_hiz(hiz, depth);
+    const FrustumPlanes planes = make_frustum_planes(any_object_to_clip, depth);  // refuses a contradiction
+    if (source.count == 0) return;
+    pp::OcclusionParams params = make_params(planes, hiz, source.margins != 0, with_frustum);
+    glUseProgram(impl_->context.program("occlusion.comp.glsl", detail::patch_source_defines(source)));
+    detail::bind_patch_source(*impl_, source, source_params);
+    glBindTextureUnit(shared::kTextureUnitHiZ, hiz.texture);
+    detail::dispatch_patches(impl_->block, params, source.first, source.count, shared::kCullGroupSize);
+    detail::finish_pass("OcclusionPass");
+}
+
+void OcclusionPass::run(const GpuPatchSource& source, const CullView& view, const HiZTexture& hiz, bool with_frustum) {
+    run(source, view.object_to_clip, view.depth, hiz, with_frustum);
 }
 
 }  // namespace patchcull::gl

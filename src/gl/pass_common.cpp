@@ -1,6 +1,7 @@
 // PassContext and the helpers of the cull passes (src/gl/pass_common.h, patchcull/gl/gl_passes.h).
 #include "pass_common.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -23,6 +24,26 @@ static_assert(sizeof(pp::FusedCullParams) == 4 * 16 + 3 * 16 + 16 + 32);
 static_assert(offsetof(pp::FusedCullParams, first_patch) == 4 * 16 + 3 * 16 + 16);
 static_assert(offsetof(pp::OcclusionParams, first_patch) == 4 * 16 + 3 * 16);
 static_assert(offsetof(pp::DisplacedParams, first_patch) == 64 + 6 * 16 + 3 * 16 + 5 * 16);
+static_assert(sizeof(pp::PatchSourceParams) == 48);
+
+// shared.h's patch-source constants are core/patch_source.h's: the basis order, the phantom slots
+// of each boundary mask and the change of basis' constants.
+static_assert(shared::kSourceBasisBezier == static_cast<unsigned>(PatchBasis::bezier));
+static_assert(shared::kSourceBasisBspline == static_cast<unsigned>(PatchBasis::bspline));
+static_assert(shared::kSourceBasisGregory == static_cast<unsigned>(PatchBasis::gregory));
+static_assert(std::bit_cast<float>(shared::kBsplineSixthBits) == 1.0f / 6.0f);
+static_assert(std::bit_cast<float>(shared::kBsplineThirdBits) == 1.0f / 3.0f);
+static_assert([] {
+    for (unsigned m = 0; m < 16; ++m) {
+        unsigned phantom = 0;
+        if (m & 1u) phantom |= shared::kBsplinePhantomRow0;
+        if (m & 2u) phantom |= shared::kBsplinePhantomColumn3;
+        if (m & 4u) phantom |= shared::kBsplinePhantomRow3;
+        if (m & 8u) phantom |= shared::kBsplinePhantomColumn0;
+        if ((~phantom & 0xFFFFu) != bspline_real_slots(m)) return false;
+    }
+    return true;
+}());
 
 PassContext::Impl::~Impl() {
     for (const auto& [key, program] : programs) glDeleteProgram(program);
@@ -216,12 +237,13 @@ void check_buffer_size(const char* who, const char* what, GLuint buffer, std::si
                     std::to_string(bytes) + " needed");
 }
 
-void check_patch_buffers(const char* who, const PatchBuffers& patches) {
+void check_patch_buffers(const char* who, const PatchBuffers& patches, bool with_points) {
     if (patches.count == 0) return;
     if (patches.first + patches.count > 0xFFFFFFFFu / 16)
         throw Error(std::string("GL: ") + who + ": patch range past 2^28 patches");
     const std::size_t end = patches.first + patches.count;
-    check_buffer_size(who, "control-point", patches.control_points, end * 16 * 4 * sizeof(float));
+    if (with_points || patches.control_points)
+        check_buffer_size(who, "control-point", patches.control_points, end * 16 * 4 * sizeof(float));
     check_buffer_size(who, "flag", patches.flags, end * sizeof(std::uint32_t));
     if (patches.margins) check_buffer_size(who, "margin", patches.margins, end * sizeof(float));
 }
@@ -245,6 +267,86 @@ void finish_pass(const char* who) {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
                     GL_BUFFER_UPDATE_BARRIER_BIT);
     check_gl(who);
+}
+
+pp::PatchSourceParams check_patch_source(const char* who, PassContext::Impl& context, const GpuPatchSource& source) {
+    pp::PatchSourceParams params;
+    const GpuPatchSource& s = source;
+    if (s.count == 0) return params;  // nothing is read
+    const auto fail = [&](const std::string& message) { throw Error(std::string("GL: ") + who + ": " + message); };
+    if (s.components != 3 && s.components != 4)
+        fail("source.components is " + std::to_string(s.components) +
+             "; it must be 3 (x, y, z with w = 1) or 4 (homogeneous w x, w y, w z, w)");
+    const std::size_t point_bytes = static_cast<std::size_t>(s.components) * sizeof(float);
+    if (s.stride_bytes % 4 != 0 || s.offset_bytes % 4 != 0)
+        fail("source.stride_bytes (" + std::to_string(s.stride_bytes) + ") and offset_bytes (" +
+             std::to_string(s.offset_bytes) + ") must be multiples of 4: the vertex buffer is read as floats");
+    if (s.stride_bytes < s.offset_bytes + point_bytes)
+        fail("source.stride_bytes is " + std::to_string(s.stride_bytes) + ", smaller than offset_bytes (" +
+             std::to_string(s.offset_bytes) + ") + " + std::to_string(point_bytes) + " bytes of " +
+             std::to_string(s.components) + " floats: a point must lie inside its vertex");
+    if (s.basis != PatchBasis::bezier && s.basis != PatchBasis::bspline && s.basis != PatchBasis::gregory)
+        fail("unknown source.basis " + std::to_string(static_cast<int>(s.basis)));
+    const char* basis_name = s.basis == PatchBasis::bezier    ? "bezier"
+                             : s.basis == PatchBasis::bspline ? "bspline"
+                                                              : "gregory";
+    if (s.boundary_masks && s.basis != PatchBasis::bspline)
+        fail(std::string("source.boundary_masks is for bspline sources only, and the basis is ") + basis_name);
+    if (s.indices_offset_bytes % 4 != 0)
+        fail("source.indices_offset_bytes is " + std::to_string(s.indices_offset_bytes) +
+             ", not a multiple of 4 (the indices are uints)");
+    if (s.point_count == 0) fail("source.point_count is 0 for " + std::to_string(s.count) + " patches");
+    const std::size_t n = static_cast<std::size_t>(patch_source_points(s.basis));
+    const std::size_t end = s.source_first + s.count;  // source patches [source_first, end) are read
+    if (end > 0xFFFFFFFFu / 32) fail("source patch range past 2^27 patches");
+    if (!s.indices && end > s.point_count / n)
+        fail("source.indices is 0, so patch s reads points " + std::to_string(n) + " s .. " + std::to_string(n) +
+             " s + " + std::to_string(n - 1) + ": source patches up to " + std::to_string(end) + " need " +
+             std::to_string(end * n) + " points, but point_count is " + std::to_string(s.point_count));
+    // The storage blocks' sizes: the driver's limit, and 32-bit indices in the shader.
+    if (context.max_storage_block < 0) glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &context.max_storage_block);
+    const std::size_t limit = std::min<std::size_t>(
+        context.max_storage_block > 0 ? static_cast<std::size_t>(context.max_storage_block) : 0xFFFFFFFFu, 0xFFFFFFFFu);
+    const auto check_block = [&](const char* what, GLuint buffer, std::size_t bytes) {
+        if (bytes > limit)
+            fail(std::string(what) + " reads end at byte " + std::to_string(bytes) +
+                 ", past GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + std::to_string(limit) + ")");
+        check_buffer_size(who, what, buffer, bytes);
+    };
+    if (s.point_count > limit || s.stride_bytes > limit)
+        fail("source.point_count (" + std::to_string(s.point_count) + ") or stride_bytes (" +
+             std::to_string(s.stride_bytes) + ") past GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + std::to_string(limit) +
+             ")");
+    check_block("vertex", s.vertices, s.offset_bytes + (s.point_count - 1) * s.stride_bytes + point_bytes);
+    if (s.indices) check_block("index", s.indices, s.indices_offset_bytes + end * n * sizeof(std::uint32_t));
+    if (s.boundary_masks) check_block("boundary-mask", s.boundary_masks, (s.masks_offset_bytes + end + 3) / 4 * 4);
+    check_patch_buffers(who, s.flag_buffers(), false);
+    params.vertex_base = static_cast<pp::uint>(s.offset_bytes / 4);
+    params.vertex_stride = static_cast<pp::uint>(s.stride_bytes / 4);
+    params.components = static_cast<pp::uint>(s.components);
+    params.point_count = static_cast<pp::uint>(s.point_count);
+    params.basis = static_cast<pp::uint>(s.basis);
+    params.has_indices = s.indices ? 1u : 0u;
+    params.index_base = static_cast<pp::uint>(s.indices_offset_bytes / 4);
+    params.has_masks = s.boundary_masks ? 1u : 0u;
+    params.mask_base = static_cast<pp::uint>(s.masks_offset_bytes);
+    params.patch_delta = static_cast<pp::uint>(s.source_first - s.first);  // mod 2^32
+    return params;
+}
+
+const char* patch_source_defines(const GpuPatchSource& source) {
+    return source.basis == PatchBasis::gregory ? "#define PC_PATCH_SOURCE 1\n#define PC_PATCH_SOURCE_GREGORY 1\n"
+                                               : "#define PC_PATCH_SOURCE 1\n";
+}
+
+void bind_patch_source(PassState& state, const GpuPatchSource& source, const pp::PatchSourceParams& params) {
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    bind_patch_buffers(source.flag_buffers());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingSourceVertices, source.vertices);
+    if (source.indices) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingSourceIndices, source.indices);
+    if (source.boundary_masks)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingSourceMasks, source.boundary_masks);
+    state.source_block.upload(params, shared::kUniformPatchSource);
 }
 
 void store_planes(const FrustumPlanes& planes, pp::vec4 clip_rows[4], pp::vec4 normal_length[2], pp::vec4& depth) {

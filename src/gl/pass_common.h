@@ -22,6 +22,7 @@ struct PassContext::Impl {
     bool fma_via_double = false;
     bool software = false;
     std::map<std::string, GLuint> programs;  // key: shader name + "\n" + defines
+    GLint64 max_storage_block = -1;          // GL_MAX_SHADER_STORAGE_BLOCK_SIZE, read on the first source run
     GLuint probe_in = 0, probe_out = 0;
     ~Impl();
     /// The program of compute shader `shader` with `defines` (lines "#define X 1\n"), plus
@@ -32,8 +33,9 @@ struct PassContext::Impl {
 namespace detail {
 
 /// Throws unless the buffers of `patches` exist and hold its range (control points 256 bytes per
-/// patch, flags and margins 4 bytes per patch). `who` starts the message.
-void check_patch_buffers(const char* who, const PatchBuffers& patches);
+/// patch, unless with_points is false: flags and margins only; flags and margins 4 bytes per
+/// patch). `who` starts the message.
+void check_patch_buffers(const char* who, const PatchBuffers& patches, bool with_points = true);
 /// Throws unless buffer is a buffer of at least bytes bytes.
 void check_buffer_size(const char* who, const char* what, GLuint buffer, std::size_t bytes);
 
@@ -46,10 +48,10 @@ public:
     ParamBlock(const ParamBlock&) = delete;
     ParamBlock& operator=(const ParamBlock&) = delete;
     template <class Params>
-    void upload(const Params& params) {
+    void upload(const Params& params, GLuint binding = shared::kUniformPassParams) {
         if (!buffer_) create(sizeof(Params));
         glNamedBufferSubData(buffer_, 0, sizeof(Params), &params);
-        glBindBufferBase(GL_UNIFORM_BUFFER, shared::kUniformPassParams, buffer_);
+        glBindBufferBase(GL_UNIFORM_BUFFER, binding, buffer_);
     }
 
 private:
@@ -57,12 +59,27 @@ private:
     GLuint buffer_ = 0;
 };
 
-/// What every pass keeps: its context's program cache and its parameter block.
+/// What every pass keeps: its context's program cache and its parameter block (and the
+/// patch-source block of the runs over a GpuPatchSource, created on the first).
 struct PassState {
     explicit PassState(PassContext::Impl& c) : context(c) {}
     PassContext::Impl& context;
     ParamBlock block;
+    ParamBlock source_block;
 };
+
+/// Throws (one line, starting with "GL: <who>: ") unless source is valid and its buffers hold
+/// what its range reads (gl_passes.h's GpuPatchSource); returns its parameter block.
+pp::PatchSourceParams check_patch_source(const char* who, PassContext::Impl& context, const GpuPatchSource& source);
+
+/// The defines of a pass's program over source: PC_PATCH_SOURCE, and PC_PATCH_SOURCE_GREGORY for
+/// a Gregory source.
+const char* patch_source_defines(const GpuPatchSource& source);
+
+/// Binds the chain's buffers of source (flags, margins when given) and its own (vertices,
+/// indices, masks), uploads params into state.source_block at kUniformPatchSource, and issues a
+/// storage barrier so that shader writes to the caller's buffers just before are seen.
+void bind_patch_source(PassState& state, const GpuPatchSource& source, const pp::PatchSourceParams& params);
 
 /// The rule for large ranges: a range of `count` patches, `patches_per_group` per work group, is
 /// covered by dispatches of at most 65535 work groups (the GL minimum of the x count); before

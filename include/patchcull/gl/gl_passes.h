@@ -27,6 +27,10 @@
 // - displacement ranges (DisplacedPass), shared.h's kBindingDisplacementRanges:
 //   vec2 range[n] = (d_min, d_max).
 // - counters (CullStatusPass::end), kBindingCullCounters: uint c[kCounterCount] (shared.h).
+// - or, instead of the control points, your own vertex buffer, index buffer and B-spline boundary
+//   masks (GpuPatchSource below: Bezier, B-spline and Gregory patches, e.g. an OpenSubdiv patch
+//   table in place), read at kBindingSourceVertices, kBindingSourceIndices, kBindingSourceMasks
+//   by FrustumPass, OcclusionPass and the back-patch passes.
 // Textures: a depth texture (HiZBuildPass input: the caller's depth attachment, no compare mode:
 // GL_DEPTH_COMPONENT32F, GL_DEPTH32F_STENCIL8, GL_DEPTH_COMPONENT24 or GL_DEPTH24_STENCIL8), and
 // the Hi-Z pyramid, an R32F mipmapped texture made by create_hiz_texture, holding hiz.h's depth
@@ -58,6 +62,10 @@
 // framebuffer, viewport, depth or VAO state), does not wait for the GPU and allocates no GL
 // objects after its first run (programs are compiled on first use and cached in the PassContext).
 // Large ranges are split into dispatches of at most 65535 work groups (dispatch_patches).
+// A run over a GpuPatchSource also binds the source's buffers and a second parameter block at
+// kUniformPatchSource, issues glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT) before its dispatches
+// (shader writes to your vertices just before are seen), and reads
+// GL_MAX_SHADER_STORAGE_BLOCK_SIZE once per PassContext.
 // GL errors: a run first checks that no GL error is pending (one left by the caller is reported
 // as "GL: error 0x.... pending before <pass> (left by an earlier GL call)", not blamed on the
 // pass) and checks again after its work ("GL: error 0x.... after <pass>"); glGetError is the
@@ -92,6 +100,7 @@
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/math.h"
+#include "patchcull/core/patch_source.h"
 
 namespace patchcull::gl {
 
@@ -154,6 +163,51 @@ struct PatchBuffers {
     std::size_t count = 0;
 };
 
+/// The caller's own control points in GL buffers, culled in place: the GPU twin of
+/// core/patch_source.h's PatchSourceView (its rules for points, index lists, the bases, B-spline
+/// boundary masks and Gregory patches hold here), with the flag range the passes write. Patches
+/// of one basis; an OpenSubdiv Far::PatchTable is one source per patch array (docs/ENGINE.md).
+///
+/// Buffers (the caller's; read as std430 shader storage from byte 0, so every byte offset and the
+/// stride are multiples of 4, and each buffer must fit GL_MAX_SHADER_STORAGE_BLOCK_SIZE):
+/// - vertices (required), bound at shared.h's kBindingSourceVertices and read as float[]: point
+///   i's x, y, z (and w) at byte offset_bytes + i * stride_bytes; 3 components (w = 1) or 4
+///   (homogeneous, w > 0). The buffer holds point_count points.
+/// - indices (optional), kBindingSourceIndices: uint per slot, source patch s's n slots (n = 16,
+///   20 for gregory) from byte indices_offset_bytes + 4 n s; 0: patch s reads points n s ..
+///   n s + n - 1. An index >= point_count is never read: the passes leave that patch unculled
+///   (they do not read indices back to check them; check_patch_source does on the CPU).
+/// - boundary_masks (optional, bspline only), kBindingSourceMasks: one byte per patch, OpenSubdiv's
+///   PatchParam::GetBoundary() (the low 4 bits are used), source patch s's at byte
+///   masks_offset_bytes + s; read as uint words, so the buffer holds whole words.
+/// Flag range: flags[first + i] and margins[first + i] (PatchBuffers' layouts) belong to source
+/// patch source_first + i, i < count. Decisions equal the CPU entries' (cull_frustum,
+/// cull_backpatch, cull_occlusion over the same PatchSourceView) bit for bit: the shaders gather
+/// each patch as gather_bezier does (shaders/patch_source.h) and run the passes' own tests on it.
+/// Gregory sources: the frustum and occlusion tests take all 20 points; the back-patch passes
+/// never cull them (they run nothing and leave the flags as they are).
+/// Not an aggregate (a braced list names a PatchBuffers): set the members by name.
+struct GpuPatchSource {
+    GpuPatchSource() = default;
+    std::uint32_t vertices = 0;    ///< required: the vertex buffer
+    std::size_t stride_bytes = 0;  ///< >= offset_bytes + 4 * components; a multiple of 4
+    std::size_t offset_bytes = 0;  ///< of x inside each vertex; a multiple of 4
+    int components = 3;            ///< 3: (x, y, z), w = 1; 4: homogeneous (w x, w y, w z, w)
+    std::size_t point_count = 0;   ///< points the vertex buffer holds (checked against its size)
+    PatchBasis basis = PatchBasis::bezier;
+    std::uint32_t indices = 0;             ///< optional: uint per slot (0: consecutive points)
+    std::size_t indices_offset_bytes = 0;  ///< where source patch 0's slots start; a multiple of 4
+    std::uint32_t boundary_masks = 0;      ///< optional, bspline only: a byte per patch (0: all interior)
+    std::size_t masks_offset_bytes = 0;    ///< where source patch 0's mask byte is
+    std::uint32_t flags = 0;               ///< required: uint per patch (PatchBuffers::flags)
+    std::uint32_t margins = 0;             ///< optional: float per patch (PatchBuffers::margins)
+    std::size_t first = 0;                 ///< the range [first, first + count) of flags and margins
+    std::size_t count = 0;
+    std::size_t source_first = 0;  ///< the source patch of flags[first]
+    /// The flag range as PatchBuffers without control points, for CullStatusPass::begin / end.
+    PatchBuffers flag_buffers() const { return {0, flags, margins, first, count}; }
+};
+
 /// A Hi-Z pyramid texture (create_hiz_texture) of a width x height depth buffer whose viewport
 /// was (0, 0, width, height).
 struct HiZTexture {
@@ -209,6 +263,12 @@ public:
     void run(const PatchBuffers& patches, const FrustumPlanes& planes, std::uint32_t plane_values = 0);
     /// The same on one view's CullView (view.planes).
     void run(const PatchBuffers& patches, const CullView& view, std::uint32_t plane_values = 0);
+    /// The same over a patch source: cull_frustum (core/patch_source.h) on the GPU, margins
+    /// included; plane_values at 6 (first + i) for the range's patch i. A Gregory patch is
+    /// culled when all 20 points lie outside one plane. Throws Error (one line) for a bad source
+    /// (check_patch_source's rules, the buffers' sizes; see GpuPatchSource).
+    void run(const GpuPatchSource& source, const FrustumPlanes& planes, std::uint32_t plane_values = 0);
+    void run(const GpuPatchSource& source, const CullView& view, std::uint32_t plane_values = 0);
 
 private:
     struct Impl;
@@ -262,6 +322,11 @@ public:
              bool with_frustum = true);
     /// The same on one view's CullView (view.object_to_clip in view.depth).
     void run(const PatchBuffers& patches, const CullView& view, const HiZTexture& hiz, bool with_frustum = true);
+    /// The same over a patch source: cull_occlusion (core/patch_source.h) on the GPU (a Gregory
+    /// patch over its 20 points, visible when one point's NDC coordinate is NaN).
+    void run(const GpuPatchSource& source, const Mat4& object_to_clip, ClipDepth depth, const HiZTexture& hiz,
+             bool with_frustum = true);
+    void run(const GpuPatchSource& source, const CullView& view, const HiZTexture& hiz, bool with_frustum = true);
 
 private:
     struct Impl;
@@ -279,6 +344,9 @@ public:
     /// patch; a tested patch p gets (axis.xyz, cos, sin, valid 1/0, sphere centre.xyz, radius, 0,
     /// 0) at 12p.
     void run(const PatchBuffers& patches, BackpatchMethod method, Vec3 eye, std::uint32_t cone_values = 0);
+    /// The same over a patch source (cull_backpatch of core/patch_source.h on the GPU); a
+    /// Gregory source is validated and nothing runs (never back-patch culled).
+    void run(const GpuPatchSource& source, BackpatchMethod method, Vec3 eye, std::uint32_t cone_values = 0);
 
 private:
     struct Impl;
@@ -298,6 +366,10 @@ public:
     /// control plane z values (times the orientation sign, backpatch_ptp.cpp) at 128p + 8 jv + iu and their
     /// 64 rounding-error margins at 128p + 64 + 8 jv + iu. Returns false when nothing ran.
     bool run(const PatchBuffers& patches, const Mat4& object_to_clip, float alpha, PtpRule rule,
+             std::uint32_t plane_values = 0);
+    /// The same over a patch source; a Gregory source is validated and nothing runs (returns
+    /// false: never back-patch culled).
+    bool run(const GpuPatchSource& source, const Mat4& object_to_clip, float alpha, PtpRule rule,
              std::uint32_t plane_values = 0);
 
 private:
@@ -369,7 +441,8 @@ public:
     CullStatusPass(CullStatusPass&&) noexcept;
     CullStatusPass& operator=(CullStatusPass&&) noexcept;
     ~CullStatusPass();
-    /// Clears the reason bits of the range (statuses kept).
+    /// Clears the reason bits of the range (statuses kept). The control points are not read
+    /// (patches.control_points may be 0: GpuPatchSource::flag_buffers()).
     void begin(const PatchBuffers& patches);
     /// Reasons -> statuses: a patch with no reason gets kStatusVisible (plus kStatusNewlyVisible
     /// when it lacked kStatusVisible), a culled one its reason alone. Adds the counts (shared.h's
