@@ -1,0 +1,714 @@
+// The GPU cull passes over the caller's own control points (GpuPatchSource of gl_passes.h,
+// shaders/patch_source.h) against the CPU entries over the same PatchSourceView or
+// OsdPatchTableSource (core/patch_source.h, import/osd_patch_table.h): the flag words equal the
+// CPU decisions patch for patch (FrustumPass <-> cull_frustum, OcclusionPass <-> cull_occlusion,
+// BackpatchConePass and BackpatchPtpPass <-> cull_backpatch), in every ClipDepth convention.
+// - OpenSubdiv tables: regression shapes with semi-sharp and infinitely sharp creases, corners,
+//   holes and boundaries, adaptively refined to levels 1-4 with Gregory-basis and B-spline-basis
+//   end caps, the vertex buffer float3 or float4 at odd strides and offsets; the table's index
+//   arrays and boundary masks uploaded once (GpuOsdTable below, the binding an engine writes).
+// - Plain sources: Bezier and B-spline patches (random boundary masks, phantom slots holding
+//   indices past the buffer) indexed into a shuffled float3 or rational float4 buffer, and
+//   consecutive points without indices, a few with NaN and infinite coordinates.
+// - An index past point_count leaves its patch unculled; each bad input is a one-line Error.
+#include <gtest/gtest.h>
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <opensubdiv/far/patchTable.h>
+#include <opensubdiv/far/patchTableFactory.h>
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/topologyRefiner.h>
+
+#include "gl_test_util.h"
+#include "import/osd_topology.h"
+#include "patchcull/core/backpatch_methods.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/cull_view.h"
+#include "patchcull/core/error.h"
+#include "patchcull/core/hiz.h"
+#include "patchcull/core/patch_source.h"
+#include "patchcull/gl/gl_passes.h"
+#include "patchcull/import/obj.h"
+#include "patchcull/import/osd_patch_table.h"
+
+using namespace patchcull;
+using namespace patchcull::gl;
+namespace Far = OpenSubdiv::Far;
+
+namespace {
+
+// ---- GL helpers --------------------------------------------------------------------------------
+
+// A GL buffer holding `bytes` bytes of data (zeros when data is null), deleted at scope end.
+class GlBuffer {
+public:
+    GlBuffer() = default;
+    GlBuffer(const void* data, std::size_t bytes) {
+        test::passes();
+        glCreateBuffers(1, &name_);
+        std::vector<std::uint8_t> zeros;
+        if (!data) {
+            zeros.assign(std::max<std::size_t>(bytes, 4), 0);
+            data = zeros.data();
+        }
+        glNamedBufferData(name_, static_cast<GLsizeiptr>(std::max<std::size_t>(bytes, 4)), data, GL_DYNAMIC_DRAW);
+    }
+    GlBuffer(GlBuffer&& o) noexcept : name_(std::exchange(o.name_, 0)) {}
+    GlBuffer& operator=(GlBuffer&& o) noexcept {
+        std::swap(name_, o.name_);
+        return *this;
+    }
+    ~GlBuffer() {
+        if (name_) glDeleteBuffers(1, &name_);
+    }
+    GLuint name() const { return name_; }
+
+private:
+    GLuint name_ = 0;
+};
+
+struct Passes {
+    FrustumPass frustum{test::passes()};
+    OcclusionPass occlusion{test::passes()};
+    BackpatchConePass cones{test::passes()};
+    BackpatchPtpPass ptp{test::passes()};
+    HiZBuildPass hiz_build{test::passes()};
+};
+
+Passes& gpu() {
+    static Passes p;
+    return p;
+}
+
+// ---- Subjects: CPU views and their GPU twins over one flag buffer --------------------------------
+
+struct Part {
+    PatchSourceView cpu;
+    GpuPatchSource gpu;  // flags [gpu.first, gpu.first + gpu.count)
+};
+
+struct Subject {
+    std::string name;
+    std::vector<Part> parts;
+    const OsdPatchTableSource* table = nullptr;  // the CPU decisions over the table when set
+    std::size_t patch_count = 0;
+    GlBuffer flags;
+    Vec3 centre{0, 0, 0};
+    float radius = 1;
+    std::vector<std::uint8_t> gregory;  // per patch
+};
+
+// An OsdPatchTableSource's arrays as GPU patch sources over the caller's vertex buffer: the
+// table's index arrays (in array order) and the boundary masks (a byte per table patch) uploaded
+// once; array a is a source of its own whose flags are the table's patches [first_patch,
+// first_patch + count) of one flag buffer.
+struct GpuOsdTable {
+    GlBuffer indices, masks;
+    std::vector<GpuPatchSource> arrays;
+
+    GpuOsdTable(const OsdPatchTableSource& table, GLuint vertices, const PointLayout& layout, GLuint flags) {
+        std::vector<std::uint32_t> all_indices;
+        std::vector<std::uint8_t> all_masks((table.patch_count() + 3) / 4 * 4, 0);
+        std::vector<std::size_t> index_offset;
+        for (const OsdPatchArraySource& a : table.arrays()) {
+            const std::size_t n = static_cast<std::size_t>(patch_source_points(a.source.basis)) * a.source.count;
+            index_offset.push_back(all_indices.size());
+            all_indices.insert(all_indices.end(), a.source.indices, a.source.indices + n);
+            if (a.source.boundary_mask)
+                std::copy(a.source.boundary_mask, a.source.boundary_mask + a.source.count,
+                          all_masks.begin() + static_cast<std::ptrdiff_t>(a.first_patch));
+        }
+        indices = GlBuffer(all_indices.data(), all_indices.size() * sizeof(std::uint32_t));
+        masks = GlBuffer(all_masks.data(), all_masks.size());
+        for (std::size_t i = 0; i < table.arrays().size(); ++i) {
+            const OsdPatchArraySource& a = table.arrays()[i];
+            GpuPatchSource s;
+            s.vertices = vertices;
+            s.stride_bytes = layout.stride_bytes;
+            s.offset_bytes = layout.offset_bytes;
+            s.components = layout.components;
+            s.point_count = layout.point_count;
+            s.basis = a.source.basis;
+            s.indices = indices.name();
+            s.indices_offset_bytes = index_offset[i] * sizeof(std::uint32_t);
+            if (a.source.boundary_mask) {
+                s.boundary_masks = masks.name();
+                s.masks_offset_bytes = a.first_patch;
+            }
+            s.flags = flags;
+            s.first = a.first_patch;
+            s.count = a.source.count;
+            s.source_first = 0;
+            arrays.push_back(s);
+        }
+    }
+};
+
+// ---- Views ------------------------------------------------------------------------------------
+
+constexpr int W = 64, H = 48;
+
+struct ViewCase {
+    CullView view;
+    HiZPyramid hiz;
+    HiZTexture gpu_hiz;
+    GLuint depth_texture = 0;
+    ViewCase() = default;
+    ViewCase(const ViewCase&) = delete;
+    ViewCase& operator=(const ViewCase&) = delete;
+    ~ViewCase() {
+        glDeleteTextures(1, &depth_texture);
+        glDeleteTextures(1, &gpu_hiz.texture);
+    }
+};
+
+// A random view of a subject in convention depth, from distances that put parts of it outside
+// the frustum (the far plane cuts through it), and a depth layer of random rectangles across its
+// depth range; the pyramid built on the CPU and on the GPU from the same depth buffer.
+void make_view(const Subject& s, std::mt19937& rng, ClipDepth depth, ViewCase& out) {
+    std::uniform_real_distribution<float> u(-1, 1), unit(0, 1);
+    Vec3 dir{u(rng), u(rng), u(rng)};
+    dir = normalize(dir + Vec3{0, 0, 1e-3f});
+    const float dist = s.radius * (0.4f + 2.6f * unit(rng));
+    const Vec3 eye = s.centre + dist * dir;
+    const Vec3 target = s.centre + (0.6f * s.radius) * Vec3{u(rng), u(rng), u(rng)};
+    const float fovy = 0.5f + 0.8f * unit(rng);
+    const float z_near = 0.02f * s.radius, z_far = dist + 0.8f * s.radius;
+    const Mat4 projection = perspective(fovy, float(W) / float(H), z_near, z_far, depth);
+    out.view = make_cull_view(look_at(eye, target, {0, 1, 0}), projection, depth, eye);
+
+    const bool reversed = is_reversed(depth);
+    std::vector<float> buffer(static_cast<std::size_t>(W) * H, reversed ? 0.0f : 1.0f);
+    const auto window_depth = [&](float distance) {
+        const Vec4 q = projection * Vec4{0, 0, -distance, 1};
+        const float d = q.z / q.w;
+        return depth == ClipDepth::minus_one_to_one ? 0.5f * d + 0.5f : d;
+    };
+    for (int r = 0; r < 6; ++r) {
+        const int x0 = static_cast<int>(unit(rng) * W), y0 = static_cast<int>(unit(rng) * H);
+        const int w = 1 + static_cast<int>(unit(rng) * W * 0.7f), h = 1 + static_cast<int>(unit(rng) * H * 0.7f);
+        const float z = window_depth(std::max(2.0f * z_near, dist + s.radius * (1.2f * unit(rng) - 0.9f)));
+        for (int y = y0; y < std::min(H, y0 + h); ++y)
+            for (int x = x0; x < std::min(W, x0 + w); ++x) {
+                float& d = buffer[static_cast<std::size_t>(y) * W + static_cast<std::size_t>(x)];
+                d = reversed ? std::max(d, z) : std::min(d, z);
+            }
+    }
+    out.hiz.build(buffer.data(), W, H, depth);
+    glCreateTextures(GL_TEXTURE_2D, 1, &out.depth_texture);
+    glTextureStorage2D(out.depth_texture, 1, GL_DEPTH_COMPONENT32F, W, H);
+    glTextureSubImage2D(out.depth_texture, 0, 0, 0, W, H, GL_DEPTH_COMPONENT, GL_FLOAT, buffer.data());
+    out.gpu_hiz = create_hiz_texture(W, H);
+    gpu().hiz_build.run(out.depth_texture, out.gpu_hiz, depth);
+}
+
+// ---- The comparison ---------------------------------------------------------------------------
+
+struct Tally {
+    std::size_t tested = 0, viewed = 0, frustum = 0, occluded = 0, back = 0, gregory_culled = 0;
+    int mismatches = 0;
+};
+
+// Clears the flags, runs `pass` on every part, reads the flag words back.
+std::vector<std::uint32_t> run_gpu(const Subject& s, const std::function<void(const GpuPatchSource&)>& pass) {
+    const std::uint32_t zero = 0;
+    glClearNamedBufferData(s.flags.name(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    for (const Part& p : s.parts) pass(p.gpu);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<std::uint32_t> flags(s.patch_count);
+    glGetNamedBufferSubData(s.flags.name(), 0, static_cast<GLsizeiptr>(flags.size() * 4), flags.data());
+    return flags;
+}
+
+// Expects flag word i to be want(i) for every patch.
+void expect_flags(const Subject& s, const char* what, ClipDepth depth, const std::vector<std::uint32_t>& got,
+                  const std::function<std::uint32_t(std::size_t)>& want, Tally& tally) {
+    for (std::size_t i = 0; i < s.patch_count; ++i) {
+        ++tally.tested;
+        const std::uint32_t w = want(i);
+        if (w != 0 && s.gregory[i]) ++tally.gregory_culled;
+        if (got[i] != w && ++tally.mismatches <= 8)
+            ADD_FAILURE() << s.name << ", " << what << ", " << clip_depth_name(depth) << ": patch " << i
+                          << (s.gregory[i] ? " (gregory)" : "") << " has flag word " << got[i] << ", the CPU says "
+                          << w;
+    }
+}
+
+void compare_view(const Subject& s, const ViewCase& vc, Tally& tally) {
+    const CullView& view = vc.view;
+    const std::size_t n = s.patch_count;
+    std::vector<std::uint8_t> cpu(n + 1, 0xAB);
+    // Flag words outside every part's range stay 0 (the CPU's 0 there too).
+    const auto for_parts = [&](const std::function<void(const PatchSourceView&, std::uint8_t*)>& entry) {
+        std::fill(cpu.begin(), cpu.end() - 1, 0);
+        for (const Part& p : s.parts) entry(p.cpu, cpu.data() + p.gpu.first);
+    };
+    tally.viewed += n;
+
+    // Frustum.
+    if (s.table) {
+        cull_frustum(*s.table, nullptr, view, cpu.data());
+    } else {
+        for_parts([&](const PatchSourceView& v, std::uint8_t* out) { cull_frustum(v, nullptr, view, out); });
+    }
+    EXPECT_EQ(cpu[n], 0xAB);
+    std::vector<std::uint32_t> got = run_gpu(s, [&](const GpuPatchSource& g) { gpu().frustum.run(g, view); });
+    expect_flags(
+        s, "frustum", view.depth, got, [&](std::size_t i) { return cpu[i] ? kCullFrustum : 0u; }, tally);
+    tally.frustum += static_cast<std::size_t>(std::count_if(cpu.begin(), cpu.end() - 1, [](auto c) { return c; }));
+
+    // Occlusion (with the frustum test first, as cull_occlusion).
+    if (s.table) {
+        cull_occlusion(*s.table, view, vc.hiz, cpu.data());
+    } else {
+        for_parts([&](const PatchSourceView& v, std::uint8_t* out) { cull_occlusion(v, view, vc.hiz, out); });
+    }
+    got = run_gpu(s, [&](const GpuPatchSource& g) { gpu().occlusion.run(g, view, vc.gpu_hiz); });
+    expect_flags(
+        s, "occlusion", view.depth, got,
+        [&](std::size_t i) {
+            return cpu[i] == kHiZFrustumCulled ? kCullFrustum : cpu[i] == kHiZOccluded ? kCullOcclusion : 0u;
+        },
+        tally);
+    tally.occluded += static_cast<std::size_t>(std::count(cpu.begin(), cpu.end() - 1, kHiZOccluded));
+
+    // Back-patch: tcone, ncone, ptp with both rules.
+    struct Method {
+        BackpatchMethod id;
+        PtpRule rule;
+        const char* name;
+    };
+    for (const Method& m : {Method{BackpatchMethod::tcone, PtpRule::ncnt, "tcone"},
+                            Method{BackpatchMethod::ncone, PtpRule::ncnt, "ncone"},
+                            Method{BackpatchMethod::ptp, PtpRule::ncnt, "ptp ncnt"},
+                            Method{BackpatchMethod::ptp, PtpRule::pcnt, "ptp pcnt"}}) {
+        BackpatchOptions options;
+        options.ptp_rule = m.rule;
+        if (s.table) {
+            cull_backpatch(m.id, *s.table, view, options, cpu.data());
+        } else {
+            for_parts(
+                [&](const PatchSourceView& v, std::uint8_t* out) { cull_backpatch(m.id, v, view, options, out); });
+        }
+        got = run_gpu(s, [&](const GpuPatchSource& g) {
+            if (m.id == BackpatchMethod::ptp) {
+                gpu().ptp.run(g, view.object_to_clip, view.alpha, m.rule);
+            } else {
+                gpu().cones.run(g, m.id, view.eye);
+            }
+        });
+        expect_flags(
+            s, m.name, view.depth, got, [&](std::size_t i) { return cpu[i] ? kCullBackPatch : 0u; }, tally);
+        tally.back += static_cast<std::size_t>(std::count_if(cpu.begin(), cpu.end() - 1, [](auto c) { return c; }));
+    }
+}
+
+// Views of the subject in every convention (views_per_depth of each).
+void compare_views(const Subject& s, std::mt19937& rng, int views_per_depth, Tally& tally) {
+    for (int v = 0; v < views_per_depth; ++v)
+        for (ClipDepth depth :
+             {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed, ClipDepth::reversed_infinite}) {
+            ViewCase vc;
+            make_view(s, rng, depth, vc);
+            compare_view(s, vc, tally);
+        }
+}
+
+// ---- OpenSubdiv tables --------------------------------------------------------------------------
+
+using EndCap = Far::PatchTableFactory::Options::EndCapType;
+constexpr EndCap kGregoryEnds = Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS;
+constexpr EndCap kBsplineEnds = Far::PatchTableFactory::Options::ENDCAP_BSPLINE_BASIS;
+
+struct D3 {
+    double x = 0, y = 0, z = 0;
+    void Clear(void* = nullptr) { x = y = z = 0; }
+    void AddWithWeight(const D3& p, double w) {
+        x += w * p.x;
+        y += w * p.y;
+        z += w * p.z;
+    }
+};
+
+// A table of shape (tests/data/opensubdiv) at level with the end caps given, and its vertex
+// buffer (every refined level, then the local points) in layout.
+struct OsdCase {
+    osd_detail::RefinerPtr refiner;
+    std::unique_ptr<const Far::PatchTable> table;
+    std::vector<unsigned char> bytes;
+    PointLayout layout;
+    OsdPatchTableSource source;
+    GlBuffer vertices;
+    std::unique_ptr<GpuOsdTable> gpu_table;
+    Subject subject;
+};
+
+std::unique_ptr<OsdCase> make_osd_case(const std::string& shape, int level, EndCap ends, int components,
+                                       std::size_t stride, std::size_t offset) {
+    auto c = std::make_unique<OsdCase>();
+    const ControlMesh mesh = load_obj(std::string(PATCHCULL_SOURCE_DIR) + "/tests/data/opensubdiv/" + shape + ".obj");
+    c->refiner = osd_detail::create_refiner(mesh);
+    Far::PatchTableFactory::Options options(level);
+    options.SetEndCapType(ends);
+    c->refiner->RefineAdaptive(options.GetRefineAdaptiveOptions());
+    c->table.reset(Far::PatchTableFactory::Create(*c->refiner, options));
+    const int refined = c->refiner->GetNumVerticesTotal();
+    std::vector<D3> all(static_cast<std::size_t>(refined + c->table->GetNumLocalPoints()));
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v)
+        all[v] = D3{mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z};
+    Far::PrimvarRefinerReal<double> primvar(*c->refiner);
+    D3* src = all.data();
+    for (int l = 1; l <= c->refiner->GetMaxLevel(); ++l) {
+        D3* dst = src + c->refiner->GetLevel(l - 1).GetNumVertices();
+        primvar.Interpolate(l, src, dst);
+        src = dst;
+    }
+    if (const auto* local = c->table->GetLocalPointStencilTable<float>())
+        local->UpdateValues(all.data(), all.data() + refined);
+    c->bytes.assign(all.size() * stride, 0xCD);  // padding: NaN-like garbage
+    Vec3 lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+    for (std::size_t i = 0; i < all.size(); ++i) {
+        const float xyzw[4] = {static_cast<float>(all[i].x), static_cast<float>(all[i].y), static_cast<float>(all[i].z),
+                               1.0f};
+        std::memcpy(c->bytes.data() + i * stride + offset, xyzw, static_cast<std::size_t>(components) * sizeof(float));
+        lo = {std::min(lo.x, xyzw[0]), std::min(lo.y, xyzw[1]), std::min(lo.z, xyzw[2])};
+        hi = {std::max(hi.x, xyzw[0]), std::max(hi.y, xyzw[1]), std::max(hi.z, xyzw[2])};
+    }
+    c->layout = PointLayout{c->bytes.data(), stride, offset, components, all.size()};
+    c->source = OsdPatchTableSource(*c->table, c->layout);
+    c->vertices = GlBuffer(c->bytes.data(), c->bytes.size());
+    Subject& s = c->subject;
+    s.name = shape + " level " + std::to_string(level) + (ends == kGregoryEnds ? ", gregory" : ", bspline") +
+             " ends, float" + std::to_string(components) + " stride " + std::to_string(stride);
+    s.patch_count = c->source.patch_count();
+    s.flags = GlBuffer(nullptr, s.patch_count * sizeof(std::uint32_t));
+    c->gpu_table = std::make_unique<GpuOsdTable>(c->source, c->vertices.name(), c->layout, s.flags.name());
+    s.table = &c->source;
+    s.gregory.assign(s.patch_count, 0);
+    for (std::size_t a = 0; a < c->source.arrays().size(); ++a) {
+        const OsdPatchArraySource& arr = c->source.arrays()[a];
+        s.parts.push_back({arr.source, c->gpu_table->arrays[a]});
+        if (arr.source.basis == PatchBasis::gregory)
+            std::fill_n(s.gregory.begin() + static_cast<std::ptrdiff_t>(arr.first_patch), arr.source.count, 1);
+    }
+    s.centre = 0.5f * (lo + hi);
+    s.radius = 0.5f * length(hi - lo);
+    return c;
+}
+
+// Every shape and level with both end caps, float3 and float4 alternating: one view per convention.
+void check_tables() {
+    const char* const shapes[] = {"catmark_chaikin1", "catmark_cubes_infsharp", "catmark_edgeonly",
+                                  "catmark_hole_test1"};
+    std::mt19937 rng(20261204);
+    Tally tally;
+    std::size_t gregory = 0, boundary = 0, tables = 0;
+    for (const char* shape : shapes)
+        for (int level = 1; level <= 4; ++level)
+            for (EndCap ends : {kGregoryEnds, kBsplineEnds}) {
+                const bool float4 = (level + (ends == kBsplineEnds)) % 2 == 1;
+                const auto c = make_osd_case(shape, level, ends, float4 ? 4 : 3, float4 ? 36 : 28, float4 ? 12 : 8);
+                for (const OsdPatchArraySource& a : c->source.arrays()) {
+                    if (a.source.basis == PatchBasis::gregory) gregory += a.source.count;
+                    if (a.source.boundary_mask)
+                        for (std::size_t p = 0; p < a.source.count; ++p) boundary += a.source.boundary_mask[p] != 0;
+                }
+                compare_views(c->subject, rng, 1, tally);
+                ++tables;
+                if (tally.mismatches > 8) break;
+            }
+    EXPECT_EQ(tally.mismatches, 0);
+    EXPECT_EQ(tables, 32u);
+    EXPECT_GT(gregory, 100u);
+    EXPECT_GT(boundary, 100u);
+    // The views cull a good fraction, Gregory end caps included: the comparison sees both answers.
+    EXPECT_GT(tally.frustum, tally.viewed / 20) << "frustum culls";
+    EXPECT_GT(tally.occluded, tally.viewed / 100) << "occlusion culls";
+    EXPECT_GT(tally.back, tally.viewed / 10) << "back-patch culls (the four methods together)";
+    EXPECT_GT(tally.gregory_culled, 10u);
+}
+
+// ---- Plain sources ----------------------------------------------------------------------------
+
+// Bezier and B-spline sources over the split teapot's control points, in a shuffled vertex buffer
+// with unused vertices between (indexed), and consecutive points (not indexed); float3 at stride 20
+// from byte 4, or homogeneous float4 with weights in [0.5, 2] at stride 24 from byte 8. A few
+// patches carry NaN or infinite coordinates.
+struct PlainCase {
+    std::vector<unsigned char> bytes;
+    std::vector<std::uint32_t> indices, bspline_indices;
+    std::vector<std::uint8_t> masks;
+    GlBuffer vertices, index_buffer, mask_buffer;
+    Subject subject;
+};
+
+std::unique_ptr<PlainCase> make_plain_case(int components, bool indexed, std::uint32_t seed) {
+    auto c = std::make_unique<PlainCase>();
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> unit(0, 1);
+    const std::vector<BezierPatch> patches = test::split_teapot(2);  // 512 patches
+    const std::size_t n = patches.size();
+    const std::size_t stride = components == 4 ? 24 : 20, offset = components == 4 ? 8 : 4;
+    // Points: patch p's point k is point 16 p + k, placed at slot perm[16 p + k] of a buffer
+    // twice as large (indexed) or at 16 p + k (not indexed).
+    const std::size_t points = indexed ? 32 * n : 16 * n;
+    std::vector<std::uint32_t> perm(points);
+    std::iota(perm.begin(), perm.end(), 0u);
+    if (indexed) std::shuffle(perm.begin(), perm.end(), rng);
+    c->bytes.assign(points * stride, 0x7F);
+    for (std::size_t p = 0; p < n; ++p)
+        for (int k = 0; k < 16; ++k) {
+            Vec4 q = patches[p].cp[k];
+            if (p % 97 == 5 && k == 6) q.y = std::numeric_limits<float>::quiet_NaN();
+            if (p % 97 == 11 && k == 9) q.x = std::numeric_limits<float>::infinity();
+            const float w = components == 4 ? std::exp2(2.0f * unit(rng) - 1.0f) : 1.0f;
+            const float xyzw[4] = {w * q.x, w * q.y, w * q.z, w};
+            const std::size_t at = perm[16 * p + static_cast<std::size_t>(k)];
+            std::memcpy(c->bytes.data() + at * stride + offset, xyzw, static_cast<std::size_t>(components) * 4);
+        }
+    const PointLayout layout{c->bytes.data(), stride, offset, components, points};
+    c->vertices = GlBuffer(c->bytes.data(), c->bytes.size());
+    Subject& s = c->subject;
+    s.name = std::string("teapot, float") + std::to_string(components) + (indexed ? ", indexed" : ", consecutive");
+    // Flags: the Bezier source's patches at [0, n), the B-spline source's at [n + 3, 2n + 3).
+    s.patch_count = 2 * n + 3;
+    s.flags = GlBuffer(nullptr, s.patch_count * sizeof(std::uint32_t));
+    s.gregory.assign(s.patch_count, 0);
+    if (indexed) {
+        c->indices.assign(perm.begin(), perm.begin() + static_cast<std::ptrdiff_t>(16 * n));
+        c->bspline_indices = c->indices;
+        c->masks.resize((n + 3) / 4 * 4);
+        for (std::size_t p = 0; p < n; ++p) {
+            c->masks[p] = static_cast<std::uint8_t>(p % 3 == 0 ? 0 : rng() % 16);
+            const std::uint32_t real = bspline_real_slots(c->masks[p]);
+            for (int k = 0; k < 16; ++k)  // phantom slots: never read
+                if (!((real >> k) & 1u))
+                    c->bspline_indices[16 * p + static_cast<std::size_t>(k)] = 0xFFFFFFF0u + p % 16;
+        }
+        // One index buffer: two patches of garbage, the B-spline source's indices (from byte
+        // 128), the Bezier source's (from byte 128 + 64 n); the masks after two bytes of garbage.
+        std::vector<std::uint32_t> gpu_indices(32, 0xFFFFFFFFu);
+        gpu_indices.insert(gpu_indices.end(), c->bspline_indices.begin(), c->bspline_indices.end());
+        gpu_indices.insert(gpu_indices.end(), c->indices.begin(), c->indices.end());
+        std::vector<std::uint8_t> gpu_masks(2, 0xFF);
+        gpu_masks.insert(gpu_masks.end(), c->masks.begin(), c->masks.end());
+        gpu_masks.resize((gpu_masks.size() + 3) / 4 * 4, 0xFF);
+        c->index_buffer = GlBuffer(gpu_indices.data(), gpu_indices.size() * 4);
+        c->mask_buffer = GlBuffer(gpu_masks.data(), gpu_masks.size());
+    }
+    for (PatchBasis basis : {PatchBasis::bezier, PatchBasis::bspline}) {
+        Part part;
+        part.cpu.points = layout;
+        part.cpu.count = n;
+        part.cpu.basis = basis;
+        GpuPatchSource& g = part.gpu;
+        g.vertices = c->vertices.name();
+        g.stride_bytes = stride;
+        g.offset_bytes = offset;
+        g.components = components;
+        g.point_count = points;
+        g.basis = basis;
+        g.flags = s.flags.name();
+        g.count = n;
+        if (basis == PatchBasis::bspline) {
+            g.first = n + 3;
+            g.source_first = 0;
+        }
+        if (indexed) {
+            part.cpu.indices = basis == PatchBasis::bspline ? c->bspline_indices.data() : c->indices.data();
+            g.indices = c->index_buffer.name();
+            g.indices_offset_bytes = 32 * 4 + (basis == PatchBasis::bspline ? 0 : 64 * n);
+            if (basis == PatchBasis::bspline) {
+                part.cpu.boundary_mask = c->masks.data();
+                g.boundary_masks = c->mask_buffer.name();
+                g.masks_offset_bytes = 2;
+            }
+        }
+        s.parts.push_back(part);
+    }
+    s.centre = {0, 0, 1.5f};
+    s.radius = 3.5f;
+    return c;
+}
+
+// float3 and float4, indexed and consecutive: one view per convention.
+void check_plain_sources() {
+    std::mt19937 rng(7);
+    Tally tally;
+    for (int components : {3, 4})
+        for (bool indexed : {true, false}) {
+            const auto c = make_plain_case(components, indexed, 100u + static_cast<std::uint32_t>(components));
+            compare_views(c->subject, rng, 1, tally);
+        }
+    EXPECT_EQ(tally.mismatches, 0);
+    EXPECT_GT(tally.frustum, 0u);
+    EXPECT_GT(tally.occluded, 0u);
+    EXPECT_GT(tally.back, 0u);
+}
+
+// One test, so that llvmpipe compiles the seven programs once (about 12 s without Mesa's shader
+// cache; the comparisons themselves take about 4 s on 2 cores).
+TEST(OsdPatchSourceGpu, TablesAndStridedSourcesMatchTheCpuPatchForPatch) {
+    check_plain_sources();
+    check_tables();
+}
+
+// A source patch whose index lies past point_count is never read: the passes leave it unculled
+// (the CPU entries refuse the view instead), and the other patches are culled as usual.
+TEST(OsdPatchSourceGpu, IndexPastThePointsLeavesThePatchUnculled) {
+    const std::vector<BezierPatch> patches = test::split_teapot(0);
+    std::vector<float> points;
+    for (const BezierPatch& b : patches)
+        for (const Vec4& q : b.cp) points.insert(points.end(), {q.x, q.y, q.z});
+    std::vector<std::uint32_t> indices(16 * patches.size());
+    std::iota(indices.begin(), indices.end(), 0u);
+    indices[16 * 3 + 5] = static_cast<std::uint32_t>(16 * patches.size());  // one past the points
+    const GlBuffer vertices(points.data(), points.size() * 4), index_buffer(indices.data(), indices.size() * 4);
+    Subject s;
+    s.patch_count = patches.size();
+    s.flags = GlBuffer(nullptr, patches.size() * 4);
+    GpuPatchSource g;
+    g.vertices = vertices.name();
+    g.stride_bytes = 12;
+    g.point_count = 16 * patches.size();
+    g.indices = index_buffer.name();
+    g.flags = s.flags.name();
+    g.count = patches.size();
+    s.parts.push_back({PatchSourceView{}, g});
+    // Looking away from the teapot: every readable patch is outside the frustum.
+    const CullView view =
+        make_cull_view(look_at({0, 0, 10}, {0, 0, 20}, {0, 1, 0}),
+                       perspective(0.8f, 1.0f, 0.1f, 100.0f, ClipDepth::zero_to_one), ClipDepth::zero_to_one);
+    const std::vector<std::uint32_t> got = run_gpu(s, [&](const GpuPatchSource& src) { gpu().frustum.run(src, view); });
+    for (std::size_t p = 0; p < patches.size(); ++p) EXPECT_EQ(got[p], p == 3 ? 0u : kCullFrustum) << "patch " << p;
+}
+
+// ---- Bad input --------------------------------------------------------------------------------
+
+// The message of what run() throws ("" when nothing): one line.
+std::string error_of(const std::function<void()>& run) {
+    try {
+        run();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(OsdPatchSourceGpu, BadSourcesAreOneLineErrors) {
+    std::vector<float> points(16 * 4 * 2, 0.5f);
+    const GlBuffer vertices(points.data(), points.size() * 4);  // 32 float4 points, 512 bytes
+    std::vector<std::uint32_t> indices(32, 0);
+    const GlBuffer index_buffer(indices.data(), indices.size() * 4);
+    const GlBuffer small(nullptr, 8), flags(nullptr, 8), masks(nullptr, 4);
+    const auto good = [&] {
+        GpuPatchSource g;
+        g.vertices = vertices.name();
+        g.stride_bytes = 16;
+        g.components = 4;
+        g.point_count = 32;
+        g.flags = flags.name();
+        g.count = 2;
+        return g;
+    };
+    const CullView view =
+        make_cull_view(look_at({0, 0, 5}, {0, 0, 0}, {0, 1, 0}),
+                       perspective(0.8f, 1.0f, 0.1f, 100.0f, ClipDepth::zero_to_one), ClipDepth::zero_to_one);
+    const auto frustum_error = [&](const GpuPatchSource& g) { return error_of([&] { gpu().frustum.run(g, view); }); };
+    EXPECT_EQ(frustum_error(good()), "");
+
+    struct Bad {
+        std::function<void(GpuPatchSource&)> change;
+        const char* says;
+    };
+    const Bad bad[] = {
+        {[](GpuPatchSource& g) { g.components = 5; }, "source.components is 5"},
+        {[](GpuPatchSource& g) { g.stride_bytes = 18; }, "multiples of 4"},
+        {[](GpuPatchSource& g) { g.offset_bytes = 2; }, "multiples of 4"},
+        {[](GpuPatchSource& g) { g.stride_bytes = 12; }, "a point must lie inside its vertex"},
+        {[](GpuPatchSource& g) { g.basis = static_cast<PatchBasis>(7); }, "unknown source.basis 7"},
+        {[&](GpuPatchSource& g) { g.boundary_masks = masks.name(); }, "boundary_masks is for bspline sources only"},
+        {[&](GpuPatchSource& g) {
+             g.basis = PatchBasis::gregory;
+             g.boundary_masks = masks.name();
+         },
+         "the basis is gregory"},
+        {[](GpuPatchSource& g) { g.point_count = 31; }, "need 32 points, but point_count is 31"},
+        {[](GpuPatchSource& g) { g.point_count = 0; }, "source.point_count is 0"},
+        {[](GpuPatchSource& g) { g.basis = PatchBasis::gregory; }, "need 40 points"},
+        {[&](GpuPatchSource& g) { g.vertices = small.name(); }, "vertex buffer of 8 bytes, 512 needed"},
+        {[](GpuPatchSource& g) { g.vertices = 0; }, "vertex 0 is not a buffer"},
+        {[&](GpuPatchSource& g) {
+             g.indices = index_buffer.name();
+             g.indices_offset_bytes = 8;
+         },
+         "index buffer of 128 bytes, 136 needed"},
+        {[&](GpuPatchSource& g) {
+             g.indices = index_buffer.name();
+             g.indices_offset_bytes = 2;
+         },
+         "indices_offset_bytes is 2, not a multiple of 4"},
+        {[&](GpuPatchSource& g) {
+             g.basis = PatchBasis::bspline;
+             g.boundary_masks = masks.name();
+             g.masks_offset_bytes = 3;
+         },
+         "boundary-mask buffer of 4 bytes, 8 needed"},
+        {[&](GpuPatchSource& g) { g.first = 1; }, "flag buffer of 8 bytes, 12 needed"},
+        {[&](GpuPatchSource& g) {
+             g.flags = index_buffer.name();
+             g.margins = small.name();
+             g.first = 1;
+         },
+         "margin buffer of 8 bytes, 12 needed"},
+        {[](GpuPatchSource& g) { g.source_first = 1; }, "need 48 points"},
+    };
+    for (const Bad& b : bad) {
+        GpuPatchSource g = good();
+        b.change(g);
+        const std::string e = frustum_error(g);
+        EXPECT_NE(e.find(b.says), std::string::npos) << "got: " << e << "\nwanted: " << b.says;
+        EXPECT_EQ(e.rfind("GL: FrustumPass: ", 0), 0u) << e;
+        EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    }
+    // The other passes check alike, before anything runs.
+    GpuPatchSource g = good();
+    g.boundary_masks = masks.name();
+    HiZTexture hiz = create_hiz_texture(8, 8);
+    EXPECT_NE(error_of([&] { gpu().occlusion.run(g, view, hiz); }).find("GL: OcclusionPass: source.boundary_masks"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] {
+                  gpu().cones.run(g, BackpatchMethod::tcone, view.eye);
+              }).find("GL: BackpatchConePass: source.boundary_masks"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] {
+                  gpu().ptp.run(g, view.object_to_clip, view.alpha, PtpRule::ncnt);
+              }).find("GL: BackpatchPtpPass: source.boundary_masks"),
+              std::string::npos);
+    glDeleteTextures(1, &hiz.texture);
+    // A Gregory source is never back-patch culled: validated, nothing runs.
+    g = good();
+    g.basis = PatchBasis::gregory;
+    g.count = 1;
+    EXPECT_FALSE(gpu().ptp.run(g, view.object_to_clip, view.alpha, PtpRule::ncnt));
+    EXPECT_EQ(error_of([&] { gpu().cones.run(g, BackpatchMethod::ncone, view.eye); }), "");
+    // An empty range reads nothing and checks nothing.
+    GpuPatchSource empty;
+    EXPECT_EQ(error_of([&] { gpu().frustum.run(empty, view); }), "");
+}
+
+}  // namespace
