@@ -16,6 +16,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -33,12 +34,14 @@
 #include <opensubdiv/far/primvarRefiner.h>
 #include <opensubdiv/far/topologyRefiner.h>
 
+#include "core/ptp_internal.h"
 #include "gl_test_util.h"
 #include "import/osd_topology.h"
 #include "patchcull/core/backpatch_methods.h"
 #include "patchcull/core/clip_space.h"
 #include "patchcull/core/cull_view.h"
 #include "patchcull/core/error.h"
+#include "patchcull/core/frustum.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/patch_source.h"
 #include "patchcull/gl/gl_passes.h"
@@ -248,6 +251,81 @@ void expect_flags(const Subject& s, const char* what, ClipDepth depth, const std
     }
 }
 
+std::vector<float> read_floats(const GlBuffer& buffer, std::size_t count) {
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    std::vector<float> out(count);
+    glGetNamedBufferSubData(buffer.name(), 0, static_cast<GLsizeiptr>(count * sizeof(float)), out.data());
+    return out;
+}
+
+bool same_float(float a, float b) {
+    return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b) || (std::isnan(a) && std::isnan(b));
+}
+
+// The points the CPU reads for patch i of a source: source_bezier_patch's 16 (Bezier and B-spline),
+// or a Gregory patch's 20 as stored.
+std::vector<Vec4> cpu_points(const PatchSourceView& v, std::size_t i) {
+    std::vector<Vec4> out;
+    if (v.basis != PatchBasis::gregory) {
+        const BezierPatch b = source_bezier_patch(v, i);
+        out.assign(std::begin(b.cp), std::end(b.cp));
+        return out;
+    }
+    for (std::size_t k = 0; k < 20; ++k) {
+        const std::size_t index = v.indices ? v.indices[20 * i + k] : 20 * i + k;
+        float q[4] = {0, 0, 0, 1};
+        std::memcpy(q, static_cast<const char*>(v.points.data) + v.points.offset_bytes + index * v.points.stride_bytes,
+                    static_cast<std::size_t>(v.points.components) * sizeof(float));
+        out.push_back({q[0], q[1], q[2], q[3]});
+    }
+    return out;
+}
+
+// The gathered points, bit for bit, through the frustum pass's diagnostics: the six plane maxima
+// of every patch equal FrustumVerdict's over the CPU's points.
+void expect_gathered_points(const Subject& s, const CullView& view, const std::vector<float>& got, Tally& tally) {
+    for (const Part& part : s.parts)
+        for (std::size_t i = 0; i < part.gpu.count; ++i) {
+            FrustumVerdict verdict;
+            for (const Vec4& q : cpu_points(part.cpu, i)) {
+                float v[6];
+                frustum_plane_values(view.planes, q.x, q.y, q.z, q.w, v);
+                verdict.add(v);
+            }
+            const std::size_t p = part.gpu.first + i;
+            for (int q = 0; q < 6; ++q)
+                if (!same_float(got[6 * p + static_cast<std::size_t>(q)], verdict.max[q]) && ++tally.mismatches <= 8)
+                    ADD_FAILURE() << s.name << ", " << clip_depth_name(view.depth) << ": patch " << p
+                                  << (s.gregory[p] ? " (gregory)" : "") << ", plane " << q << ": the GPU's maximum "
+                                  << got[6 * p + static_cast<std::size_t>(q)] << ", the CPU's " << verdict.max[q];
+        }
+}
+
+// The same through ptp's diagnostics: every control plane value t (a sum over all 16 points) and
+// margin, bit for bit (Bezier and B-spline parts).
+void expect_ptp_planes(const Subject& s, const CullView& view, const std::vector<float>& got, Tally& tally) {
+    ptp_detail::PtpClipRows rows;
+    if (!ptp_detail::ptp_clip_rows(view.object_to_clip, view.alpha, rows)) return;
+    for (const Part& part : s.parts) {
+        if (part.cpu.basis == PatchBasis::gregory) continue;
+        for (std::size_t i = 0; i < part.gpu.count; ++i) {
+            const BezierPatch b = source_bezier_patch(part.cpu, i);
+            float t[64], thr[64];
+            ptp_detail::ptp_control_planes_z(b, rows, t);
+            const bool finite = ptp_detail::ptp_rounding_margins(b, rows, thr);
+            const std::size_t p = part.gpu.first + i;
+            for (std::size_t k = 0; k < 64; ++k) {
+                const bool same =
+                    same_float(got[128 * p + k], t[k]) && (!finite || same_float(got[128 * p + 64 + k], thr[k]));
+                if (!same && ++tally.mismatches <= 8)
+                    ADD_FAILURE() << s.name << ", " << clip_depth_name(view.depth) << ": patch " << p << ", ptp t[" << k
+                                  << "]: the GPU's " << got[128 * p + k] << " (margin " << got[128 * p + 64 + k]
+                                  << "), the CPU's " << t[k] << " (margin " << thr[k] << ")";
+            }
+        }
+    }
+}
+
 void compare_view(const Subject& s, const ViewCase& vc, Tally& tally) {
     const CullView& view = vc.view;
     const std::size_t n = s.patch_count;
@@ -266,7 +344,10 @@ void compare_view(const Subject& s, const ViewCase& vc, Tally& tally) {
         for_parts([&](const PatchSourceView& v, std::uint8_t* out) { cull_frustum(v, nullptr, view, out); });
     }
     EXPECT_EQ(cpu[n], 0xAB);
-    std::vector<std::uint32_t> got = run_gpu(s, [&](const GpuPatchSource& g) { gpu().frustum.run(g, view); });
+    const GlBuffer plane_values(nullptr, 6 * n * sizeof(float));
+    std::vector<std::uint32_t> got =
+        run_gpu(s, [&](const GpuPatchSource& g) { gpu().frustum.run(g, view, plane_values.name()); });
+    expect_gathered_points(s, view, read_floats(plane_values, 6 * n), tally);
     expect_flags(
         s, "frustum", view.depth, got, [&](std::size_t i) { return cpu[i] ? kCullFrustum : 0u; }, tally);
     tally.frustum += static_cast<std::size_t>(std::count_if(cpu.begin(), cpu.end() - 1, [](auto c) { return c; }));
@@ -304,15 +385,18 @@ void compare_view(const Subject& s, const ViewCase& vc, Tally& tally) {
             for_parts(
                 [&](const PatchSourceView& v, std::uint8_t* out) { cull_backpatch(m.id, v, view, options, out); });
         }
+        const bool with_planes = m.id == BackpatchMethod::ptp && m.rule == PtpRule::ncnt;
+        const GlBuffer ptp_planes(nullptr, with_planes ? 128 * n * sizeof(float) : 4);
         got = run_gpu(s, [&](const GpuPatchSource& g) {
             if (m.id == BackpatchMethod::ptp) {
-                gpu().ptp.run(g, view.object_to_clip, view.alpha, m.rule);
+                gpu().ptp.run(g, view.object_to_clip, view.alpha, m.rule, with_planes ? ptp_planes.name() : 0);
             } else {
                 gpu().cones.run(g, m.id, view.eye);
             }
         });
         expect_flags(
             s, m.name, view.depth, got, [&](std::size_t i) { return cpu[i] ? kCullBackPatch : 0u; }, tally);
+        if (with_planes) expect_ptp_planes(s, view, read_floats(ptp_planes, 128 * n), tally);
         tally.back += static_cast<std::size_t>(std::count_if(cpu.begin(), cpu.end() - 1, [](auto c) { return c; }));
     }
 }
