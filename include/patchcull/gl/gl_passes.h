@@ -183,7 +183,8 @@ struct PatchBuffers {
 /// Flag range: flags[first + i] and margins[first + i] (PatchBuffers' layouts) belong to source
 /// patch source_first + i, i < count. Decisions equal the CPU entries' (cull_frustum,
 /// cull_backpatch, cull_occlusion over the same PatchSourceView) bit for bit: the shaders gather
-/// each patch as gather_bezier does (shaders/patch_source.h) and run the passes' own tests on it.
+/// each patch as gather_bezier does (shaders/patch_source.h) and run the passes' own tests on it
+/// (subnormal coordinates excepted: GPUs and llvmpipe flush them to zero, gl_backpatch.h (1)).
 /// Gregory sources: the frustum and occlusion tests take all 20 points; the back-patch passes
 /// never cull them (they run nothing and leave the flags as they are).
 /// Not an aggregate (a braced list names a PatchBuffers): set the members by name.
