@@ -1,5 +1,8 @@
-// Shared by the ptp kernels (backpatch_ptp.cpp, backpatch_ptp_simd.cpp); private to patchcull.
+// Shared by the ptp kernels (backpatch_ptp.cpp, backpatch_ptp_simd.cpp, backpatch_ptp_pcnt_simd.cpp);
+// private to patchcull.
 #pragma once
+
+#include <cstdint>
 
 #include "patchcull/core/math.h"
 #include "patchcull/core/patch.h"
@@ -22,5 +25,9 @@ void ptp_control_planes_z(const BezierPatch& patch, const PtpClipRows& rows, flo
 /// The scalar kernel's rounding-error margins thr[64] >= |t - exact t| of one patch (ptp_schedule.h,
 /// "Rounding-error margin"); false (thr unspecified) when a coordinate is not finite (kept).
 bool ptp_rounding_margins(const BezierPatch& patch, const PtpClipRows& rows, float thr[64]);
+
+/// The SIMD kernel's pcnt rule (backpatch_ptp_pcnt_simd.cpp) on rows from ptp_clip_rows: culled[i]
+/// as cull_ptp_simd with PtpRule::pcnt writes it.
+void cull_ptp_pcnt_simd(const PatchBatchView& patches, const PtpClipRows& rows, std::uint8_t* culled);
 
 }  // namespace patchcull::ptp_detail

@@ -1,5 +1,5 @@
 // Per-target building blocks shared by the Highway SIMD kernels (frustum_simd.cpp,
-// backpatch_cones_simd.cpp, backpatch_ptp_simd.cpp, hiz_simd.cpp); private to patchcull.
+// backpatch_cones_simd.cpp, backpatch_ptp_simd-inl.h, fused_cull_simd.cpp); private to patchcull.
 //
 // Lanes are patches: lane j of a vector holds patch i + j, loaded straight from a PatchBatchView's
 // arrays (unaligned loads, so plain subranges at any offset work), in either layout (GroupAt): a
