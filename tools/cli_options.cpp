@@ -1,4 +1,6 @@
 // Strict option values and output-path checks shared by the CLI's commands (cli_options.h).
+#include <CLI/CLI.hpp>
+
 #include "cli_options.h"
 
 #include <fcntl.h>

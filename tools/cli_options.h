@@ -9,7 +9,7 @@
 // path costs no render and never surfaces as a filesystem exception afterwards.
 #pragma once
 
-#include <CLI/CLI.hpp>
+#include "cli_fwd.h"
 
 #include "patchcull/core/clip_space.h"
 

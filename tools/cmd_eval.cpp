@@ -21,6 +21,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <CLI/CLI.hpp>
+
 #include "cli_options.h"
 #include "commands.h"
 #include "eval/eval_displaced.h"

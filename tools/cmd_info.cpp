@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <CLI/CLI.hpp>
+
 #include "commands.h"
 
 namespace patchcull::cli {

@@ -64,6 +64,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <CLI/CLI.hpp>
+
 #include "cli_options.h"
 #include "commands.h"
 #include "cull_mode_names.h"

@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <memory>
 
+#include <CLI/CLI.hpp>
+
 #include "cli_options.h"
 #include "commands.h"
 #include "cull_mode_names.h"

@@ -2,7 +2,7 @@
 // runs it after parsing. Commands use only the public headers (include/patchcull).
 #pragma once
 
-#include <CLI/CLI.hpp>
+#include "cli_fwd.h"
 
 #include <functional>
 #include <string>

@@ -6,6 +6,8 @@
 #include <iostream>
 #include <string>
 
+#include <CLI/CLI.hpp>
+
 #include "cli_options.h"
 #include "commands.h"
 #include "patchcull/core/error.h"

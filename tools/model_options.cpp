@@ -2,6 +2,8 @@
 #include <cmath>
 #include <iostream>
 
+#include <CLI/CLI.hpp>
+
 #include "cli_options.h"
 #include "commands.h"
 #include "patchcull/core/error.h"

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_fwd.h"
 #include "patchcull/gl/gl_object_queries.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/import/scene_object_level.h"

@@ -1,5 +1,7 @@
 // The tessellation and displacement options of `render` and `view` (render_options.h), and
 // parse_size (commands.h).
+#include <CLI/CLI.hpp>
+
 #include "render_options.h"
 
 #include <cmath>

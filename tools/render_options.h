@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "cli_fwd.h"
 #include "patchcull/core/displaced_bounds.h"
 #include "patchcull/gl/gl_renderer.h"
 #include "patchcull/import/scene_model.h"
