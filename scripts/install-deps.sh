@@ -5,7 +5,7 @@ set -euo pipefail
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 PACKAGES=(
-  g++ cmake make pkg-config
+  g++ cmake make ninja-build pkg-config  # scripts/test.sh builds with Ninja
   libegl-dev libgl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libepoxy-dev glslang-tools
   libosd-dev libstb-dev libtbb-dev libhwy-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
