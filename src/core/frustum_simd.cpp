@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 
+#include "core/patch_source_internal.h"
 #include "patchcull/core/frustum.h"
 
 #undef HWY_TARGET_INCLUDE
@@ -190,6 +191,14 @@ void cull_frustum_disp_simd(const PatchBatchView& patches, const float* max_disp
     if (patches.count == 0) return;
     HWY_DYNAMIC_DISPATCH(CullFrustumDisp)(patches, max_displacement, planes, culled);
 }
+
+namespace detail {
+void cull_frustum_disp_simd_planes(const PatchBatchView& patches, const float* max_displacement,
+                                   const FrustumPlanes& planes, std::uint8_t* culled) {
+    if (patches.count == 0) return;
+    HWY_DYNAMIC_DISPATCH(CullFrustumDisp)(patches, max_displacement, planes, culled);
+}
+}  // namespace detail
 
 const char* simd_target_name() { return HWY_DYNAMIC_DISPATCH(TargetName)(); }
 

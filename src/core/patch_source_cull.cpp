@@ -1,10 +1,15 @@
 // The cull kernels over a PatchSourceView (patchcull/core/patch_source.h): Bezier and B-spline
 // sources are gathered 16 patches at a time into a stack block and run through the batch kernels;
-// Gregory sources take the scalar 20-point path below.
+// Gregory sources take the scalar 20-point path below. Each entry checks its inputs once, then
+// runs the unchecked range function of core/patch_source_internal.h (which the parallel entries
+// run per range).
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
 
+#include "core/patch_source_internal.h"
+#include "patchcull/core/error.h"
 #include "patchcull/core/fused_cull.h"
 #include "patchcull/core/patch_source.h"
 
@@ -14,13 +19,13 @@ namespace {
 
 constexpr int kGregoryPoints = 20;
 
-// Calls body(block view, first) for every block of kBlockPatches patches of a Bezier or B-spline
-// source, gathered into one 4 KiB stack block.
+// Calls body(block view, first) for every block of kBlockPatches patches of source patches
+// [begin, end) of a Bezier or B-spline source, gathered into one 4 KiB stack block.
 template <class Body>
-void for_each_block(const PatchSourceView& source, const Body& body) {
+void for_each_block(const PatchSourceView& source, std::size_t begin, std::size_t end, const Body& body) {
     alignas(64) float block[kBlockFloats];
-    for (std::size_t first = 0; first < source.count; first += kBlockPatches) {
-        const std::size_t n = std::min(kBlockPatches, source.count - first);
+    for (std::size_t first = begin; first < end; first += kBlockPatches) {
+        const std::size_t n = std::min(kBlockPatches, end - first);
         gather_bezier(source, first, n, block);
         body(PatchBatchView{block, n, kBlockPatches, kBlockFloats}, first);
     }
@@ -48,6 +53,56 @@ bool gregory_frustum_culled(const FrustumPlanes& planes, const float pts[kGregor
         verdict.add(v);
     }
     return verdict.culled(planes);
+}
+
+// cull_frustum_disp_scalar's test (frustum.cpp) on the box of the 20 Cartesian points grown by d,
+// operation by operation: X / W, min / max as `a < b ? a : b`, the 8 corners' clip rows as nested
+// fmas, the plane values and their maxima, the probe over the raw coordinates.
+bool gregory_frustum_disp_culled(const FrustumPlanes& planes, const float pts[kGregoryPoints][4], float d) {
+    float lo[3] = {}, hi[3] = {};
+    float probe = 0;
+    for (int k = 0; k < kGregoryPoints; ++k) {
+        const float W = pts[k][3];
+        for (int a = 0; a < 4; ++a) probe = std::fma(pts[k][a], 0.0f, probe);
+        for (int a = 0; a < 3; ++a) {
+            const float v = pts[k][a] / W;
+            lo[a] = k == 0 ? v : (lo[a] < v ? lo[a] : v);
+            hi[a] = k == 0 ? v : (hi[a] > v ? hi[a] : v);
+        }
+    }
+    float box[3][2];
+    for (int a = 0; a < 3; ++a) {
+        box[a][0] = lo[a] - d;
+        box[a][1] = hi[a] + d;
+    }
+    float clip[4][8];  // corner i*4 + j*2 + s: x from box[0][i], y from box[1][j], z from box[2][s]
+    for (int r = 0; r < 4; ++r) {
+        const Vec4 m = planes.clip_rows[r];
+        float tz[2], tyz[4];
+        for (int s = 0; s < 2; ++s) tz[s] = std::fma(m.z, box[2][s], m.w);
+        for (int j = 0; j < 2; ++j)
+            for (int s = 0; s < 2; ++s) tyz[j * 2 + s] = std::fma(m.y, box[1][j], tz[s]);
+        for (int i = 0; i < 2; ++i)
+            for (int js = 0; js < 4; ++js) clip[r][i * 4 + js] = std::fma(m.x, box[0][i], tyz[js]);
+    }
+    const auto plane_values = [&](int corner, float v[6]) {
+        const float cx = clip[0][corner], cy = clip[1][corner], cz = clip[2][corner], cw = clip[3][corner];
+        v[0] = cw + cx;
+        v[1] = cw - cx;
+        v[2] = cw + cy;
+        v[3] = cw - cy;
+        v[4] = cz + planes.near_w * cw;
+        v[5] = planes.far_w * cw - cz;
+    };
+    float mx[6], v[6];
+    plane_values(0, mx);
+    for (int corner = 1; corner < 8; ++corner) {
+        plane_values(corner, v);
+        for (int q = 0; q < 6; ++q) mx[q] = mx[q] > v[q] ? mx[q] : v[q];
+    }
+    bool out = mx[5] < planes.far_limit;
+    for (int q = 0; q < 5; ++q) out |= mx[q] < 0.0f;
+    return out && probe == 0.0f;
 }
 
 // hiz.h's steps 2-9 over the 20 points: true when the pyramid hides them all. The clip rows are
@@ -88,60 +143,124 @@ bool gregory_occluded(const FrustumPlanes& planes, const HiZPyramid& hiz, const 
 
 }  // namespace
 
-void cull_frustum(const PatchSourceView& source, const float* max_displacement, const CullView& view,
-                  std::uint8_t* culled) {
-    check_patch_source(source, "cull_frustum");
+namespace detail {
+
+void source_frustum(const PatchSourceView& source, std::size_t first, std::size_t last, const float* max_displacement,
+                    const FrustumPlanes& planes, std::uint8_t* culled) {
     if (source.basis == PatchBasis::gregory) {
         float pts[kGregoryPoints][4];
-        for (std::size_t p = 0; p < source.count; ++p) {
+        for (std::size_t p = first; p < last; ++p) {
             gregory_points(source, p, pts);
-            culled[p] = gregory_frustum_culled(view.planes, pts, max_displacement ? max_displacement + p : nullptr);
+            culled[p] = gregory_frustum_culled(planes, pts, max_displacement ? max_displacement + p : nullptr);
         }
         return;
     }
-    for_each_block(source, [&](const PatchBatchView& block, std::size_t first) {
-        cull_frustum_simd(block, max_displacement ? max_displacement + first : nullptr, view.planes, culled + first);
+    for_each_block(source, first, last, [&](const PatchBatchView& block, std::size_t f) {
+        cull_frustum_simd(block, max_displacement ? max_displacement + f : nullptr, planes, culled + f);
     });
+}
+
+void source_frustum_disp(const PatchSourceView& source, std::size_t first, std::size_t last,
+                         const float* max_displacement, const FrustumPlanes& planes, std::uint8_t* culled) {
+    if (source.basis == PatchBasis::gregory) {
+        float pts[kGregoryPoints][4];
+        for (std::size_t p = first; p < last; ++p) {
+            gregory_points(source, p, pts);
+            culled[p] = gregory_frustum_disp_culled(planes, pts, max_displacement ? max_displacement[p] : 0.0f);
+        }
+        return;
+    }
+    for_each_block(source, first, last, [&](const PatchBatchView& block, std::size_t f) {
+        cull_frustum_disp_simd_planes(block, max_displacement ? max_displacement + f : nullptr, planes, culled + f);
+    });
+}
+
+void source_backpatch(BackpatchKernel kernel, const PatchSourceView& source, std::size_t first, std::size_t last,
+                      const CullView& view, const BackpatchOptions& options, std::uint8_t* culled) {
+    if (source.basis == PatchBasis::gregory) {
+        if (last > first) std::memset(culled + first, 0, last - first);
+        return;
+    }
+    for_each_block(source, first, last,
+                   [&](const PatchBatchView& block, std::size_t f) { kernel(block, view, options, culled + f); });
+}
+
+void source_fused(const PatchSourceView& source, std::size_t first, std::size_t last, const FusedCullSetup& setup,
+                  const FusedPlan& plan, std::uint8_t* decision, FusedCullStats* stats) {
+    if (source.basis == PatchBasis::gregory) {
+        float pts[kGregoryPoints][4];
+        for (std::size_t p = first; p < last; ++p) {
+            gregory_points(source, p, pts);
+            std::uint8_t d = kFusedVisible;
+            for (int pos = 0; pos < plan.count && d == kFusedVisible; ++pos) {
+                if (stats) ++stats->groups_entered[pos];
+                const FusedStage stage = plan.stages[pos];
+                if (stage == FusedStage::frustum && gregory_frustum_culled(setup.planes, pts, nullptr))
+                    d = kFusedFrustumCulled;
+                if (stage == FusedStage::occlusion && gregory_occluded(setup.planes, *setup.hiz, pts))
+                    d = kFusedOccluded;
+                // FusedStage::backpatch: never culls a Gregory patch.
+                if (stats && d != kFusedVisible) ++stats->patches_culled[static_cast<int>(stage)];
+            }
+            decision[p] = d;
+        }
+        if (stats) stats->groups += last - first;
+        return;
+    }
+    for_each_block(source, first, last, [&](const PatchBatchView& block, std::size_t f) {
+        cull_fused_simd(block, setup, plan, decision + f, stats);
+    });
+}
+
+void check_fused_inputs(const FusedCullSetup& setup, const FusedPlan& plan, const char* what) {
+    if (!valid_fused_plan(plan)) throw Error(std::string(what) + ": invalid plan " + fused_plan_name(plan));
+    bool occlusion = false;
+    for (int pos = 0; pos < plan.count; ++pos) occlusion |= plan.stages[pos] == FusedStage::occlusion;
+    if (!occlusion) return;
+    if (!setup.hiz) throw Error(std::string(what) + ": the plan has occlusion but setup.hiz is null");
+    check_hiz_convention(*setup.hiz, setup.planes.depth, what);
+}
+
+}  // namespace detail
+
+void cull_frustum(const PatchSourceView& source, const float* max_displacement, const CullView& view,
+                  std::uint8_t* culled) {
+    check_patch_source(source, "cull_frustum");
+    detail::source_frustum(source, 0, source.count, max_displacement, view.planes, culled);
+}
+
+void cull_frustum_disp(const PatchSourceView& source, const float* max_displacement, const CullView& view,
+                       std::uint8_t* culled) {
+    check_patch_source(source, "cull_frustum_disp");
+    const FrustumPlanes planes = make_frustum_planes(view.object_to_clip, view.depth);  // refuses a contradiction
+    detail::source_frustum_disp(source, 0, source.count, max_displacement, planes, culled);
 }
 
 void cull_backpatch(BackpatchMethod id, const PatchSourceView& source, const CullView& view,
                     const BackpatchOptions& options, std::uint8_t* culled) {
     check_patch_source(source, "cull_backpatch");
     const BackpatchMethodInfo& method = backpatch_method_info(id);
-    const BackpatchKernel kernel = method.simd ? method.simd : method.scalar;
-    if (source.basis == PatchBasis::gregory) {
-        if (source.count) std::memset(culled, 0, source.count);
-        return;
-    }
-    for_each_block(
-        source, [&](const PatchBatchView& block, std::size_t first) { kernel(block, view, options, culled + first); });
+    detail::source_backpatch(method.simd ? method.simd : method.scalar, source, 0, source.count, view, options, culled);
 }
 
 void cull_occlusion(const PatchSourceView& source, const CullView& view, const HiZPyramid& hiz,
                     std::uint8_t* decision) {
     check_patch_source(source, "cull_occlusion");
     check_hiz_convention(hiz, view.depth, "cull_occlusion");
-    if (source.basis == PatchBasis::gregory) {
-        float pts[kGregoryPoints][4];
-        for (std::size_t p = 0; p < source.count; ++p) {
-            gregory_points(source, p, pts);
-            if (gregory_frustum_culled(view.planes, pts, nullptr)) {
-                decision[p] = kHiZFrustumCulled;
-            } else {
-                decision[p] = gregory_occluded(view.planes, hiz, pts) ? kHiZOccluded : kHiZVisible;
-            }
-        }
-        return;
-    }
-    // cull_occlusion_simd's plan on a setup made once.
+    // cull_occlusion_simd's plan on a setup made once (the Gregory path: frustum, then steps 2-9).
     const FusedCullSetup setup = make_fused_setup(view, BackPatchCone::tcone, &hiz);
     FusedPlan plan;
     plan.stages[0] = FusedStage::frustum;
     plan.stages[1] = FusedStage::occlusion;
     plan.count = 2;
-    for_each_block(source, [&](const PatchBatchView& block, std::size_t first) {
-        cull_fused_simd(block, setup, plan, decision + first, nullptr);
-    });
+    detail::source_fused(source, 0, source.count, setup, plan, decision, nullptr);
+}
+
+void cull_fused(const PatchSourceView& source, const FusedCullSetup& setup, const FusedPlan& plan,
+                std::uint8_t* decision, FusedCullStats* stats) {
+    check_patch_source(source, "cull_fused");
+    detail::check_fused_inputs(setup, plan, "cull_fused");
+    detail::source_fused(source, 0, source.count, setup, plan, decision, stats);
 }
 
 }  // namespace patchcull

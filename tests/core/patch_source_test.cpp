@@ -3,7 +3,9 @@
 // kernels on the same Bezier patches; B-spline spans (interior, boundary and corner patches under
 // OpenSubdiv's boundary mask) convert to Bezier patches of the same surface and decide as the
 // batch of those; Gregory patches are never culled where a dense sample of their surface is
-// visible, and are culled when wholly outside; bad views are refused with a message.
+// visible, and are culled when wholly outside; bad views are refused with a message. Every entry:
+// frustum, frustum-disp, the back-patch methods, occlusion, the fused kernel (every plan, both
+// cones), and their parallel twins (parallel_cull.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -24,7 +26,9 @@
 #include "patchcull/core/cull_view.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
+#include "patchcull/core/fused_cull.h"
 #include "patchcull/core/hiz.h"
+#include "patchcull/core/parallel_cull.h"
 #include "patchcull/core/patch.h"
 #include "patchcull/core/patch_source.h"
 
@@ -217,6 +221,51 @@ void expect_same_decisions(const PatchSourceView& source, const PatchBatchView& 
     std::size_t occluded = 0;
     for (std::size_t i = 0; i < n; ++i) occluded += want[i] == kHiZOccluded;
     culled["occluded"] += occluded;
+    cull_occlusion_parallel(source, s.view, s.hiz, got.data());
+    compare("occlusion parallel");
+    cull_frustum_parallel(source, disp.data(), s.view, got.data());
+    cull_frustum(batch, disp.data(), s.view, want.data());
+    compare("frustum+disp parallel");
+    cull_backpatch(BackpatchMethod::ncone, batch, s.view, {}, want.data());
+    cull_backpatch_parallel(BackpatchMethod::ncone, source, s.view, {}, got.data());
+    compare("ncone parallel");
+
+    // frustum-disp: Sathe's box, without and with displacement.
+    for (const float* d : {static_cast<const float*>(nullptr), static_cast<const float*>(disp.data())}) {
+        const std::string what = d ? "frustum-disp+disp" : "frustum-disp";
+        cull_frustum_disp(batch, d, s.view, want.data());
+        cull_frustum_disp(source, d, s.view, got.data());
+        compare(what);
+        cull_frustum_disp_parallel(source, d, s.view, got.data());
+        compare(what + " parallel");
+    }
+
+    // The fused kernel: every valid plan of one, two or three stages, both cones; the statistics
+    // equal cull_fused_simd's on the batch too.
+    for (BackPatchCone cone : {BackPatchCone::tcone, BackPatchCone::ncone}) {
+        const FusedCullSetup setup = make_fused_setup(s.view, cone, &s.hiz);
+        for (unsigned stages = 1; stages < 8; ++stages) {
+            FusedPlan plans[6];
+            const int count = fused_plans_of(stages, plans);
+            for (int k = 0; k < count; ++k) {
+                const std::string what =
+                    "fused " + fused_plan_name(plans[k]) + (cone == BackPatchCone::tcone ? " tcone" : " ncone");
+                FusedCullStats want_stats, got_stats;
+                cull_fused_simd(batch, setup, plans[k], want.data(), &want_stats);
+                cull_fused(source, setup, plans[k], got.data(), &got_stats);
+                compare(what);
+                EXPECT_EQ(got_stats.groups, want_stats.groups) << what;
+                for (int q = 0; q < kFusedStages; ++q) {
+                    EXPECT_EQ(got_stats.groups_entered[q], want_stats.groups_entered[q]) << what;
+                    EXPECT_EQ(got_stats.patches_culled[q], want_stats.patches_culled[q]) << what;
+                }
+                if (stages == 7) {
+                    cull_fused_parallel(source, setup, plans[k], got.data());
+                    compare(what + " parallel");
+                }
+            }
+        }
+    }
 }
 
 void expect_teeth(const std::map<std::string, std::size_t>& culled, std::size_t total) {
@@ -314,6 +363,18 @@ TEST(PatchSource, NonFinitePointsAreNeverCulled) {
         for (std::size_t i = 1; i < grids.size(); ++i)
             if (!(components == 3 && (i - 1) / 3 % 4 == 3)) {
                 EXPECT_EQ(culled[i], kHiZVisible) << "copy " << i;
+            }
+        cull_frustum_disp(src.view, nullptr, s.view, culled.data());
+        EXPECT_EQ(culled[0], 1) << "the finite patch is outside";
+        for (std::size_t i = 1; i < grids.size(); ++i)
+            if (!(components == 3 && (i - 1) / 3 % 4 == 3)) {
+                EXPECT_EQ(culled[i], 0) << "frustum-disp, copy " << i;
+            }
+        cull_fused(src.view, make_fused_setup(s.view, BackPatchCone::ncone, &s.hiz), FusedPlan{}, culled.data());
+        EXPECT_EQ(culled[0], kFusedFrustumCulled);
+        for (std::size_t i = 1; i < grids.size(); ++i)
+            if (!(components == 3 && (i - 1) / 3 % 4 == 3)) {
+                EXPECT_EQ(culled[i], kFusedVisible) << "fused, copy " << i;
             }
     }
 }
@@ -565,10 +626,20 @@ TEST(PatchSource, GregoryNeverCullsAVisibleSampleAndCullsWhatIsOutside) {
             cull_frustum(src.view, nullptr, s.view, frustum.data());
             cull_occlusion(src.view, s.view, s.hiz, occlusion.data());
             cull_backpatch(BackpatchMethod::ptp, src.view, s.view, {PtpRule::pcnt}, back.data());
-            std::size_t n_frustum = 0, n_occluded = 0;
+            std::vector<std::uint8_t> disp_box(patches.size()), fused(patches.size());
+            cull_frustum_disp(src.view, nullptr, s.view, disp_box.data());
+            cull_fused(src.view, make_fused_setup(s.view, BackPatchCone::ncone, &s.hiz), FusedPlan{}, fused.data());
+            std::size_t n_frustum = 0, n_occluded = 0, n_box = 0;
             for (std::size_t p = 0; p < patches.size(); ++p) {
                 EXPECT_EQ(back[p], 0) << "back-patch methods never cull a Gregory patch";
                 EXPECT_EQ(frustum[p] == 1, occlusion[p] == kHiZFrustumCulled) << "patch " << p;
+                // The fused plan frustum, back-patch, Hi-Z: cull_occlusion's decisions.
+                EXPECT_EQ(fused[p], occlusion[p]) << "patch " << p;
+                // The box holds the hull: what it culls, the hull test culls.
+                if (disp_box[p]) {
+                    EXPECT_EQ(frustum[p], 1) << "patch " << p;
+                }
+                n_box += disp_box[p];
                 n_frustum += frustum[p];
                 n_occluded += occlusion[p] == kHiZOccluded;
                 if (occlusion[p] == kHiZVisible) continue;
@@ -595,6 +666,7 @@ TEST(PatchSource, GregoryNeverCullsAVisibleSampleAndCullsWhatIsOutside) {
             EXPECT_GT(n_frustum, 10u);
             EXPECT_LT(n_frustum, patches.size());
             EXPECT_GT(n_occluded, 0u);
+            EXPECT_GT(n_box, 10u);
         }
     }
 }
@@ -629,6 +701,40 @@ TEST(PatchSource, GregoryOfABezierPatchDecidesAsTheBezierBatch) {
         cull_occlusion(src.view, s.view, s.hiz, got.data());
         EXPECT_EQ(want, got);
         EXPECT_GT(std::count(want.begin(), want.end(), kHiZOccluded), 0);
+        cull_occlusion_parallel(src.view, s.view, s.hiz, got.data());
+        EXPECT_EQ(want, got);
+        // frustum-disp: the box of the 20 points is the box of the 16.
+        for (const float* d : {static_cast<const float*>(nullptr), static_cast<const float*>(disp.data())}) {
+            cull_frustum_disp(batch.view(), d, s.view, want.data());
+            cull_frustum_disp(src.view, d, s.view, got.data());
+            EXPECT_EQ(want, got);
+            EXPECT_GT(std::count(want.begin(), want.end(), 1), 0);
+            cull_frustum_disp_parallel(src.view, d, s.view, got.data());
+            EXPECT_EQ(want, got);
+        }
+        // The fused kernel: the plan without its back-patch stage (which never culls a Gregory
+        // patch) on the batch; a plan of back-patch alone keeps every patch.
+        const FusedCullSetup setup = make_fused_setup(s.view, BackPatchCone::tcone, &s.hiz);
+        FusedPlan plans[6];
+        const int count = fused_plans_of(7, plans);
+        for (int k = 0; k < count; ++k) {
+            FusedPlan without;
+            without.count = 0;
+            for (int pos = 0; pos < plans[k].count; ++pos)
+                if (plans[k].stages[pos] != FusedStage::backpatch)
+                    without.stages[without.count++] = plans[k].stages[pos];
+            cull_fused_simd(batch.view(), setup, without, want.data());
+            cull_fused(src.view, setup, plans[k], got.data());
+            EXPECT_EQ(want, got) << fused_plan_name(plans[k]);
+            EXPECT_GT(std::count(want.begin(), want.end(), kFusedOccluded), 0);
+            cull_fused_parallel(src.view, setup, plans[k], got.data());
+            EXPECT_EQ(want, got) << fused_plan_name(plans[k]) << " parallel";
+        }
+        FusedPlan back_only;
+        back_only.stages[0] = FusedStage::backpatch;
+        back_only.count = 1;
+        cull_fused(src.view, setup, back_only, got.data());
+        EXPECT_EQ(std::count(got.begin(), got.end(), kFusedVisible), static_cast<std::ptrdiff_t>(got.size()));
     }
 }
 
@@ -663,6 +769,15 @@ TEST(PatchSource, GregoryOutsideOrHiddenIsCulledAndNonFiniteIsNot) {
         EXPECT_EQ(culled[i], 0) << "copy " << i;
         EXPECT_EQ(decision[i], kHiZVisible) << "copy " << i;
     }
+    cull_frustum_disp(src.view, nullptr, s.view, culled.data());
+    cull_fused(src.view, make_fused_setup(s.view, BackPatchCone::tcone, &s.hiz), FusedPlan{}, decision.data());
+    EXPECT_EQ(culled[0], 1);
+    EXPECT_EQ(decision[0], kFusedFrustumCulled);
+    EXPECT_EQ(culled[1], 0);
+    for (std::size_t i = 2; i < greg.size(); ++i) {
+        EXPECT_EQ(culled[i], 0) << "frustum-disp, copy " << i;
+        EXPECT_EQ(decision[i], kFusedVisible) << "fused, copy " << i;
+    }
     // Behind a wall at the near distance: occluded.
     std::vector<float> wall(static_cast<std::size_t>(W) * H, 0.5f);  // window depth 0.5: about 0.2 away
     HiZPyramid hiz;
@@ -677,15 +792,32 @@ TEST(PatchSource, GregoryOutsideOrHiddenIsCulledAndNonFiniteIsNot) {
 
 void expect_refused(const PatchSourceView& v, const std::string& message, const Scene& s) {
     std::vector<std::uint8_t> out(std::max<std::size_t>(v.count, 1), 0xAB);
-    for (int entry = 0; entry < 3; ++entry) {
+    const FusedCullSetup setup = make_fused_setup(s.view, BackPatchCone::tcone, &s.hiz);
+    for (int entry = 0; entry < 10; ++entry) {
         try {
             if (entry == 0) cull_frustum(v, nullptr, s.view, out.data());
             if (entry == 1) cull_backpatch(BackpatchMethod::tcone, v, s.view, {}, out.data());
             if (entry == 2) cull_occlusion(v, s.view, s.hiz, out.data());
+            if (entry == 3) cull_frustum_disp(v, nullptr, s.view, out.data());
+            if (entry == 4) cull_fused(v, setup, FusedPlan{}, out.data());
+            if (entry == 5) cull_frustum_parallel(v, nullptr, s.view, out.data());
+            if (entry == 6) cull_backpatch_parallel(BackpatchMethod::tcone, v, s.view, {}, out.data());
+            if (entry == 7) cull_occlusion_parallel(v, s.view, s.hiz, out.data());
+            if (entry == 8) cull_frustum_disp_parallel(v, nullptr, s.view, out.data());
+            if (entry == 9) cull_fused_parallel(v, setup, FusedPlan{}, out.data());
             ADD_FAILURE() << "no Error for: " << message;
         } catch (const Error& e) {
             const std::string what = e.what();
-            const char* name[3] = {"cull_frustum: ", "cull_backpatch: ", "cull_occlusion: "};
+            const char* name[10] = {"cull_frustum: ",
+                                    "cull_backpatch: ",
+                                    "cull_occlusion: ",
+                                    "cull_frustum_disp: ",
+                                    "cull_fused: ",
+                                    "cull_frustum_parallel: ",
+                                    "cull_backpatch_parallel: ",
+                                    "cull_occlusion_parallel: ",
+                                    "cull_frustum_disp_parallel: ",
+                                    "cull_fused_parallel: "};
             EXPECT_EQ(what.rfind(name[entry], 0), 0u) << what;
             EXPECT_NE(what.find(message), std::string::npos) << what;
             EXPECT_EQ(what.find('\n'), std::string::npos);
@@ -750,6 +882,34 @@ TEST(PatchSource, BadViewsAreRefusedWithAMessage) {
     std::vector<float> d(16, 0.0f);
     reversed.build(d.data(), 4, 4, ClipDepth::reversed);
     EXPECT_THROW(cull_occlusion(src.view, s.view, reversed, out.data()), Error);
+    // The fused kernel's own inputs: a plan valid_fused_plan refuses, occlusion without a pyramid
+    // or with one never built or of the other direction; without occlusion no pyramid is needed.
+    src.indices[16 + 3] = src.indices[16 + 5] = 0;  // the view is good again
+    FusedCullSetup setup = make_fused_setup(s.view, BackPatchCone::tcone, &s.hiz);
+    FusedPlan bad;
+    bad.stages[0] = FusedStage::occlusion;
+    bad.stages[1] = FusedStage::frustum;
+    bad.count = 2;
+    const auto fused_error = [&](const FusedCullSetup& st, const FusedPlan& plan) -> std::string {
+        try {
+            cull_fused(src.view, st, plan, out.data());
+        } catch (const Error& e) {
+            return e.what();
+        }
+        return "";
+    };
+    EXPECT_EQ(fused_error(setup, bad), "cull_fused: invalid plan HF");
+    setup.hiz = nullptr;
+    EXPECT_EQ(fused_error(setup, FusedPlan{}), "cull_fused: the plan has occlusion but setup.hiz is null");
+    FusedPlan fb;
+    fb.count = 2;
+    EXPECT_EQ(fused_error(setup, fb), "");
+    HiZPyramid unbuilt;
+    setup.hiz = &unbuilt;
+    EXPECT_NE(fused_error(setup, FusedPlan{}).find("never built"), std::string::npos);
+    setup.hiz = &reversed;
+    EXPECT_NE(fused_error(setup, FusedPlan{}).find("reversed"), std::string::npos);
+    EXPECT_THROW(cull_fused_parallel(src.view, setup, FusedPlan{}, out.data()), Error);
 }
 
 }  // namespace

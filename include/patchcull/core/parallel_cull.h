@@ -11,6 +11,11 @@
 // which an entry runs on the calling thread alone (docs/PERFORMANCE.md, "2-core scaling"): 1,024
 // patches for the frustum kernels, 512 for occlusion, 256 for the back-patch and fused kernels.
 //
+// Over a PatchSourceView (patch_source.h: the caller's own points, e.g. an OpenSubdiv patch table's
+// arrays) the entries split [0, source.count) the same way and run the patch-source entry's work
+// on each range (its 4 KiB stack block per thread, nothing else allocated): the same decisions as
+// the single-threaded patch-source entry, byte for byte.
+//
 // Errors: the same as the single-threaded entry's, checked once before any range runs.
 #pragma once
 
@@ -22,6 +27,7 @@
 #include "patchcull/core/fused_cull.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/patch.h"
+#include "patchcull/core/patch_source.h"
 
 namespace patchcull {
 
@@ -44,6 +50,20 @@ void cull_occlusion_parallel(const PatchBatchView& patches, const CullView& view
 /// cull_fused_simd (fused_cull.h) on every core; throws Error for a plan valid_fused_plan refuses.
 /// Takes no FusedCullStats: the counts would be a shared write per group (profile single-threaded).
 void cull_fused_parallel(const PatchBatchView& patches, const FusedCullSetup& setup, const FusedPlan& plan,
+                         std::uint8_t* decision);
+
+/// The patch-source entries (patch_source.h: cull_frustum, cull_frustum_disp, cull_backpatch,
+/// cull_occlusion, cull_fused over a PatchSourceView) on every core, with their checks (the view
+/// once, the plan and pyramid for cull_fused_parallel) before any range runs.
+void cull_frustum_parallel(const PatchSourceView& source, const float* max_displacement, const CullView& view,
+                           std::uint8_t* culled);
+void cull_frustum_disp_parallel(const PatchSourceView& source, const float* max_displacement, const CullView& view,
+                                std::uint8_t* culled);
+void cull_backpatch_parallel(BackpatchMethod id, const PatchSourceView& source, const CullView& view,
+                             const BackpatchOptions& options, std::uint8_t* culled);
+void cull_occlusion_parallel(const PatchSourceView& source, const CullView& view, const HiZPyramid& hiz,
+                             std::uint8_t* decision);
+void cull_fused_parallel(const PatchSourceView& source, const FusedCullSetup& setup, const FusedPlan& plan,
                          std::uint8_t* decision);
 
 }  // namespace patchcull

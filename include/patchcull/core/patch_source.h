@@ -9,7 +9,9 @@
 // layout, converting B-spline points to Bezier ones on the way) and run the existing kernel on it:
 // for Bezier and B-spline sources every decision equals the batch kernel's on the same (converted)
 // Bezier patches, byte for byte. Gregory patches have 20 points and a rational interior, so they
-// get a small scalar path of their own (below).
+// get a small scalar path of their own (below). The entries: cull_frustum, cull_frustum_disp,
+// cull_backpatch, cull_occlusion and cull_fused (every test and mode of the batch kernels), and
+// their multi-threaded twins in parallel_cull.h.
 //
 // ---- Points --------------------------------------------------------------------------------------
 // Point i is read from (const char*)points.data + points.offset_bytes + i * points.stride_bytes
@@ -52,6 +54,7 @@
 
 #include "patchcull/core/backpatch_methods.h"
 #include "patchcull/core/cull_view.h"
+#include "patchcull/core/fused_cull.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/patch.h"
 
@@ -129,11 +132,34 @@ void cull_frustum(const PatchSourceView& source, const float* max_displacement, 
 void cull_backpatch(BackpatchMethod id, const PatchSourceView& source, const CullView& view,
                     const BackpatchOptions& options, std::uint8_t* culled);
 
+/// frustum-disp kernel (frustum.h, cull_frustum_disp: Sathe's box test) over source: culled holds
+/// source.count bytes; max_displacement as for cull_frustum (null: the box of the control points
+/// alone, a looser test than cull_frustum's but valid for any source). Bezier and B-spline:
+/// culled[i] equals cull_frustum_disp's on the converted patches. Gregory: the box of all 20
+/// Cartesian points (it holds the patch: the surface lies in their convex hull), grown by the
+/// displacement and tested as cull_frustum_disp_scalar tests the box of 16 (never culled with a
+/// non-finite coordinate). Throws Error before the loop for a bad view or a matrix that
+/// contradicts view.depth.
+void cull_frustum_disp(const PatchSourceView& source, const float* max_displacement, const CullView& view,
+                       std::uint8_t* culled);
+
 /// Frustum + Hi-Z occlusion (hiz.h, cull_occlusion) over source: decision holds source.count
 /// bytes of HiZDecision. Bezier and B-spline: equals cull_occlusion on the converted patches.
 /// Gregory: kHiZFrustumCulled as cull_frustum above (no displacement); else hiz.h's steps 2-9
 /// over the 20 points (not projectable, or a NaN box, -> visible). Throws Error before the loop for
 /// a bad view or a pyramid that does not match view.depth (check_hiz_convention).
 void cull_occlusion(const PatchSourceView& source, const CullView& view, const HiZPyramid& hiz, std::uint8_t* decision);
+
+/// The fused kernel (fused_cull.h, cull_fused_simd: the plan's frustum, back-patch cone and Hi-Z
+/// stages in one pass, each patch's decision the first stage that culls it) over source: decision
+/// holds source.count bytes of FusedDecision. Bezier and B-spline: decision[i] equals
+/// cull_fused_simd's on the converted patches, and stats (optional) counts as cull_fused_simd's
+/// on them. Gregory: the frustum stage is cull_frustum's 20-point test (no displacement), the
+/// occlusion stage cull_occlusion's (not projectable, or a NaN box, -> not occluded), and the
+/// back-patch stage never culls (stats count one group per patch, as cull_fused_scalar's). Throws
+/// Error before the loop for a bad view, a plan valid_fused_plan refuses, or a plan with occlusion
+/// whose setup.hiz is null, never built or of the other depth direction than setup.planes.
+void cull_fused(const PatchSourceView& source, const FusedCullSetup& setup, const FusedPlan& plan,
+                std::uint8_t* decision, FusedCullStats* stats = nullptr);
 
 }  // namespace patchcull
