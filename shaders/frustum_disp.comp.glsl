@@ -11,6 +11,9 @@
 // adds and subtracts, `precise` everywhere so that the compiler neither contracts nor reassociates.
 // A link of the flag chain (gl_passes.h): a patch that an earlier pass culled is left as it is;
 // otherwise a culled patch gets the reason kCullFrustum.
+// With PC_PATCH_SOURCE the points come from the caller's patch source (patch_source.h: Bezier or
+// converted B-spline points; with PC_PATCH_SOURCE_GREGORY the box of a Gregory patch's 20 points,
+// as cull_frustum_disp over a PatchSourceView).
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
@@ -22,6 +25,15 @@
 #include "exact_fma.h"
 #include "backpatch_exact.h"
 #include "flag_chain.h"
+#include "patch_source.h"
+
+#ifdef PC_PATCH_SOURCE
+#define PC_BOX_POINT(p, k) pc_source_points[k]
+#define PC_BOX_POINT_COUNT PC_SOURCE_POINTS
+#else
+#define PC_BOX_POINT(p, k) control_points[16u * (p) + (k)]
+#define PC_BOX_POINT_COUNT 16u
+#endif
 
 layout(local_size_x = kCullGroupSize) in;
 
@@ -38,19 +50,22 @@ float pc_corner_row(int r, vec2 bx, vec2 by, vec2 bz, int c) {
 void main() {
     const uint p = frustum_disp.first_patch + gl_GlobalInvocationID.x;
     if (gl_GlobalInvocationID.x >= frustum_disp.patch_count || pc_chain_culled(p)) return;
+#ifdef PC_PATCH_SOURCE
+    if (!pc_gather_source(p)) return;  // an index past the points: left unculled
+#endif
     const float d = pc_margin(p, frustum_disp.has_margins);
 
-    // The Cartesian AABB of the 16 control points.
+    // The Cartesian AABB of the 16 control points (a Gregory patch's 20).
     // A NaN or infinite coordinate anywhere: never culled (frustum.h, "Non-finite input").
-    const vec4 p0 = control_points[16u * p];
+    const vec4 p0 = PC_BOX_POINT(p, 0u);
     precise float lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
         lo[a] = pc_div(p0[a], p0.w);
         hi[a] = lo[a];
     }
     bool non_finite = false;
-    for (uint k = 0u; k < 16u; ++k) {
-        const vec4 point = control_points[16u * p + k];
+    for (uint k = 0u; k < PC_BOX_POINT_COUNT; ++k) {
+        const vec4 point = PC_BOX_POINT(p, k);
         for (int a = 0; a < 4; ++a)
             non_finite = non_finite || (floatBitsToUint(point[a]) & 0x7F800000u) == 0x7F800000u;
         if (k == 0u) continue;

@@ -13,6 +13,11 @@
 // displaced patches (margin > 0) get the frustum test with their margin only (the cone and the
 // control-point Hi-Z test bound neither a displaced surface's normals nor its depth), as in the
 // chain; DisplacedPass tests them afterwards.
+// With PC_PATCH_SOURCE the points come from the caller's patch source (patch_source.h: Bezier or
+// converted B-spline points, gathered once per patch); with PC_PATCH_SOURCE_GREGORY a Gregory
+// patch's 20 points feed the frustum and Hi-Z tests (a point whose NDC coordinate is NaN leaves
+// the patch unoccluded, as occlusion.comp.glsl) and the cone test never runs (cull_fused over a
+// PatchSourceView: the back-patch stage never culls a Gregory patch).
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
@@ -25,6 +30,12 @@
 #define u_zero fused.zero
 #include "backpatch_cones.h"
 #include "flag_chain.h"
+#include "patch_source.h"
+
+#ifdef PC_PATCH_SOURCE
+#define PC_PATCH_POINT(p, k) pc_source_points[k]
+#define PC_PATCH_POINT_COUNT PC_SOURCE_POINTS
+#endif
 
 #ifdef PATCHCULL_NCONE
 #define PC_PASS_CONE pc_normal_cone
@@ -52,6 +63,11 @@ layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 // front depth (occlusion.comp.glsl's steps 3-4). Only the six maxima and the box stay live, not
 // the points (the cone test reloads them, from cache, if the patch gets that far), which keeps
 // the registers low on a GPU. The price: a patch the frustum culls has had its box built too.
+#ifdef PC_PATCH_SOURCE_GREGORY
+// True when v is NaN (a test of the bits, which no compiler folds away).
+bool pc_is_nan(float v) { return (floatBitsToUint(v) & 0x7FFFFFFFu) > 0x7F800000u; }
+#endif
+
 struct PcFusedPoints {
     bool frustum_culled;
     bool projectable;  // step 3 held for every point (else the patch is not screen-tested)
@@ -70,8 +86,8 @@ PcFusedPoints pc_fused_points(uint p, bool frustum, bool hiz, bool with_margins,
     HiZPointBox box;
     box.nxmin = box.nxmax = box.nymin = box.nymax = box.zmin = 0.0;
     bool non_finite = false;
-    for (uint k = 0u; k < 16u; ++k) {
-        const vec4 P = control_points[16u * p + k];
+    for (uint k = 0u; k < PC_PATCH_POINT_COUNT; ++k) {
+        const vec4 P = PC_PATCH_POINT(p, k);
         const vec4 c = pc_clip_point(P);
         if (frustum) {
             float v[6];
@@ -85,6 +101,10 @@ PcFusedPoints pc_fused_points(uint p, bool frustum, bool hiz, bool with_margins,
         }
         // Steps 3-4 (hiz_box_test.h), as occlusion.comp.glsl.
         if (r.projectable) r.projectable = hiz_add_point(P, c, u_clip_rows[3], k == 0u, box);
+#ifdef PC_PATCH_SOURCE_GREGORY
+        if (r.projectable && (pc_is_nan(hiz_div(c.x, c.w)) || pc_is_nan(hiz_div(c.y, c.w)) || pc_is_nan(hiz_div(c.z, c.w))))
+            r.projectable = false;
+#endif
     }
     r.frustum_culled = frustum && pc_frustum_outside(m, non_finite);
     r.nxmin = box.nxmin;
@@ -98,6 +118,9 @@ PcFusedPoints pc_fused_points(uint p, bool frustum, bool hiz, bool with_margins,
 void main() {
     const uint p = fused.first_patch + gl_GlobalInvocationID.x;
     if (gl_GlobalInvocationID.x >= fused.patch_count || pc_chain_culled(p)) return;
+#ifdef PC_PATCH_SOURCE
+    if (!pc_gather_source(p)) return;  // an index past the points: left unculled
+#endif
     const float d = pc_margin(p, fused.has_margins);
     // The separate passes' own conditions (the same for a valid margin, >= 0; these keep even a
     // NaN or negative one's decisions equal): BackpatchConePass skips margin > 0, OcclusionPass
@@ -113,9 +136,10 @@ void main() {
         pc_chain_cull(p, kCullFrustum);
         return;
     }
+#ifndef PC_PATCH_SOURCE_GREGORY
     if (cone_tested) {
         vec4 P[16];
-        for (int k = 0; k < 16; ++k) P[k] = control_points[16u * p + uint(k)];
+        for (int k = 0; k < 16; ++k) P[k] = PC_PATCH_POINT(p, uint(k));
         const PcCone cone = PC_PASS_CONE(P);
         const PcSphere sphere = pc_sphere_of_points(P);
         if (pc_is_polynomial(P) && pc_back_facing(cone, sphere, fused.eye.xyz)) {
@@ -123,6 +147,7 @@ void main() {
             return;
         }
     }
+#endif
     // Steps 5-9 on the box (hiz_box_test.h).
     if (points.projectable &&
         hiz_box_occluded(points.nxmin, points.nxmax, points.nymin, points.nymax, points.zmin))

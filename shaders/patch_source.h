@@ -1,7 +1,8 @@
 // shaders/patch_source.h (GLSL only): a cull pass's control points read from the caller's own
 // buffers (GpuPatchSource of include/patchcull/gl/gl_passes.h), the GPU twin of
-// core/patch_source.h's gather_bezier. Included by frustum.comp.glsl, occlusion.comp.glsl,
-// backpatch_cones.comp.glsl and backpatch_ptp.comp.glsl after shared.h and pass_params.h; empty
+// core/patch_source.h's gather_bezier. Included by frustum.comp.glsl, frustum_disp.comp.glsl,
+// occlusion.comp.glsl, fused_cull.comp.glsl, backpatch_cones.comp.glsl and backpatch_ptp.comp.glsl
+// after shared.h and pass_params.h; empty
 // unless the program is compiled with PC_PATCH_SOURCE (and PC_PATCH_SOURCE_GREGORY for Gregory
 // sources, 20 points per patch).
 //

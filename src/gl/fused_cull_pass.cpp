@@ -1,5 +1,6 @@
 // FusedCullPass (patchcull/gl/gl_passes.h): the frustum, cone back-patch and Hi-Z tests in one
-// dispatch, shaders/fused_cull.comp.glsl (ncone compiled with PATCHCULL_NCONE).
+// dispatch, shaders/fused_cull.comp.glsl (ncone compiled with PATCHCULL_NCONE; over a
+// GpuPatchSource with patch_source_defines as well).
 #include "pass_common.h"
 
 namespace patchcull::gl {
@@ -13,10 +14,11 @@ FusedCullPass::FusedCullPass(FusedCullPass&&) noexcept = default;
 FusedCullPass& FusedCullPass::operator=(FusedCullPass&&) noexcept = default;
 FusedCullPass::~FusedCullPass() = default;
 
-void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const Mat4& any_object_to_clip,
-                        ClipDepth depth, BackpatchMethod method, Vec3 eye, const HiZTexture* hiz) {
-    detail::begin_pass("FusedCullPass");
-    detail::check_patch_buffers("FusedCullPass", patches);
+namespace {
+
+// The checks of both runs (after the buffers'), then the planes and the parameter block.
+pp::FusedCullParams fused_params(std::uint32_t tests, const Mat4& any_object_to_clip, ClipDepth depth,
+                                 BackpatchMethod method, Vec3 eye, const HiZTexture* hiz, bool has_margins) {
     if (tests & ~(shared::kCullFrustum | shared::kCullBackPatch | shared::kCullOcclusion))
         throw Error("GL: FusedCullPass: tests must be kCullFrustum, kCullBackPatch and kCullOcclusion bits");
     const bool backpatch = (tests & shared::kCullBackPatch) != 0;
@@ -31,11 +33,10 @@ void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const 
                     " but the Hi-Z pyramid was built from a " + (hiz->reversed ? "reversed" : "forward") +
                     " depth buffer (HiZBuildPass::run's convention)");
     const FrustumPlanes planes = make_frustum_planes(any_object_to_clip, depth);  // refuses a contradiction
-    if (patches.count == 0 || tests == 0) return;
     pp::FusedCullParams params;
     detail::store_planes(planes, params.clip_rows, params.plane_normal_length, params.plane_depth);
     params.eye = {eye.x, eye.y, eye.z, 1.0f};
-    params.has_margins = patches.margins ? 1u : 0u;
+    params.has_margins = has_margins ? 1u : 0u;
     params.tests = tests;
     if (occlusion) {
         params.screen_width = hiz->width;
@@ -43,11 +44,40 @@ void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const 
         params.hiz_levels = HiZPyramid::level_count(hiz->width, hiz->height);
     }
     params.zero = 0.0f;
-    const bool ncone = backpatch && method == BackpatchMethod::ncone;
+    return params;
+}
+
+}  // namespace
+
+void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const Mat4& any_object_to_clip,
+                        ClipDepth depth, BackpatchMethod method, Vec3 eye, const HiZTexture* hiz) {
+    detail::begin_pass("FusedCullPass");
+    detail::check_patch_buffers("FusedCullPass", patches);
+    pp::FusedCullParams params = fused_params(tests, any_object_to_clip, depth, method, eye, hiz, patches.margins != 0);
+    if (patches.count == 0 || tests == 0) return;
+    const bool ncone = (tests & shared::kCullBackPatch) != 0 && method == BackpatchMethod::ncone;
     glUseProgram(impl_->context.program("fused_cull.comp.glsl", ncone ? "#define PATCHCULL_NCONE 1\n" : ""));
     detail::bind_patch_buffers(patches);
-    if (occlusion) glBindTextureUnit(shared::kTextureUnitHiZ, hiz->texture);
+    if (tests & shared::kCullOcclusion) glBindTextureUnit(shared::kTextureUnitHiZ, hiz->texture);
     detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kCullGroupSize);
+    detail::finish_pass("FusedCullPass");
+}
+
+void FusedCullPass::run(const GpuPatchSource& source, std::uint32_t tests, const Mat4& any_object_to_clip,
+                        ClipDepth depth, BackpatchMethod method, Vec3 eye, const HiZTexture* hiz) {
+    detail::begin_pass("FusedCullPass");
+    const pp::PatchSourceParams source_params = detail::check_patch_source("FusedCullPass", impl_->context, source);
+    pp::FusedCullParams params = fused_params(tests, any_object_to_clip, depth, method, eye, hiz, source.margins != 0);
+    if (source.count == 0 || tests == 0) return;
+    // A Gregory program has no cone test (never back-patch culled): one program for both cones.
+    const bool ncone = (tests & shared::kCullBackPatch) != 0 && method == BackpatchMethod::ncone &&
+                       source.basis != PatchBasis::gregory;
+    const std::string defines =
+        std::string(ncone ? "#define PATCHCULL_NCONE 1\n" : "") + detail::patch_source_defines(source);
+    glUseProgram(impl_->context.program("fused_cull.comp.glsl", defines));
+    detail::bind_patch_source(*impl_, source, source_params);
+    if (tests & shared::kCullOcclusion) glBindTextureUnit(shared::kTextureUnitHiZ, hiz->texture);
+    detail::dispatch_patches(impl_->block, params, source.first, source.count, shared::kCullGroupSize);
     detail::finish_pass("FusedCullPass");
 }
 
@@ -55,6 +85,12 @@ void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const 
                         const HiZTexture* hiz) {
     if (!view.has_eye) tests &= ~shared::kCullBackPatch;
     run(patches, tests, view.object_to_clip, view.depth, method, view.eye, hiz);
+}
+
+void FusedCullPass::run(const GpuPatchSource& source, std::uint32_t tests, const CullView& view, BackpatchMethod method,
+                        const HiZTexture* hiz) {
+    if (!view.has_eye) tests &= ~shared::kCullBackPatch;
+    run(source, tests, view.object_to_clip, view.depth, method, view.eye, hiz);
 }
 
 }  // namespace patchcull::gl

@@ -2,7 +2,9 @@
 // shaders/patch_source.h) against the CPU entries over the same PatchSourceView or
 // OsdPatchTableSource (core/patch_source.h, import/osd_patch_table.h): the flag words equal the
 // CPU decisions patch for patch (FrustumPass <-> cull_frustum, OcclusionPass <-> cull_occlusion,
-// BackpatchConePass and BackpatchPtpPass <-> cull_backpatch), in every ClipDepth convention.
+// BackpatchConePass and BackpatchPtpPass <-> cull_backpatch; in a second test FrustumDispPass <->
+// cull_frustum_disp and FusedCullPass <-> cull_fused for every test mask that is a valid plan, tcone
+// and ncone), in every ClipDepth convention.
 // - OpenSubdiv tables: regression shapes with semi-sharp and infinitely sharp creases, corners,
 //   holes and boundaries, adaptively refined to levels 1-4 with Gregory-basis and B-spline-basis
 //   end caps, the vertex buffer float3 or float4 at odd strides and offsets; the table's index
@@ -42,6 +44,7 @@
 #include "patchcull/core/cull_view.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/frustum.h"
+#include "patchcull/core/fused_cull.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/patch_source.h"
 #include "patchcull/gl/gl_passes.h"
@@ -90,6 +93,8 @@ struct Passes {
     BackpatchConePass cones{test::passes()};
     BackpatchPtpPass ptp{test::passes()};
     HiZBuildPass hiz_build{test::passes()};
+    FrustumDispPass frustum_disp{test::passes()};
+    FusedCullPass fused{test::passes()};
 };
 
 Passes& gpu() {
@@ -223,8 +228,13 @@ void make_view(const Subject& s, std::mt19937& rng, ClipDepth depth, ViewCase& o
 
 struct Tally {
     std::size_t tested = 0, viewed = 0, frustum = 0, occluded = 0, back = 0, gregory_culled = 0;
+    std::size_t box = 0, fused_frustum = 0, fused_back = 0, fused_occluded = 0;  // the second test's
     int mismatches = 0;
 };
+
+// Which passes compare_view compares: the first test's (frustum, occlusion, back-patch) or the
+// second's (frustum-disp, fused).
+enum class Compared { separate, box_and_fused };
 
 // Clears the flags, runs `pass` on every part, reads the flag words back.
 std::vector<std::uint32_t> run_gpu(const Subject& s, const std::function<void(const GpuPatchSource&)>& pass) {
@@ -326,7 +336,66 @@ void expect_ptp_planes(const Subject& s, const CullView& view, const std::vector
     }
 }
 
-void compare_view(const Subject& s, const ViewCase& vc, Tally& tally) {
+// FrustumDispPass <-> cull_frustum_disp; FusedCullPass <-> cull_fused with the plan of its test
+// mask in the chain's order (frustum, back-patch, Hi-Z), over every part (an OpenSubdiv table's
+// arrays, each at its table position).
+void compare_box_and_fused(const Subject& s, const ViewCase& vc, Tally& tally) {
+    const CullView& view = vc.view;
+    const std::size_t n = s.patch_count;
+    std::vector<std::uint8_t> cpu(n + 1, 0xAB);
+    const auto for_parts = [&](const std::function<void(const PatchSourceView&, std::uint8_t*)>& entry) {
+        std::fill(cpu.begin(), cpu.end() - 1, 0);
+        for (const Part& p : s.parts) entry(p.cpu, cpu.data() + p.gpu.first);
+    };
+    tally.viewed += n;
+
+    for_parts([&](const PatchSourceView& v, std::uint8_t* out) { cull_frustum_disp(v, nullptr, view, out); });
+    EXPECT_EQ(cpu[n], 0xAB);
+    std::vector<std::uint32_t> got = run_gpu(s, [&](const GpuPatchSource& g) { gpu().frustum_disp.run(g, view); });
+    expect_flags(
+        s, "frustum-disp", view.depth, got, [&](std::size_t i) { return cpu[i] ? kCullFrustum : 0u; }, tally);
+    tally.box += static_cast<std::size_t>(std::count_if(cpu.begin(), cpu.end() - 1, [](auto c) { return c; }));
+
+    struct Fused {
+        std::uint32_t tests;
+        BackpatchMethod method;
+        const char* name;
+    };
+    const std::uint32_t all = kCullFrustum | kCullBackPatch | kCullOcclusion;
+    for (const Fused& f :
+         {Fused{all, BackpatchMethod::tcone, "fused FBH tcone"}, Fused{all, BackpatchMethod::ncone, "fused FBH ncone"},
+          Fused{kCullFrustum | kCullOcclusion, BackpatchMethod::tcone, "fused FH"},
+          Fused{kCullFrustum | kCullBackPatch, BackpatchMethod::tcone, "fused FB"},
+          Fused{kCullBackPatch, BackpatchMethod::ncone, "fused B ncone"}}) {
+        FusedPlan plan;  // the chain's order
+        plan.count = 0;
+        for (const auto& [bit, stage] :
+             {std::pair{kCullFrustum, FusedStage::frustum}, std::pair{kCullBackPatch, FusedStage::backpatch},
+              std::pair{kCullOcclusion, FusedStage::occlusion}})
+            if (f.tests & bit) plan.stages[plan.count++] = stage;
+        const FusedCullSetup setup = make_fused_setup(
+            view, f.method == BackpatchMethod::ncone ? BackPatchCone::ncone : BackPatchCone::tcone, &vc.hiz);
+        for_parts([&](const PatchSourceView& v, std::uint8_t* out) { cull_fused(v, setup, plan, out); });
+        got = run_gpu(s, [&](const GpuPatchSource& g) { gpu().fused.run(g, f.tests, view, f.method, &vc.gpu_hiz); });
+        expect_flags(
+            s, f.name, view.depth, got,
+            [&](std::size_t i) {
+                return cpu[i] == kFusedFrustumCulled     ? kCullFrustum
+                       : cpu[i] == kFusedBackPatchCulled ? kCullBackPatch
+                       : cpu[i] == kFusedOccluded        ? kCullOcclusion
+                                                         : 0u;
+            },
+            tally);
+        for (std::size_t i = 0; i < n; ++i) {
+            tally.fused_frustum += cpu[i] == kFusedFrustumCulled;
+            tally.fused_back += cpu[i] == kFusedBackPatchCulled;
+            tally.fused_occluded += cpu[i] == kFusedOccluded;
+        }
+    }
+}
+
+void compare_view(const Subject& s, const ViewCase& vc, Tally& tally, Compared compared) {
+    if (compared == Compared::box_and_fused) return compare_box_and_fused(s, vc, tally);
     const CullView& view = vc.view;
     const std::size_t n = s.patch_count;
     std::vector<std::uint8_t> cpu(n + 1, 0xAB);
@@ -402,13 +471,13 @@ void compare_view(const Subject& s, const ViewCase& vc, Tally& tally) {
 }
 
 // Views of the subject in every convention (views_per_depth of each).
-void compare_views(const Subject& s, std::mt19937& rng, int views_per_depth, Tally& tally) {
+void compare_views(const Subject& s, std::mt19937& rng, int views_per_depth, Tally& tally, Compared compared) {
     for (int v = 0; v < views_per_depth; ++v)
         for (ClipDepth depth :
              {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed, ClipDepth::reversed_infinite}) {
             ViewCase vc;
             make_view(s, rng, depth, vc);
-            compare_view(s, vc, tally);
+            compare_view(s, vc, tally, compared);
         }
 }
 
@@ -495,15 +564,18 @@ std::unique_ptr<OsdCase> make_osd_case(const std::string& shape, int level, EndC
 }
 
 // Every shape and level with both end caps, float3 and float4 alternating: one view per convention.
-void check_tables() {
+// For the second test (box_and_fused) half of them: Gregory end caps at levels 1 and 3, B-spline
+// end caps at levels 2 and 4.
+void check_tables(Compared compared) {
     const char* const shapes[] = {"catmark_chaikin1", "catmark_cubes_infsharp", "catmark_edgeonly",
                                   "catmark_hole_test1"};
-    std::mt19937 rng(20261204);
+    std::mt19937 rng(compared == Compared::separate ? 20261204 : 1204);
     Tally tally;
     std::size_t gregory = 0, boundary = 0, tables = 0;
     for (const char* shape : shapes)
         for (int level = 1; level <= 4; ++level)
             for (EndCap ends : {kGregoryEnds, kBsplineEnds}) {
+                if (compared == Compared::box_and_fused && (level % 2 == 1) != (ends == kGregoryEnds)) continue;
                 const bool float4 = (level + (ends == kBsplineEnds)) % 2 == 1;
                 const auto c = make_osd_case(shape, level, ends, float4 ? 4 : 3, float4 ? 36 : 28, float4 ? 12 : 8);
                 for (const OsdPatchArraySource& a : c->source.arrays()) {
@@ -511,14 +583,23 @@ void check_tables() {
                     if (a.source.boundary_mask)
                         for (std::size_t p = 0; p < a.source.count; ++p) boundary += a.source.boundary_mask[p] != 0;
                 }
-                compare_views(c->subject, rng, 1, tally);
+                compare_views(c->subject, rng, 1, tally, compared);
                 ++tables;
                 if (tally.mismatches > 8) break;
             }
     EXPECT_EQ(tally.mismatches, 0);
-    EXPECT_EQ(tables, 32u);
     EXPECT_GT(gregory, 100u);
     EXPECT_GT(boundary, 100u);
+    if (compared == Compared::box_and_fused) {
+        EXPECT_EQ(tables, 16u);
+        EXPECT_GT(tally.box, tally.viewed / 40) << "frustum-disp culls";
+        EXPECT_GT(tally.fused_frustum, tally.viewed / 10) << "fused frustum culls (the five masks together)";
+        EXPECT_GT(tally.fused_occluded, tally.viewed / 100) << "fused occlusion culls";
+        EXPECT_GT(tally.fused_back, tally.viewed / 10) << "fused back-patch culls";
+        EXPECT_GT(tally.gregory_culled, 10u);
+        return;
+    }
+    EXPECT_EQ(tables, 32u);
     // The views cull a good fraction, Gregory end caps included: the comparison sees both answers.
     EXPECT_GT(tally.frustum, tally.viewed / 20) << "frustum culls";
     EXPECT_GT(tally.occluded, tally.viewed / 100) << "occlusion culls";
@@ -630,15 +711,22 @@ std::unique_ptr<PlainCase> make_plain_case(int components, bool indexed, std::ui
 }
 
 // float3 and float4, indexed and consecutive: one view per convention.
-void check_plain_sources() {
-    std::mt19937 rng(7);
+void check_plain_sources(Compared compared) {
+    std::mt19937 rng(compared == Compared::separate ? 7 : 8);
     Tally tally;
     for (int components : {3, 4})
         for (bool indexed : {true, false}) {
             const auto c = make_plain_case(components, indexed, 100u + static_cast<std::uint32_t>(components));
-            compare_views(c->subject, rng, 1, tally);
+            compare_views(c->subject, rng, 1, tally, compared);
         }
     EXPECT_EQ(tally.mismatches, 0);
+    if (compared == Compared::box_and_fused) {
+        EXPECT_GT(tally.box, 0u);
+        EXPECT_GT(tally.fused_frustum, 0u);
+        EXPECT_GT(tally.fused_occluded, 0u);
+        EXPECT_GT(tally.fused_back, 0u);
+        return;
+    }
     EXPECT_GT(tally.frustum, 0u);
     EXPECT_GT(tally.occluded, 0u);
     EXPECT_GT(tally.back, 0u);
@@ -647,8 +735,15 @@ void check_plain_sources() {
 // One test, so that llvmpipe compiles the seven programs once (about 12 s without Mesa's shader
 // cache; the comparisons themselves take about 4 s on 2 cores).
 TEST(OsdPatchSourceGpu, TablesAndStridedSourcesMatchTheCpuPatchForPatch) {
-    check_plain_sources();
-    check_tables();
+    check_plain_sources(Compared::separate);
+    check_tables(Compared::separate);
+}
+
+// FrustumDispPass and FusedCullPass (tcone and ncone, Bezier, B-spline and Gregory programs) on
+// the same kinds of sources: half of the tables, every plain source.
+TEST(OsdPatchSourceGpu, FrustumDispAndFusedMatchTheCpuPatchForPatch) {
+    check_plain_sources(Compared::box_and_fused);
+    check_tables(Compared::box_and_fused);
 }
 
 // A source patch whose index lies past point_count is never read: the passes leave it unculled
@@ -679,6 +774,15 @@ TEST(OsdPatchSourceGpu, IndexPastThePointsLeavesThePatchUnculled) {
                        perspective(0.8f, 1.0f, 0.1f, 100.0f, ClipDepth::zero_to_one), ClipDepth::zero_to_one);
     const std::vector<std::uint32_t> got = run_gpu(s, [&](const GpuPatchSource& src) { gpu().frustum.run(src, view); });
     for (std::size_t p = 0; p < patches.size(); ++p) EXPECT_EQ(got[p], p == 3 ? 0u : kCullFrustum) << "patch " << p;
+    const std::vector<std::uint32_t> box =
+        run_gpu(s, [&](const GpuPatchSource& src) { gpu().frustum_disp.run(src, view); });
+    const std::vector<std::uint32_t> fused = run_gpu(s, [&](const GpuPatchSource& src) {
+        gpu().fused.run(src, kCullFrustum | kCullBackPatch, view, BackpatchMethod::tcone, nullptr);
+    });
+    for (std::size_t p = 0; p < patches.size(); ++p) {
+        EXPECT_EQ(box[p], p == 3 ? 0u : kCullFrustum) << "frustum-disp, patch " << p;
+        EXPECT_EQ(fused[p], p == 3 ? 0u : kCullFrustum) << "fused, patch " << p;
+    }
 }
 
 // ---- Bad input --------------------------------------------------------------------------------
@@ -782,6 +886,25 @@ TEST(OsdPatchSourceGpu, BadSourcesAreOneLineErrors) {
     EXPECT_NE(error_of([&] {
                   gpu().ptp.run(g, view.object_to_clip, view.alpha, PtpRule::ncnt);
               }).find("GL: BackpatchPtpPass: source.boundary_masks"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] { gpu().frustum_disp.run(g, view); }).find("GL: FrustumDispPass: source.boundary_masks"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] {
+                  gpu().fused.run(g, kCullFrustum, view, BackpatchMethod::tcone, nullptr);
+              }).find("GL: FusedCullPass: source.boundary_masks"),
+              std::string::npos);
+    // The fused pass's own refusals hold over a source too, one line each.
+    for (const std::string& e :
+         {error_of([&] { gpu().fused.run(good(), kCullOcclusion, view, BackpatchMethod::tcone, nullptr); }),
+          error_of([&] { gpu().fused.run(good(), kCullBackPatch, view, BackpatchMethod::ptp, nullptr); }),
+          error_of([&] { gpu().fused.run(good(), kCullObject, view, BackpatchMethod::tcone, nullptr); })}) {
+        EXPECT_EQ(e.rfind("GL: FusedCullPass: ", 0), 0u) << e;
+        EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    }
+    const GlBuffer few_values(nullptr, 8);
+    EXPECT_NE(error_of([&] {
+                  gpu().frustum_disp.run(good(), view, few_values.name());
+              }).find("GL: FrustumDispPass: plane-value buffer of 8 bytes, 48 needed"),
               std::string::npos);
     glDeleteTextures(1, &hiz.texture);
     // A Gregory source is never back-patch culled: validated, nothing runs.

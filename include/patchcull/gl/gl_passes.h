@@ -30,7 +30,7 @@
 // - or, instead of the control points, your own vertex buffer, index buffer and B-spline boundary
 //   masks (GpuPatchSource below: Bezier, B-spline and Gregory patches, e.g. an OpenSubdiv patch
 //   table in place), read at kBindingSourceVertices, kBindingSourceIndices, kBindingSourceMasks
-//   by FrustumPass, OcclusionPass and the back-patch passes.
+//   by FrustumPass, FrustumDispPass, OcclusionPass, the back-patch passes and FusedCullPass.
 // Textures: a depth texture (HiZBuildPass input: the caller's depth attachment, no compare mode:
 // GL_DEPTH_COMPONENT32F, GL_DEPTH32F_STENCIL8, GL_DEPTH_COMPONENT24 or GL_DEPTH24_STENCIL8), and
 // the Hi-Z pyramid, an R32F mipmapped texture made by create_hiz_texture, holding hiz.h's depth
@@ -182,11 +182,13 @@ struct PatchBuffers {
 ///   masks_offset_bytes + s; read as uint words, so the buffer holds whole words.
 /// Flag range: flags[first + i] and margins[first + i] (PatchBuffers' layouts) belong to source
 /// patch source_first + i, i < count. Decisions equal the CPU entries' (cull_frustum,
-/// cull_backpatch, cull_occlusion over the same PatchSourceView) bit for bit: the shaders gather
+/// cull_frustum_disp, cull_backpatch, cull_occlusion, cull_fused over the same PatchSourceView)
+/// bit for bit: the shaders gather
 /// each patch as gather_bezier does (shaders/patch_source.h) and run the passes' own tests on it
 /// (subnormal coordinates excepted: GPUs and llvmpipe flush them to zero, gl_backpatch.h (1)).
-/// Gregory sources: the frustum and occlusion tests take all 20 points; the back-patch passes
-/// never cull them (they run nothing and leave the flags as they are).
+/// Gregory sources: the frustum, frustum-disp and occlusion tests take all 20 points; the
+/// back-patch passes never cull them (they run nothing and leave the flags as they are), nor does
+/// FusedCullPass's cone test (its program over a Gregory source has none).
 /// Not an aggregate (a braced list names a PatchBuffers): set the members by name.
 struct GpuPatchSource {
     GpuPatchSource() = default;
@@ -299,6 +301,12 @@ public:
     void run(const PatchBuffers& patches, const Mat4& object_to_clip, ClipDepth depth, std::uint32_t plane_values = 0);
     /// The same on one view's CullView (view.object_to_clip in view.depth).
     void run(const PatchBuffers& patches, const CullView& view, std::uint32_t plane_values = 0);
+    /// The same over a patch source: cull_frustum_disp (core/patch_source.h) on the GPU, margins
+    /// included (none: the box of the points alone); plane_values at 6 (first + i) for the range's
+    /// patch i. A Gregory patch's box holds its 20 points. Throws Error (one line) for a bad
+    /// source (check_patch_source's rules, the buffers' sizes; see GpuPatchSource).
+    void run(const GpuPatchSource& source, const Mat4& object_to_clip, ClipDepth depth, std::uint32_t plane_values = 0);
+    void run(const GpuPatchSource& source, const CullView& view, std::uint32_t plane_values = 0);
 
 private:
     struct Impl;
@@ -428,6 +436,17 @@ public:
     /// The same on one view's CullView (view.object_to_clip in view.depth, view.eye; a view
     /// without an eye runs no back-patch test).
     void run(const PatchBuffers& patches, std::uint32_t tests, const CullView& view, BackpatchMethod method,
+             const HiZTexture* hiz);
+    /// The same over a patch source, the points gathered once per patch (shaders/patch_source.h):
+    /// without margins each flag word's reason is cull_fused's decision (core/patch_source.h) with
+    /// the plan of `tests` in the chain's order (frustum, back-patch, Hi-Z; a plan for every mask
+    /// but those with Hi-Z and no frustum) on the same matrix, eye, cone and pyramid. A Gregory
+    /// patch: frustum and Hi-Z over its 20 points, never back-patch culled. Throws Error (one
+    /// line) for a bad source (see GpuPatchSource) and for what the run above refuses, before
+    /// anything runs.
+    void run(const GpuPatchSource& source, std::uint32_t tests, const Mat4& object_to_clip, ClipDepth depth,
+             BackpatchMethod method, Vec3 eye, const HiZTexture* hiz);
+    void run(const GpuPatchSource& source, std::uint32_t tests, const CullView& view, BackpatchMethod method,
              const HiZTexture* hiz);
 
 private:
