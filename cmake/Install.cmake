@@ -28,10 +28,11 @@ foreach(layer core objects import eval)
 endforeach()
 
 # Headers: the GL layers' folders only with GL, so a CPU-only install holds no header it cannot link.
+# gl_osd stays in this tree (its library is not installed).
 if(PATCHCULL_WITH_GL)
-  set(patchcull_header_excludes)
+  set(patchcull_header_excludes PATTERN "gl_osd" EXCLUDE)
 else()
-  set(patchcull_header_excludes PATTERN "gl" EXCLUDE PATTERN "eval_gl" EXCLUDE)
+  set(patchcull_header_excludes PATTERN "gl" EXCLUDE PATTERN "eval_gl" EXCLUDE PATTERN "gl_osd" EXCLUDE)
 endif()
 install(DIRECTORY include/patchcull DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   FILES_MATCHING PATTERN "*.h" ${patchcull_header_excludes})

@@ -14,6 +14,11 @@
 #include <string>
 #include <type_traits>
 
+#include <opensubdiv/far/patchTableFactory.h>
+#include <opensubdiv/far/primvarRefiner.h>
+#include <opensubdiv/far/stencilTable.h>
+
+#include "import/osd_topology.h"
 #include "patchcull/core/error.h"
 
 namespace patchcull {
@@ -155,6 +160,51 @@ void cull_occlusion(const OsdPatchTableSource& table, const CullView& view, cons
     for_each_array(table, "cull_occlusion", [&](const PatchSourceView& s, std::size_t first) {
         cull_occlusion(s, view, hiz, decision + first);
     });
+}
+
+namespace {
+
+// A point for Far's primvar refinement and stencils (float, as the buffer an engine draws).
+struct RefinePoint {
+    float x = 0, y = 0, z = 0;
+    void Clear(void* = nullptr) { x = y = z = 0; }
+    void AddWithWeight(const RefinePoint& p, float w) {
+        x += w * p.x;
+        y += w * p.y;
+        z += w * p.z;
+    }
+};
+
+}  // namespace
+
+OsdAdaptiveTable make_osd_adaptive_table(const ControlMesh& mesh, int isolation_level, bool bspline_end_caps) {
+    if (isolation_level < 1 || isolation_level > 10)
+        throw Error(mesh.name + ": isolation level " + std::to_string(isolation_level) + " is not in 1..10");
+    osd_detail::RefinerPtr refiner = osd_detail::create_refiner(mesh);
+    Far::PatchTableFactory::Options options(static_cast<unsigned>(isolation_level));
+    options.SetEndCapType(bspline_end_caps ? Far::PatchTableFactory::Options::ENDCAP_BSPLINE_BASIS
+                                           : Far::PatchTableFactory::Options::ENDCAP_GREGORY_BASIS);
+    refiner->RefineAdaptive(options.GetRefineAdaptiveOptions());
+    OsdAdaptiveTable out;
+    out.table.reset(Far::PatchTableFactory::Create(*refiner, options));
+    if (!out.table) throw Error(mesh.name + ": OpenSubdiv built no patch table");
+
+    const int refined = refiner->GetNumVerticesTotal();
+    std::vector<RefinePoint> all(static_cast<std::size_t>(refined + out.table->GetNumLocalPoints()));
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v)
+        all[v] = {mesh.positions[v].x, mesh.positions[v].y, mesh.positions[v].z};
+    Far::PrimvarRefinerReal<float> primvar(*refiner);
+    RefinePoint* src = all.data();
+    for (int l = 1; l <= refiner->GetMaxLevel(); ++l) {
+        RefinePoint* dst = src + refiner->GetLevel(l - 1).GetNumVertices();
+        primvar.Interpolate(l, src, dst);
+        src = dst;
+    }
+    if (const Far::StencilTable* local = out.table->GetLocalPointStencilTable())
+        local->UpdateValues(all.data(), all.data() + refined);
+    out.points.reserve(all.size());
+    for (const RefinePoint& p : all) out.points.push_back({p.x, p.y, p.z});
+    return out;
 }
 
 }  // namespace patchcull

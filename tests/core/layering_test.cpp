@@ -2,7 +2,8 @@
 // and of public headers (include/patchcull/<layer>), and its files include the public headers of
 // the layers below it only:
 //   core <- objects <- import <- eval;  core, objects <- gl;  eval, gl <- eval_gl (the
-//   evaluations of the GPU pipeline);  tools -> public headers.
+//   evaluations of the GPU pipeline);  import, gl <- gl_osd (OpenSubdiv's GL patch tables culled
+//   by the gl passes);  tools -> public headers.
 // The kernels and the object level include no OpenSubdiv, stb or GL.
 #include <gtest/gtest.h>
 
@@ -26,6 +27,7 @@ const std::map<std::string, std::set<std::string>> kAllowed = {
     {"eval", {"core", "objects", "import", "eval"}},
     {"gl", {"core", "objects", "gl"}},
     {"eval_gl", {"core", "objects", "import", "eval", "gl", "eval_gl"}},
+    {"gl_osd", {"core", "objects", "import", "gl", "gl_osd"}},
 };
 
 struct Include {

@@ -29,6 +29,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <opensubdiv/far/patchTable.h>
@@ -36,6 +37,8 @@
 #include "patchcull/core/backpatch_methods.h"
 #include "patchcull/core/cull_view.h"
 #include "patchcull/core/hiz.h"
+#include "patchcull/core/math.h"
+#include "patchcull/core/mesh.h"
 #include "patchcull/core/patch_source.h"
 
 namespace patchcull {
@@ -93,6 +96,22 @@ private:
     std::size_t patch_count_ = 0;
     std::size_t points_needed_ = 0;
 };
+
+/// A feature-adaptive table of a control mesh with its points: what an engine that draws
+/// OpenSubdiv's patch tables holds.
+struct OsdAdaptiveTable {
+    std::unique_ptr<const OpenSubdiv::Far::PatchTable> table;
+    /// Every refined level's vertices (level 0 = mesh.positions), then the table's local points:
+    /// point i is the vertex the table's index i names (float3, PointLayout stride 12).
+    std::vector<Vec3> points;
+};
+
+/// Builds mesh's feature-adaptive Far::PatchTable at isolation_level (1..10): Catmull-Clark with
+/// the mesh's creases, corners, holes and options (as Scheme::osd), REGULAR B-spline patches and
+/// GREGORY_BASIS end caps (Far's default; B-spline end caps when bspline_end_caps), no
+/// single-crease patches; its points refined by Far::PrimvarRefiner and its local point stencils.
+/// Throws Error for a bad mesh (as load_model) or level.
+OsdAdaptiveTable make_osd_adaptive_table(const ControlMesh& mesh, int isolation_level, bool bspline_end_caps = false);
 
 /// cull_frustum (core/patch_source.h) over every array: culled[i] for the table's patch i
 /// (patch_count() bytes); max_displacement null or patch_count() values >= 0 in table order.

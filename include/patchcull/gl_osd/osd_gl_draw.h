@@ -1,0 +1,155 @@
+// patchcull/gl_osd/osd_gl_draw.h: OpenSubdiv's own patch table drawn with OpenSubdiv's own GLSL
+// patch shaders, culled in place by patchcull's GPU passes (library patchcull_gl_osd: the gl
+// layer plus OpenSubdiv's osdGPU; the gl layer itself never sees OpenSubdiv).
+//
+// What is drawn is what an engine built on OpenSubdiv draws: Osd::GLPatchTable (the table's
+// control-vertex index buffer, its patch-param texture buffer and its PatchArrays) over the
+// engine's vertex buffer, every REGULAR array with Osd::GLSLPatchShaderSource's B-spline
+// shaders and every GREGORY_BASIS array with its Gregory-basis shaders, each program composed as
+// OpenSubdiv's examples compose theirs (version, stage defines, OSD_PATCH_BASIS_GLSL with
+// GetPatchBasisShaderSource, GetCommonShaderSource, a client header, the stage's patch source) with a small main
+// fragment shader that writes the patch's id. The client header includes shared.h and
+// patchcull_tcs.h in the TCS and redefines OpenSubdiv's OSD_PATCH_CULL(N) hook as
+// PATCHCULL_RETURN_UNLESS_DRAWN(OsdGetPatchIndex(gl_PrimitiveID), mask, value): the flag index is
+// Far's patch index (PatchArray::GetPrimitiveIdBase() + gl_PrimitiveID).
+//
+// Culling: each patch array is one GpuPatchSource (gl_passes.h) over the same vertex buffer, the
+// table's index buffer and a buffer of boundary masks, all writing one flag buffer in Far's patch
+// order, so FrustumPass, BackpatchConePass, BackpatchPtpPass and OcclusionPass run on the table
+// in place. OsdCullFrame runs Niessner & Loop's two-pass frame ("Patch-Based Occlusion Culling
+// for Hardware Tessellation"): pass 1 draws the patches the previous frame found visible, the
+// Hi-Z pyramid is built from its depth, the chain tests every patch, pass 2 draws the newly
+// visible ones.
+//
+// What contributes a pixel (as README's rule): a shape drawn one-sided (closed, outward oriented:
+// the only shapes to give a back-patch pass) keeps a fragment only where the cosine between
+// OpenSubdiv's evaluated normal and the direction to the eye, computed at the tessellated
+// vertices and interpolated, exceeds shared.h's kFrontFacingMinCosine; open shapes are two-sided.
+//
+// llvmpipe: gl_PrimitiveID restarts within indexed draws there (patchcull_tcs.h), so on a software
+// rasterizer each array is drawn as sub-draws of at most 1024 / n patches (n = 16 or 20), each
+// with its PrimitiveIdBase; on a GPU one draw per array.
+//
+// Threads and lifetime: as gl_passes.h (the context current at construction, on its thread).
+// Errors: patchcull::Error with one line (a table with other patch types, a vertex layout the
+// draw cannot read, a shader the driver rejects, a GL error).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <opensubdiv/far/patchTable.h>
+
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/backpatch_methods.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/cull_view.h"
+#include "patchcull/core/math.h"
+#include "patchcull/gl/gl_passes.h"
+
+namespace patchcull::gl_osd {
+
+/// The caller's vertex buffer: float3 positions (OpenSubdiv's shaders read x, y, z), every
+/// refined level's vertices then the table's local points (import/osd_patch_table.h's "Points").
+struct OsdVertexBuffer {
+    std::uint32_t buffer = 0;
+    std::size_t stride_bytes = 12;  ///< a multiple of 4, >= offset_bytes + 12
+    std::size_t offset_bytes = 0;   ///< of x; a multiple of 4
+    std::size_t point_count = 0;    ///< points the buffer holds
+};
+
+/// One view as both the draw and the passes see it: the object-to-view matrix (the TES's
+/// OsdModelViewMatrix, a rigid transform), the projection written in `depth`, the eye in
+/// object space.
+struct OsdView {
+    Mat4 model_view;
+    Mat4 projection;
+    ClipDepth depth = ClipDepth::zero_to_one;
+    Vec3 eye{0, 0, 0};
+    float tess_level = 4;    ///< OsdTessLevel(): OpenSubdiv's uniform level (1..16)
+    bool one_sided = false;  ///< the one-sided rule above (closed shapes)
+    CullView cull_view() const { return make_cull_view(model_view, projection, depth, eye); }
+};
+
+/// A feature-adaptive Far::PatchTable on the GPU with OpenSubdiv's programs for its arrays.
+class OsdPatchTableDraw {
+public:
+    /// Uploads table (Osd::GLPatchTable, plus a byte per patch of boundary masks) and compiles
+    /// OpenSubdiv's programs for the array types present. table: REGULAR and GREGORY_BASIS arrays
+    /// only (Error naming the array and type otherwise); it need not outlive this object.
+    OsdPatchTableDraw(gl::PassContext& passes, const OpenSubdiv::Far::PatchTable& table);
+    OsdPatchTableDraw(OsdPatchTableDraw&&) noexcept;
+    OsdPatchTableDraw& operator=(OsdPatchTableDraw&&) noexcept;
+    ~OsdPatchTableDraw();
+
+    /// Patches in the table: the size of the flag buffer (uint per patch, Far's order).
+    std::size_t patch_count() const;
+    /// 1 + the largest index a patch reads: OsdVertexBuffer::point_count must be at least this.
+    std::size_t points_needed() const;
+    /// The table's arrays as GpuPatchSources over vertices and flags (array a's flags are Far's
+    /// patches [first, first + count)). Error for a bad vertex layout.
+    std::vector<gl::GpuPatchSource> sources(const OsdVertexBuffer& vertices, std::uint32_t flags) const;
+    /// Draws every array into the bound framebuffer (its viewport, depth test and clip control as
+    /// the caller set them), keeping patch p when (flags[p] & mask) == value (patchcull_tcs.h);
+    /// the fragment output 0 (R32UI) gets p + 1. Leaves no program or VAO bound.
+    void draw(const OsdVertexBuffer& vertices, std::uint32_t flags, std::uint32_t mask, std::uint32_t value,
+              const OsdView& view) const;
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+/// Which tests a frame runs (each off by default).
+struct OsdCullSettings {
+    bool frustum = false;
+    std::optional<BackpatchMethod> backpatch;  ///< tcone, ncone or ptp: one-sided closed shapes only
+    PtpRule ptp_rule = PtpRule::ncnt;
+    bool occlusion = false;  ///< two-pass Hi-Z occlusion culling
+};
+
+/// What one culled frame did (CullStatusPass's counters).
+struct OsdFrameStats {
+    std::size_t frustum = 0, backpatch = 0, occlusion = 0;  ///< patches culled per reason
+    std::size_t drawn_pass1 = 0, drawn_pass2 = 0;           ///< drawn in pass 1 / pass 2 (or the one pass)
+};
+
+/// The frame's targets (an R32UI id texture, a DEPTH32F depth texture, width x height), the flag
+/// buffer and the Hi-Z pyramid, for one table. The flag buffer keeps the statuses from frame to
+/// frame (temporal coherence); reset() primes it as Niessner & Loop §3 do (even patches visible).
+class OsdCullFrame {
+public:
+    /// width, height in [1, 8192].
+    OsdCullFrame(gl::PassContext& passes, const OsdPatchTableDraw& draw, int width, int height);
+    OsdCullFrame(OsdCullFrame&&) noexcept;
+    OsdCullFrame& operator=(OsdCullFrame&&) noexcept;
+    ~OsdCullFrame();
+
+    /// kStatusVisible on the even patches, 0 on the others.
+    void reset();
+    /// One culled frame: without occlusion, the chain (frustum, back-patch) then one draw of the
+    /// unculled patches; with occlusion, the two-pass frame. Sets glClipControl, the viewport and
+    /// the depth test for view.depth; leaves framebuffer 0 bound, the default clip control (lower
+    /// left, -1..1), GL_LESS and the depth test off. Checks view and vertices before any GL work.
+    OsdFrameStats render(const OsdVertexBuffer& vertices, const OsdView& view, const OsdCullSettings& settings);
+    /// Every patch drawn (the reference); the flags are left as they were.
+    void render_unculled(const OsdVertexBuffer& vertices, const OsdView& view);
+    /// The last frame's ids (row 0 = bottom; 0 background, p + 1 for Far's patch p) and window
+    /// depths.
+    std::vector<std::uint32_t> read_ids() const;
+    std::vector<float> read_depth() const;
+    std::uint32_t flag_buffer() const;
+    int width() const;
+    int height() const;
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace patchcull::gl_osd
