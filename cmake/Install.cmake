@@ -48,10 +48,11 @@ if(PATCHCULL_WITH_GL)
   # The GLSL headers of gl_passes.h's shipped_glsl, as the library embeds them: shared.h (the
   # constants of C++ and GLSL, with core/cull_flags.h's flag word inlined by the shader build, so an
   # engine's shader include system needs no second folder) and patchcull_tcs.h (the TCS include,
-  # which uses shared.h's constants); patchcull::gl puts this folder on the include path, as the
-  # build puts shaders/.
+  # which uses shared.h's constants) and patchcull_draw_list.h (the vertex side of a compacted
+  # draw, gl_compaction.h); patchcull::gl puts this folder on the include path, as the build puts
+  # shaders/.
   install(FILES ${PROJECT_BINARY_DIR}/src/gl/shaders/shipped/shared.h shaders/patchcull_tcs.h
-    DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/patchcull/glsl)
+    shaders/patchcull_draw_list.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/patchcull/glsl)
 endif()
 if(TARGET patchcull_cli)
   install(TARGETS patchcull_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

@@ -151,6 +151,23 @@ PC_PARAMS(CullStatusParams, kUniformPassParams) {
     PC_UINT(mode);                     // kStatusBegin or kStatusEnd
 } PC_END(status);
 
+// compact.comp.glsl (CompactPass, gl_compaction.h): the patches of the range whose flag word
+// satisfies (flag & mask) == value, written to the draw list from list_first on.
+PC_PARAMS(CompactParams, kUniformPassParams) {
+    PC_UINT(first_patch);
+    PC_UINT(patch_count);
+    PC_UINT(mask);
+    PC_UINT(value);
+    PC_UINT(mode);                     // kCompactInit .. kCompactScatter
+    PC_UINT(list_first);               // the range's first entry of the draw list
+    PC_UINT(command_word);             // the command at words [command_word, command_word + 4)
+    PC_UINT(count_word);               // the draw count at this word of its buffer
+    PC_UINT(write_count);              // the draw-count buffer is bound
+    PC_UINT(group_base);               // scan: the range-wide index of this dispatch's first work group
+    PC_UINT(group_count);              // scan: the range's work groups (entries of the sums)
+    PC_UINT(pad0);
+} PC_END(compact);
+
 // fused_cull.comp.glsl (FusedCullPass): the frustum, back-patch cone and Hi-Z tests of one patch in
 // one invocation, in the chain's order (tcone, or ncone with PATCHCULL_NCONE).
 PC_PARAMS(FusedCullParams, kUniformPassParams) {

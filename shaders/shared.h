@@ -80,6 +80,14 @@ PATCHCULL_CONST uint kBindingPoseTangentTable = 22u;
 PATCHCULL_CONST uint kBindingSourceVertices = 23u;
 PATCHCULL_CONST uint kBindingSourceIndices = 24u;
 PATCHCULL_CONST uint kBindingSourceMasks = 25u;
+// Compaction (gl_compaction.h's CompactPass: compact.comp.glsl; the draw side patchcull_draw_list.h):
+// uint list[n], the indices of the patches a draw selection keeps; the indirect commands
+// (DrawArraysIndirectCommand, 4 uints each) and the draw counts, read as uint words; the pass's own
+// per-work-group sums of its prefix scan.
+PATCHCULL_CONST uint kBindingDrawList = 26u;
+PATCHCULL_CONST uint kBindingDrawCommands = 27u;
+PATCHCULL_CONST uint kBindingDrawCount = 28u;
+PATCHCULL_CONST uint kBindingCompactSums = 29u;
 
 // Uniform buffer binding of the passes' parameter blocks (pass_params.h; one pass runs at a time).
 PATCHCULL_CONST uint kUniformPassParams = 0u;
@@ -115,6 +123,17 @@ PATCHCULL_CONST uint kDrawValueFirstPass = kStatusVisible;
 PATCHCULL_CONST uint kDrawMaskSecondPass = kStatusVisible | kStatusNewlyVisible;  // newly visible
 PATCHCULL_CONST uint kDrawValueSecondPass = kStatusVisible | kStatusNewlyVisible;
 
+// compact.comp.glsl's modes (CompactParams::mode): the atomic append (init, append, finish) and
+// the order-preserving prefix scan (group counts, scan of the sums, scatter).
+PATCHCULL_CONST uint kCompactInit = 0u;
+PATCHCULL_CONST uint kCompactAppend = 1u;
+PATCHCULL_CONST uint kCompactFinish = 2u;
+PATCHCULL_CONST uint kCompactGroupCounts = 3u;
+PATCHCULL_CONST uint kCompactScanSums = 4u;
+PATCHCULL_CONST uint kCompactScatter = 5u;
+// Control points a compacted draw pulls per patch (gl_VertexID / kDrawListPatchVertices indexes the list).
+PATCHCULL_CONST uint kDrawListPatchVertices = 16u;
+
 // Counters added by cull_status (end) (kBindingCullCounters); the caller clears them.
 PATCHCULL_CONST uint kCounterFrustum = 0u;       // patches culled by a frustum test (the bound's, for displaced ones)
 PATCHCULL_CONST uint kCounterBackPatch = 1u;     // ... by a back-patch test
@@ -145,6 +164,8 @@ PATCHCULL_CONST uint kIdOccluderBit = 0x80000000u;
 
 // Compute work-group size of the per-patch cull shaders (one invocation per patch).
 PATCHCULL_CONST uint kCullGroupSize = 64u;
+// Compaction work groups (one invocation per patch; the scan of the group sums runs in one group).
+PATCHCULL_CONST uint kCompactGroupSize = 256u;
 // Hi-Z build work groups: kHiZGroupSize x kHiZGroupSize texels of one level.
 PATCHCULL_CONST uint kHiZGroupSize = 8u;
 // 24-bit depth textures (HiZBuildPass): a depth d read as float is widened by 1.5 / (2^24 - 1)

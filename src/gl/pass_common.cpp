@@ -160,7 +160,7 @@ std::vector<float> PassContext::probe(BackpatchProbe op, const std::vector<Vec3>
 }
 
 std::string_view shipped_glsl(std::string_view name) {
-    if (name != "shared.h" && name != "patchcull_tcs.h") return {};
+    if (name != "shared.h" && name != "patchcull_tcs.h" && name != "patchcull_draw_list.h") return {};
     const char* text = find_shader_source(name);
     return text ? std::string_view(text) : std::string_view();
 }

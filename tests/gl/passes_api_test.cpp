@@ -1,6 +1,6 @@
 // What gl_passes.h ships for an engine's own shaders: the embedded GLSL headers equal the files
 // in shaders/ byte for byte, shared.h with the flag word (patchcull/core/cull_flags.h) inlined in
-// place of its #include line, and only those two are handed out.
+// place of its #include line, and only those three are handed out.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -31,12 +31,14 @@ std::string read_source(const std::string& name) {
 }  // namespace
 
 TEST(PassesApi, ShippedGlslIsTheSourceFile) {
-    for (const char* name : {"shared.h", "patchcull_tcs.h"}) {
+    for (const char* name : {"shared.h", "patchcull_tcs.h", "patchcull_draw_list.h"}) {
         const std::string_view shipped = patchcull::gl::shipped_glsl(name);
         ASSERT_FALSE(shipped.empty()) << name;
         EXPECT_EQ(std::string(shipped), read_source(name)) << name;
     }
     EXPECT_NE(patchcull::gl::shipped_glsl("patchcull_tcs.h").find("patchcull_patch_drawn"), std::string_view::npos);
+    EXPECT_NE(patchcull::gl::shipped_glsl("patchcull_draw_list.h").find("patchcull_draw_list_patch"),
+              std::string_view::npos);
     EXPECT_TRUE(patchcull::gl::shipped_glsl("frustum.comp.glsl").empty());  // internal, not shipped
     EXPECT_TRUE(patchcull::gl::shipped_glsl("nonexistent.h").empty());
     // The C++ side of the same constants.

@@ -156,15 +156,16 @@ elseif(MODE STREQUAL "cpu")
       -DPATCHCULL_BUILD_EXAMPLES=ON -DPATCHCULL_BUILD_FUZZERS=OFF
       -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON)
   expect_no_gl_search("cpu-only" "${CPU_BUILD_DIR}/CMakeCache.txt")
+  # The help target lists one target a line: "... NAME" (Makefiles) or "NAME: phony" (Ninja).
   execute_process(COMMAND ${CMAKE_COMMAND} --build "${CPU_BUILD_DIR}" --target help OUTPUT_VARIABLE targets)
   foreach(target patchcull_core patchcull_objects patchcull_import patchcull_eval patchcull_core_tests
                  patchcull_import_tests)
-    if(NOT targets MATCHES "\\.\\.\\. ${target}\n")
+    if(NOT targets MATCHES "(\\.\\.\\. |\n)${target}(: phony)?\n")
       message(FATAL_ERROR "cpu-only: no target ${target}")
     endif()
   endforeach()
   foreach(target patchcull_gl patchcull_cli patchcull_shaders patchcull_gl_tests patchcull_bench)
-    if(targets MATCHES "\\.\\.\\. ${target}\n")
+    if(targets MATCHES "(\\.\\.\\. |\n)${target}(: phony)?\n")
       message(FATAL_ERROR "cpu-only: target ${target} exists without GL")
     endif()
   endforeach()

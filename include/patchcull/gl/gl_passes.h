@@ -113,7 +113,8 @@ using patchcull::parse_backpatch_method;
 /// The text of a GLSL header shipped for an engine's own shaders, embedded in the library:
 /// "shared.h" (the constants shared by C++ and GLSL: bindings, flag bits, draw selections,
 /// counters; C++ code includes the same file from shaders/, on patchcull_gl's public include
-/// path) and "patchcull_tcs.h" (the TCS include, shaders/patchcull_tcs.h). Paste it in place of
+/// path), "patchcull_tcs.h" (the TCS include, shaders/patchcull_tcs.h) and "patchcull_draw_list.h"
+/// (the vertex shader of a compacted draw, gl_compaction.h). Paste it in place of
 /// the #include line (or register it with your include mechanism). Empty for any other name.
 std::string_view shipped_glsl(std::string_view name);
 

@@ -1,0 +1,95 @@
+// patchcull/gl/gl_compaction.h: draw only what survives (library patchcull_gl). CompactPass turns the
+// flag words of a patch range (gl_passes.h) into a list of the patch indices a draw selection keeps
+// and an indirect draw command over that list, on the GPU: the culled patches are never issued,
+// instead of being issued and discarded by the TCS with tessellation levels 0 (patchcull_tcs.h).
+// Counts stay on the GPU; nothing is read back.
+//
+// The draw (docs/ENGINE.md, "Draw only what survives"): bind the command buffer to
+// GL_DRAW_INDIRECT_BUFFER and the draw-count buffer to GL_PARAMETER_BUFFER, and call
+// glMultiDrawArraysIndirectCount(GL_PATCHES, command_offset, draw_count_offset, 1, 0) (GL 4.6 or
+// GL_ARB_indirect_parameters; else glMultiDrawArraysIndirect(GL_PATCHES, command_offset, 1, 0),
+// which issues the command even with 0 vertices) with GL_PATCH_VERTICES 16 and no vertex
+// attributes. The vertex shader pulls its control point itself: point gl_VertexID % 16 of patch
+// list[gl_VertexID / 16] (shaders/patchcull_draw_list.h, shipped_glsl("patchcull_draw_list.h"); the
+// list stays bound at shared.h's kBindingDrawList after the pass, and the vertex shader must be
+// allowed a storage block, GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS >= 1, as on every desktop driver).
+// The patch index it finds is the flag buffer's index: pass it on (flat) as the flag path does.
+//
+// Buffers (the caller's; bound whole as std430 storage, so offsets need only be multiples of 4):
+// - the flag range of PatchBuffers (control points and margins are not read, may be 0);
+// - list, kBindingDrawList: uint entries; the range's survivors go to list[list_first ..
+//   list_first + n), n <= count; the buffer must hold list_first + count entries (the worst case);
+//   entries past n are left as they were;
+// - command, kBindingDrawCommands: one DrawArraysIndirectCommand at byte command_offset, written
+//   whole: {16 n, 1, 16 list_first, 0} (first = 16 list_first, so gl_VertexID / 16 indexes the
+//   list itself; several ranges, e.g. one per object, can share one list and one command buffer);
+// - draw count (optional), kBindingDrawCount: one uint at byte draw_count_offset, 1 when n > 0, else
+//   0 (glMultiDrawArraysIndirectCount's drawcount for this one command).
+// State contract: gl_passes.h's, plus GL_COMMAND_BARRIER_BIT in the closing barrier (the indirect
+// command and the draw count are visible to the draw). It binds the flag buffer at
+// kBindingCullFlags, the list, command and count buffers at their bindings, and, for the prefix
+// scan, a buffer of its own at kBindingCompactSums (one uint per 256 patches of the largest range
+// seen, allocated on the first scan run and grown when a larger range comes: the only GL objects
+// made after the first run). Ranges of any size up to 2^28 patches (list_first + count < 2^28,
+// so that 16 (list_first + count) fits in 32 bits) are covered by dispatches of at most 65535
+// work groups. Errors: patchcull::Error with one line ("GL: CompactPass: ..."): a buffer that is
+// not one or too small, an offset not a multiple of 4, a range past 2^28.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string_view>
+
+#include "patchcull/gl/gl_passes.h"
+
+namespace patchcull::gl {
+
+/// GL's DrawArraysIndirectCommand {count, instanceCount, first, baseInstance}, as CompactPass
+/// writes it (for a read-back or a CPU-side draw).
+struct DrawArraysIndirectCommand {
+    std::uint32_t count = 0;           ///< vertices: 16 per surviving patch
+    std::uint32_t instance_count = 0;  ///< 1
+    std::uint32_t first = 0;           ///< 16 * list_first
+    std::uint32_t base_instance = 0;   ///< 0
+};
+static_assert(sizeof(DrawArraysIndirectCommand) == 16);
+
+/// How the list is built. Both give the same set of patches.
+enum class CompactMethod {
+    atomic_append,  ///< one atomicAdd per work group: the order of the list changes from run to run
+    prefix_scan,    ///< a prefix scan over work-group sums: ascending patch index, every run
+};
+
+/// "atomic" or "scan".
+std::string_view compact_method_name(CompactMethod method);
+
+/// Where CompactPass writes (GL buffer names and byte offsets; see the header).
+struct DrawListBuffers {
+    std::uint32_t list = 0;             ///< required: uint entries
+    std::size_t list_first = 0;         ///< the range's first entry
+    std::uint32_t command = 0;          ///< required: the DrawArraysIndirectCommand's buffer
+    std::size_t command_offset = 0;     ///< bytes, a multiple of 4
+    std::uint32_t draw_count = 0;       ///< optional (0: not written): the draw count's buffer
+    std::size_t draw_count_offset = 0;  ///< bytes, a multiple of 4
+};
+
+class CompactPass {
+public:
+    explicit CompactPass(PassContext& context);
+    CompactPass(CompactPass&&) noexcept;
+    CompactPass& operator=(CompactPass&&) noexcept;
+    ~CompactPass();
+    /// Writes the indices p in [patches.first, patches.first + patches.count) with
+    /// (flags[p] & mask) == value (shared.h's kDrawMask* / kDrawValue* pairs; 0, 0 keeps every
+    /// patch) to out.list, and the command and draw count (see the header). A range of 0 patches
+    /// writes the command {0, 1, 16 list_first, 0} and draw count 0.
+    void run(const PatchBuffers& patches, std::uint32_t mask, std::uint32_t value, const DrawListBuffers& out,
+             CompactMethod method = CompactMethod::prefix_scan);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace patchcull::gl

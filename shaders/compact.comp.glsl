@@ -1,0 +1,117 @@
+// Compaction pass (CompactPass, src/gl/compact_pass.cpp; include/patchcull/gl/gl_compaction.h): the
+// patches p of the range [first_patch, first_patch + patch_count) whose flag word satisfies
+// (flag & mask) == value go into the draw list (kBindingDrawList) from entry list_first on, and
+// the range's DrawArraysIndirectCommand {16 n, 1, 16 list_first, 0} (n survivors) and its draw
+// count (1 when n > 0, else 0) are written for an indirect draw that pulls point
+// gl_VertexID % 16 of patch list[gl_VertexID / 16]. One invocation per patch.
+// The atomic append (order not stable):
+// - kCompactInit (one invocation): the command {0, 1, 16 list_first, 0}.
+// - kCompactAppend: each work group counts its survivors in shared memory, reserves their slots
+//   with one atomicAdd on the command's vertex count (16 per patch) and writes them.
+// - kCompactFinish (one invocation): the draw count from the command's vertex count.
+// The prefix scan (ascending patch order, the same every frame):
+// - kCompactGroupCounts: group g's survivor count into sums[g] (kBindingCompactSums).
+// - kCompactScanSums (one work group): sums -> their exclusive prefix sums, looping over the
+//   groups kCompactGroupSize at a time; then the command and the draw count from the total.
+// - kCompactScatter: each survivor at list[list_first + sums[g] + its rank within group g].
+#version 450 core
+#include "shared.h"
+#include "pass_params.h"
+#define PC_CULL_FLAGS readonly
+#include "patch_buffers.h"
+
+layout(local_size_x = kCompactGroupSize) in;
+
+layout(std430, binding = kBindingDrawList) writeonly buffer DrawList {
+    uint draw_list[];
+};
+layout(std430, binding = kBindingDrawCommands) buffer DrawCommands {
+    uint draw_commands[];  // count, instanceCount, first, baseInstance at command_word
+};
+layout(std430, binding = kBindingDrawCount) writeonly buffer DrawCount {
+    uint draw_count[];
+};
+layout(std430, binding = kBindingCompactSums) buffer CompactSums {
+    uint group_sums[];
+};
+
+shared uint s_scan[kCompactGroupSize];
+shared uint s_total;
+
+// Inclusive prefix sum of v over the work group (Hillis-Steele); s_scan[last] is the total after.
+uint group_inclusive_scan(uint v) {
+    const uint i = gl_LocalInvocationIndex;
+    s_scan[i] = v;
+    barrier();
+    for (uint offset = 1u; offset < kCompactGroupSize; offset <<= 1u) {
+        uint sum = s_scan[i];
+        if (i >= offset) sum += s_scan[i - offset];
+        barrier();
+        s_scan[i] = sum;
+        barrier();
+    }
+    return s_scan[i];
+}
+
+void write_command(uint survivors) {
+    const uint w = compact.command_word;
+    draw_commands[w] = kDrawListPatchVertices * survivors;
+    draw_commands[w + 1u] = 1u;
+    draw_commands[w + 2u] = kDrawListPatchVertices * compact.list_first;
+    draw_commands[w + 3u] = 0u;
+}
+
+void main() {
+    const uint lid = gl_LocalInvocationIndex;
+    const uint mode = compact.mode;
+    if (mode == kCompactInit) {
+        if (gl_GlobalInvocationID.x == 0u) write_command(0u);
+        return;
+    }
+    if (mode == kCompactFinish) {
+        if (gl_GlobalInvocationID.x == 0u && compact.write_count != 0u)
+            draw_count[compact.count_word] = draw_commands[compact.command_word] != 0u ? 1u : 0u;
+        return;
+    }
+    if (mode == kCompactScanSums) {
+        uint carry = 0u;
+        for (uint start = 0u; start < compact.group_count; start += kCompactGroupSize) {
+            const uint g = start + lid;
+            const uint v = g < compact.group_count ? group_sums[g] : 0u;
+            const uint inclusive = group_inclusive_scan(v);
+            if (g < compact.group_count) group_sums[g] = carry + inclusive - v;
+            carry += s_scan[kCompactGroupSize - 1u];
+            barrier();  // every invocation has read s_scan before the next chunk writes it
+        }
+        if (lid == 0u) {
+            write_command(carry);
+            if (compact.write_count != 0u) draw_count[compact.count_word] = carry != 0u ? 1u : 0u;
+        }
+        return;
+    }
+
+    const uint index = gl_GlobalInvocationID.x;
+    const uint p = compact.first_patch + index;
+    const bool keep = index < compact.patch_count && (cull_flags[p] & compact.mask) == compact.value;
+    if (mode == kCompactAppend || mode == kCompactGroupCounts) {
+        if (lid == 0u) s_total = 0u;
+        barrier();
+        uint slot = 0u;
+        if (keep) slot = atomicAdd(s_total, 1u);
+        barrier();
+        if (mode == kCompactGroupCounts) {
+            if (lid == 0u) group_sums[compact.group_base + gl_WorkGroupID.x] = s_total;
+            return;
+        }
+        if (lid == 0u && s_total != 0u)
+            s_total = atomicAdd(draw_commands[compact.command_word], kDrawListPatchVertices * s_total) /
+                      kDrawListPatchVertices;
+        barrier();
+        if (keep) draw_list[compact.list_first + s_total + slot] = p;
+        return;
+    }
+    // kCompactScatter
+    const uint k = keep ? 1u : 0u;
+    const uint rank = group_inclusive_scan(k) - k;
+    if (keep) draw_list[compact.list_first + group_sums[compact.group_base + gl_WorkGroupID.x] + rank] = p;
+}

@@ -1,0 +1,133 @@
+// CompactPass (patchcull/gl/gl_compaction.h): the flag words of a range -> a draw list and an
+// indirect command, shaders/compact.comp.glsl.
+#include "patchcull/gl/gl_compaction.h"
+
+#include <algorithm>
+#include <string>
+
+#include "pass_common.h"
+
+namespace patchcull::gl {
+
+static_assert(sizeof(pp::CompactParams) == 48);
+
+std::string_view compact_method_name(CompactMethod method) {
+    return method == CompactMethod::atomic_append ? "atomic" : "scan";
+}
+
+struct CompactPass::Impl {
+    explicit Impl(PassContext::Impl& c) : context(c) {}
+    ~Impl() { glDeleteBuffers(1, &sums); }
+    PassContext::Impl& context;
+    detail::ParamBlock block;
+    GLuint sums = 0;  // the scan's work-group sums
+    std::size_t sums_capacity = 0;
+
+    static void check_offset(const char* what, std::size_t offset) {
+        if (offset % 4 != 0)
+            throw Error(std::string("GL: CompactPass: ") + what + " offset " + std::to_string(offset) +
+                        " is not a multiple of 4");
+    }
+
+    // One dispatch per at most 65535 work groups over the range; group_base counts the groups before.
+    void dispatch_range(pp::CompactParams& params, std::size_t first, std::size_t count) {
+        constexpr std::size_t group = shared::kCompactGroupSize;
+        constexpr std::size_t per_dispatch = 65535 * group;
+        for (std::size_t offset = 0; offset < count; offset += per_dispatch) {
+            const std::size_t n = std::min(per_dispatch, count - offset);
+            params.first_patch = static_cast<pp::uint>(first + offset);
+            params.patch_count = static_cast<pp::uint>(n);
+            params.group_base = static_cast<pp::uint>(offset / group);
+            block.upload(params);
+            glDispatchCompute(static_cast<GLuint>((n + group - 1) / group), 1, 1);
+        }
+    }
+
+    void dispatch_one(pp::CompactParams& params, pp::uint mode) {
+        params.mode = mode;
+        block.upload(params);
+        glDispatchCompute(1, 1, 1);
+    }
+
+    void run(const PatchBuffers& patches, pp::uint mask, pp::uint value, const DrawListBuffers& out,
+             CompactMethod method) {
+        const char* who = "CompactPass";
+        detail::begin_pass(who);
+        detail::check_patch_buffers(who, patches, /*with_points=*/false);
+        if (out.list_first + patches.count > 0xFFFFFFFFu / 16)
+            throw Error("GL: CompactPass: list_first + count past 2^28 entries (16 vertices per patch)");
+        check_offset("command", out.command_offset);
+        detail::check_buffer_size(who, "draw-list", out.list, (out.list_first + patches.count) * 4);
+        detail::check_buffer_size(who, "indirect-command", out.command,
+                                  out.command_offset + sizeof(DrawArraysIndirectCommand));
+        if (out.draw_count) {
+            check_offset("draw-count", out.draw_count_offset);
+            detail::check_buffer_size(who, "draw-count", out.draw_count, out.draw_count_offset + 4);
+        }
+        pp::CompactParams params;
+        params.mask = mask;
+        params.value = value;
+        params.list_first = static_cast<pp::uint>(out.list_first);
+        params.command_word = static_cast<pp::uint>(out.command_offset / 4);
+        params.count_word = static_cast<pp::uint>(out.draw_count_offset / 4);
+        params.write_count = out.draw_count ? 1u : 0u;
+        constexpr std::size_t group = shared::kCompactGroupSize;
+        const std::size_t groups = (patches.count + group - 1) / group;
+        params.group_count = static_cast<pp::uint>(groups);
+        const bool scan = method == CompactMethod::prefix_scan;
+        if (scan && groups > sums_capacity) {
+            const std::size_t capacity = std::max<std::size_t>(groups, 2 * sums_capacity);
+            glDeleteBuffers(1, &sums);
+            glCreateBuffers(1, &sums);
+            glNamedBufferStorage(sums, static_cast<GLsizeiptr>(capacity * 4), nullptr, 0);
+            sums_capacity = capacity;
+        }
+
+        glUseProgram(context.program("compact.comp.glsl"));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCullFlags, patches.flags);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDrawList, out.list);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDrawCommands, out.command);
+        if (out.draw_count) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDrawCount, out.draw_count);
+        // Earlier shader writes to the flags (the chain's passes) and to these buffers are seen.
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        if (scan) {
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCompactSums, sums);
+            if (patches.count) {
+                params.mode = shared::kCompactGroupCounts;
+                dispatch_range(params, patches.first, patches.count);
+                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            }
+            dispatch_one(params, shared::kCompactScanSums);
+            if (patches.count) {
+                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+                params.mode = shared::kCompactScatter;
+                dispatch_range(params, patches.first, patches.count);
+            }
+        } else {
+            dispatch_one(params, shared::kCompactInit);
+            if (patches.count) {
+                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+                params.mode = shared::kCompactAppend;
+                dispatch_range(params, patches.first, patches.count);
+            }
+            if (out.draw_count) {
+                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+                dispatch_one(params, shared::kCompactFinish);
+            }
+        }
+        glMemoryBarrier(GL_COMMAND_BARRIER_BIT);
+        detail::finish_pass(who);
+    }
+};
+
+CompactPass::CompactPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
+CompactPass::CompactPass(CompactPass&&) noexcept = default;
+CompactPass& CompactPass::operator=(CompactPass&&) noexcept = default;
+CompactPass::~CompactPass() = default;
+
+void CompactPass::run(const PatchBuffers& patches, std::uint32_t mask, std::uint32_t value, const DrawListBuffers& out,
+                      CompactMethod method) {
+    impl_->run(patches, mask, value, out, method);
+}
+
+}  // namespace patchcull::gl
