@@ -29,7 +29,9 @@
 //   fma(fl(D * |row xyz|), W, value) when margins are given.
 // - frustum-disp (Sathe): the object-space AABB of the control points grown by max |D| on
 //   every side; its 8 corners are transformed to clip space and tested against the clip planes
-//   (the NDC in-out test, done as homogeneous comparisons).
+//   (the NDC in-out test, done as homogeneous comparisons). Without displacement (null
+//   max_displacement) it is the box of the control points, valid for any patch but looser than
+//   frustum's hull test; patch_source.h runs both over your own control points.
 //
 // Non-finite input: every clip coordinate of a control point with a NaN or infinite coordinate is
 // itself NaN or infinite (a zero matrix entry times +-Inf is NaN, any sum with a non-finite term

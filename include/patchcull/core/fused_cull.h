@@ -38,6 +38,9 @@
 // per stage, the patches it culled. A group is Lanes(d) patches for the SIMD kernel and 1 patch
 // for the scalar reference, so the counts differ between the two (the decisions do not).
 //
+// Over your own control points (a PatchSourceView: strided float3/float4, indices, B-spline and
+// Gregory patches, e.g. an OpenSubdiv table) the same kernel is cull_fused in patch_source.h.
+//
 // Contracts: decision holds patches.count bytes; the plan is valid; setup.hiz is set and built
 // when the plan has occlusion. Kernels never allocate or throw; make_fused_setup throws Error for a
 // matrix that contradicts its convention or a pyramid of the other direction.
