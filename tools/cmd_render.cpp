@@ -2,7 +2,7 @@
 // Niessner & Eisenacher's GPU back-patch pass) over an animated scene and a moving camera,
 // optionally verified frame by frame against the unculled render (compare_frames: a patch
 // visible unculled but culled is a false cull). Output (--json), one object:
-//   {"model","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
+//   {"model","patch_source","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
 //    "displace","displace_scale","displaced_patches","bound","cone","frustum",
 //    "frames":[{"frame","pass1_drawn","pass2_drawn","frustum_culled","backpatch_culled",
 //               "occlusion_culled","displaced_occlusion_culled","visible","newly_visible",
@@ -57,10 +57,17 @@
 // level, --cull auto, --draw-bounds, and frame 0, whose upload brings the attributes; cpu_ms: CPU
 // time of posing and uploading; done_ms: until glFinish returns; meshes_ms: of cpu_ms, animating
 // the control meshes (gpu); bytes_uploaded: bytes copied to GL).
+// --patch-source bezier|osd-table ("patch_source" in the JSON): bezier (the default) draws the
+// scheme's Bezier patches through the pipeline above; osd-table (with --scheme osd, a single OBJ
+// model) draws the model's OpenSubdiv patch table with OpenSubdiv's own GLSL patch shaders, culled
+// in place (render_osd_table.h, its own JSON); --frames, --size, --cull (not auto), --backpatch,
+// --clip-depth, --tess (up to 16), --verify and --json apply to it, any other flag is refused.
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <set>
+#include <string>
 
 #include <nlohmann/json.hpp>
 
@@ -80,6 +87,7 @@
 #include "patchcull/import/scene_poser.h"
 #include "render_dumps.h"
 #include "render_options.h"
+#include "render_osd_table.h"
 #include "render_support.h"
 
 namespace patchcull::cli {
@@ -106,6 +114,7 @@ Runner add_render_command(CLI::App& app) {
     struct State {
         std::string model = "default";
         std::string scheme = "acc";
+        std::string patch_source = "bezier";
         int split = 0;
         int frames = 6;
         std::string cull = "all";
@@ -132,6 +141,9 @@ Runner add_render_command(CLI::App& app) {
                     "OBJ control mesh, 'teapot', 'bigguy', 'monsterfrog', a built-in scene ('default', 'city', "
                     "'building') or a scene file (.json)");
     add_choice_option(*command, "--scheme", state->scheme, {"acc", "osd"}, "Catmull-Clark to Bezier scheme");
+    add_choice_option(*command, "--patch-source", state->patch_source, {"bezier", "osd-table"},
+                      "bezier patches of --scheme, or (with --scheme osd) OpenSubdiv's own patch table and GLSL "
+                      "patch shaders, culled in place");
     add_int_option(*command, "--split", state->split, 0, 4, "uniform 1-to-4 patch splits of MODEL");
     add_int_option(*command, "--frames", state->frames, 1, 1000, "number of frames");
     add_choice_option(*command, "--cull", state->cull, cull_mode_choices(),
@@ -163,9 +175,31 @@ Runner add_render_command(CLI::App& app) {
                     "P[,P...]: draw these patches' CAF (green) and OOBB (red) screen rectangles, as the occlusion "
                     "test uses them, over the last frame into --out (Niessner & Loop, Fig. 6)");
     command->add_flag("--json", state->json, "print one JSON object");
-    return [state]() {
+    return [state, command]() {
         int width = 0, height = 0;
         parse_size("--size", state->size, width, height);
+        if (state->patch_source == "osd-table") {
+            if (state->scheme != "osd") throw Error("--patch-source osd-table: needs --scheme osd");
+            const std::set<std::string> applies = {"MODEL",  "--scheme",    "--patch-source", "--frames",
+                                                   "--cull", "--backpatch", "--clip-depth",   "--tess",
+                                                   "--size", "--verify",    "--json",         "--help"};
+            for (const CLI::Option* option : command->get_options())
+                if (option->count() > 0 && !applies.count(option->get_name()))
+                    throw Error("--patch-source osd-table: not with " + option->get_name());
+            if (state->cull == "auto") throw Error("--patch-source osd-table: not with --cull auto");
+            OsdTableRender o;
+            o.model = state->model;
+            o.frames = state->frames;
+            o.width = width;
+            o.height = height;
+            o.cull = parse_cull_mode_option("--cull", state->cull);
+            o.backpatch = parse_backpatch_method("--backpatch", state->backpatch);
+            o.depth = parse_clip_depth_option(state->clip_depth);
+            o.tess = state->tess;
+            o.verify = state->verify;
+            o.json = state->json;
+            return run_osd_table_render(o);
+        }
         const bool automatic = state->cull == "auto";
         const gl::CullMode cull = automatic ? gl::CullMode::all : parse_cull_mode_option("--cull", state->cull);
         const gl::BackpatchMethod backpatch = parse_backpatch_method("--backpatch", state->backpatch);
@@ -377,6 +411,7 @@ Runner add_render_command(CLI::App& app) {
         if (state->json) {
             nlohmann::json out;
             out["model"] = scene.name;
+            out["patch_source"] = "bezier";
             out["patches"] = scene.patch_count();
             out["size"] = {width, height};
             out["clip_depth"] = clip_depth_name(clip_depth);
