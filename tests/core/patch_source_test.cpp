@@ -5,7 +5,8 @@
 // batch of those; Gregory patches are never culled where a dense sample of their surface is
 // visible, and are culled when wholly outside; bad views are refused with a message. Every entry:
 // frustum, frustum-disp, the back-patch methods, occlusion, the fused kernel (every plan, both
-// cones), and their parallel twins (parallel_cull.h).
+// cones), and their parallel twins (parallel_cull.h), against the batch kernels in every ClipDepth
+// convention.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -48,7 +49,7 @@ struct Scene {
 };
 
 // A camera at a random place, a depth layer of random rectangles at view distances 3..9 over the
-// far plane, in convention depth (zero_to_one or reversed: window depth = NDC z).
+// far plane, in convention depth (window depth = NDC z, or (z + 1) / 2 for minus_one_to_one).
 Scene make_scene(std::uint32_t seed, ClipDepth depth) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> u(-1, 1), unit(0, 1);
@@ -64,7 +65,8 @@ Scene make_scene(std::uint32_t seed, ClipDepth depth) {
         const int x0 = static_cast<int>(unit(rng) * W), y0 = static_cast<int>(unit(rng) * H);
         const int w = 1 + static_cast<int>(unit(rng) * W * 0.6f), h = 1 + static_cast<int>(unit(rng) * H * 0.6f);
         const Vec4 c = projection * Vec4{0, 0, -(3 + 6 * unit(rng)), 1};
-        const float z = c.z / c.w;
+        const float ndc = c.z / c.w;
+        const float z = depth == ClipDepth::minus_one_to_one ? 0.5f * ndc + 0.5f : ndc;
         for (int y = y0; y < std::min(H, y0 + h); ++y)
             for (int x = x0; x < std::min(W, x0 + w); ++x) {
                 float& d = s.depth[static_cast<std::size_t>(y) * W + x];
@@ -278,7 +280,8 @@ void expect_teeth(const std::map<std::string, std::size_t>& culled, std::size_t 
 }
 
 TEST(PatchSource, BezierPointsAnyLayoutDecideAsTheBatch) {
-    for (ClipDepth depth : {ClipDepth::zero_to_one, ClipDepth::reversed}) {
+    for (ClipDepth depth :
+         {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed, ClipDepth::reversed_infinite}) {
         const Scene s = make_scene(7 + static_cast<std::uint32_t>(depth), depth);
         std::mt19937 rng(11);
         for (const Layout& layout : kLayouts) {
@@ -438,7 +441,8 @@ std::uint32_t phantom_slots(unsigned mask) {
 }
 
 TEST(PatchSource, BsplineConvertsToTheSameSurfaceAndDecidesAsItsBezierBatch) {
-    for (ClipDepth depth : {ClipDepth::zero_to_one, ClipDepth::reversed}) {
+    for (ClipDepth depth :
+         {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed, ClipDepth::reversed_infinite}) {
         const Scene s = make_scene(31 + static_cast<std::uint32_t>(depth), depth);
         std::mt19937 rng(41);
         for (const Layout& layout : kLayouts) {
@@ -674,7 +678,8 @@ TEST(PatchSource, GregoryNeverCullsAVisibleSampleAndCullsWhatIsOutside) {
 TEST(PatchSource, GregoryOfABezierPatchDecidesAsTheBezierBatch) {
     // F+ = F- = the Bezier interior points: the 20 points are the 16 of the Bezier patch, so the
     // Gregory path's frustum and occlusion decisions must equal the batch kernels' exactly.
-    for (ClipDepth depth : {ClipDepth::zero_to_one, ClipDepth::reversed}) {
+    for (ClipDepth depth :
+         {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed, ClipDepth::reversed_infinite}) {
         const Scene s = make_scene(71 + static_cast<std::uint32_t>(depth), depth);
         std::mt19937 rng(81);
         std::vector<BezierPatch> bez;
