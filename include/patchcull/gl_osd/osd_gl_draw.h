@@ -94,7 +94,9 @@ public:
     std::vector<gl::GpuPatchSource> sources(const OsdVertexBuffer& vertices, std::uint32_t flags) const;
     /// Draws every array into the bound framebuffer (its viewport, depth test and clip control as
     /// the caller set them), keeping patch p when (flags[p] & mask) == value (patchcull_tcs.h);
-    /// the fragment output 0 (R32UI) gets p + 1. Leaves no program or VAO bound.
+    /// the fragment output 0 (R32UI) gets p + 1. Binds flags at kBindingCullFlags and the
+    /// patch-param texture buffer at texture unit 4, sets GL_PATCH_VERTICES; leaves no program or
+    /// VAO bound.
     void draw(const OsdVertexBuffer& vertices, std::uint32_t flags, std::uint32_t mask, std::uint32_t value,
               const OsdView& view) const;
 
@@ -123,7 +125,7 @@ struct OsdFrameStats {
 /// frame (temporal coherence); reset() primes it as Niessner & Loop §3 do (even patches visible).
 class OsdCullFrame {
 public:
-    /// width, height in [1, 8192].
+    /// width, height in [1, 8192]. draw must outlive the frame (it is kept by reference).
     OsdCullFrame(gl::PassContext& passes, const OsdPatchTableDraw& draw, int width, int height);
     OsdCullFrame(OsdCullFrame&&) noexcept;
     OsdCullFrame& operator=(OsdCullFrame&&) noexcept;
