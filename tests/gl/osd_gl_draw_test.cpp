@@ -1,7 +1,8 @@
 // OpenSubdiv's own patch table drawn with OpenSubdiv's own GLSL patch shaders and culled in place
 // by patchcull's passes (patchcull/gl_osd/osd_gl_draw.h), checked by the id buffer:
 // - OpenSubdiv regression shapes with semi-sharp and infinitely sharp creases, corners, holes and
-//   boundaries, feature-adaptive tables at levels 1-4 (B-spline patches, Gregory-basis end caps);
+//   boundaries, feature-adaptive tables at levels 1-4 (B-spline patches, Gregory-basis end caps,
+//   which must draw pixels too);
 // - every mode: frustum, back-patch tcone / ncone / ptp (closed shapes, drawn one-sided), Hi-Z
 //   occlusion in Niessner & Loop's two-pass frame, and all of them at once, over a few frames of
 //   an orbit (the flags carry the statuses from frame to frame);
@@ -171,6 +172,8 @@ std::vector<Mode> modes() {
 struct Totals {
     std::map<std::string, std::size_t> culled;
     std::size_t frames = 0, pixels = 0;
+    std::size_t gregory_pixels = 0;  // of pixels: Gregory-basis end caps
+    std::set<std::string> closed_shapes;
 };
 
 // Every pixel of ids lies in the window box of its patch's control points (1 pixel of slack).
@@ -209,6 +212,7 @@ void expect_ids_name_their_patches(const GpuTable& t, const OsdView& view, const
 }
 
 void run_table(const Shape& shape, int level, Totals& totals) {
+    if (shape.closed) totals.closed_shapes.insert(shape.name);
     GpuTable t(shape.mesh, level);
     gl::PassContext& passes = gl::test::passes();
     OsdPatchTableDraw draw(passes, *t.table.table);
@@ -237,8 +241,14 @@ void run_table(const Shape& shape, int level, Totals& totals) {
                 EXPECT_EQ(diff, 0) << what;
                 totals.culled[m.name] += stats.frustum + stats.backpatch + stats.occlusion;
                 ++totals.frames;
-                totals.pixels +=
-                    static_cast<std::size_t>(std::count_if(want.begin(), want.end(), [](auto i) { return i; }));
+                for (std::uint32_t id : want) {
+                    if (id == 0) continue;
+                    ++totals.pixels;
+                    for (const OsdPatchArraySource& a : t.cpu.arrays())
+                        if (a.source.basis == PatchBasis::gregory && id - 1 >= a.first_patch &&
+                            id - 1 < a.first_patch + a.source.count)
+                            ++totals.gregory_pixels;
+                }
             }
     }
 }
@@ -259,7 +269,11 @@ TEST(OsdGlDraw, CulledFramesEqualTheUnculledDrawOnRegressionShapes) {
     }
     for (const Mode& m : modes()) EXPECT_GT(totals.culled[m.name], 0u) << m.name << " culled nothing";
     EXPECT_GT(totals.pixels, totals.frames * 200);
+    EXPECT_GT(totals.gregory_pixels, totals.frames * 5) << "the Gregory-basis programs drew too little";
+    EXPECT_EQ(totals.closed_shapes, (std::set<std::string>{"catmark_chaikin1", "catmark_cubes_infsharp"}));
     for (const auto& [name, n] : totals.culled) std::printf("%s culled %zu\n", name.c_str(), n);
+    std::printf("%zu frames, %zu pixels drawn unculled, %zu of them by Gregory-basis end caps\n", totals.frames,
+                totals.pixels, totals.gregory_pixels);
 }
 
 TEST(OsdGlDraw, BadInputIsAOneLineError) {
