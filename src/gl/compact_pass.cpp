@@ -64,6 +64,15 @@ struct CompactPass::Impl {
             check_offset("draw-count", out.draw_count_offset);
             detail::check_buffer_size(who, "draw-count", out.draw_count, out.draw_count_offset + 4);
         }
+        // The flags and the list are read as storage blocks from byte 0: the driver's limit holds them.
+        if (context.max_storage_block < 0)
+            glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &context.max_storage_block);
+        const std::size_t limit = context.max_storage_block > 0 ? static_cast<std::size_t>(context.max_storage_block)
+                                                                : std::size_t{0xFFFFFFFFu};
+        const std::size_t reach = std::max(patches.first, out.list_first) + patches.count;
+        if (reach * 4 > limit)
+            throw Error("GL: CompactPass: the flags or the list reach byte " + std::to_string(reach * 4) +
+                        ", past GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + std::to_string(limit) + ")");
         pp::CompactParams params;
         params.mask = mask;
         params.value = value;

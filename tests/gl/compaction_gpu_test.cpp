@@ -175,6 +175,9 @@ TEST(GpuCompaction, MillionsOfPatches) {
     const std::vector<std::uint32_t> flags = random_flags(total, 5);
     Buffer flags_buffer(flags);
     const Selection& s = kSelections[0];
+    GLint64 block = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &block);
+    std::printf("GL_MAX_SHADER_STORAGE_BLOCK_SIZE: %lld bytes\n", static_cast<long long>(block));
     for (const CompactMethod m : kMethods) {
         const auto t0 = std::chrono::steady_clock::now();
         check_compaction(pass, flags_buffer, flags, first, count, s, m, std::string(compact_method_name(m)) + " 2.6M");

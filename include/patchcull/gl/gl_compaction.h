@@ -32,8 +32,10 @@
 // seen, allocated on the first scan run and grown when a larger range comes: the only GL objects
 // made after the first run). Ranges of any size up to 2^28 patches (list_first + count < 2^28,
 // so that 16 (list_first + count) fits in 32 bits) are covered by dispatches of at most 65535
-// work groups. Errors: patchcull::Error with one line ("GL: CompactPass: ..."): a buffer that is
-// not one or too small, an offset not a multiple of 4, a range past 2^28.
+// work groups; the flags up to first + count and the list up to list_first + count must fit
+// GL_MAX_SHADER_STORAGE_BLOCK_SIZE (read once per PassContext; 128 MiB on llvmpipe: 2^25 patches).
+// Errors: patchcull::Error with one line ("GL: CompactPass: ..."): a buffer that is not one or too
+// small, an offset not a multiple of 4, a range past 2^28 or past the block size.
 #pragma once
 
 #include <cstddef>
