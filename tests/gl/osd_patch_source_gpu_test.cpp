@@ -10,8 +10,8 @@
 //   end caps, the vertex buffer float3 or float4 at odd strides and offsets; the table's index
 //   arrays and boundary masks uploaded once (GpuOsdTable below, the binding an engine writes).
 // - Plain sources: Bezier and B-spline patches (random boundary masks, phantom slots holding
-//   indices past the buffer) indexed into a shuffled float3 or rational float4 buffer, and
-//   consecutive points without indices, a few with NaN and infinite coordinates.
+//   indices past the buffer) and Gregory patches indexed into a shuffled float3 or rational float4
+//   buffer, and consecutive points without indices, a few with NaN and infinite coordinates.
 // - An index past point_count leaves its patch unculled; each bad input is a one-line Error.
 #include <gtest/gtest.h>
 
@@ -322,7 +322,13 @@ void expect_ptp_planes(const Subject& s, const CullView& view, const std::vector
             const BezierPatch b = source_bezier_patch(part.cpu, i);
             float t[64], thr[64];
             ptp_detail::ptp_control_planes_z(b, rows, t);
-            const bool finite = ptp_detail::ptp_rounding_margins(b, rows, thr);
+            // A patch with a NaN point is never culled and its margins are not compared: the
+            // max and min over the points then depend on where the NaN stands and on how each
+            // machine's max treats it (the CPU's std::max keeps its first argument).
+            const bool all_finite = std::all_of(std::begin(b.cp), std::end(b.cp), [](const Vec4& q) {
+                return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w);
+            });
+            const bool finite = ptp_detail::ptp_rounding_margins(b, rows, thr) && all_finite;
             const std::size_t p = part.gpu.first + i;
             for (std::size_t k = 0; k < 64; ++k) {
                 const bool same =
@@ -609,13 +615,15 @@ void check_tables(Compared compared) {
 
 // ---- Plain sources ----------------------------------------------------------------------------
 
-// Bezier and B-spline sources over the split teapot's control points, in a shuffled vertex buffer
-// with unused vertices between (indexed), and consecutive points (not indexed); float3 at stride 20
-// from byte 4, or homogeneous float4 with weights in [0.5, 2] at stride 24 from byte 8. A few
-// patches carry NaN or infinite coordinates.
+// Bezier and B-spline sources over the split teapot's control points, and a Gregory source of
+// the same patches (F+ and F- the Bezier interior point, moved apart a little), in a shuffled
+// vertex buffer with unused vertices between (indexed), and consecutive points (not indexed; the
+// Gregory points after the others, from a multiple of 20: a CPU view from there, source_first on
+// the GPU); float3 at stride 20 from byte 4, or homogeneous float4 with weights in [0.5, 2] at
+// stride 24 from byte 8. A few patches of each source carry NaN or infinite coordinates.
 struct PlainCase {
     std::vector<unsigned char> bytes;
-    std::vector<std::uint32_t> indices, bspline_indices;
+    std::vector<std::uint32_t> indices, bspline_indices, gregory_indices;
     std::vector<std::uint8_t> masks;
     GlBuffer vertices, index_buffer, mask_buffer;
     Subject subject;
@@ -628,9 +636,11 @@ std::unique_ptr<PlainCase> make_plain_case(int components, bool indexed, std::ui
     const std::vector<BezierPatch> patches = test::split_teapot(2);  // 512 patches
     const std::size_t n = patches.size();
     const std::size_t stride = components == 4 ? 24 : 20, offset = components == 4 ? 8 : 4;
-    // Points: patch p's point k is point 16 p + k, placed at slot perm[16 p + k] of a buffer
-    // twice as large (indexed) or at 16 p + k (not indexed).
-    const std::size_t points = indexed ? 32 * n : 16 * n;
+    // Points: patch p's point k is point 16 p + k, its Gregory patch's point k is point g0 + 20 p +
+    // k, each placed at slot perm[point] of a buffer twice as large (indexed) or at point (not
+    // indexed).
+    const std::size_t g0 = (16 * n + 19) / 20 * 20, logical = g0 + 20 * n;
+    const std::size_t points = indexed ? 2 * logical : logical;
     std::vector<std::uint32_t> perm(points);
     std::iota(perm.begin(), perm.end(), 0u);
     if (indexed) std::shuffle(perm.begin(), perm.end(), rng);
@@ -645,14 +655,32 @@ std::unique_ptr<PlainCase> make_plain_case(int components, bool indexed, std::ui
             const std::size_t at = perm[16 * p + static_cast<std::size_t>(k)];
             std::memcpy(c->bytes.data() + at * stride + offset, xyzw, static_cast<std::size_t>(components) * 4);
         }
+    // Gregory points (Far's GREGORY_BASIS order: corner c's P, E+, E-, F+, F- at 5c) of patch p.
+    constexpr int kGregoryOf[20][2] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {1, 1}, {3, 0}, {3, 1}, {2, 0}, {2, 1}, {2, 1},
+                                       {3, 3}, {2, 3}, {3, 2}, {2, 2}, {2, 2}, {0, 3}, {0, 2}, {1, 3}, {1, 2}, {1, 2}};
+    std::mt19937 gregory_rng(seed + 1);  // its own: the other sources' points and masks stay as they were
+    for (std::size_t p = 0; p < n; ++p)
+        for (int k = 0; k < 20; ++k) {
+            Vec4 q = patches[p].cp[4 * kGregoryOf[k][1] + kGregoryOf[k][0]];
+            if (k % 5 >= 3)
+                q = {q.x + 0.02f * (unit(gregory_rng) - 0.5f), q.y + 0.02f * (unit(gregory_rng) - 0.5f), q.z, q.w};
+            if (p % 97 == 7 && k == 13) q.z = std::numeric_limits<float>::quiet_NaN();
+            if (p % 97 == 13 && k == 2) q.x = -std::numeric_limits<float>::infinity();
+            const float w = components == 4 ? std::exp2(2.0f * unit(gregory_rng) - 1.0f) : 1.0f;
+            const float xyzw[4] = {w * q.x, w * q.y, w * q.z, w};
+            const std::size_t at = perm[g0 + 20 * p + static_cast<std::size_t>(k)];
+            std::memcpy(c->bytes.data() + at * stride + offset, xyzw, static_cast<std::size_t>(components) * 4);
+        }
     const PointLayout layout{c->bytes.data(), stride, offset, components, points};
     c->vertices = GlBuffer(c->bytes.data(), c->bytes.size());
     Subject& s = c->subject;
     s.name = std::string("teapot, float") + std::to_string(components) + (indexed ? ", indexed" : ", consecutive");
-    // Flags: the Bezier source's patches at [0, n), the B-spline source's at [n + 3, 2n + 3).
-    s.patch_count = 2 * n + 3;
+    // Flags: the Bezier source's patches at [0, n), the B-spline source's at [n + 3, 2n + 3), the
+    // Gregory source's at [2n + 5, 3n + 5).
+    s.patch_count = 3 * n + 5;
     s.flags = GlBuffer(nullptr, s.patch_count * sizeof(std::uint32_t));
     s.gregory.assign(s.patch_count, 0);
+    std::fill_n(s.gregory.begin() + static_cast<std::ptrdiff_t>(2 * n + 5), n, 1);
     if (indexed) {
         c->indices.assign(perm.begin(), perm.begin() + static_cast<std::ptrdiff_t>(16 * n));
         c->bspline_indices = c->indices;
@@ -664,18 +692,22 @@ std::unique_ptr<PlainCase> make_plain_case(int components, bool indexed, std::ui
                 if (!((real >> k) & 1u))
                     c->bspline_indices[16 * p + static_cast<std::size_t>(k)] = 0xFFFFFFF0u + p % 16;
         }
+        c->gregory_indices.assign(perm.begin() + static_cast<std::ptrdiff_t>(g0),
+                                  perm.begin() + static_cast<std::ptrdiff_t>(g0 + 20 * n));
         // One index buffer: two patches of garbage, the B-spline source's indices (from byte
-        // 128), the Bezier source's (from byte 128 + 64 n); the masks after two bytes of garbage.
+        // 128), the Bezier source's (from byte 128 + 64 n), the Gregory source's (from byte 128 +
+        // 128 n); the masks after two bytes of garbage.
         std::vector<std::uint32_t> gpu_indices(32, 0xFFFFFFFFu);
         gpu_indices.insert(gpu_indices.end(), c->bspline_indices.begin(), c->bspline_indices.end());
         gpu_indices.insert(gpu_indices.end(), c->indices.begin(), c->indices.end());
+        gpu_indices.insert(gpu_indices.end(), c->gregory_indices.begin(), c->gregory_indices.end());
         std::vector<std::uint8_t> gpu_masks(2, 0xFF);
         gpu_masks.insert(gpu_masks.end(), c->masks.begin(), c->masks.end());
         gpu_masks.resize((gpu_masks.size() + 3) / 4 * 4, 0xFF);
         c->index_buffer = GlBuffer(gpu_indices.data(), gpu_indices.size() * 4);
         c->mask_buffer = GlBuffer(gpu_masks.data(), gpu_masks.size());
     }
-    for (PatchBasis basis : {PatchBasis::bezier, PatchBasis::bspline}) {
+    for (PatchBasis basis : {PatchBasis::bezier, PatchBasis::bspline, PatchBasis::gregory}) {
         Part part;
         part.cpu.points = layout;
         part.cpu.count = n;
@@ -693,10 +725,22 @@ std::unique_ptr<PlainCase> make_plain_case(int components, bool indexed, std::ui
             g.first = n + 3;
             g.source_first = 0;
         }
+        if (basis == PatchBasis::gregory) {
+            g.first = 2 * n + 5;
+            if (!indexed) {  // the points from g0: a view from there, source patches from g0 / 20
+                part.cpu.points.data = c->bytes.data() + g0 * stride;
+                part.cpu.points.point_count = points - g0;
+                g.source_first = g0 / 20;
+            }
+        }
         if (indexed) {
-            part.cpu.indices = basis == PatchBasis::bspline ? c->bspline_indices.data() : c->indices.data();
+            part.cpu.indices = basis == PatchBasis::bspline  ? c->bspline_indices.data()
+                               : basis == PatchBasis::bezier ? c->indices.data()
+                                                             : c->gregory_indices.data();
             g.indices = c->index_buffer.name();
-            g.indices_offset_bytes = 32 * 4 + (basis == PatchBasis::bspline ? 0 : 64 * n);
+            g.indices_offset_bytes = 32 * 4 + (basis == PatchBasis::bspline  ? 0
+                                               : basis == PatchBasis::bezier ? 64 * n
+                                                                             : 128 * n);
             if (basis == PatchBasis::bspline) {
                 part.cpu.boundary_mask = c->masks.data();
                 g.boundary_masks = c->mask_buffer.name();
@@ -720,6 +764,7 @@ void check_plain_sources(Compared compared) {
             compare_views(c->subject, rng, 1, tally, compared);
         }
     EXPECT_EQ(tally.mismatches, 0);
+    EXPECT_GT(tally.gregory_culled, 0u);
     if (compared == Compared::box_and_fused) {
         EXPECT_GT(tally.box, 0u);
         EXPECT_GT(tally.fused_frustum, 0u);
