@@ -793,6 +793,72 @@ TEST(PatchSource, GregoryOutsideOrHiddenIsCulledAndNonFiniteIsNot) {
     EXPECT_EQ(d, kHiZOccluded);
 }
 
+// The parallel entries over several grains and a ragged tail: every range reads its own slice of
+// the indices, masks and displacement bounds and writes its own slice of the output, as the
+// single-threaded entry does (Bezier, masked B-spline and Gregory sources, indexed and not).
+TEST(PatchSource, ParallelEntriesOverManyRangesDecideAsTheSingleThreadedOnes) {
+    const Scene s = make_scene(111, ClipDepth::reversed);
+    std::mt19937 rng(13);
+    const std::size_t count = 2 * kParallelGrain + 37;  // three ranges of up to kParallelGrain
+    std::vector<std::array<Vec4, 16>> grids;
+    std::vector<std::array<Vec4, 20>> gregory;
+    std::vector<std::uint8_t> masks;
+    for (std::size_t i = 0; i < count; ++i) {
+        grids.push_back(random_grid(rng, s, i % 3 == 0));
+        masks.push_back(static_cast<std::uint8_t>(rng() % 16));
+        if (i % 211 == 7) grids.back()[5].y = kNaN;
+    }
+    for (std::size_t i = 0; i < count; ++i) {
+        BezierPatch b;
+        std::copy(grids[i].begin(), grids[i].end(), b.cp);
+        gregory.push_back(gregory_of(b));
+    }
+    std::vector<float> disp(count);
+    for (std::size_t i = 0; i < count; ++i) disp[i] = 0.03f * static_cast<float>(i % 5);
+    const FusedCullSetup setup = make_fused_setup(s.view, BackPatchCone::ncone, &s.hiz);
+    std::vector<std::uint8_t> want(count + 1, 0xAB), got(count + 1, 0xAB);
+    for (bool indexed : {true, false}) {
+        Source bezier = make_source(grids, {4, 24, 4, indexed}, PatchBasis::bezier);
+        Source bspline = make_source(grids, {3, 16, 0, indexed}, PatchBasis::bspline);
+        bspline.masks = masks;
+        bspline.view.boundary_mask = bspline.masks.data();
+        Source greg = make_source(gregory, {3, 12, 0, indexed}, PatchBasis::gregory);
+        for (const PatchSourceView* v : {&bezier.view, &bspline.view, &greg.view}) {
+            const std::string name =
+                std::string(indexed ? "indexed " : "consecutive ") + (v->basis == PatchBasis::bezier    ? "bezier"
+                                                                      : v->basis == PatchBasis::bspline ? "bspline"
+                                                                                                        : "gregory");
+            const auto check = [&](const std::string& what) {
+                EXPECT_EQ(got[count], 0xAB) << name << ", " << what << ": wrote past count";
+                std::size_t differ = 0, culled = 0;
+                for (std::size_t i = 0; i < count; ++i) {
+                    differ += got[i] != want[i];
+                    culled += want[i] != 0;
+                }
+                EXPECT_EQ(differ, 0u) << name << ", " << what;
+                if (!(v->basis == PatchBasis::gregory && what == "ptp")) {
+                    EXPECT_GT(culled, 0u) << name << ", " << what;
+                }
+            };
+            cull_frustum(*v, disp.data(), s.view, want.data());
+            cull_frustum_parallel(*v, disp.data(), s.view, got.data());
+            check("frustum");
+            cull_frustum_disp(*v, disp.data(), s.view, want.data());
+            cull_frustum_disp_parallel(*v, disp.data(), s.view, got.data());
+            check("frustum-disp");
+            cull_backpatch(BackpatchMethod::ptp, *v, s.view, {}, want.data());
+            cull_backpatch_parallel(BackpatchMethod::ptp, *v, s.view, {}, got.data());
+            check("ptp");
+            cull_occlusion(*v, s.view, s.hiz, want.data());
+            cull_occlusion_parallel(*v, s.view, s.hiz, got.data());
+            check("occlusion");
+            cull_fused(*v, setup, FusedPlan{}, want.data());
+            cull_fused_parallel(*v, setup, FusedPlan{}, got.data());
+            check("fused");
+        }
+    }
+}
+
 // ---- bad views ----------------------------------------------------------------------------------
 
 void expect_refused(const PatchSourceView& v, const std::string& message, const Scene& s) {
