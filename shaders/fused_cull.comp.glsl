@@ -57,17 +57,18 @@ layout(binding = kTextureUnitHiZ) uniform sampler2D u_hiz;
 #include "frustum_test.h"
 #include "hiz_box_test.h"
 
-// The fusion: one loop over the 16 control points. Each goes to clip space once (frustum_test.h's
-// pc_clip_point, which is hiz.h's step 2 in its operation order), and those coordinates feed both
-// the frustum planes' maxima (pc_frustum_culled's arithmetic) and the Hi-Z test's NDC box and
-// front depth (occlusion.comp.glsl's steps 3-4). Only the six maxima and the box stay live, not
-// the points (the cone test reloads them, from cache, if the patch gets that far), which keeps
-// the registers low on a GPU. The price: a patch the frustum culls has had its box built too.
 #ifdef PC_PATCH_SOURCE_GREGORY
 // True when v is NaN (a test of the bits, which no compiler folds away).
 bool pc_is_nan(float v) { return (floatBitsToUint(v) & 0x7FFFFFFFu) > 0x7F800000u; }
 #endif
 
+// The fusion: one loop over the 16 control points (a Gregory patch's 20). Each goes to clip space
+// once (frustum_test.h's pc_clip_point, which is hiz.h's step 2 in its operation order), and those
+// coordinates feed both the frustum planes' maxima (pc_frustum_culled's arithmetic) and the Hi-Z
+// test's NDC box and front depth (occlusion.comp.glsl's steps 3-4). Only the six maxima and the
+// box stay live, not the points (the cone test reloads them, from cache, if the patch gets that
+// far), which keeps the registers low on a GPU. The price: a patch the frustum culls has had its
+// box built too.
 struct PcFusedPoints {
     bool frustum_culled;
     bool projectable;  // step 3 held for every point (else the patch is not screen-tested)
@@ -102,7 +103,8 @@ PcFusedPoints pc_fused_points(uint p, bool frustum, bool hiz, bool with_margins,
         // Steps 3-4 (hiz_box_test.h), as occlusion.comp.glsl.
         if (r.projectable) r.projectable = hiz_add_point(P, c, u_clip_rows[3], k == 0u, box);
 #ifdef PC_PATCH_SOURCE_GREGORY
-        if (r.projectable && (pc_is_nan(hiz_div(c.x, c.w)) || pc_is_nan(hiz_div(c.y, c.w)) || pc_is_nan(hiz_div(c.z, c.w))))
+        if (r.projectable &&
+            (pc_is_nan(hiz_div(c.x, c.w)) || pc_is_nan(hiz_div(c.y, c.w)) || pc_is_nan(hiz_div(c.z, c.w))))
             r.projectable = false;
 #endif
     }
