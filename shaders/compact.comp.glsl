@@ -14,6 +14,9 @@
 // - kCompactScanSums (one work group): sums -> their exclusive prefix sums, looping over the
 //   groups kCompactGroupSize at a time; then the command and the draw count from the total.
 // - kCompactScatter: each survivor at list[list_first + sums[g] + its rank within group g].
+// Two programs: the scan's modes with PC_COMPACT_SCAN, the append's without (on llvmpipe the
+// append ran several times slower in one program with the scan's code: 39-76 ms against 14-17 ms
+// per 1M patches, bench/compaction_bench.cpp under varying load).
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
@@ -38,6 +41,26 @@ layout(std430, binding = kBindingCompactSums) buffer CompactSums {
 shared uint s_scan[kCompactGroupSize];
 shared uint s_total;
 
+void write_command(uint survivors) {
+    const uint w = compact.command_word;
+    draw_commands[w] = kDrawListPatchVertices * survivors;
+    draw_commands[w + 1u] = 1u;
+    draw_commands[w + 2u] = kDrawListPatchVertices * compact.list_first;
+    draw_commands[w + 3u] = 0u;
+}
+
+// Survivors of the work group: s_total their count, the return value this invocation's slot
+// (an order that depends on the atomics' order).
+uint group_count(bool keep) {
+    if (gl_LocalInvocationIndex == 0u) s_total = 0u;
+    barrier();
+    uint slot = 0u;
+    if (keep) slot = atomicAdd(s_total, 1u);
+    barrier();
+    return slot;
+}
+
+#ifdef PC_COMPACT_SCAN
 // Inclusive prefix sum of v over the work group (Hillis-Steele); s_scan[last] is the total after.
 uint group_inclusive_scan(uint v) {
     const uint i = gl_LocalInvocationIndex;
@@ -52,17 +75,9 @@ uint group_inclusive_scan(uint v) {
     }
     return s_scan[i];
 }
-
-void write_command(uint survivors) {
-    const uint w = compact.command_word;
-    draw_commands[w] = kDrawListPatchVertices * survivors;
-    draw_commands[w + 1u] = 1u;
-    draw_commands[w + 2u] = kDrawListPatchVertices * compact.list_first;
-    draw_commands[w + 3u] = 0u;
-}
+#endif
 
 void main() {
-    const uint lid = gl_LocalInvocationIndex;
     const uint mode = compact.mode;
     if (mode == kCompactInit) {
         if (gl_GlobalInvocationID.x == 0u) write_command(0u);
@@ -73,6 +88,8 @@ void main() {
             draw_count[compact.count_word] = draw_commands[compact.command_word] != 0u ? 1u : 0u;
         return;
     }
+    const uint lid = gl_LocalInvocationIndex;
+#ifdef PC_COMPACT_SCAN
     if (mode == kCompactScanSums) {
         uint carry = 0u;
         for (uint start = 0u; start < compact.group_count; start += kCompactGroupSize) {
@@ -89,29 +106,27 @@ void main() {
         }
         return;
     }
-
+#endif
     const uint index = gl_GlobalInvocationID.x;
     const uint p = compact.first_patch + index;
     const bool keep = index < compact.patch_count && (cull_flags[p] & compact.mask) == compact.value;
-    if (mode == kCompactAppend || mode == kCompactGroupCounts) {
-        if (lid == 0u) s_total = 0u;
-        barrier();
-        uint slot = 0u;
-        if (keep) slot = atomicAdd(s_total, 1u);
-        barrier();
-        if (mode == kCompactGroupCounts) {
-            if (lid == 0u) group_sums[compact.group_base + gl_WorkGroupID.x] = s_total;
-            return;
-        }
-        if (lid == 0u && s_total != 0u)
-            s_total = atomicAdd(draw_commands[compact.command_word], kDrawListPatchVertices * s_total) /
-                      kDrawListPatchVertices;
-        barrier();
-        if (keep) draw_list[compact.list_first + s_total + slot] = p;
+#ifdef PC_COMPACT_SCAN
+    if (mode == kCompactGroupCounts) {
+        group_count(keep);
+        if (lid == 0u) group_sums[compact.group_base + gl_WorkGroupID.x] = s_total;
         return;
     }
     // kCompactScatter
     const uint k = keep ? 1u : 0u;
     const uint rank = group_inclusive_scan(k) - k;
     if (keep) draw_list[compact.list_first + group_sums[compact.group_base + gl_WorkGroupID.x] + rank] = p;
+#else
+    // kCompactAppend
+    const uint slot = group_count(keep);
+    if (lid == 0u && s_total != 0u)
+        s_total = atomicAdd(draw_commands[compact.command_word], kDrawListPatchVertices * s_total) /
+                  kDrawListPatchVertices;
+    barrier();
+    if (keep) draw_list[compact.list_first + s_total + slot] = p;
+#endif
 }

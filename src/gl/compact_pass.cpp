@@ -92,7 +92,7 @@ struct CompactPass::Impl {
             sums_capacity = capacity;
         }
 
-        glUseProgram(context.program("compact.comp.glsl"));
+        glUseProgram(context.program("compact.comp.glsl", scan ? "#define PC_COMPACT_SCAN 1\n" : ""));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCullFlags, patches.flags);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDrawList, out.list);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDrawCommands, out.command);
