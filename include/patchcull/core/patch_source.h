@@ -132,9 +132,10 @@ void cull_frustum(const PatchSourceView& source, const float* max_displacement, 
 void cull_backpatch(BackpatchMethod id, const PatchSourceView& source, const CullView& view,
                     const BackpatchOptions& options, std::uint8_t* culled);
 
-/// frustum-disp kernel (frustum.h, cull_frustum_disp: Sathe's box test) over source: culled holds
-/// source.count bytes; max_displacement as for cull_frustum (null: the box of the control points
-/// alone, a looser test than cull_frustum's but valid for any source). Bezier and B-spline:
+/// frustum-disp kernel (frustum.h, cull_frustum_disp: the box test of Sathe, "View Frustum Culling
+/// of Catmull-Clark Patches in DirectX 11") over source: culled holds source.count bytes;
+/// max_displacement as for cull_frustum (null: the box of the control points alone, a looser test
+/// than cull_frustum's but valid for any source). Bezier and B-spline:
 /// culled[i] equals cull_frustum_disp's on the converted patches. Gregory: the box of all 20
 /// Cartesian points (it holds the patch: the surface lies in their convex hull), grown by the
 /// displacement and tested as cull_frustum_disp_scalar tests the box of 16 (never culled with a
