@@ -3,17 +3,20 @@
 // (flag & mask) == value go into the draw list (kBindingDrawList) from entry list_first on, and
 // the range's DrawArraysIndirectCommand {16 n, 1, 16 list_first, 0} (n survivors) and its draw
 // count (1 when n > 0, else 0) are written for an indirect draw that pulls point
-// gl_VertexID % 16 of patch list[gl_VertexID / 16]. One invocation per patch.
+// gl_VertexID % 16 of patch list[gl_VertexID / 16].
 // The atomic append (order not stable):
 // - kCompactInit (one invocation): the command {0, 1, 16 list_first, 0}.
 // - kCompactAppend: each work group counts its survivors in shared memory, reserves their slots
 //   with one atomicAdd on the command's vertex count (16 per patch) and writes them.
 // - kCompactFinish (one invocation): the draw count from the command's vertex count.
 // The prefix scan (ascending patch order, the same every frame):
-// - kCompactGroupCounts: group g's survivor count into sums[g] (kBindingCompactSums).
+// - kCompactGroupCounts: group g's survivor count into sums[g] (kBindingCompactSums); in the
+//   scan's modes each invocation holds kCompactScanRun consecutive patches (a group
+//   kCompactGroupSize kCompactScanRun of them: fewer groups, fewer barriers).
 // - kCompactScanSums (one work group): sums -> their exclusive prefix sums, looping over the
 //   groups kCompactGroupSize at a time; then the command and the draw count from the total.
-// - kCompactScatter: each survivor at list[list_first + sums[g] + its rank within group g].
+// - kCompactScatter: each survivor at list[list_first + sums[g] + its rank within group g]
+//   (a scan of the invocations' counts, then each writes its run's survivors in order).
 // Two programs: the scan's modes with PC_COMPACT_SCAN, the append's without (on llvmpipe the
 // append ran several times slower in one program with the scan's code: 39-76 ms against 14-17 ms
 // per 1M patches, bench/compaction_bench.cpp under varying load).
@@ -49,6 +52,7 @@ void write_command(uint survivors) {
     draw_commands[w + 3u] = 0u;
 }
 
+#ifndef PC_COMPACT_SCAN
 // Survivors of the work group: s_total their count, the return value this invocation's slot
 // (an order that depends on the atomics' order).
 uint group_count(bool keep) {
@@ -59,6 +63,7 @@ uint group_count(bool keep) {
     barrier();
     return slot;
 }
+#endif
 
 #ifdef PC_COMPACT_SCAN
 // Inclusive prefix sum of v over the work group (Hillis-Steele); s_scan[last] is the total after.
@@ -107,21 +112,37 @@ void main() {
         return;
     }
 #endif
-    const uint index = gl_GlobalInvocationID.x;
-    const uint p = compact.first_patch + index;
-    const bool keep = index < compact.patch_count && (cull_flags[p] & compact.mask) == compact.value;
 #ifdef PC_COMPACT_SCAN
+    // Invocation lid of group g holds kCompactScanRun consecutive patches of the range, from
+    // index (g kCompactGroupSize + lid) kCompactScanRun on: its survivors' bits and their count.
+    const uint run_first = (gl_WorkGroupID.x * kCompactGroupSize + lid) * kCompactScanRun;
+    uint bits = 0u;
+    uint count = 0u;
+    for (uint k = 0u; k < kCompactScanRun; ++k) {
+        const uint index = run_first + k;
+        if (index < compact.patch_count && (cull_flags[compact.first_patch + index] & compact.mask) == compact.value) {
+            bits |= 1u << k;
+            ++count;
+        }
+    }
     if (mode == kCompactGroupCounts) {
-        group_count(keep);
+        if (lid == 0u) s_total = 0u;
+        barrier();
+        if (count != 0u) atomicAdd(s_total, count);
+        barrier();
         if (lid == 0u) group_sums[compact.group_base + gl_WorkGroupID.x] = s_total;
         return;
     }
-    // kCompactScatter
-    const uint k = keep ? 1u : 0u;
-    const uint rank = group_inclusive_scan(k) - k;
-    if (keep) draw_list[compact.list_first + group_sums[compact.group_base + gl_WorkGroupID.x] + rank] = p;
+    // kCompactScatter: the runs' survivors in order, after those of the groups and runs before.
+    uint at = compact.list_first + group_sums[compact.group_base + gl_WorkGroupID.x] +
+              group_inclusive_scan(count) - count;
+    for (uint k = 0u; k < kCompactScanRun; ++k)
+        if ((bits & (1u << k)) != 0u) draw_list[at++] = compact.first_patch + run_first + k;
 #else
     // kCompactAppend
+    const uint index = gl_GlobalInvocationID.x;
+    const uint p = compact.first_patch + index;
+    const bool keep = index < compact.patch_count && (cull_flags[p] & compact.mask) == compact.value;
     const uint slot = group_count(keep);
     if (lid == 0u && s_total != 0u)
         s_total = atomicAdd(draw_commands[compact.command_word], kDrawListPatchVertices * s_total) /

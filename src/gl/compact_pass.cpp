@@ -29,10 +29,10 @@ struct CompactPass::Impl {
                         " is not a multiple of 4");
     }
 
-    // One dispatch per at most 65535 work groups over the range; group_base counts the groups before.
-    void dispatch_range(pp::CompactParams& params, std::size_t first, std::size_t count) {
-        constexpr std::size_t group = shared::kCompactGroupSize;
-        constexpr std::size_t per_dispatch = 65535 * group;
+    // One dispatch per at most 65535 work groups of `group` patches over the range; group_base
+    // counts the groups before.
+    void dispatch_range(pp::CompactParams& params, std::size_t first, std::size_t count, std::size_t group) {
+        const std::size_t per_dispatch = 65535 * group;
         for (std::size_t offset = 0; offset < count; offset += per_dispatch) {
             const std::size_t n = std::min(per_dispatch, count - offset);
             params.first_patch = static_cast<pp::uint>(first + offset);
@@ -80,10 +80,11 @@ struct CompactPass::Impl {
         params.command_word = static_cast<pp::uint>(out.command_offset / 4);
         params.count_word = static_cast<pp::uint>(out.draw_count_offset / 4);
         params.write_count = out.draw_count ? 1u : 0u;
-        constexpr std::size_t group = shared::kCompactGroupSize;
+        const bool scan = method == CompactMethod::prefix_scan;
+        // Patches per work group: one per invocation in the append, a run of kCompactScanRun in the scan.
+        const std::size_t group = shared::kCompactGroupSize * (scan ? shared::kCompactScanRun : 1);
         const std::size_t groups = (patches.count + group - 1) / group;
         params.group_count = static_cast<pp::uint>(groups);
-        const bool scan = method == CompactMethod::prefix_scan;
         if (scan && groups > sums_capacity) {
             const std::size_t capacity = std::max<std::size_t>(groups, 2 * sums_capacity);
             glDeleteBuffers(1, &sums);
@@ -103,21 +104,21 @@ struct CompactPass::Impl {
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCompactSums, sums);
             if (patches.count) {
                 params.mode = shared::kCompactGroupCounts;
-                dispatch_range(params, patches.first, patches.count);
+                dispatch_range(params, patches.first, patches.count, group);
                 glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
             }
             dispatch_one(params, shared::kCompactScanSums);
             if (patches.count) {
                 glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
                 params.mode = shared::kCompactScatter;
-                dispatch_range(params, patches.first, patches.count);
+                dispatch_range(params, patches.first, patches.count, group);
             }
         } else {
             dispatch_one(params, shared::kCompactInit);
             if (patches.count) {
                 glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
                 params.mode = shared::kCompactAppend;
-                dispatch_range(params, patches.first, patches.count);
+                dispatch_range(params, patches.first, patches.count, group);
             }
             if (out.draw_count) {
                 glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);

@@ -28,7 +28,7 @@
 // State contract: gl_passes.h's, plus GL_COMMAND_BARRIER_BIT in the closing barrier (the indirect
 // command and the draw count are visible to the draw). It binds the flag buffer at
 // kBindingCullFlags, the list, command and count buffers at their bindings, and, for the prefix
-// scan, a buffer of its own at kBindingCompactSums (one uint per 256 patches of the largest range
+// scan, a buffer of its own at kBindingCompactSums (one uint per 2048 patches of the largest range
 // seen, allocated on the first scan run and grown when a larger range comes: the only GL objects
 // made after the first run). Ranges of any size up to 2^28 patches (list_first + count < 2^28,
 // so that 16 (list_first + count) fits in 32 bits) are covered by dispatches of at most 65535
