@@ -164,7 +164,7 @@ PATCHCULL_CONST uint kIdOccluderBit = 0x80000000u;
 
 // Compute work-group size of the per-patch cull shaders (one invocation per patch).
 PATCHCULL_CONST uint kCullGroupSize = 64u;
-// Compaction work groups (the append: one invocation per patch; the scan of the group sums runs in one group)
+// Compaction work groups (the append: one invocation per patch; the scan of the group sums runs in one group).
 PATCHCULL_CONST uint kCompactGroupSize = 256u;
 // ... and the patches of one invocation in the scan's modes (consecutive; a group holds 2048).
 PATCHCULL_CONST uint kCompactScanRun = 8u;

@@ -187,6 +187,17 @@ TEST(GpuCompaction, MillionsOfPatches) {
     }
 }
 
+// Past one dispatch: the append covers 65535 work groups of 256 patches a dispatch (the scan 65535
+// of 2048, past llvmpipe's storage-block size, so its split is not reached here).
+TEST(GpuCompaction, AppendSplitsPastOneDispatch) {
+    CompactPass pass(test::passes());
+    const std::size_t first = 5, count = 65535u * sh::kCompactGroupSize + 1001;
+    const std::vector<std::uint32_t> flags = random_flags(first + count, 13);
+    Buffer flags_buffer(flags);
+    check_compaction(pass, flags_buffer, flags, first, count, kSelections[0], CompactMethod::atomic_append,
+                     "atomic, two dispatches");
+}
+
 TEST(GpuCompaction, BadBuffersAreOneLineErrors) {
     CompactPass pass(test::passes());
     Buffer flags_buffer(std::vector<std::uint32_t>(100, 0u));
