@@ -162,6 +162,23 @@ void cull_occlusion(const OsdPatchTableSource& table, const CullView& view, cons
     });
 }
 
+void cull_frustum_disp(const OsdPatchTableSource& table, const float* max_displacement, const CullView& view,
+                       std::uint8_t* culled) {
+    check_clip_depth(view.object_to_clip, view.depth, "cull_frustum_disp");
+    for_each_array(table, "cull_frustum_disp", [&](const PatchSourceView& s, std::size_t first) {
+        cull_frustum_disp(s, max_displacement ? max_displacement + first : nullptr, view, culled + first);
+    });
+}
+
+void cull_fused(const OsdPatchTableSource& table, const FusedCullSetup& setup, const FusedPlan& plan,
+                std::uint8_t* decision, FusedCullStats* stats) {
+    // The plan and the pyramid: the first array's entry checks them before it writes anything, and
+    // every array's are the same.
+    for_each_array(table, "cull_fused", [&](const PatchSourceView& s, std::size_t first) {
+        cull_fused(s, setup, plan, decision + first, stats);
+    });
+}
+
 namespace {
 
 // A point for Far's primvar refinement and stencils (float, as the buffer an engine draws).

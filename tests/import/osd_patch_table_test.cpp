@@ -14,7 +14,9 @@
 //     derivatives) inside the frustum, in front of a synthetic depth layer or facing the eye, in
 //     every ClipDepth convention, the object at the origin and placed thousands of units out
 //     with the camera (camera-relative, as docs/ENGINE.md asks; see check_cases); and every kind
-//     of cull happens, Gregory end caps included (the checks can fail).
+//     of cull happens, Gregory end caps included (the checks can fail). Sathe's box
+//     (cull_frustum_disp) is checked as the frustum is; the fused kernel's decision is the first
+//     separate entry's that culls (frustum, ncone, Hi-Z), so their checks cover it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -39,6 +41,7 @@
 #include "patchcull/core/clip_space.h"
 #include "patchcull/core/cull_view.h"
 #include "patchcull/core/error.h"
+#include "patchcull/core/fused_cull.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/patch_source.h"
 #include "patchcull/import/obj.h"
@@ -309,7 +312,8 @@ Truth far_truth(const Case& c) {
 }
 
 struct Counts {
-    std::size_t frustum = 0, occluded = 0, gregory_frustum = 0, gregory_occluded = 0;
+    std::size_t frustum = 0, occluded = 0, gregory_frustum = 0, gregory_occluded = 0, box = 0, gregory_box = 0;
+    std::size_t fused_back = 0;  // patches whose fused decision is the back-patch stage
     std::vector<std::size_t> backpatch = std::vector<std::size_t>(backpatch_method_ids().size(), 0);
     int failures = 0;
 };
@@ -431,6 +435,37 @@ void check_view(const Case& c, const Truth& truth, std::mt19937& rng, ClipDepth 
             }
         }
     }
+    // Sathe's box: every culled patch's samples outside, as the frustum's.
+    std::vector<std::uint8_t> box(n + 1, 0xAB);
+    cull_frustum_disp(c.source, nullptr, view, box.data());
+    EXPECT_EQ(box[n], 0xAB);
+    for (std::size_t p = 0; p < n; ++p) {
+        if (!box[p]) continue;
+        ++counts.box;
+        counts.gregory_box += is_gregory(p);
+        const Sample* ps = samples + p * kGrid * kGrid;
+        for (int k = 0; k < kGrid * kGrid; ++k)
+            if (inside(clip(ps[k].p))) {
+                fail(p, "the frustum-disp box", ps[k]);
+                break;
+            }
+    }
+    // The fused kernel (frustum, ncone, Hi-Z): each patch's decision is the first of the separate
+    // entries that culls it, so the checks of those entries here hold for it too.
+    std::vector<std::uint8_t> ncone(n + 1, 0xAB), fused(n + 1, 0xAB);
+    cull_backpatch(BackpatchMethod::ncone, c.source, view, BackpatchOptions{}, ncone.data());
+    cull_fused(c.source, make_fused_setup(view, BackPatchCone::ncone, &hiz), FusedPlan{}, fused.data());
+    EXPECT_EQ(fused[n], 0xAB);
+    for (std::size_t p = 0; p < n; ++p) {
+        const std::uint8_t want = frustum[p]                     ? kFusedFrustumCulled
+                                  : ncone[p]                     ? kFusedBackPatchCulled
+                                  : occlusion[p] == kHiZOccluded ? kFusedOccluded
+                                                                 : kFusedVisible;
+        if (fused[p] != want && ++counts.failures <= 8)
+            ADD_FAILURE() << c.name << ", " << clip_depth_name(depth) << ": patch " << p << " fused decision "
+                          << int(fused[p]) << ", the separate entries say " << int(want);
+        counts.fused_back += fused[p] == kFusedBackPatchCulled;
+    }
     for (BackpatchMethod id : backpatch_method_ids()) {
         cull_backpatch(id, c.source, view, BackpatchOptions{}, back.data());
         EXPECT_EQ(back[n], 0xAB);
@@ -480,6 +515,9 @@ void expect_teeth(const Counts& counts) {
     EXPECT_GT(counts.occluded, 0u);
     EXPECT_GT(counts.gregory_frustum, 0u);
     EXPECT_GT(counts.gregory_occluded, 0u);
+    EXPECT_GT(counts.box, 0u);
+    EXPECT_GT(counts.gregory_box, 0u);
+    EXPECT_GT(counts.fused_back, 0u);
     for (BackpatchMethod id : backpatch_method_ids())
         EXPECT_GT(counts.backpatch[static_cast<std::size_t>(id)], 0u) << backpatch_method_name(id);
 }
@@ -590,7 +628,21 @@ TEST(OsdPatchTable, RefusesOtherPatchTypesAndShortBuffers) {
     EXPECT_NE(
         error_of([&] { cull_backpatch(BackpatchMethod::tcone, moved, view, {}, out.data()); }).find("cull_backpatch"),
         std::string::npos);
+    EXPECT_NE(error_of([&] { cull_frustum_disp(moved, nullptr, view, out.data()); }).find("cull_frustum_disp: "),
+              std::string::npos);
+    // The fused entry: the view, then the plan (occlusion without a pyramid) before any array.
+    const FusedCullSetup setup = make_fused_setup(view, BackPatchCone::tcone, nullptr);
+    FusedPlan frustum_only;
+    frustum_only.count = 1;
+    EXPECT_NE(error_of([&] { cull_fused(moved, setup, frustum_only, out.data()); }).find("cull_fused: "),
+              std::string::npos);
+    PointLayout full = shorter;
+    full.point_count = c->points.size();
+    moved.bind_points(full);
+    EXPECT_EQ(error_of([&] { cull_fused(moved, setup, FusedPlan{}, out.data()); }),
+              "cull_fused: the plan has occlusion but setup.hiz is null");
     EXPECT_TRUE(std::all_of(out.begin(), out.end(), [](std::uint8_t b) { return b == 0xAB; }));
+    EXPECT_EQ(error_of([&] { cull_fused(moved, setup, frustum_only, out.data()); }), "(no error)");
 }
 
 }  // namespace

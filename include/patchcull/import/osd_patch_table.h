@@ -127,4 +127,15 @@ void cull_backpatch(BackpatchMethod id, const OsdPatchTableSource& table, const 
 void cull_occlusion(const OsdPatchTableSource& table, const CullView& view, const HiZPyramid& hiz,
                     std::uint8_t* decision);
 
+/// cull_frustum_disp over every array (Sathe's box; a Gregory end cap's over its 20 points):
+/// culled[i] for the table's patch i; max_displacement as for cull_frustum.
+void cull_frustum_disp(const OsdPatchTableSource& table, const float* max_displacement, const CullView& view,
+                       std::uint8_t* culled);
+
+/// cull_fused (core/patch_source.h) over every array: decision[i] (FusedDecision) for the table's
+/// patch i, the plan's first stage that culls it (Gregory end caps: never the back-patch stage).
+/// The plan and the pyramid are checked before any array is culled.
+void cull_fused(const OsdPatchTableSource& table, const FusedCullSetup& setup, const FusedPlan& plan,
+                std::uint8_t* decision, FusedCullStats* stats = nullptr);
+
 }  // namespace patchcull
