@@ -13,6 +13,7 @@
 //   displaced bounds       cull_displaced_frustum/_occlusion DisplacedPass   displaced.comp.glsl
 //   frustum + cone + Hi-Z  (the three above, in one)      FusedCullPass      fused_cull.comp.glsl
 //   (ends of the chain)    -                              CullStatusPass     cull_status.comp.glsl
+//   (after the chain)      -                              CompactPass        compact.comp.glsl (gl_compaction.h)
 // Each makes the same decisions as its CPU kernel on the same inputs (the arithmetic notes are
 // in gl_backpatch.h, gl_displaced.h and the shaders; tests/gl/*_gpu_test.cpp check it).
 //
