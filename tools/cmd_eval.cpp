@@ -1,5 +1,6 @@
 // `patchcull eval ...`: the papers' evaluations, a subcommand group: `eval occlusion` (here),
-// `eval displaced` (tools/eval/eval_displaced.cpp) and `eval temporal` (tools/eval/eval_temporal.cpp).
+// `eval displaced` (tools/eval/eval_displaced.cpp) and `eval temporal` (tools/eval/eval_temporal.cpp);
+// `eval osd-cull` (tools/eval/eval_osd_cull.cpp): OpenSubdiv's own TCS culling beside patchcull's passes.
 //
 // `eval occlusion MODEL [--split N] [--views N] --json` reproduces Niessner & Loop §6.2 for non-displaced
 // models (culling within one object): views that contain the whole object (camera.h, contain
@@ -27,6 +28,7 @@
 #include "commands.h"
 #include "eval/eval_displaced.h"
 #include "eval/eval_fused.h"
+#include "eval/eval_osd_cull.h"
 #include "eval/eval_progress.h"
 #include "eval/eval_scene.h"
 #include "eval/eval_temporal.h"
@@ -101,8 +103,7 @@ int run_occlusion(const OcclusionOptions& o) {
 
 Runner add_eval_command(CLI::App& app) {
     CLI::App* eval = app.add_subcommand(
-        "eval",
-        "Reproduce the papers' evaluations (eval occlusion, eval displaced, eval temporal, eval scene, eval fused)");
+        "eval", "Reproduce the papers' evaluations (eval occlusion, displaced, temporal, scene, fused, osd-cull)");
     // At most one; none is reported by the runner ("eval: expected a subcommand ..."), which names
     // the command, unlike CLI11's own message.
     eval->require_subcommand(0, 1);
@@ -201,16 +202,31 @@ Runner add_eval_command(CLI::App& app) {
     add_choice_option(*fused_command, "--cone", fused->cone, {"tcone", "ncone"}, "the back-patch cone test");
     add_clip_depth_option(*fused_command, fused->clip_depth);
     fused_command->add_flag("--json", fused->json, "print one JSON object");
+
+    auto osd_cull = std::make_shared<OsdCullEvalOptions>();
+    CLI::App* osd_cull_command = eval->add_subcommand(
+        "osd-cull",
+        "OpenSubdiv's own TCS frustum culling (OSD_ENABLE_PATCH_CULL) beside patchcull's passes on OpenSubdiv's patch "
+        "table: patches tessellated and frame time");
+    add_text_option(*osd_cull_command, "MODEL", osd_cull->model, "OBJ control mesh or a shipped model ('bigguy')")
+        ->required();
+    add_int_option(*osd_cull_command, "--level", osd_cull->level, 1, 4, "adaptive isolation level");
+    add_int_option(*osd_cull_command, "--tess", osd_cull->tess, 1, 16, "OpenSubdiv's uniform tessellation level");
+    add_size_option(*osd_cull_command, "--size", osd_cull->size, "framebuffer size");
+    add_int_option(*osd_cull_command, "--rounds", osd_cull->rounds, 1, 1000,
+                   "timed rounds per view (one frame of each mode)");
+    add_int_option(*osd_cull_command, "--warmup", osd_cull->warmup, 0, 100, "untimed rounds per view first");
     return [command, occlusion, displaced_command, displaced, temporal_command, temporal, scene_command, scene,
-            fused_command, fused]() {
+            fused_command, fused, osd_cull_command, osd_cull]() {
         if (command->parsed()) return run_occlusion(*occlusion);
         if (displaced_command->parsed()) return run_displaced_eval(*displaced);
         if (temporal_command->parsed()) return run_temporal_eval(*temporal);
         if (scene_command->parsed()) return run_scene_eval(*scene);
         if (fused_command->parsed()) return run_fused_eval(*fused);
+        if (osd_cull_command->parsed()) return run_osd_cull_eval(*osd_cull);
         throw Error(
-            "eval: expected a subcommand: occlusion, displaced, temporal, scene or fused (e.g. patchcull eval "
-            "occlusion MODEL --json)");
+            "eval: expected a subcommand: occlusion, displaced, temporal, scene, fused or osd-cull (e.g. patchcull "
+            "eval occlusion MODEL --json)");
     };
 }
 

@@ -39,6 +39,9 @@ namespace Osd = OpenSubdiv::Osd;
 namespace sh = gl::shared;
 
 constexpr GLuint kPatchParamUnit = 4;  // the patch-param texture buffer's unit during a draw
+// OsdDrawOptions::record_tessellated's buffer during a draw: above every binding of shared.h.
+constexpr GLuint kBindingTessellated = 30;
+static_assert(kBindingTessellated > sh::kBindingCompactSums && kBindingTessellated > sh::kBindingDrawCount);
 
 void check_gl(const char* what) {
     const GLenum e = glGetError();
@@ -63,7 +66,7 @@ float OsdTessLevel() { return TessLevel; }
 int OsdGregoryQuadOffsetBase() { return 0; }
 int OsdPrimitiveIdBase() { return PrimitiveIdBase; }
 int OsdBaseVertex() { return 0; }
-#ifdef PC_OSD_TESS_CONTROL
+#if defined(PC_OSD_TESS_CONTROL) && !defined(OSD_ENABLE_PATCH_CULL)
 uniform uint u_draw_mask, u_draw_value;
 patch out int pc_patch;
 #undef OSD_PATCH_CULL
@@ -71,16 +74,35 @@ patch out int pc_patch;
     pc_patch = OsdGetPatchIndex(gl_PrimitiveID);   \
     PATCHCULL_RETURN_UNLESS_DRAWN(pc_patch, u_draw_mask, u_draw_value)
 #endif
+#if defined(PC_OSD_TESS_CONTROL) && defined(OSD_ENABLE_PATCH_CULL)
+// OpenSubdiv's OSD_PATCH_CULL(N) stays; patchcull's check runs earlier, in the per-control-point
+// hook (every invocation, before OpenSubdiv's invocation-0 block; no barrier in between).
+uniform uint u_draw_mask, u_draw_value;
+patch out int pc_patch;
+#undef OSD_USER_VARYING_PER_CONTROL_POINT
+#define OSD_USER_VARYING_PER_CONTROL_POINT(ID_OUT, ID_IN)                           \
+    if (gl_InvocationID == 0) {                                                     \
+        pc_patch = OsdGetPatchIndex(gl_PrimitiveID);                                \
+        PATCHCULL_RETURN_UNLESS_DRAWN(pc_patch, u_draw_mask, u_draw_value)          \
+    }
+#endif
 #ifdef PC_OSD_TESS_EVAL
 patch in int pc_patch;
 flat out int pc_id;
 out float pc_facing;
 // The cosine between the normal and the direction to the eye (eye space: the eye at 0).
 float pc_cosine(vec3 p, vec3 n) { return dot(n, -p) / (length(n) * length(p)); }
+#ifdef PC_OSD_RECORD_TESSELLATED
+layout(std430, binding = PC_OSD_RECORD_TESSELLATED) writeonly buffer PcTessellated { uint pc_tessellated[]; };
+#define PC_RECORD() pc_tessellated[pc_patch] = 1u
+#else
+#define PC_RECORD()
+#endif
 #undef OSD_DISPLACEMENT_CALLBACK
 #define OSD_DISPLACEMENT_CALLBACK \
     pc_id = pc_patch;             \
-    pc_facing = pc_cosine(outpt.v.position.xyz, outpt.v.normal)
+    pc_facing = pc_cosine(outpt.v.position.xyz, outpt.v.normal); \
+    PC_RECORD()
 #endif
 )";
 }
@@ -114,8 +136,11 @@ GLuint compile(GLenum stage, const std::string& text, const char* what) {
 }
 
 // One program for a patch type: OpenSubdiv's stages composed as its examples compose them.
-GLuint build_program(Far::PatchDescriptor::Type type) {
-    const std::string version = "#version 450\n";
+GLuint build_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& options) {
+    std::string version = "#version 450\n";
+    if (options.opensubdiv_patch_cull) version += "#define OSD_ENABLE_PATCH_CULL\n";
+    if (options.record_tessellated)
+        version += "#define PC_OSD_RECORD_TESSELLATED " + std::to_string(kBindingTessellated) + "\n";
     const std::string common = "#define OSD_PATCH_BASIS_GLSL\n" +
                                Osd::GLSLPatchShaderSource::GetPatchBasisShaderSource() +
                                Osd::GLSLPatchShaderSource::GetCommonShaderSource();
@@ -155,9 +180,9 @@ struct Program {
           one_sided = -1;
 };
 
-Program make_program(Far::PatchDescriptor::Type type) {
+Program make_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& options) {
     Program p;
-    p.name = build_program(type);
+    p.name = build_program(type, options);
     p.model_view = glGetUniformLocation(p.name, "ModelViewMatrix");
     p.projection = glGetUniformLocation(p.name, "ProjectionMatrix");
     p.tess_level = glGetUniformLocation(p.name, "TessLevel");
@@ -202,7 +227,7 @@ struct OsdPatchTableDraw::Impl {
     };
     std::unique_ptr<Osd::GLPatchTable> table;
     std::vector<Array> arrays;
-    GLuint masks = 0, vao = 0;
+    GLuint masks = 0, vao = 0, tessellated = 0;
     Program bspline, gregory;
     std::size_t patch_count = 0, points_needed = 0;
     bool software = false;
@@ -210,12 +235,14 @@ struct OsdPatchTableDraw::Impl {
     ~Impl() {
         for (GLuint p : {bspline.name, gregory.name})
             if (p) glDeleteProgram(p);
-        if (masks) glDeleteBuffers(1, &masks);
+        for (GLuint b : {masks, tessellated})
+            if (b) glDeleteBuffers(1, &b);
         if (vao) glDeleteVertexArrays(1, &vao);
     }
 };
 
-OsdPatchTableDraw::OsdPatchTableDraw(gl::PassContext& passes, const Far::PatchTable& table)
+OsdPatchTableDraw::OsdPatchTableDraw(gl::PassContext& passes, const Far::PatchTable& table,
+                                     const OsdDrawOptions& options)
     : impl_(std::make_unique<Impl>()) {
     Impl& m = *impl_;
     m.software = passes.is_software();
@@ -271,8 +298,14 @@ OsdPatchTableDraw::OsdPatchTableDraw(gl::PassContext& passes, const Far::PatchTa
     glVertexArrayAttribFormat(m.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(m.vao, 0, 0);
     glEnableVertexArrayAttrib(m.vao, 0);
-    if (any_bspline) m.bspline = make_program(Far::PatchDescriptor::REGULAR);
-    if (any_gregory) m.gregory = make_program(Far::PatchDescriptor::GREGORY_BASIS);
+    if (any_bspline) m.bspline = make_program(Far::PatchDescriptor::REGULAR, options);
+    if (any_gregory) m.gregory = make_program(Far::PatchDescriptor::GREGORY_BASIS, options);
+    if (options.record_tessellated) {
+        glCreateBuffers(1, &m.tessellated);
+        glNamedBufferStorage(m.tessellated, static_cast<GLsizeiptr>(4 * std::max<std::size_t>(m.patch_count, 1)),
+                             nullptr, GL_DYNAMIC_STORAGE_BIT);
+        clear_tessellated();
+    }
     check_gl("after building the OpenSubdiv patch programs");
 }
 
@@ -282,6 +315,20 @@ OsdPatchTableDraw::~OsdPatchTableDraw() = default;
 
 std::size_t OsdPatchTableDraw::patch_count() const { return impl_->patch_count; }
 std::size_t OsdPatchTableDraw::points_needed() const { return impl_->points_needed; }
+
+void OsdPatchTableDraw::clear_tessellated() const {
+    if (!impl_->tessellated) throw Error("OsdPatchTableDraw: built without record_tessellated");
+    const GLuint zero = 0;
+    glClearNamedBufferData(impl_->tessellated, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+}
+
+std::size_t OsdPatchTableDraw::tessellated_count() const {
+    if (!impl_->tessellated) throw Error("OsdPatchTableDraw: built without record_tessellated");
+    std::vector<std::uint32_t> words(impl_->patch_count);
+    glGetNamedBufferSubData(impl_->tessellated, 0, static_cast<GLsizeiptr>(4 * words.size()), words.data());
+    check_gl("after reading the tessellated patches");
+    return static_cast<std::size_t>(std::count_if(words.begin(), words.end(), [](std::uint32_t w) { return w != 0; }));
+}
 
 namespace {
 
@@ -342,6 +389,7 @@ void OsdPatchTableDraw::draw(const OsdVertexBuffer& vertices, std::uint32_t flag
     glBindVertexArray(m.vao);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullFlags, flags);
     glBindTextureUnit(kPatchParamUnit, m.table->GetPatchParamTextureBuffer());
+    if (m.tessellated) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTessellated, m.tessellated);
     for (const Impl::Array& a : m.arrays) {
         if (a.patches == 0) continue;
         const Program& p = a.type == Far::PatchDescriptor::REGULAR ? m.bspline : m.gregory;

@@ -276,6 +276,51 @@ TEST(OsdGlDraw, CulledFramesEqualTheUnculledDrawOnRegressionShapes) {
                 totals.pixels, totals.gregory_pixels);
 }
 
+// OsdDrawOptions: OpenSubdiv's own OSD_ENABLE_PATCH_CULL draws the same pixels as the unculled
+// draw with fewer patches tessellated, and the record counts what the frame's counters say.
+TEST(OsdGlDraw, OpenSubdivPatchCullAndTheTessellatedRecord) {
+    gl::test::context().make_current();
+    gl::PassContext& passes = gl::test::passes();
+    const Shape shape = load_shape("catmark_chaikin1");
+    GpuTable t(shape.mesh, 2);
+    OsdDrawOptions plain_options, native_options;
+    plain_options.record_tessellated = true;
+    native_options.record_tessellated = true;
+    native_options.opensubdiv_patch_cull = true;
+    const OsdPatchTableDraw plain(passes, *t.table.table, plain_options),
+        native(passes, *t.table.table, native_options);
+    OsdCullFrame plain_frame(passes, plain, W, H), native_frame(passes, native, W, H);
+    std::size_t native_total = 0, plain_total = 0;
+    for (int view = 0; view < 3; ++view) {
+        const OsdView v = orbit_view(t, view, 0, shape.closed);
+        const std::string what = "view " + std::to_string(view);
+        plain.clear_tessellated();
+        plain_frame.render_unculled(t.vertices, v);
+        EXPECT_EQ(plain.tessellated_count(), plain.patch_count()) << what;
+        const std::vector<std::uint32_t> want = plain_frame.read_ids();
+        native.clear_tessellated();
+        native_frame.render_unculled(t.vertices, v);
+        const std::size_t kept = native.tessellated_count();
+        EXPECT_LE(kept, native.patch_count()) << what;
+        EXPECT_GT(kept, 0u) << what;
+        native_total += kept;
+        plain_total += native.patch_count();
+        EXPECT_TRUE(native_frame.read_ids() == want) << what << ": OSD_ENABLE_PATCH_CULL changed pixels";
+        OsdCullSettings frustum;
+        frustum.frustum = true;
+        plain.clear_tessellated();
+        const OsdFrameStats stats = plain_frame.render(t.vertices, v, frustum);
+        EXPECT_EQ(plain.tessellated_count(), stats.drawn_pass1) << what;
+        EXPECT_TRUE(plain_frame.read_ids() == want) << what;
+    }
+    EXPECT_LT(native_total, plain_total) << "OpenSubdiv's patch cull culled nothing";
+    std::printf("OSD_ENABLE_PATCH_CULL tessellated %zu of %zu patches over 3 views\n", native_total, plain_total);
+    OsdPatchTableDraw unrecorded(passes, *t.table.table);
+    EXPECT_THROW(unrecorded.clear_tessellated(), Error);
+    EXPECT_THROW((void)unrecorded.tessellated_count(), Error);
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
 TEST(OsdGlDraw, BadInputIsAOneLineError) {
     gl::test::context().make_current();
     gl::PassContext& passes = gl::test::passes();

@@ -74,13 +74,32 @@ struct OsdView {
     CullView cull_view() const { return make_cull_view(model_view, projection, depth, eye); }
 };
 
+/// How OsdPatchTableDraw compiles OpenSubdiv's programs (both off: the programs described above).
+struct OsdDrawOptions {
+    /// OpenSubdiv's own TCS frustum culling as well: every stage is compiled with
+    /// OSD_ENABLE_PATCH_CULL, so OpenSubdiv's vertex shader computes clip flags from
+    /// OsdModelViewProjectionMatrix() and its OSD_PATCH_CULL(N) (kept as OpenSubdiv 3.5 defines it)
+    /// gives a patch levels 0 unless, for each of x, y, z, some control point has c < w and some
+    /// c > -w (a patch is skipped when all its points lie beyond one plane; the near plane is z = -w
+    /// whatever view.depth says, looser than z = 0 for zero_to_one). The patch index comes from
+    /// OpenSubdiv's OSD_USER_VARYING_PER_CONTROL_POINT hook instead, and patchcull's flags are
+    /// checked there (invocation 0), before OpenSubdiv's test: a patch is drawn when both keep it.
+    bool opensubdiv_patch_cull = false;
+    /// Records the patches tessellated (levels non-zero): the TES writes 1 to the patch's word of
+    /// a per-patch buffer, bound at SSBO binding 30 during a draw (an instrumented program: time
+    /// draws without it). clear_tessellated()
+    /// and tessellated_count() read it.
+    bool record_tessellated = false;
+};
+
 /// A feature-adaptive Far::PatchTable on the GPU with OpenSubdiv's programs for its arrays.
 class OsdPatchTableDraw {
 public:
     /// Uploads table (Osd::GLPatchTable, plus a byte per patch of boundary masks) and compiles
     /// OpenSubdiv's programs for the array types present. table: REGULAR and GREGORY_BASIS arrays
     /// only (Error naming the array and type otherwise); it need not outlive this object.
-    OsdPatchTableDraw(gl::PassContext& passes, const OpenSubdiv::Far::PatchTable& table);
+    OsdPatchTableDraw(gl::PassContext& passes, const OpenSubdiv::Far::PatchTable& table,
+                      const OsdDrawOptions& options = {});
     OsdPatchTableDraw(OsdPatchTableDraw&&) noexcept;
     OsdPatchTableDraw& operator=(OsdPatchTableDraw&&) noexcept;
     ~OsdPatchTableDraw();
@@ -99,6 +118,10 @@ public:
     /// VAO bound.
     void draw(const OsdVertexBuffer& vertices, std::uint32_t flags, std::uint32_t mask, std::uint32_t value,
               const OsdView& view) const;
+    /// record_tessellated only (Error otherwise): zeroes the record; the patches tessellated by
+    /// the draws since (each counted once), read back (a GL sync).
+    void clear_tessellated() const;
+    std::size_t tessellated_count() const;
 
     struct Impl;
 
