@@ -25,7 +25,7 @@ std::string read_file(const std::string& path) {
 }  // namespace
 
 int main() {
-    for (const char* name : {"shared.h", "patchcull_tcs.h"}) {
+    for (const char* name : {"shared.h", "patchcull_tcs.h", "patchcull_draw_list.h"}) {
         const std::string path = std::string(CONSUMER_GLSL_DIR) + "/" + name;
         const std::string installed = read_file(path);
         const std::string_view embedded = patchcull::gl::shipped_glsl(name);
