@@ -1,6 +1,7 @@
 # Fails unless every example includes only what an installed patchcull offers a user: public
 # headers (patchcull/LAYER/NAME.h that exist in include/patchcull; patchcull/version.h), shared.h (the GLSL/C++ header on
-# patchcull_gl's include path), the standard library and the examples' own GL stack (epoxy, GLFW).
+# patchcull_gl's include path), the standard library, the examples' own GL stack (epoxy, GLFW) and
+# OpenSubdiv's Far headers (05 builds its own Far::TopologyRefiner, as an engine on OpenSubdiv does).
 #   cmake -DSOURCE_DIR=<repository root> -P check_includes.cmake
 # Prints each offending example:line and include.
 cmake_minimum_required(VERSION 3.25)
@@ -43,11 +44,11 @@ foreach(file IN LISTS examples)
       if(header STREQUAL "shared.h")
         continue()
       endif()
-      if(header MATCHES "^patchcull/([a-z]+/)?[a-z0-9_]+\\.h$" AND EXISTS "${SOURCE_DIR}/include/${header}")
+      if(header MATCHES "^patchcull/([a-z_]+/)?[a-z0-9_]+\\.h$" AND EXISTS "${SOURCE_DIR}/include/${header}")
         continue()
       endif()
-    elseif(NOT header MATCHES "/" OR header MATCHES "^(epoxy/gl\\.h|GLFW/glfw3\\.h)$")
-      continue()  # <vector>, <cstdio>, ...: the standard library; the examples' own GL loader and window
+    elseif(NOT header MATCHES "/" OR header MATCHES "^(epoxy/gl\\.h|GLFW/glfw3\\.h|opensubdiv/far/[A-Za-z]+\\.h)$")
+      continue()  # <vector>, <cstdio>, ...: the standard library; the examples' own GL loader, window and Far
     endif()
     file(RELATIVE_PATH relative "${SOURCE_DIR}" "${file}")
     if(quote STREQUAL "<")
