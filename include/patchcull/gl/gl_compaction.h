@@ -12,11 +12,11 @@
 // attributes. The vertex shader pulls its control point itself: point gl_VertexID % 16 of patch
 // list[gl_VertexID / 16] (shaders/patchcull_draw_list.h, shipped_glsl("patchcull_draw_list.h"); the
 // list stays bound at shared.h's kBindingDrawList after the pass, and the vertex shader must be
-// allowed a storage block, GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS >= 1, as on every desktop driver).
+// allowed a storage block: GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS >= 1, which GL 4.5 does not promise).
 // The patch index it finds is the flag buffer's index: pass it on (flat) as the flag path does.
 //
 // Buffers (the caller's; bound whole as std430 storage, so offsets need only be multiples of 4):
-// - the flag range of PatchBuffers (control points and margins are not read, may be 0);
+// - the flag range of PatchBuffers (control points and margins are not read: 0, or checked for size);
 // - list, kBindingDrawList: uint entries; the range's survivors go to list[list_first ..
 //   list_first + n), n <= count; the buffer must hold list_first + count entries (the worst case);
 //   entries past n are left as they were;
@@ -59,7 +59,7 @@ static_assert(sizeof(DrawArraysIndirectCommand) == 16);
 
 /// How the list is built. Both give the same set of patches.
 enum class CompactMethod {
-    atomic_append,  ///< one atomicAdd per work group: the order of the list changes from run to run
+    atomic_append,  ///< one atomicAdd per work group: the list's order may change from run to run
     prefix_scan,    ///< a prefix scan over work-group sums: ascending patch index, every run
 };
 
