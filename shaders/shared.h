@@ -88,6 +88,9 @@ PATCHCULL_CONST uint kBindingDrawList = 26u;
 PATCHCULL_CONST uint kBindingDrawCommands = 27u;
 PATCHCULL_CONST uint kBindingDrawCount = 28u;
 PATCHCULL_CONST uint kBindingCompactSums = 29u;
+// OpenSubdiv's own patch shaders as gl_osd's OsdPatchTableDraw draws them: with
+// OsdDrawOptions::record_tessellated, uint marks[n], set by the TES for each patch it evaluates.
+PATCHCULL_CONST uint kBindingOsdTessellated = 30u;
 
 // Uniform buffer binding of the passes' parameter blocks (pass_params.h; one pass runs at a time).
 PATCHCULL_CONST uint kUniformPassParams = 0u;
@@ -98,6 +101,7 @@ PATCHCULL_CONST uint kUniformPatchSource = 1u;
 PATCHCULL_CONST uint kTextureUnitDisplacement = 0u;  // R32F height map, GL_REPEAT, bilinear
 PATCHCULL_CONST uint kTextureUnitDepth = 1u;         // DEPTH32F depth buffer (Hi-Z level 0 input)
 PATCHCULL_CONST uint kTextureUnitHiZ = 2u;           // R32F Hi-Z pyramid, level l = hiz.h's level l
+PATCHCULL_CONST uint kTextureUnitOsdPatchParam = 4u; // OpenSubdiv's patch-param texture buffer (gl_osd's draws)
 
 // Image units.
 PATCHCULL_CONST uint kImageUnitHiZOut = 0u;          // R32F Hi-Z level being written

@@ -38,11 +38,6 @@ namespace Far = OpenSubdiv::Far;
 namespace Osd = OpenSubdiv::Osd;
 namespace sh = gl::shared;
 
-constexpr GLuint kPatchParamUnit = 4;  // the patch-param texture buffer's unit during a draw
-// OsdDrawOptions::record_tessellated's buffer during a draw: above every binding of shared.h.
-constexpr GLuint kBindingTessellated = 30;
-static_assert(kBindingTessellated > sh::kBindingCompactSums && kBindingTessellated > sh::kBindingDrawCount);
-
 void check_gl(const char* what) {
     const GLenum e = glGetError();
     if (e != GL_NO_ERROR) {
@@ -140,7 +135,7 @@ GLuint build_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& opti
     std::string version = "#version 450\n";
     if (options.opensubdiv_patch_cull) version += "#define OSD_ENABLE_PATCH_CULL\n";
     if (options.record_tessellated)
-        version += "#define PC_OSD_RECORD_TESSELLATED " + std::to_string(kBindingTessellated) + "\n";
+        version += "#define PC_OSD_RECORD_TESSELLATED " + std::to_string(sh::kBindingOsdTessellated) + "\n";
     const std::string common = "#define OSD_PATCH_BASIS_GLSL\n" +
                                Osd::GLSLPatchShaderSource::GetPatchBasisShaderSource() +
                                Osd::GLSLPatchShaderSource::GetCommonShaderSource();
@@ -191,7 +186,7 @@ Program make_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& opti
     p.value = glGetUniformLocation(p.name, "u_draw_value");
     p.one_sided = glGetUniformLocation(p.name, "u_one_sided");
     const GLint params = glGetUniformLocation(p.name, "OsdPatchParamBuffer");
-    if (params >= 0) glProgramUniform1i(p.name, params, static_cast<GLint>(kPatchParamUnit));
+    if (params >= 0) glProgramUniform1i(p.name, params, static_cast<GLint>(sh::kTextureUnitOsdPatchParam));
     return p;
 }
 
@@ -388,8 +383,8 @@ void OsdPatchTableDraw::draw(const OsdVertexBuffer& vertices, std::uint32_t flag
                               static_cast<GLsizei>(vertices.stride_bytes));
     glBindVertexArray(m.vao);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullFlags, flags);
-    glBindTextureUnit(kPatchParamUnit, m.table->GetPatchParamTextureBuffer());
-    if (m.tessellated) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindingTessellated, m.tessellated);
+    glBindTextureUnit(sh::kTextureUnitOsdPatchParam, m.table->GetPatchParamTextureBuffer());
+    if (m.tessellated) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingOsdTessellated, m.tessellated);
     for (const Impl::Array& a : m.arrays) {
         if (a.patches == 0) continue;
         const Program& p = a.type == Far::PatchDescriptor::REGULAR ? m.bspline : m.gregory;

@@ -52,7 +52,7 @@ TEST(ShaderBindings, EveryStorageBindingIsDeclaredOnceWithItsOwnNumber) {
     const std::regex literal_re(R"(binding\s*=\s*\d)");
     const std::regex used_re(R"(\bkBinding\w+)");
     std::size_t shaders = 0;
-    for (const char* dir : {"shaders", "src/gl"})
+    for (const char* dir : {"shaders", "src/gl", "src/gl_osd"})
         for (const auto& entry : fs::directory_iterator(kRoot / dir)) {
             if (!entry.is_regular_file() || entry.path().extension() == ".txt") continue;
             const std::string text = read_text(entry.path());
