@@ -3,8 +3,8 @@
 // rule), so that the compiler builds the two fully unrolled rules in parallel; private to
 // patchcull. See backpatch_ptp_simd.cpp for the arithmetic contract.
 //
-// A Highway "-inl.h" header (included once per target after <hwy/highway.h>, inside
-// patchcull::HWY_NAMESPACE), hence the toggling include guard instead of #pragma once.
+// A Highway "-inl.h" header, included at file scope once per target after <hwy/highway.h> (it
+// opens patchcull::HWY_NAMESPACE itself), hence the toggling include guard, not #pragma once.
 #if defined(PATCHCULL_CORE_BACKPATCH_PTP_SIMD_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef PATCHCULL_CORE_BACKPATCH_PTP_SIMD_INL_H_
 #undef PATCHCULL_CORE_BACKPATCH_PTP_SIMD_INL_H_
