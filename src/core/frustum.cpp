@@ -20,16 +20,10 @@
 // x86-64 a second clone of each scalar kernel is compiled with FMA enabled (std::fma becomes one
 // vfmadd instruction) and picked once at load time (ifunc). Results are identical by definition:
 // fma is exactly rounded either way.
+#include "core/frustum_box_internal.h"
 #include "core/scalar_clones.h"
 
 namespace patchcull {
-namespace {
-
-inline float min_like_simd(float a, float b) { return a < b ? a : b; }
-inline float max_like_simd(float a, float b) { return a > b ? a : b; }
-
-}  // namespace
-
 FrustumPlanes make_frustum_planes(const Mat4& any_object_to_clip, ClipDepth depth) {
     check_clip_depth(any_object_to_clip, depth, "make_frustum_planes");
     const Mat4 object_to_clip = to_depth_key(any_object_to_clip, depth);
@@ -90,60 +84,10 @@ PATCHCULL_SCALAR_CLONES
 void cull_frustum_disp_scalar(const PatchBatchView& patches, const float* max_displacement, const Mat4& object_to_clip,
                               ClipDepth depth, std::uint8_t* culled) {
     const FrustumPlanes planes = make_frustum_planes(object_to_clip, depth);
-    Mat4 m;
-    for (int r = 0; r < 4; ++r) {
-        const Vec4 row = planes.clip_rows[r];
-        m.at(r, 0) = row.x;
-        m.at(r, 1) = row.y;
-        m.at(r, 2) = row.z;
-        m.at(r, 3) = row.w;
-    }
     for (std::size_t p = 0; p < patches.count; ++p) {
         const float d = max_displacement ? max_displacement[p] : 0.0f;
-        float lo[3] = {}, hi[3] = {};  // set by point 0
-        float probe = 0;
-        for (int k = 0; k < kPatchPoints; ++k) {
-            const float W = patches.at(p, k, 3);
-            for (int a = 0; a < 4; ++a) probe = std::fma(patches.at(p, k, a), 0.0f, probe);
-            for (int a = 0; a < 3; ++a) {
-                const float v = patches.at(p, k, a) / W;
-                lo[a] = k == 0 ? v : min_like_simd(lo[a], v);
-                hi[a] = k == 0 ? v : max_like_simd(hi[a], v);
-            }
-        }
-        float box[3][2];  // [axis][0 = low, 1 = high]
-        for (int a = 0; a < 3; ++a) {
-            box[a][0] = lo[a] - d;
-            box[a][1] = hi[a] + d;
-        }
-        // Corner index i*4 + j*2 + s: x from box[0][i], y from box[1][j], z from box[2][s].
-        float clip[4][8];
-        for (int r = 0; r < 4; ++r) {
-            float tz[2], tyz[4];
-            for (int s = 0; s < 2; ++s) tz[s] = std::fma(m.at(r, 2), box[2][s], m.at(r, 3));
-            for (int j = 0; j < 2; ++j)
-                for (int s = 0; s < 2; ++s) tyz[j * 2 + s] = std::fma(m.at(r, 1), box[1][j], tz[s]);
-            for (int i = 0; i < 2; ++i)
-                for (int js = 0; js < 4; ++js) clip[r][i * 4 + js] = std::fma(m.at(r, 0), box[0][i], tyz[js]);
-        }
-        auto plane_values = [&clip, &planes](int corner, float v[6]) {
-            const float cx = clip[0][corner], cy = clip[1][corner], cz = clip[2][corner], cw = clip[3][corner];
-            v[0] = cw + cx;
-            v[1] = cw - cx;
-            v[2] = cw + cy;
-            v[3] = cw - cy;
-            v[4] = cz + planes.near_w * cw;
-            v[5] = planes.far_w * cw - cz;
-        };
-        float mx[6], v[6];
-        plane_values(0, mx);
-        for (int corner = 1; corner < 8; ++corner) {
-            plane_values(corner, v);
-            for (int q = 0; q < 6; ++q) mx[q] = max_like_simd(mx[q], v[q]);
-        }
-        bool out = mx[5] < planes.far_limit;
-        for (int q = 0; q < 5; ++q) out |= mx[q] < 0.0f;
-        culled[p] = out && probe == 0.0f ? 1 : 0;
+        const auto point_at = [&patches, p](int k, int a) { return patches.at(p, k, a); };
+        culled[p] = frustum_detail::box_outside_frustum(planes, kPatchPoints, d, point_at) ? 1 : 0;
     }
 }
 

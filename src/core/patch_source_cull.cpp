@@ -8,6 +8,7 @@
 #include <cstring>
 #include <string>
 
+#include "core/frustum_box_internal.h"
 #include "core/patch_source_internal.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/fused_cull.h"
@@ -55,54 +56,10 @@ bool gregory_frustum_culled(const FrustumPlanes& planes, const float pts[kGregor
     return verdict.culled(planes);
 }
 
-// cull_frustum_disp_scalar's test (frustum.cpp) on the box of the 20 Cartesian points grown by d,
-// operation by operation: X / W, min / max as `a < b ? a : b`, the 8 corners' clip rows as nested
-// fmas, the plane values and their maxima, the probe over the raw coordinates.
+// cull_frustum_disp_scalar's test (frustum.cpp) on the box of the 20 Cartesian points grown by d.
 bool gregory_frustum_disp_culled(const FrustumPlanes& planes, const float pts[kGregoryPoints][4], float d) {
-    float lo[3] = {}, hi[3] = {};
-    float probe = 0;
-    for (int k = 0; k < kGregoryPoints; ++k) {
-        const float W = pts[k][3];
-        for (int a = 0; a < 4; ++a) probe = std::fma(pts[k][a], 0.0f, probe);
-        for (int a = 0; a < 3; ++a) {
-            const float v = pts[k][a] / W;
-            lo[a] = k == 0 ? v : (lo[a] < v ? lo[a] : v);
-            hi[a] = k == 0 ? v : (hi[a] > v ? hi[a] : v);
-        }
-    }
-    float box[3][2];
-    for (int a = 0; a < 3; ++a) {
-        box[a][0] = lo[a] - d;
-        box[a][1] = hi[a] + d;
-    }
-    float clip[4][8];  // corner i*4 + j*2 + s: x from box[0][i], y from box[1][j], z from box[2][s]
-    for (int r = 0; r < 4; ++r) {
-        const Vec4 m = planes.clip_rows[r];
-        float tz[2], tyz[4];
-        for (int s = 0; s < 2; ++s) tz[s] = std::fma(m.z, box[2][s], m.w);
-        for (int j = 0; j < 2; ++j)
-            for (int s = 0; s < 2; ++s) tyz[j * 2 + s] = std::fma(m.y, box[1][j], tz[s]);
-        for (int i = 0; i < 2; ++i)
-            for (int js = 0; js < 4; ++js) clip[r][i * 4 + js] = std::fma(m.x, box[0][i], tyz[js]);
-    }
-    const auto plane_values = [&](int corner, float v[6]) {
-        const float cx = clip[0][corner], cy = clip[1][corner], cz = clip[2][corner], cw = clip[3][corner];
-        v[0] = cw + cx;
-        v[1] = cw - cx;
-        v[2] = cw + cy;
-        v[3] = cw - cy;
-        v[4] = cz + planes.near_w * cw;
-        v[5] = planes.far_w * cw - cz;
-    };
-    float mx[6], v[6];
-    plane_values(0, mx);
-    for (int corner = 1; corner < 8; ++corner) {
-        plane_values(corner, v);
-        for (int q = 0; q < 6; ++q) mx[q] = mx[q] > v[q] ? mx[q] : v[q];
-    }
-    bool out = mx[5] < planes.far_limit;
-    for (int q = 0; q < 5; ++q) out |= mx[q] < 0.0f;
-    return out && probe == 0.0f;
+    const auto point_at = [pts](int k, int a) { return pts[k][a]; };
+    return frustum_detail::box_outside_frustum(planes, kGregoryPoints, d, point_at);
 }
 
 // hiz.h's steps 2-9 over the 20 points: true when the pyramid hides them all. The clip rows are
