@@ -28,6 +28,7 @@
 #include <utility>
 
 #include "patchcull/core/error.h"
+#include "patchcull/import/osd_patch_table.h"
 #include "shared.h"
 
 namespace patchcull::gl_osd {
@@ -190,27 +191,6 @@ Program make_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& opti
     return p;
 }
 
-std::string type_name(Far::PatchDescriptor::Type type) {
-    switch (type) {
-        case Far::PatchDescriptor::REGULAR:
-            return "REGULAR";
-        case Far::PatchDescriptor::GREGORY_BASIS:
-            return "GREGORY_BASIS";
-        case Far::PatchDescriptor::GREGORY:
-            return "GREGORY";
-        case Far::PatchDescriptor::GREGORY_BOUNDARY:
-            return "GREGORY_BOUNDARY";
-        case Far::PatchDescriptor::QUADS:
-            return "QUADS";
-        case Far::PatchDescriptor::TRIANGLES:
-            return "TRIANGLES";
-        case Far::PatchDescriptor::LOOP:
-            return "LOOP";
-        default:
-            return "type " + std::to_string(static_cast<int>(type));
-    }
-}
-
 }  // namespace
 
 struct OsdPatchTableDraw::Impl {
@@ -253,8 +233,8 @@ OsdPatchTableDraw::OsdPatchTableDraw(gl::PassContext& passes, const Far::PatchTa
         array.patches = static_cast<std::size_t>(table.GetNumPatches(a));
         array.first_patch = first;
         if (array.type != Far::PatchDescriptor::REGULAR && array.type != Far::PatchDescriptor::GREGORY_BASIS)
-            throw Error("OpenSubdiv patch table: array " + std::to_string(a) + " holds " + type_name(array.type) +
-                        " patches (only REGULAR and GREGORY_BASIS are drawn)");
+            throw Error("OpenSubdiv patch table: array " + std::to_string(a) + " holds " +
+                        osd_patch_type_name(array.type) + " patches (only REGULAR and GREGORY_BASIS are drawn)");
         const Far::ConstIndexArray cvs = table.GetPatchArrayVertices(a);
         array.index_base = static_cast<std::size_t>(&cvs[0] - &all_indices[0]);
         masks.resize(first + array.patches, 0);

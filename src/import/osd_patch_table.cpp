@@ -27,7 +27,18 @@ namespace {
 
 namespace Far = OpenSubdiv::Far;
 
-std::string type_name(Far::PatchDescriptor::Type type) {
+constexpr bool kIndexIsViewable = std::is_same_v<std::make_unsigned_t<Far::Index>, std::uint32_t>;
+
+// Runs body(array source, array's first patch) for every array, after checking them all.
+template <class Body>
+void for_each_array(const OsdPatchTableSource& table, const char* what, const Body& body) {
+    for (const OsdPatchArraySource& a : table.arrays()) check_patch_source(a.source, what);
+    for (const OsdPatchArraySource& a : table.arrays()) body(a.source, a.first_patch);
+}
+
+}  // namespace
+
+std::string osd_patch_type_name(Far::PatchDescriptor::Type type) {
     switch (type) {
         case Far::PatchDescriptor::NON_PATCH:
             return "NON_PATCH";
@@ -55,17 +66,6 @@ std::string type_name(Far::PatchDescriptor::Type type) {
     return "type " + std::to_string(static_cast<int>(type));
 }
 
-constexpr bool kIndexIsViewable = std::is_same_v<std::make_unsigned_t<Far::Index>, std::uint32_t>;
-
-// Runs body(array source, array's first patch) for every array, after checking them all.
-template <class Body>
-void for_each_array(const OsdPatchTableSource& table, const char* what, const Body& body) {
-    for (const OsdPatchArraySource& a : table.arrays()) check_patch_source(a.source, what);
-    for (const OsdPatchArraySource& a : table.arrays()) body(a.source, a.first_patch);
-}
-
-}  // namespace
-
 OsdPatchTableSource::OsdPatchTableSource(const Far::PatchTable& table, const PointLayout& points) {
     static_assert(sizeof(Far::Index) == sizeof(std::uint32_t) || !kIndexIsViewable);
     const int array_count = table.GetNumPatchArrays();
@@ -82,7 +82,7 @@ OsdPatchTableSource::OsdPatchTableSource(const Far::PatchTable& table, const Poi
         const bool gregory = type == Far::PatchDescriptor::GREGORY_BASIS && per_patch == 20;
         if (!regular && !gregory)
             throw Error("OsdPatchTableSource: patch array " + std::to_string(a) + " holds " + std::to_string(count) +
-                        " patches of type " + type_name(type) + " (" + std::to_string(per_patch) +
+                        " patches of type " + osd_patch_type_name(type) + " (" + std::to_string(per_patch) +
                         " points); only REGULAR (16-point B-spline) and GREGORY_BASIS (20-point) patches can be "
                         "culled: build the table adaptively, with ENDCAP_GREGORY_BASIS or ENDCAP_BSPLINE_BASIS");
         OsdPatchArraySource out;

@@ -30,6 +30,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <opensubdiv/far/patchTable.h>
@@ -112,6 +113,10 @@ struct OsdAdaptiveTable {
 /// single-crease patches; its points refined by Far::PrimvarRefiner and its local point stencils.
 /// Throws Error for a bad mesh (as load_model) or level.
 OsdAdaptiveTable make_osd_adaptive_table(const ControlMesh& mesh, int isolation_level, bool bspline_end_caps = false);
+
+/// Far's name of a patch type ("REGULAR", "GREGORY_BASIS", ...; "type N" for a value Far does not
+/// name), for error messages about a table.
+std::string osd_patch_type_name(OpenSubdiv::Far::PatchDescriptor::Type type);
 
 /// cull_frustum (core/patch_source.h) over every array: culled[i] for the table's patch i
 /// (patch_count() bytes); max_displacement null or patch_count() values >= 0 in table order.
