@@ -1,9 +1,10 @@
 # cmake --install: what an engine needs to use patchcull from its own CMake project.
 #
-#   include/patchcull/<layer>/*.h         public headers by layer (core, objects, import, eval; gl
-#                                         and eval_gl with GL) and the generated include/patchcull/version.h
+#   include/patchcull/<layer>/*.h         public headers by layer (core, objects, import, eval; gl,
+#                                         eval_gl and gl_osd with GL) and the generated include/patchcull/version.h
 #   include/patchcull/glsl/*.h            GLSL headers an engine's shaders include (with GL)
-#   lib/libpatchcull_<layer>.a            one static library per layer (patchcull_gl, patchcull_eval_gl with GL)
+#   lib/libpatchcull_<layer>.a            one static library per layer (patchcull_gl, patchcull_eval_gl,
+#                                         patchcull_gl_osd with GL)
 #   lib/cmake/patchcull/                  patchcullConfig.cmake, patchcullConfigVersion.cmake, targets
 #   share/patchcull/{models,scenes}/      the shipped models and scenes (patchcull_DATA_DIR)
 #   share/doc/patchcull/                  LICENSE, NOTICE
@@ -12,7 +13,8 @@
 # find_package(patchcull CONFIG COMPONENTS ...) gives one target per layer asked for (and the
 # layers it needs): patchcull::core (the kernels: TBB and Highway), patchcull::objects,
 # patchcull::import (OpenSubdiv, stb), patchcull::eval and, when the package was built with GL,
-# patchcull::gl and patchcull::eval_gl (patchcullConfig.cmake.in).
+# patchcull::gl, patchcull::eval_gl and patchcull::gl_osd (OpenSubdiv's osdGPU)
+# (patchcullConfig.cmake.in).
 include(CMakePackageConfigHelpers)
 set(PATCHCULL_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/patchcull)
 
@@ -28,9 +30,8 @@ foreach(layer core objects import eval)
 endforeach()
 
 # Headers: the GL layers' folders only with GL, so a CPU-only install holds no header it cannot link.
-# gl_osd stays in this tree (its library is not installed).
 if(PATCHCULL_WITH_GL)
-  set(patchcull_header_excludes PATTERN "gl_osd" EXCLUDE)
+  set(patchcull_header_excludes)
 else()
   set(patchcull_header_excludes PATTERN "gl" EXCLUDE PATTERN "eval_gl" EXCLUDE PATTERN "gl_osd" EXCLUDE)
 endif()
@@ -45,6 +46,9 @@ if(PATCHCULL_WITH_GL)
   install(TARGETS patchcull_eval_gl EXPORT patchcullEvalGLTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
   install(EXPORT patchcullEvalGLTargets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
+  install(TARGETS patchcull_gl_osd EXPORT patchcullGlOsdTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(EXPORT patchcullGlOsdTargets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
   # The GLSL headers of gl_passes.h's shipped_glsl, as the library embeds them: shared.h (the
   # constants of C++ and GLSL, with core/cull_flags.h's flag word inlined by the shader build, so an
   # engine's shader include system needs no second folder) and patchcull_tcs.h (the TCS include,

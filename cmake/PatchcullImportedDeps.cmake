@@ -7,6 +7,8 @@
 #   patchcull_import_model_deps(<missing-var>) PatchcullDeps::OpenSubdiv (osdCPU), PatchcullDeps::stb
 #                                              (the import layer's)
 #   patchcull_import_gl_deps(<missing-var>)    PatchcullDeps::epoxy, PatchcullDeps::stb (the gl layer's)
+#   patchcull_import_osd_gpu_deps(<missing-var>) PatchcullDeps::OpenSubdivGPU (osdGPU: the gl_osd
+#                                              layer's, besides the model and GL dependencies)
 
 # OpenSubdiv 3.5's package config is broken on Debian 12 (its targets file names static
 # libraries that are not shipped) and there is no pkg-config file: osdCPU is imported by hand.
@@ -39,6 +41,23 @@ function(patchcull_import_gl_deps missing_var)
     endif()
   endif()
   _patchcull_import_stb(missing)  # the PNG output of the renderer
+  set(${missing_var} "${missing}" PARENT_SCOPE)
+endfunction()
+
+# OpenSubdiv's GL patch tables and GLSL patch shader sources (Osd::GLPatchTable,
+# Osd::GLSLPatchShaderSource) are in libosdGPU, which Debian's libosd-dev ships beside osdCPU.
+function(patchcull_import_osd_gpu_deps missing_var)
+  set(missing)
+  if(NOT TARGET PatchcullDeps::OpenSubdivGPU)
+    find_library(PATCHCULL_OPENSUBDIV_GPU_LIBRARY osdGPU)
+    if(PATCHCULL_OPENSUBDIV_GPU_LIBRARY)
+      add_library(PatchcullDeps::OpenSubdivGPU UNKNOWN IMPORTED)
+      set_target_properties(PatchcullDeps::OpenSubdivGPU PROPERTIES
+        IMPORTED_LOCATION "${PATCHCULL_OPENSUBDIV_GPU_LIBRARY}")
+    else()
+      list(APPEND missing "OpenSubdiv's libosdGPU (Debian libosd-dev)")
+    endif()
+  endif()
   set(${missing_var} "${missing}" PARENT_SCOPE)
 endfunction()
 

@@ -4,8 +4,9 @@
 #     installs the build BUILD_DIR into WORK/prefix (cmake --install), checks the layout, that no
 #     PATCHCULL_* definition of the build reaches a consumer, moves the prefix to WORK/moved/prefix
 #     (the installed CLI resolves `cull bigguy` there), then configures, builds and runs
-#     tests/package/consumer with find_package(patchcull 0.2 CONFIG): with patchcull::import and
-#     patchcull::gl (core_consumer, import_consumer, gl_consumer), and with COMPONENTS core alone
+#     tests/package/consumer with find_package(patchcull 0.2 CONFIG): with patchcull::import,
+#     patchcull::gl and patchcull::gl_osd (core_consumer, import_consumer, gl_consumer,
+#     gl_osd_consumer), and with COMPONENTS core alone
 #     (the kernels), which must search for no GL, OpenSubdiv or stb package;
 #     find_package(patchcull NEXT_MINOR) must refuse the package (version file).
 #   cmake -DMODE=cpu -DCPU_BUILD_DIR=... -DWORK=... -DSOURCE_DIR=... -DCXX=... -P run.cmake
@@ -83,6 +84,9 @@ function(build_consumer name prefix consumer_gl consumer_import)
   elseif(NOT consumer_gl)
     expect_no_model_search("${name}" "${dir}/CMakeCache.txt")
   endif()
+  if(EXISTS "${dir}/gl_osd_consumer")
+    run("${name}: gl_osd_consumer" "${dir}/gl_osd_consumer")
+  endif()
   if(consumer_gl)
     run("${name}: gl_consumer" "${dir}/gl_consumer")
   else()
@@ -98,7 +102,9 @@ if(MODE STREQUAL "install")
   expect_files("install" "${cmakedir}/patchcullConfig.cmake" "${cmakedir}/patchcullConfigVersion.cmake"
     "${cmakedir}/patchcullCoreTargets.cmake" "${cmakedir}/patchcullObjectsTargets.cmake"
     "${cmakedir}/patchcullImportTargets.cmake" "${cmakedir}/patchcullEvalTargets.cmake"
-    "${cmakedir}/patchcullGLTargets.cmake" "${cmakedir}/PatchcullImportedDeps.cmake"
+    "${cmakedir}/patchcullGLTargets.cmake" "${cmakedir}/patchcullGlOsdTargets.cmake"
+    "${cmakedir}/PatchcullImportedDeps.cmake" "${prefix}/lib/libpatchcull_gl_osd.a"
+    "${prefix}/include/patchcull/gl_osd/osd_gl_draw.h"
     "${prefix}/lib/libpatchcull_core.a" "${prefix}/lib/libpatchcull_objects.a" "${prefix}/lib/libpatchcull_import.a"
     "${prefix}/lib/libpatchcull_eval.a" "${prefix}/lib/libpatchcull_gl.a"
     "${prefix}/include/patchcull/core/frustum.h" "${prefix}/include/patchcull/gl/gl_passes.h"
@@ -122,7 +128,8 @@ if(MODE STREQUAL "install")
   set(prefix "${moved}")
   run("moved CLI: cull bigguy" ${CMAKE_COMMAND} -E env --unset=PATCHCULL_DATA_DIR "${prefix}/bin/patchcull" cull bigguy
       --views 2)
-  build_consumer(consumer "${prefix}" ON ON)
+  build_consumer(consumer "${prefix}" ON ON -DCONSUMER_GL_OSD=ON)
+  expect_files("consumer" "${WORK}/consumer/gl_osd_consumer")
   # The kernels alone: no GL, OpenSubdiv or stb package searched for.
   build_consumer(consumer_kernels_only "${prefix}" OFF OFF)
   # The version file: 0.x releases are compatible within a minor version only.
@@ -176,6 +183,7 @@ elseif(MODE STREQUAL "cpu")
     "${prefix}/include/patchcull/core/frustum.h"
     "${prefix}/lib/cmake/patchcull/patchcullConfig.cmake")
   expect_no_files("cpu-only: install" "${prefix}/lib/libpatchcull_gl.a" "${prefix}/include/patchcull/gl"
+    "${prefix}/lib/libpatchcull_gl_osd.a" "${prefix}/include/patchcull/gl_osd"
     "${prefix}/include/patchcull/glsl" "${prefix}/lib/cmake/patchcull/patchcullGLTargets.cmake")
   build_consumer(consumer_cpu "${prefix}" OFF ON
     -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON ${consumer_link_flags})
