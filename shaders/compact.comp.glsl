@@ -1,22 +1,25 @@
 // Compaction pass (CompactPass, src/gl/compact_pass.cpp; include/patchcull/gl/gl_compaction.h): the
 // patches p of the range [first_patch, first_patch + patch_count) whose flag word satisfies
-// (flag & mask) == value go into the draw list (kBindingDrawList) from entry list_first on, and
-// the range's DrawArraysIndirectCommand {16 n, 1, 16 list_first, 0} (n survivors) and its draw
-// count (1 when n > 0, else 0) are written for an indirect draw that pulls point
+// (flag & mask) == value go into the draw list (kBindingDrawList) from entry list_first on; their
+// count n goes to a word of the pass's own buffer (kBindingCompactSums); then kCompactFinish
+// writes the range's C = max(1, ceil(patch_count / K)) DrawArraysIndirectCommands (K =
+// patches_per_command): command c = {16 m_c, 1, 16 (list_first + c K), 0}, m_c = min(K, n - c K)
+// where positive, else 0, and the draw count ceil(n / K), for an indirect draw that pulls point
 // gl_VertexID % 16 of patch list[gl_VertexID / 16].
 // The atomic append (order not stable):
-// - kCompactInit (one invocation): the command {0, 1, 16 list_first, 0}.
+// - kCompactInit (one invocation): the total sums[0] = 0.
 // - kCompactAppend: each work group counts its survivors in shared memory, reserves their slots
-//   with one atomicAdd on the command's vertex count (16 per patch) and writes them.
-// - kCompactFinish (one invocation): the draw count from the command's vertex count.
+//   with one atomicAdd on sums[0] and writes them.
 // The prefix scan (ascending patch order, the same every frame):
-// - kCompactGroupCounts: group g's survivor count into sums[g] (kBindingCompactSums); in the
+// - kCompactGroupCounts: group g's survivor count into sums[g]; in the
 //   scan's modes each invocation holds kCompactScanRun consecutive patches (a group
 //   kCompactGroupSize kCompactScanRun of them: fewer groups, fewer barriers).
 // - kCompactScanSums (one work group): sums -> their exclusive prefix sums, looping over the
-//   groups kCompactGroupSize at a time; then the command and the draw count from the total.
+//   groups kCompactGroupSize at a time; the total n into sums[group_count].
 // - kCompactScatter: each survivor at list[list_first + sums[g] + its rank within group g]
 //   (a scan of the invocations' counts, then each writes its run's survivors in order).
+// Both end with kCompactFinish: one invocation per command (group_base: the dispatch's first
+// command; group_count: the word of sums holding n).
 // Two programs: the scan's modes with PC_COMPACT_SCAN, the append's without (on llvmpipe the
 // append ran several times slower in one program with the scan's code: 39-76 ms against 14-17 ms
 // per 1M patches, bench/compaction_bench.cpp under varying load).
@@ -31,8 +34,8 @@ layout(local_size_x = kCompactGroupSize) in;
 layout(std430, binding = kBindingDrawList) writeonly buffer DrawList {
     uint draw_list[];
 };
-layout(std430, binding = kBindingDrawCommands) buffer DrawCommands {
-    uint draw_commands[];  // count, instanceCount, first, baseInstance at command_word
+layout(std430, binding = kBindingDrawCommands) writeonly buffer DrawCommands {
+    uint draw_commands[];  // count, instanceCount, first, baseInstance from command_word on
 };
 layout(std430, binding = kBindingDrawCount) writeonly buffer DrawCount {
     uint draw_count[];
@@ -44,11 +47,12 @@ layout(std430, binding = kBindingCompactSums) buffer CompactSums {
 shared uint s_scan[kCompactGroupSize];
 shared uint s_total;
 
-void write_command(uint survivors) {
-    const uint w = compact.command_word;
-    draw_commands[w] = kDrawListPatchVertices * survivors;
+// Command c of the range: m patches from list entry first_entry on.
+void write_command(uint c, uint m, uint first_entry) {
+    const uint w = compact.command_word + 4u * c;
+    draw_commands[w] = kDrawListPatchVertices * m;
     draw_commands[w + 1u] = 1u;
-    draw_commands[w + 2u] = kDrawListPatchVertices * compact.list_first;
+    draw_commands[w + 2u] = kDrawListPatchVertices * first_entry;
     draw_commands[w + 3u] = 0u;
 }
 
@@ -85,12 +89,20 @@ uint group_inclusive_scan(uint v) {
 void main() {
     const uint mode = compact.mode;
     if (mode == kCompactInit) {
-        if (gl_GlobalInvocationID.x == 0u) write_command(0u);
+        if (gl_GlobalInvocationID.x == 0u) group_sums[0] = 0u;
         return;
     }
     if (mode == kCompactFinish) {
-        if (gl_GlobalInvocationID.x == 0u && compact.write_count != 0u)
-            draw_count[compact.count_word] = draw_commands[compact.command_word] != 0u ? 1u : 0u;
+        // patch_count: the range's; K <= max(patch_count, 1), so no sum below overflows.
+        const uint k = compact.patches_per_command;
+        const uint commands = max(1u, (compact.patch_count + k - 1u) / k);
+        const uint c = compact.group_base + gl_GlobalInvocationID.x;
+        const uint n = group_sums[compact.group_count];
+        if (c < commands) {
+            const uint start = c * k;
+            write_command(c, n > start ? min(k, n - start) : 0u, compact.list_first + start);
+        }
+        if (c == 0u && compact.write_count != 0u) draw_count[compact.count_word] = (n + k - 1u) / k;
         return;
     }
     const uint lid = gl_LocalInvocationIndex;
@@ -105,10 +117,7 @@ void main() {
             carry += s_scan[kCompactGroupSize - 1u];
             barrier();  // every invocation has read s_scan before the next chunk writes it
         }
-        if (lid == 0u) {
-            write_command(carry);
-            if (compact.write_count != 0u) draw_count[compact.count_word] = carry != 0u ? 1u : 0u;
-        }
+        if (lid == 0u) group_sums[compact.group_count] = carry;
         return;
     }
 #endif
@@ -144,9 +153,7 @@ void main() {
     const uint p = compact.first_patch + index;
     const bool keep = index < compact.patch_count && (cull_flags[p] & compact.mask) == compact.value;
     const uint slot = group_count(keep);
-    if (lid == 0u && s_total != 0u)
-        s_total = atomicAdd(draw_commands[compact.command_word], kDrawListPatchVertices * s_total) /
-                  kDrawListPatchVertices;
+    if (lid == 0u && s_total != 0u) s_total = atomicAdd(group_sums[0], s_total);
     barrier();
     if (keep) draw_list[compact.list_first + s_total + slot] = p;
 #endif

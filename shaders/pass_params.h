@@ -163,9 +163,11 @@ PC_PARAMS(CompactParams, kUniformPassParams) {
     PC_UINT(command_word);             // the command at words [command_word, command_word + 4)
     PC_UINT(count_word);               // the draw count at this word of its buffer
     PC_UINT(write_count);              // the draw-count buffer is bound
-    PC_UINT(group_base);               // scan: the range-wide index of this dispatch's first work group
-    PC_UINT(group_count);              // scan: the range's work groups (entries of the sums)
-    PC_UINT(pad0);
+    PC_UINT(group_base);               // the range-wide index of this dispatch's first work group
+                                       // (kCompactFinish: its first command)
+    PC_UINT(group_count);              // scan: the range's work groups (entries of the sums);
+                                       // kCompactFinish: the word of the sums holding the total
+    PC_UINT(patches_per_command);      // K of the commands, in [1, max(patch_count, 1)]
 } PC_END(compact);
 
 // fused_cull.comp.glsl (FusedCullPass): the frustum, back-patch cone and Hi-Z tests of one patch in

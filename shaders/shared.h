@@ -127,8 +127,9 @@ PATCHCULL_CONST uint kDrawValueFirstPass = kStatusVisible;
 PATCHCULL_CONST uint kDrawMaskSecondPass = kStatusVisible | kStatusNewlyVisible;  // newly visible
 PATCHCULL_CONST uint kDrawValueSecondPass = kStatusVisible | kStatusNewlyVisible;
 
-// compact.comp.glsl's modes (CompactParams::mode): the atomic append (init, append, finish) and
-// the order-preserving prefix scan (group counts, scan of the sums, scatter).
+// compact.comp.glsl's modes (CompactParams::mode): the atomic append (init, append) and the
+// order-preserving prefix scan (group counts, scan of the sums, scatter), each then finish (the
+// commands and the draw count from the total).
 PATCHCULL_CONST uint kCompactInit = 0u;
 PATCHCULL_CONST uint kCompactAppend = 1u;
 PATCHCULL_CONST uint kCompactFinish = 2u;

@@ -15,6 +15,11 @@ std::string_view compact_method_name(CompactMethod method) {
     return method == CompactMethod::atomic_append ? "atomic" : "scan";
 }
 
+std::size_t compact_command_count(std::size_t count, std::size_t patches_per_command) {
+    if (patches_per_command == 0 || count == 0) return 1;
+    return (count + patches_per_command - 1) / patches_per_command;
+}
+
 struct CompactPass::Impl {
     explicit Impl(PassContext::Impl& c) : context(c) {}
     ~Impl() { glDeleteBuffers(1, &sums); }
@@ -58,8 +63,9 @@ struct CompactPass::Impl {
             throw Error("GL: CompactPass: list_first + count past 2^28 entries (16 vertices per patch)");
         check_offset("command", out.command_offset);
         detail::check_buffer_size(who, "draw-list", out.list, (out.list_first + patches.count) * 4);
+        const std::size_t commands = compact_command_count(patches.count, out.patches_per_command);
         detail::check_buffer_size(who, "indirect-command", out.command,
-                                  out.command_offset + sizeof(DrawArraysIndirectCommand));
+                                  out.command_offset + commands * sizeof(DrawArraysIndirectCommand));
         if (out.draw_count) {
             check_offset("draw-count", out.draw_count_offset);
             detail::check_buffer_size(who, "draw-count", out.draw_count, out.draw_count_offset + 4);
@@ -80,13 +86,19 @@ struct CompactPass::Impl {
         params.command_word = static_cast<pp::uint>(out.command_offset / 4);
         params.count_word = static_cast<pp::uint>(out.draw_count_offset / 4);
         params.write_count = out.draw_count ? 1u : 0u;
+        // K in [1, max(count, 1)]: the same commands as the header's, and no overflow in the shader.
+        const std::size_t range = std::max<std::size_t>(patches.count, 1);
+        params.patches_per_command =
+            static_cast<pp::uint>(out.patches_per_command == 0 ? range : std::min(out.patches_per_command, range));
         const bool scan = method == CompactMethod::prefix_scan;
         // Patches per work group: one per invocation in the append, a run of kCompactScanRun in the scan.
         const std::size_t group = shared::kCompactGroupSize * (scan ? shared::kCompactScanRun : 1);
         const std::size_t groups = (patches.count + group - 1) / group;
         params.group_count = static_cast<pp::uint>(groups);
-        if (scan && groups > sums_capacity) {
-            const std::size_t capacity = std::max<std::size_t>(groups, 2 * sums_capacity);
+        // The scan's group sums and the total after them; the append's total alone.
+        const std::size_t sum_words = scan ? groups + 1 : 1;
+        if (sum_words > sums_capacity) {
+            const std::size_t capacity = std::max<std::size_t>(sum_words, 2 * sums_capacity);
             glDeleteBuffers(1, &sums);
             glCreateBuffers(1, &sums);
             glNamedBufferStorage(sums, static_cast<GLsizeiptr>(capacity * 4), nullptr, 0);
@@ -100,8 +112,8 @@ struct CompactPass::Impl {
         if (out.draw_count) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDrawCount, out.draw_count);
         // Earlier shader writes to the flags (the chain's passes) and to these buffers are seen.
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCompactSums, sums);
         if (scan) {
-            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCompactSums, sums);
             if (patches.count) {
                 params.mode = shared::kCompactGroupCounts;
                 dispatch_range(params, patches.first, patches.count, group);
@@ -120,10 +132,20 @@ struct CompactPass::Impl {
                 params.mode = shared::kCompactAppend;
                 dispatch_range(params, patches.first, patches.count, group);
             }
-            if (out.draw_count) {
-                glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-                dispatch_one(params, shared::kCompactFinish);
-            }
+        }
+        // The commands and the draw count from the total (sums[groups] after the scan, sums[0]
+        // after the append), one invocation per command.
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        params.mode = shared::kCompactFinish;
+        params.patch_count = static_cast<pp::uint>(patches.count);
+        params.group_count = static_cast<pp::uint>(scan ? groups : 0);
+        const std::size_t per_dispatch = std::size_t{65535} * shared::kCompactGroupSize;
+        for (std::size_t c = 0; c < commands; c += per_dispatch) {
+            const std::size_t n = std::min(per_dispatch, commands - c);
+            params.group_base = static_cast<pp::uint>(c);
+            block.upload(params);
+            glDispatchCompute(static_cast<GLuint>((n + shared::kCompactGroupSize - 1) / shared::kCompactGroupSize), 1,
+                              1);
         }
         glMemoryBarrier(GL_COMMAND_BARRIER_BIT);
         detail::finish_pass(who);

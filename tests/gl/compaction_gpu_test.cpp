@@ -4,6 +4,7 @@
 // the draw count are right; ranges with first > 0, of 0, 1, odd and several million patches. Then
 // the draw itself: a compacted glMultiDrawArraysIndirect(Count) of a patch-pulling tessellation
 // program gives the same id image as the flag path (all patches issued, levels 0 for the culled).
+// With at most K patches a command: ceil(count / K) commands, the empty ones past the survivors.
 #include <gtest/gtest.h>
 
 #include <epoxy/gl.h>
@@ -87,32 +88,42 @@ private:
 
 constexpr std::uint32_t kSentinel = 0xDEADBEEFu;
 
-// Runs the pass over flags[first, first + count) and checks list, command and draw count against
-// the CPU's selection. The outputs sit at odd places: the list from entry list_first, the command
-// at byte 20 (not 16-aligned), the draw count at byte 8; the words around them keep the sentinel.
+// Runs the pass over flags[first, first + count) and checks list, commands and draw count against
+// the CPU's selection. The outputs sit at odd places: the list from entry list_first, the commands
+// from byte 20 (not 16-aligned), the draw count at byte 8; the words around them keep the
+// sentinel. per_command: DrawListBuffers::patches_per_command (0: one command).
 void check_compaction(CompactPass& pass, const Buffer& flags_buffer, const std::vector<std::uint32_t>& flags,
                       std::size_t first, std::size_t count, const Selection& s, CompactMethod method,
-                      const std::string& label) {
+                      const std::string& label, std::size_t per_command = 0) {
     const std::size_t list_first = 3;
     const std::size_t list_words = list_first + count + 2;
+    const std::size_t commands = compact_command_count(count, per_command);
+    const std::size_t command_words = 5 + 4 * commands + 1;
     Buffer list(std::vector<std::uint32_t>(list_words, kSentinel));
-    Buffer command(std::vector<std::uint32_t>(10, kSentinel));
+    Buffer command(std::vector<std::uint32_t>(command_words, kSentinel));
     Buffer draw_count(std::vector<std::uint32_t>(4, kSentinel));
     const PatchBuffers patches{0, flags_buffer.name(), 0, first, count};
-    const DrawListBuffers out{list.name(), list_first, command.name(), 20, draw_count.name(), 8};
+    const DrawListBuffers out{list.name(), list_first, command.name(), 20, draw_count.name(), 8, per_command};
     pass.run(patches, s.mask, s.value, out, method);
     ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 
     const std::vector<std::uint32_t> expected = cpu_select(flags, first, count, s);
     const std::size_t n = expected.size();
-    const std::vector<std::uint32_t> cmd = command.read(0, 10);
-    EXPECT_EQ(cmd[5], 16u * n) << label;
-    EXPECT_EQ(cmd[6], 1u) << label;
-    EXPECT_EQ(cmd[7], 16u * list_first) << label;
-    EXPECT_EQ(cmd[8], 0u) << label;
-    for (std::size_t w : {0, 1, 2, 3, 4, 9}) EXPECT_EQ(cmd[w], kSentinel) << label << " command word " << w;
+    const std::size_t k = per_command == 0 ? std::max<std::size_t>(count, 1) : per_command;
+    const std::vector<std::uint32_t> cmd = command.read(0, command_words);
+    for (std::size_t c = 0; c < commands; ++c) {
+        const std::size_t start = c * k, m = n > start ? std::min(k, n - start) : 0;
+        const std::uint32_t* w = &cmd[5 + 4 * c];
+        EXPECT_EQ(w[0], 16u * m) << label << " command " << c;
+        EXPECT_EQ(w[1], 1u) << label << " command " << c;
+        EXPECT_EQ(w[2], 16u * (list_first + start)) << label << " command " << c;
+        EXPECT_EQ(w[3], 0u) << label << " command " << c;
+    }
+    for (std::size_t w :
+         {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{3}, std::size_t{4}, command_words - 1})
+        EXPECT_EQ(cmd[w], kSentinel) << label << " command word " << w;
     const std::vector<std::uint32_t> dc = draw_count.read(0, 4);
-    EXPECT_EQ(dc[2], n ? 1u : 0u) << label;
+    EXPECT_EQ(dc[2], (n + k - 1) / k) << label;
     EXPECT_EQ(dc[0], kSentinel) << label;
     EXPECT_EQ(dc[3], kSentinel) << label;
 
@@ -144,6 +155,32 @@ TEST(GpuCompaction, ListCommandAndCountMatchTheCpuSelection) {
                 check_compaction(pass, flags_buffer, flags, r.first, r.count, s, m,
                                  std::string(compact_method_name(m)) + " " + s.name + " [" + std::to_string(r.first) +
                                      ", +" + std::to_string(r.count) + ")");
+}
+
+// DrawListBuffers::patches_per_command = K: ceil(count / K) commands of at most K patches, those
+// past the survivors empty, the draw count ceil(n / K); K of 1 (one command per patch), odd, equal
+// to and past the range, and a range whose commands need more than one work group.
+TEST(GpuCompaction, CommandsOfAtMostKPatches) {
+    EXPECT_EQ(compact_command_count(0, 0), 1u);
+    EXPECT_EQ(compact_command_count(0, 7), 1u);
+    EXPECT_EQ(compact_command_count(100, 0), 1u);
+    EXPECT_EQ(compact_command_count(100, 7), 15u);
+    EXPECT_EQ(compact_command_count(14, 7), 2u);
+    CompactPass pass(test::passes());
+    const std::vector<std::uint32_t> flags = random_flags(20000, 17);
+    Buffer flags_buffer(flags);
+    struct Case {
+        std::size_t first, count, k;
+    };
+    const Case cases[] = {{0, 0, 5},     {4, 1, 1},      {9, 300, 1},    {0, 257, 7},    {13, 4097, 15},
+                          {2, 999, 999}, {2, 999, 5000}, {1, 19999, 60}, {0, 20000, 226}};
+    for (const Case& c : cases)
+        for (const Selection& s : kSelections)
+            for (const CompactMethod m : kMethods)
+                check_compaction(pass, flags_buffer, flags, c.first, c.count, s, m,
+                                 std::string(compact_method_name(m)) + " " + s.name + " [" + std::to_string(c.first) +
+                                     ", +" + std::to_string(c.count) + ") K " + std::to_string(c.k),
+                                 c.k);
 }
 
 TEST(GpuCompaction, ScanIsTheSameEveryRunAndAppendHoldsTheSameSet) {
@@ -220,6 +257,7 @@ TEST(GpuCompaction, BadBuffersAreOneLineErrors) {
         message({big.name(), 0, big.name(), 0, big.name(), 6}, patches),     // draw-count offset
         message({0, 0, big.name(), 0, 0, 0}, patches),                       // no list
         message({big.name(), 0, big.name(), 0, 0, 0}, {0, flags_buffer.name(), 0, 50, 100}),  // flags
+        message({big.name(), 0, big.name(), 0, 0, 0, 1}, patches),  // 100 commands: 1600 bytes, the buffer 800
     };
     for (const std::string& m : cases) {
         EXPECT_EQ(m.rfind("GL: CompactPass: ", 0), 0u) << m;
@@ -346,7 +384,7 @@ TEST(GpuCompaction, CompactedDrawGivesTheFlagPathsIdImage) {
 
     const std::vector<std::uint32_t> flags = random_flags(kPatches, 3);
     Buffer flags_buffer(flags), list(std::vector<std::uint32_t>(kPatches + 8, 0u)),
-        command(std::vector<std::uint32_t>(8, 0u)), draw_count(std::vector<std::uint32_t>(4, 0u));
+        command(std::vector<std::uint32_t>(4 + 4 * kPatches, 0u)), draw_count(std::vector<std::uint32_t>(4, 0u));
     CompactPass pass(test::passes());
 
     const auto draw = [&](GLuint program, const Selection& s, auto&& issue) {
@@ -377,37 +415,42 @@ TEST(GpuCompaction, CompactedDrawGivesTheFlagPathsIdImage) {
     std::size_t compared = 0;
     for (const Range r : {Range{0, kPatches}, Range{5, 37}, Range{47, 1}, Range{9, 0}})
         for (const Selection& s : kSelections)
-            for (const CompactMethod m : kMethods) {
-                const std::string label = std::string(compact_method_name(m)) + " " + s.name + " [" +
-                                          std::to_string(r.first) + ", +" + std::to_string(r.count) + ")";
-                const std::vector<std::uint32_t> reference = draw(flag_program, s, [&] {
-                    glDrawArrays(GL_PATCHES, static_cast<GLint>(16 * r.first), static_cast<GLsizei>(16 * r.count));
-                });
-                const PatchBuffers patches{cp, flags_buffer.name(), 0, r.first, r.count};
-                pass.run(patches, s.mask, s.value, {list.name(), 2, command.name(), 16, draw_count.name(), 4}, m);
-                for (const bool counted : {false, true}) {
-                    if (counted && !with_count) continue;
-                    const std::vector<std::uint32_t> ids = draw(list_program, s, [&] {
-                        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, command.name());
-                        if (counted) {
-                            glBindBuffer(GL_PARAMETER_BUFFER_ARB, draw_count.name());
-                            glMultiDrawArraysIndirectCountARB(GL_PATCHES, reinterpret_cast<const void*>(16), 4, 1, 0);
-                            glBindBuffer(GL_PARAMETER_BUFFER_ARB, 0);
-                        } else {
-                            glMultiDrawArraysIndirect(GL_PATCHES, reinterpret_cast<const void*>(16), 1, 0);
-                        }
-                        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+            for (const CompactMethod m : kMethods)
+                for (const std::size_t k : {std::size_t{0}, std::size_t{5}}) {  // one command, or several
+                    const std::string label = std::string(compact_method_name(m)) + " " + s.name + " [" +
+                                              std::to_string(r.first) + ", +" + std::to_string(r.count) + ") K " +
+                                              std::to_string(k);
+                    const std::vector<std::uint32_t> reference = draw(flag_program, s, [&] {
+                        glDrawArrays(GL_PATCHES, static_cast<GLint>(16 * r.first), static_cast<GLsizei>(16 * r.count));
                     });
-                    ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR)) << label;
-                    ASSERT_TRUE(ids == reference) << label << (counted ? " (indirect count)" : " (indirect)");
-                    // And the image holds exactly the CPU's selection.
-                    std::set<std::uint32_t> expected;
-                    for (const std::uint32_t p : cpu_select(flags, r.first, r.count, s)) expected.insert(p + 1);
-                    ASSERT_TRUE(test::ids_present(ids) == expected) << label;
-                    ++compared;
+                    const PatchBuffers patches{cp, flags_buffer.name(), 0, r.first, r.count};
+                    pass.run(patches, s.mask, s.value, {list.name(), 2, command.name(), 16, draw_count.name(), 4, k},
+                             m);
+                    const auto commands = static_cast<GLsizei>(compact_command_count(r.count, k));
+                    for (const bool counted : {false, true}) {
+                        if (counted && !with_count) continue;
+                        const std::vector<std::uint32_t> ids = draw(list_program, s, [&] {
+                            glBindBuffer(GL_DRAW_INDIRECT_BUFFER, command.name());
+                            if (counted) {
+                                glBindBuffer(GL_PARAMETER_BUFFER_ARB, draw_count.name());
+                                glMultiDrawArraysIndirectCountARB(GL_PATCHES, reinterpret_cast<const void*>(16), 4,
+                                                                  commands, 0);
+                                glBindBuffer(GL_PARAMETER_BUFFER_ARB, 0);
+                            } else {
+                                glMultiDrawArraysIndirect(GL_PATCHES, reinterpret_cast<const void*>(16), commands, 0);
+                            }
+                            glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+                        });
+                        ASSERT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR)) << label;
+                        ASSERT_TRUE(ids == reference) << label << (counted ? " (indirect count)" : " (indirect)");
+                        // And the image holds exactly the CPU's selection.
+                        std::set<std::uint32_t> expected;
+                        for (const std::uint32_t p : cpu_select(flags, r.first, r.count, s)) expected.insert(p + 1);
+                        ASSERT_TRUE(test::ids_present(ids) == expected) << label;
+                        ++compared;
+                    }
                 }
-            }
-    EXPECT_GE(compared, 32u);
+    EXPECT_GE(compared, 64u);
     glDeleteProgram(flag_program);
     glDeleteProgram(list_program);
     glDeleteVertexArrays(1, &vao);
