@@ -14,6 +14,7 @@ PACKAGES=(
   python3-matplotlib  # scripts/plot_figures.py
   assimp-testmodels  # third-party OBJ files for the unseen-models test
   clang-14 libclang-rt-14-dev  # libFuzzer for the fuzz targets (scripts/fuzz.sh)
+  libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers  # the Vulkan passes (patchcull_vk) and their tests on lavapipe
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

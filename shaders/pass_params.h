@@ -30,7 +30,7 @@ struct vec4 {
 #define PC_INT(member) std::int32_t member = 0
 #define PC_FLOAT(member) float member = 0
 #else
-#define PC_PARAMS(name, slot) layout(std140, binding = slot) uniform name
+#include "api.h"  // PC_PARAMS: a std140 uniform block (OpenGL) or the push constants (Vulkan)
 #define PC_END(instance) instance
 #define PC_VEC4(member) vec4 member
 #define PC_MAT4(member) mat4 member

@@ -3,8 +3,8 @@
 // the layers below it only:
 //   core <- objects <- import <- eval;  core, objects <- gl;  eval, gl <- eval_gl (the
 //   evaluations of the GPU pipeline);  import, gl <- gl_osd (OpenSubdiv's GL patch tables culled
-//   by the gl passes);  tools -> public headers.
-// The kernels and the object level include no OpenSubdiv, stb or GL.
+//   by the gl passes);  core <- vk (the Vulkan passes, no GL);  tools -> public headers.
+// The kernels and the object level include no OpenSubdiv, stb or GL; the Vulkan layer no GL.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -28,6 +28,7 @@ const std::map<std::string, std::set<std::string>> kAllowed = {
     {"gl", {"core", "objects", "gl"}},
     {"eval_gl", {"core", "objects", "import", "eval", "gl", "eval_gl"}},
     {"gl_osd", {"core", "objects", "import", "gl", "gl_osd"}},
+    {"vk", {"core", "vk"}},
 };
 
 struct Include {
@@ -105,6 +106,16 @@ TEST(Layering, KernelsAndObjectLevelNeedNoOpenSubdivStbOrGl) {
                 EXPECT_EQ(i.target.find("GL"), std::string::npos) << i.file;
                 EXPECT_EQ(i.target.find("epoxy"), std::string::npos) << i.file;
             }
+}
+
+TEST(Layering, VulkanLayerNeedsNoGl) {
+    for (const char* dir : {"src/vk", "include/patchcull/vk"})
+        for (const Include& i : includes_under(kRoot / dir)) {
+            EXPECT_EQ(i.target.find("epoxy"), std::string::npos) << i.file << " includes " << i.target;
+            EXPECT_EQ(i.target.find("GL/"), std::string::npos) << i.file << " includes " << i.target;
+            EXPECT_EQ(i.target.find("EGL"), std::string::npos) << i.file << " includes " << i.target;
+            EXPECT_EQ(i.target.find("gl_"), std::string::npos) << i.file << " includes " << i.target;
+        }
 }
 
 TEST(Layering, ToolsUseOnlyPublicHeaders) {

@@ -1,0 +1,175 @@
+// patchcull/vk/vk_passes.h: the GPU cull passes on Vulkan (library patchcull_vk, CMake option
+// PATCHCULL_WITH_VULKAN), recorded into the CALLER's VkCommandBuffer, on the caller's VkDevice and
+// VkBuffers. Each makes the same decisions as its CPU scalar kernel and its OpenGL twin
+// (gl/gl_passes.h) on the same inputs, flag word for flag word: they compile the same GLSL
+// source (shaders/*.comp.glsl, to SPIR-V at build time; the API differences are shaders/api.h).
+//
+//   test                   CPU kernel (scalar)            pass               shader
+//   frustum                cull_frustum_scalar            FrustumPass        frustum.comp.glsl
+//   (ends of the chain)    -                              CullStatusPass     cull_status.comp.glsl
+// The other passes of gl_passes.h (frustum-disp, back-patch, Hi-Z, displaced, fused, compaction)
+// and the passes over a GpuPatchSource have no Vulkan twin yet (docs/ENGINE.md, "Vulkan").
+//
+// Buffers: the layouts of gl_passes.h (control points 16 vec4 per patch in patch.h order, 256
+// bytes; the flag word, core/cull_flags.h, one uint per patch; margins one float per patch;
+// counters kCounterCount uints, shaders/shared.h), each given as a BufferRange whose bytes the
+// shader indexes from the range's start: patch p's data at offset + p * (its size). Every range
+// holds patches [0, first + count), lies within maxStorageBufferRange, starts at a multiple of
+// minStorageBufferOffsetAlignment and is in a buffer made with VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+// the passes check the sizes, alignments and limits they can see (Error) and trust the rest.
+//
+// What a pass records (its run, begin or end), in this order:
+//   vkCmdBindPipeline(VK_PIPELINE_BIND_POINT_COMPUTE, its pipeline)
+//   vkCmdPushDescriptorSetKHR(set 0): the caller's ranges as storage-buffer descriptors at the
+//     binding numbers of shaders/shared.h (kBindingControlPoints 0, kBindingCullFlags 1,
+//     kBindingMaxDisplacement 2, kBindingPlaneValues 4, kBindingCullCounters 6); an optional
+//     range left empty is replaced by a small buffer of the PassContext (never read)
+//   per dispatch: vkCmdPushConstants (its pass_params.h block, std140, at offset 0) and
+//     vkCmdDispatch; ranges of more than 65535 work groups are split into several
+//   vkCmdPipelineBarrier: one VkMemoryBarrier from VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT /
+//     VK_ACCESS_SHADER_WRITE_BIT to PassContextOptions::after_stages / after_access (default:
+//     every stage and access), so the next pass of the chain, a draw's tessellation control
+//     shader, an indirect draw or a copy back sees the writes.
+// It leaves the command buffer's compute pipeline, compute push descriptors (set 0) and push
+// constants as it set them (rebind yours after), changes no graphics state, records no render
+// pass, and must be recorded outside a render pass instance. It creates no Vulkan object after
+// the pipeline of its shader exists (first use per PassContext) and allocates nothing on the
+// host per call.
+// Before a pass, the caller orders its own earlier work on the ranges: writes (uploads, copies,
+// its shaders) made available and visible to VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT with
+// VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, and earlier reads of the buffers the
+// pass writes (flags, counters, diagnostics; e.g. the previous frame's draw) finished before
+// COMPUTE_SHADER (an execution dependency). A pass after another patchcull pass needs nothing:
+// the barrier the first left covers it.
+//
+// The device: the caller's, created with VK_KHR_push_descriptor enabled, and with the
+// shaderFloat64 feature enabled when PassContext chooses the exact fma (below). Pipelines are
+// cached per PassContext, one per shader and variant, created on first use (with the caller's
+// VkPipelineCache when given); make one PassContext per VkDevice.
+//
+// The flag chain, the reasons and the statuses are gl_passes.h's: CullStatusPass::begin clears
+// the reasons, each test pass skips the patches already culled and writes its reason into the
+// ones it culls, CullStatusPass::end turns reasons into statuses (+ counts).
+//
+// Clip conventions: Vulkan draws in ClipDepth::zero_to_one or, reversed, ClipDepth::reversed /
+// reversed_infinite (clip_space.h); the passes take the convention wherever a decision depends on
+// depth (FrustumPlanes is made with one). Vulkan's y-down clip space (a projection whose y row is
+// negated, or a viewport of negative height) needs nothing: the frustum planes w + y >= 0 and
+// w - y >= 0 are the same pair, so every decision is the same for the flipped and the unflipped
+// projection of one camera.
+//
+// Threads and lifetime: a PassContext and its passes are used from one thread at a time; command
+// buffers recorded with them must have finished executing before the PassContext is destroyed.
+// Errors: patchcull::Error with one line starting with "Vulkan: " (a missing extension or
+// feature, a range too small or misaligned, a Vulkan call that failed, with its VkResult).
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+#include "patchcull/core/cull_view.h"
+#include "patchcull/core/frustum.h"
+
+namespace patchcull::vk {
+
+/// A byte range of one of the caller's buffers: [offset, offset + size). size 0 with buffer
+/// VK_NULL_HANDLE: none (optional ranges); VK_WHOLE_SIZE is not accepted (the pass checks sizes).
+struct BufferRange {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceSize offset = 0;
+    VkDeviceSize size = 0;
+};
+
+/// A range of patches in the caller's buffers (see the header for the layouts).
+struct PatchBuffers {
+    BufferRange control_points;  ///< required by the test passes (not by CullStatusPass): 256 bytes per patch
+    BufferRange flags;           ///< required: 4 bytes per patch
+    BufferRange margins;         ///< optional (none: no patch displaced): 4 bytes per patch
+    std::size_t first = 0;       ///< the patches [first, first + count) of those ranges
+    std::size_t count = 0;
+};
+
+/// How PassContext compiles and synchronizes.
+struct PassContextOptions {
+    /// The multiply-adds of the decisions (shaders/exact_fma.h). exact_double: pc_fma computed
+    /// exactly in double precision, bit-identical to std::fma (needs shaderFloat64 enabled on the
+    /// device); hardware: GLSL fma(), which Vulkan does not require to round once (use it on a
+    /// device whose fma is fused, e.g. a desktop GPU's FFMA, for speed; decisions may then differ
+    /// from the CPU kernels' in the last bit of a plane value); automatic: exact_double where the
+    /// physical device supports shaderFloat64, else Error (choose hardware explicitly).
+    enum class Fma { automatic, exact_double, hardware };
+    Fma fma = Fma::automatic;
+    /// Optional: the caller's pipeline cache, used when the passes create their pipelines.
+    VkPipelineCache pipeline_cache = VK_NULL_HANDLE;
+    /// Optional: the device's vkGetDeviceProcAddr (e.g. from the caller's own loader); default the
+    /// Vulkan loader's. Every device command of the passes is fetched through it once.
+    PFN_vkGetDeviceProcAddr get_device_proc_addr = nullptr;
+    /// The second scope of the barrier each pass records after its dispatches.
+    VkPipelineStageFlags after_stages = VK_PIPELINE_STAGE_ALL_COMMANDS_BIT;
+    VkAccessFlags after_access = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+};
+
+/// What the passes share on one VkDevice: the device commands, the pipeline cache (one compute
+/// pipeline per shader and variant, with its push-descriptor set layout and pipeline layout,
+/// created on first use), the fma choice, and a 256-byte device buffer bound in place of an
+/// optional range the caller leaves empty.
+class PassContext {
+public:
+    /// physical_device and device: the caller's (device made from physical_device with
+    /// VK_KHR_push_descriptor enabled). Throws Error when the physical device lacks the
+    /// extension, when options.fma is automatic and shaderFloat64 is not supported, or when a
+    /// Vulkan call fails. Creates the 256-byte buffer and its memory (device-local when offered).
+    PassContext(VkPhysicalDevice physical_device, VkDevice device, const PassContextOptions& options = {});
+    PassContext(PassContext&&) noexcept;
+    PassContext& operator=(PassContext&&) noexcept;
+    /// Destroys its pipelines, layouts, modules and buffer (the caller's work using them must be done).
+    ~PassContext();
+    /// True when the passes use the exact double-precision fma.
+    bool fma_via_double() const;
+
+    struct Impl;
+    Impl& impl();
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+/// The two ends of the flag chain (see the header).
+class CullStatusPass {
+public:
+    explicit CullStatusPass(PassContext& context);
+    /// Records the clearing of the reason bits of the range (statuses kept). The control points
+    /// are not read (patches.control_points may be empty).
+    void begin(VkCommandBuffer cmd, const PatchBuffers& patches);
+    /// Records reasons -> statuses: a patch with no reason gets kStatusVisible (plus
+    /// kStatusNewlyVisible when it lacked kStatusVisible), a culled one its reason alone; adds
+    /// the counts (shared.h's kCounter*; kCounterDisplacedOcclusion needs the margins) to
+    /// counters (kCounterCount uints from its offset; empty: not counted).
+    void end(VkCommandBuffer cmd, const PatchBuffers& patches, const BufferRange& counters = {});
+
+private:
+    PassContext::Impl* context_;
+};
+
+/// cull_frustum_scalar on the GPU: reason kCullFrustum for a patch whose control points (moved
+/// out by its margin) lie outside one plane of planes (make_frustum_planes of object_to_clip).
+class FrustumPass {
+public:
+    explicit FrustumPass(PassContext& context);
+    /// Records the test of the range. plane_values (optional, diagnostics): >= 6 floats per patch
+    /// of the ranges; a tested patch p gets the six maxima the decision compares with 0 at 6p
+    /// (bit-identical to the CPU kernel's with the exact fma).
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, const FrustumPlanes& planes,
+             const BufferRange& plane_values = {});
+    /// The same on one view's CullView (view.planes).
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, const CullView& view,
+             const BufferRange& plane_values = {});
+
+private:
+    PassContext::Impl* context_;
+};
+
+}  // namespace patchcull::vk

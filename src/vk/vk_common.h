@@ -1,0 +1,120 @@
+// What the Vulkan passes (patchcull/vk/vk_passes.h) share, not a public header: the device
+// commands, the pipeline cache of the PassContext, the range checks, and the one way a pass is
+// recorded (bind, push descriptors, push constants and dispatches, the barrier after).
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+#include <map>
+#include <string>
+
+#include "pass_params.h"
+#include "patchcull/core/error.h"
+#include "patchcull/vk/vk_passes.h"
+#include "shared.h"
+
+namespace patchcull::vk {
+
+namespace pp = gl::pass_params;
+namespace shared = gl::shared;
+
+namespace detail {
+
+/// "Vulkan: <who>: <what> failed (VkResult <code>)" unless result is VK_SUCCESS.
+void check_vk(VkResult result, const char* who, const char* what);
+
+/// The device commands the passes use, fetched once through vkGetDeviceProcAddr.
+struct DeviceCommands {
+    PFN_vkCreateShaderModule CreateShaderModule = nullptr;
+    PFN_vkDestroyShaderModule DestroyShaderModule = nullptr;
+    PFN_vkCreateDescriptorSetLayout CreateDescriptorSetLayout = nullptr;
+    PFN_vkDestroyDescriptorSetLayout DestroyDescriptorSetLayout = nullptr;
+    PFN_vkCreatePipelineLayout CreatePipelineLayout = nullptr;
+    PFN_vkDestroyPipelineLayout DestroyPipelineLayout = nullptr;
+    PFN_vkCreateComputePipelines CreateComputePipelines = nullptr;
+    PFN_vkDestroyPipeline DestroyPipeline = nullptr;
+    PFN_vkCreateBuffer CreateBuffer = nullptr;
+    PFN_vkDestroyBuffer DestroyBuffer = nullptr;
+    PFN_vkGetBufferMemoryRequirements GetBufferMemoryRequirements = nullptr;
+    PFN_vkAllocateMemory AllocateMemory = nullptr;
+    PFN_vkFreeMemory FreeMemory = nullptr;
+    PFN_vkBindBufferMemory BindBufferMemory = nullptr;
+    PFN_vkCmdBindPipeline CmdBindPipeline = nullptr;
+    PFN_vkCmdPushDescriptorSetKHR CmdPushDescriptorSetKHR = nullptr;
+    PFN_vkCmdPushConstants CmdPushConstants = nullptr;
+    PFN_vkCmdDispatch CmdDispatch = nullptr;
+    PFN_vkCmdPipelineBarrier CmdPipelineBarrier = nullptr;
+};
+
+/// One cached compute pipeline: its push-descriptor set layout (storage buffers at `bindings`),
+/// its pipeline layout (that set and the push-constant range) and the pipeline.
+struct Pipeline {
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    std::uint32_t push_constant_bytes = 0;
+};
+
+/// A storage-buffer descriptor of a pass: binding number and range (empty: the context's
+/// placeholder buffer).
+struct Binding {
+    std::uint32_t binding;
+    BufferRange range;
+};
+
+/// The most storage buffers one pass binds.
+inline constexpr std::size_t kMaxBindings = 8;
+
+}  // namespace detail
+
+struct PassContext::Impl {
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+    VkDevice device = VK_NULL_HANDLE;
+    PassContextOptions options;
+    detail::DeviceCommands vk;
+    bool fma_via_double = false;
+    VkPhysicalDeviceLimits limits{};
+    VkBuffer placeholder = VK_NULL_HANDLE;  // 256 bytes, bound for an empty optional range
+    VkDeviceMemory placeholder_memory = VK_NULL_HANDLE;
+    std::map<std::string, detail::Pipeline> pipelines;  // key: shader name
+
+    ~Impl();
+    /// The pipeline of compute shader `shader` (its SPIR-V module in this context's fma variant)
+    /// reading storage buffers at `bindings` and push constants of push_constant_bytes; created
+    /// on first use. Throws Error when the block exceeds maxPushConstantsSize.
+    const detail::Pipeline& pipeline(const char* shader, std::initializer_list<std::uint32_t> bindings,
+                                     std::uint32_t push_constant_bytes);
+    /// Throws (one line naming who and what) unless range is in a buffer, holds at least bytes
+    /// bytes, starts at a multiple of minStorageBufferOffsetAlignment and fits maxStorageBufferRange.
+    /// An optional range may be empty (buffer VK_NULL_HANDLE, size 0).
+    void check_range(const char* who, const char* what, const BufferRange& range, VkDeviceSize bytes,
+                     bool optional) const;
+    /// Records a pass: binds p, pushes the descriptors, then per dispatch of at most 65535 work
+    /// groups (patches_per_group patches each) sets params.first_patch and params.patch_count,
+    /// pushes params and dispatches; then the barrier of the header.
+    template <class Params>
+    void record(VkCommandBuffer cmd, const detail::Pipeline& p, const detail::Binding* bindings,
+                std::size_t binding_count, Params& params, std::size_t first, std::size_t count,
+                std::size_t patches_per_group) const {
+        bind(cmd, p, bindings, binding_count);
+        const std::size_t per_dispatch = 65535 * patches_per_group;
+        for (std::size_t offset = 0; offset < count; offset += per_dispatch) {
+            const std::size_t n = std::min(per_dispatch, count - offset);
+            params.first_patch = static_cast<pp::uint>(first + offset);
+            params.patch_count = static_cast<pp::uint>(n);
+            vk.CmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Params), &params);
+            vk.CmdDispatch(cmd, static_cast<std::uint32_t>((n + patches_per_group - 1) / patches_per_group), 1, 1);
+        }
+        barrier_after(cmd);
+    }
+    void bind(VkCommandBuffer cmd, const detail::Pipeline& p, const detail::Binding* bindings,
+              std::size_t binding_count) const;
+    void barrier_after(VkCommandBuffer cmd) const;
+};
+
+}  // namespace patchcull::vk

@@ -1,0 +1,98 @@
+// Inputs of the Vulkan equality tests: random patches in and around a random camera's frustum
+// (clusters near the eye, across the planes, behind the eye, far beyond; a third rational;
+// optional displacement margins), the CPU scalar kernel's flag words, and the buffers of a case.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "patchcull/core/camera.h"
+#include "patchcull/core/cull_flags.h"
+#include "patchcull/core/frustum.h"
+#include "patchcull/core/patch.h"
+#include "vk/vk_test_util.h"
+
+namespace patchcull::vk::test {
+
+struct RandomCase {
+    std::vector<BezierPatch> patches;
+    std::vector<float> margins;  // empty or one per patch
+    Camera camera;
+};
+
+inline RandomCase random_case(std::uint32_t seed, std::size_t count, ClipDepth depth, bool with_margins) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+    auto range = [&](float lo, float hi) { return lo + (hi - lo) * u01(rng); };
+    RandomCase c;
+    Camera& cam = c.camera;
+    cam.eye = {range(-3, 3), range(-3, 3), range(-3, 3)};
+    cam.target = {range(-1, 1), range(-1, 1), range(-1, 1)};
+    cam.up = normalize(Vec3{range(-1, 1), range(-1, 1), range(-1, 1)});
+    cam.fovy_radians = range(0.3f, 2.0f);
+    cam.aspect = range(0.5f, 2.0f);
+    cam.z_near = range(0.01f, 1.0f);
+    cam.z_far = cam.z_near + range(0.5f, 20.0f);
+    cam.depth = depth;
+    for (std::size_t p = 0; p < count; ++p) {
+        const Vec3 centre{range(-6, 6), range(-6, 6), range(-6, 6)};
+        const float size = std::pow(10.0f, range(-2.0f, 0.5f));
+        const bool rational = p % 3 == 0;
+        BezierPatch patch;
+        for (Vec4& cp : patch.cp) {
+            const Vec3 x = centre + Vec3{range(-size, size), range(-size, size), range(-size, size)};
+            cp = homogeneous(x, rational ? std::pow(2.0f, range(-2, 2)) : 1.0f);
+        }
+        c.patches.push_back(patch);
+        if (with_margins) c.margins.push_back(u01(rng) < 0.3f ? 0.0f : std::pow(10.0f, range(-3.0f, 0.0f)));
+    }
+    return c;
+}
+
+/// cull_frustum_scalar's decisions as the flag words a chain begin -> frustum leaves on words
+/// that held no reason: kCullFrustum or 0.
+inline std::vector<std::uint32_t> cpu_frustum_words(const RandomCase& c, const FrustumPlanes& planes) {
+    PatchBatch batch(c.patches.size());
+    for (std::size_t p = 0; p < c.patches.size(); ++p)
+        for (int k = 0; k < kPatchPoints; ++k) {
+            const Vec4& P = c.patches[p].cp[k];
+            batch.component(k, 0)[p] = P.x;
+            batch.component(k, 1)[p] = P.y;
+            batch.component(k, 2)[p] = P.z;
+            batch.component(k, 3)[p] = P.w;
+        }
+    std::vector<std::uint8_t> culled(c.patches.size());
+    cull_frustum_scalar(batch.view(), c.margins.empty() ? nullptr : c.margins.data(), planes, culled.data());
+    std::vector<std::uint32_t> words(culled.size());
+    for (std::size_t p = 0; p < culled.size(); ++p) words[p] = culled[p] ? kCullFrustum : 0u;
+    return words;
+}
+
+/// The case's buffers on the test device: control points, flags (zero), margins when the case has them.
+struct CaseBuffers {
+    explicit CaseBuffers(const RandomCase& c)
+        : points(c.patches.size() * sizeof(BezierPatch)),
+          flags(c.patches.size() * 4),
+          margins(std::max<std::size_t>(c.margins.size() * 4, 4)),
+          has_margins(!c.margins.empty()) {
+        points.write(c.patches.data(), c.patches.size() * sizeof(BezierPatch));
+        if (has_margins) margins.write(c.margins.data(), c.margins.size() * 4);
+        count = c.patches.size();
+    }
+    PatchBuffers patch_buffers() const {
+        PatchBuffers b;
+        b.control_points = points.range();
+        b.flags = flags.range();
+        if (has_margins) b.margins = margins.range();
+        b.count = count;
+        return b;
+    }
+    HostBuffer points, flags, margins;
+    bool has_margins;
+    std::size_t count = 0;
+};
+
+}  // namespace patchcull::vk::test
