@@ -5,7 +5,7 @@
 //   {"model","patch_source","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
 //    "displace","displace_scale","displaced_patches","bound","cone","frustum",
 //    "frames":[{"frame","pass1_drawn","pass2_drawn","frustum_culled","backpatch_culled",
-//               "occlusion_culled","displaced_occlusion_culled","visible","newly_visible",
+//               "occlusion_culled","displaced_occlusion_culled","visible","newly_visible","submitted",
 //               "ms":{"pass1","hiz","cull","pass2",
 //               "total"[,"reference"]},"false_culls"[,"false_culled_patches":[indices]]}],
 //    "false_culls"}
@@ -57,6 +57,11 @@
 // level, --cull auto, --draw-bounds, and frame 0, whose upload brings the attributes; cpu_ms: CPU
 // time of posing and uploading; done_ms: until glFinish returns; meshes_ms: of cpu_ms, animating
 // the control meshes (gpu); bytes_uploaded: bytes copied to GL).
+// --draw flags|indirect ("draw" in the JSON; gl_pipeline.h's DrawMode): how the draw passes issue
+// patches: flags (every patch of the drawn objects; the TCS gives the culled ones levels 0) or
+// indirect (CompactPass lists each pass's survivors and indirect draws issue only those). Every
+// frame gains "submitted":{"pass1","pass2"}: the patches each draw pass issued (pass2 0 in one
+// pass and when aggressive). With --patch-source osd-table only flags (its JSON says "draw").
 // --patch-source bezier|osd-table ("patch_source" in the JSON): bezier (the default) draws the
 // scheme's Bezier patches through the pipeline above; osd-table (with --scheme osd, a single OBJ
 // model) draws the model's OpenSubdiv patch table with OpenSubdiv's own GLSL patch shaders, culled
@@ -123,6 +128,7 @@ Runner add_render_command(CLI::App& app) {
         std::string clip_depth = "zero-to-one";
         std::string pose = "cpu";
         bool fused_pass = false;
+        std::string draw = "flags";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -155,6 +161,9 @@ Runner add_render_command(CLI::App& app) {
     add_clip_depth_option(*command, state->clip_depth);
     command->add_flag("--fused-pass", state->fused_pass,
                       "frustum, back-patch (tcone/ncone) and Hi-Z tests in one compute pass");
+    add_choice_option(*command, "--draw", state->draw, {"flags", "indirect"},
+                      "how the draw passes issue patches: flags (every patch, the TCS drops the culled) or indirect "
+                      "(the survivors compacted into indirect draws: a culled patch is never issued)");
     add_choice_option(*command, "--pose", state->pose, {"cpu", "gpu"},
                       "where animated patches are evaluated: cpu, or gpu (stencils in a compute pass, bit-identical)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
@@ -180,13 +189,17 @@ Runner add_render_command(CLI::App& app) {
         parse_size("--size", state->size, width, height);
         if (state->patch_source == "osd-table") {
             if (state->scheme != "osd") throw Error("--patch-source osd-table: needs --scheme osd");
-            const std::set<std::string> applies = {"MODEL",  "--scheme",    "--patch-source", "--frames",
-                                                   "--cull", "--backpatch", "--clip-depth",   "--tess",
-                                                   "--size", "--verify",    "--json",         "--help"};
+            const std::set<std::string> applies = {
+                "MODEL",  "--scheme", "--patch-source", "--frames", "--cull", "--backpatch", "--clip-depth",
+                "--tess", "--size",   "--verify",       "--json",   "--help", "--draw"};
             for (const CLI::Option* option : command->get_options())
                 if (option->count() > 0 && !applies.count(option->get_name()))
                     throw Error("--patch-source osd-table: not with " + option->get_name());
             if (state->cull == "auto") throw Error("--patch-source osd-table: not with --cull auto");
+            if (state->draw == "indirect" && command->get_option("--draw")->count() > 0)
+                throw Error(
+                    "--patch-source osd-table: not with --draw indirect (OpenSubdiv's patch arrays are drawn "
+                    "with the flags)");
             OsdTableRender o;
             o.model = state->model;
             o.frames = state->frames;
@@ -300,6 +313,7 @@ Runner add_render_command(CLI::App& app) {
             params.cone = displace_cone(state->displace);
             params.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
             params.fused_pass = state->fused_pass;
+            params.draw = state->draw == "indirect" ? gl::DrawMode::indirect : gl::DrawMode::flags;
             object_level->apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height,
                                 params, width);
             if (automatic) {
@@ -375,7 +389,8 @@ Runner add_render_command(CLI::App& app) {
                                 {"bytes_uploaded", pose_cost.bytes_uploaded}}},
                               {"false_culls", false_culls},
                               {"depth_ties", depth_ties},
-                              {"fused_pass", stats.fused_pass}});
+                              {"fused_pass", stats.fused_pass},
+                              {"submitted", {{"pass1", stats.pass1_submitted}, {"pass2", stats.pass2_submitted}}}});
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
             if (automatic) frames.back()["auto_objects"] = auto_objects_json(objects, policy.decisions());
             {
@@ -429,6 +444,7 @@ Runner add_render_command(CLI::App& app) {
             out["frustum"] = state->frustum;
             out["pose"] = state->pose;
             out["fused_pass"] = state->fused_pass;
+            out["draw"] = state->draw;
             out["objects_method"] = object_level->method_name();
             out["object_occlusion"] = object_level->occlusion_name();
             out["detail_cull"] = state->objects.detail_pixels;

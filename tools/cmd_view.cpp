@@ -5,7 +5,7 @@
 // FILE drives it by frame number (viewer/viewer_script.h).
 // --frames N without a script plays render's camera path for N frames with no panel (the window
 // shows `render --out`'s images; --screenshot writes the last one), a line per frame.
-// --tess-mode / --tess-distance, --displace, --cull auto and the object-level flags as `render`.
+// --tess-mode / --tess-distance, --displace, --cull auto, --draw and the object-level flags as `render`.
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -50,6 +50,7 @@ Runner add_view_command(CLI::App& app) {
         std::string cull = "all";
         std::string backpatch = "tcone";
         std::string frustum = "hull";
+        std::string draw = "flags";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -77,6 +78,9 @@ Runner add_view_command(CLI::App& app) {
                       "back-patch test of backpatch/all");
     add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
                       "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
+    add_choice_option(*command, "--draw", state->draw, {"flags", "indirect"},
+                      "how the draw passes issue patches: flags (every patch, the TCS drops the culled) or indirect "
+                      "(the survivors compacted into indirect draws)");
     add_clip_depth_option(*command, state->clip_depth);
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
@@ -113,6 +117,7 @@ Runner add_view_command(CLI::App& app) {
         config.tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         config.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
         config.clip_depth = parse_clip_depth_option(state->clip_depth);
+        config.draw = state->draw == "indirect" ? gl::DrawMode::indirect : gl::DrawMode::flags;
 
         ViewerSettings& s = config.settings;
         set_cull_toggles(s, applicable_cull_mode(scene, cull, "view"));

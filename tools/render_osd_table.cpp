@@ -112,6 +112,7 @@ int run_osd_table_render(const OsdTableRender& o) {
         out["patches"] = patches;
         out["size"] = {o.width, o.height};
         out["patch_source"] = "osd-table";
+        out["draw"] = "flags";
         out["clip_depth"] = clip_depth_name(o.depth);
         out["tess"] = o.tess;
         out["cull"] = gl::cull_mode_name(o.cull);

@@ -32,6 +32,7 @@ std::size_t CullPipeline::patch_count() const { return impl_->renderer.patch_cou
 void CullPipeline::reset_visibility() { impl_->primed_generation = ~std::uint64_t{0}; }
 
 const char* frustum_test_name(FrustumTest test) { return test == FrustumTest::aabb ? "aabb" : "hull"; }
+const char* draw_mode_name(DrawMode mode) { return mode == DrawMode::indirect ? "indirect" : "flags"; }
 
 Vec3 eye_of_view(const Mat4& view) {
     Mat4 inverse;
@@ -98,6 +99,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     stats.two_pass = two_pass;
     stats.timing = method;
     stats.fused_pass = f.fused;
+    stats.draw = params.draw;
 
     SpanPlan plan = plan_spans(r.patch_count(), params.objects, params.object_culled);
     if (params.object_pass && params.objects.empty())
@@ -106,6 +108,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     if (m.primed_generation != r.flag_generation()) m.prime_statuses();
     r.set_culled_occluders(params.culled_occluders);
     m.ensure_counter_slots(plan.objects.size() + 1);
+    m.begin_draws();
     PassClock clock(method, m.timer_queries);
     clock.mark();
     FrameChain chain(m, params, f, plan, clock);
@@ -121,7 +124,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
                 chain.run(nullptr, &one, false);
             }
             const std::vector<PatchSpan> active = plan.active_spans(plan.objects[i]);
-            if (!active.empty()) r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, active);
+            if (!active.empty()) m.draw(0, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, active, params, plan);
         };
         params.object_pass->run(drawer);
         std::vector<PatchSpan> left_out;
@@ -138,9 +141,9 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         r.begin_frame(rp);
         if (params.object_pass) {
             run_object_pass(false);
-            r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.gaps_drawn);
+            m.draw(0, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.gaps_drawn, params, plan);
         } else {
-            r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.drawn);
+            m.draw(0, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.drawn, params, plan);
         }
         clock.mark();
         // 2. Hi-Z from that depth.
@@ -150,7 +153,7 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         // 3. test every patch (of the objects drawn), update statuses.
         chain.run(&m.hiz);
         // 4. newly visible patches (Niessner & Loop §3.1: skipped when aggressive).
-        if (!frame.aggressive) r.draw_selected(sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass, plan.drawn);
+        if (!frame.aggressive) m.draw(1, sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass, plan.drawn, params, plan);
         clock.mark();
     } else if (params.object_pass) {
         // One pass: the object pass runs the chain on each object it draws; the objects it left
@@ -165,17 +168,88 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
                 chain.mark_culled(plan.objects[i].first, plan.objects[i].first + plan.objects[i].count);
         chain.begin_gaps();
         chain.end_gaps();
-        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.gaps_drawn);
+        m.draw(0, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.gaps_drawn, params, plan);
         clock.mark();
     } else {
         chain.run(nullptr);
         r.begin_frame(rp);
-        r.draw_selected(sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.drawn);
+        m.draw(0, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.drawn, params, plan);
         clock.mark();
     }
     check_gl("render_frame");
     m.read_stats(plan, f, two_pass, frame.aggressive, clock, stats);
+    stats.pass1_submitted = m.submitted(0, params.draw);
+    stats.pass2_submitted = m.submitted(1, params.draw);
     return stats;
+}
+
+void CullPipeline::Impl::draw(int pass, std::uint32_t mask, std::uint32_t value, const std::vector<PatchSpan>& spans,
+                              const PipelineParams& params, const SpanPlan& plan) {
+    PassDrawList& l = draw_lists[pass];
+    if (params.draw == DrawMode::flags) {
+        renderer.draw_selected(mask, value, spans);
+        for (const PatchSpan& s : spans) l.issued += s.count;
+        return;
+    }
+    if (spans.empty() || renderer.patch_count() == 0) return;
+    const std::size_t k = renderer.patches_per_draw();
+    if (!l.started) {
+        // Every span a pass draws lies in one span of the plan at its first draw (an object's
+        // active spans, the gaps), so the plan's commands bound the pass's.
+        std::size_t commands = 0;
+        for (const PatchSpan& s : plan.drawn) commands += compact_command_count(s.count, k);
+        const std::size_t counts = plan.drawn.size();
+        auto grow = [](GLuint& buffer, std::size_t& capacity, std::size_t need, std::size_t bytes_each) {
+            if (buffer && need <= capacity) return;
+            capacity = std::max(need, 2 * capacity);
+            if (!buffer) glCreateBuffers(1, &buffer);
+            glNamedBufferData(buffer, static_cast<GLsizeiptr>(capacity * bytes_each), nullptr, GL_DYNAMIC_DRAW);
+        };
+        grow(l.list, l.list_capacity, std::max<std::size_t>(renderer.patch_count(), 1), 4);
+        grow(l.commands, l.command_capacity, std::max<std::size_t>(commands, 1), sizeof(DrawArraysIndirectCommand));
+        grow(l.counts, l.count_capacity, std::max<std::size_t>(counts, 1), 4);
+        l.started = true;
+    }
+    const std::size_t first_command = l.used_commands;
+    for (const PatchSpan& s : spans) {
+        const std::size_t commands = compact_command_count(s.count, k);
+        if (l.used_commands + commands > l.command_capacity || l.used_counts + 1 > l.count_capacity)
+            throw Error("render_frame: a draw pass's spans outgrew its command buffer (internal)");
+        PatchBuffers range = renderer.patch_buffers();
+        range.first = s.first;
+        range.count = s.count;
+        compact.run(range, mask, value,
+                    {l.list, s.first, l.commands, l.used_commands * sizeof(DrawArraysIndirectCommand), l.counts,
+                     l.used_counts * 4, k},
+                    params.compact);
+        l.used_commands += commands;
+        ++l.used_counts;
+    }
+    // One span: its own draw count; several: every command of theirs (the empty ones draw nothing).
+    IndirectDraw d;
+    d.list = l.list;
+    d.commands = l.commands;
+    d.first_command = first_command;
+    d.command_count = l.used_commands - first_command;
+    if (spans.size() == 1) {
+        d.draw_count = l.counts;
+        d.draw_count_offset = (l.used_counts - 1) * 4;
+    }
+    renderer.draw_indirect(d);
+}
+
+std::size_t CullPipeline::Impl::submitted(int pass, DrawMode mode) const {
+    const PassDrawList& l = draw_lists[pass];
+    if (mode == DrawMode::flags) return l.issued;
+    if (l.used_commands == 0) return 0;
+    std::vector<DrawArraysIndirectCommand> commands(l.used_commands);
+
+    glGetNamedBufferSubData(l.commands, 0, static_cast<GLsizeiptr>(commands.size() * sizeof(DrawArraysIndirectCommand)),
+                            commands.data());
+    check_gl("render_frame draw commands");
+    std::size_t n = 0;
+    for (const DrawArraysIndirectCommand& c : commands) n += c.count / sh::kDrawListPatchVertices;
+    return n;
 }
 
 void CullPipeline::Impl::read_stats(const SpanPlan& plan, const FrameTests& f, bool two_pass, bool aggressive,

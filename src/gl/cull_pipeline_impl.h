@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "patchcull/gl/gl_backpatch_passes.h"
+#include "patchcull/gl/gl_compaction.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "renderer_internal.h"
 
@@ -68,7 +69,8 @@ struct CullPipeline::Impl {
           occlusion(passes),
           displaced(passes),
           status(passes),
-          fused(passes) {
+          fused(passes),
+          compact(passes) {
         glCreateBuffers(1, &counters);
         GLint alignment = 16;
         glGetIntegerv(GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT, &alignment);
@@ -80,6 +82,10 @@ struct CullPipeline::Impl {
     ~Impl() {
         glDeleteBuffers(1, &counters);
         glDeleteTextures(1, &hiz.texture);
+        for (PassDrawList& l : draw_lists) {
+            const GLuint buffers[] = {l.list, l.commands, l.counts};
+            glDeleteBuffers(3, buffers);
+        }
         if (timer_queries[0]) glDeleteQueries(PassClock::kMaxMarks, timer_queries);
     }
     PatchRenderer renderer;  // first: makes the context current before the passes bind to it
@@ -91,6 +97,18 @@ struct CullPipeline::Impl {
     DisplacedPass displaced;
     CullStatusPass status;
     FusedCullPass fused;
+    CompactPass compact;
+    // DrawMode::indirect: one draw pass's list, commands and draw counts (pass 1, pass 2). A frame
+    // appends one CompactPass range per span drawn: commands [0, used_commands), counts
+    // [0, used_counts); a list entry per patch of the set (a span's entries at its patches).
+    struct PassDrawList {
+        GLuint list = 0, commands = 0, counts = 0;
+        std::size_t list_capacity = 0, command_capacity = 0, count_capacity = 0;  // entries
+        std::size_t used_commands = 0, used_counts = 0;
+        bool started = false;    // sized for this frame
+        std::size_t issued = 0;  // DrawMode::flags: the patches of the spans drawn
+    };
+    PassDrawList draw_lists[2];
     std::map<BackpatchMethod, std::unique_ptr<BackpatchPass>> backpatch_passes;  // made on first use
     HiZTexture hiz;                  // of the framebuffer's size; recreated when it changes
     GLuint counters = 0;             // kCounterCount uints per object (+ one slot for the rest)
@@ -127,6 +145,21 @@ struct CullPipeline::Impl {
     /// clock's intervals as the pass times.
     void read_stats(const SpanPlan& plan, const FrameTests& frame, bool two_pass, bool aggressive, PassClock& clock,
                     FrameStats& stats);
+
+    /// A draw pass's draw (pass 0 or 1) of the patches of spans that (flag & mask) == value
+    /// keeps, in the frame's DrawMode (gl_pipeline.h's PipelineParams::draw); plan sizes the
+    /// pass's buffers on its first draw of the frame.
+    void draw(int pass, std::uint32_t mask, std::uint32_t value, const std::vector<PatchSpan>& spans,
+              const PipelineParams& params, const SpanPlan& plan);
+    /// Starts a frame's draws (nothing drawn or compacted yet).
+    void begin_draws() {
+        for (PassDrawList& l : draw_lists) {
+            l.used_commands = l.used_counts = l.issued = 0;
+            l.started = false;
+        }
+    }
+    /// The patches each pass issued (FrameStats::pass*_submitted; reads the commands back).
+    std::size_t submitted(int pass, DrawMode mode) const;
 
     void ensure_hiz() {
         if (hiz.texture && hiz.width == renderer.width() && hiz.height == renderer.height()) return;

@@ -27,8 +27,12 @@ PatchRenderer::PatchRenderer(const GlContext& ctx) : impl_(std::make_unique<Impl
                                                                       {"patch.frag.glsl", GL_FRAGMENT_SHADER}};
     m.draw_program = link_program(patch_stages, "patch");
     m.mark_program = link_program(patch_stages, "patch (mark front)", "#define PATCHCULL_MARK_FRONT 1\n");
+    m.list_program = link_program(patch_stages, "patch (draw list)", "#define PATCHCULL_DRAW_LIST 1\n");
     m.draw_loc.locate(m.draw_program);
     m.mark_loc.locate(m.mark_program);
+    m.list_loc.locate(m.list_program);
+    m.indirect_count_arb = epoxy_has_gl_extension("GL_ARB_indirect_parameters");
+    m.indirect_count = m.indirect_count_arb || epoxy_gl_version() >= 46;
     m.occluder_program = link_program(
         {{"occluder.vert.glsl", GL_VERTEX_SHADER}, {"occluder.frag.glsl", GL_FRAGMENT_SHADER}}, "occluder");
     m.occluder_loc = {glGetUniformLocation(m.occluder_program, "u_object_to_clip"),
@@ -229,6 +233,27 @@ void PatchRenderer::draw_selected(std::uint32_t mask, std::uint32_t value, const
     m.draw_patches(m.frame_level, mask, value, false, &sorted);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     check_gl("draw_selected");
+}
+
+std::size_t PatchRenderer::patches_per_draw() const { return impl_->patches_per_draw(impl_->frame_level); }
+bool PatchRenderer::has_indirect_count() const { return impl_->indirect_count; }
+
+void PatchRenderer::draw_indirect(const IndirectDraw& draw) {
+    Impl& m = *impl_;
+    if (!draw.list || !draw.commands) throw Error("GL: draw_indirect: the list and the command buffer are required");
+    GLint64 bytes = 0;
+    glGetNamedBufferParameteri64v(draw.commands, GL_BUFFER_SIZE, &bytes);
+    if ((draw.first_command + draw.command_count) * 16 > static_cast<std::size_t>(std::max<GLint64>(bytes, 0)))
+        throw Error("GL: draw_indirect: commands [" + std::to_string(draw.first_command) + ", +" +
+                    std::to_string(draw.command_count) + ") leave the command buffer of " + std::to_string(bytes) +
+                    " bytes");
+    if (draw.draw_count_offset % 4 != 0)
+        throw Error("GL: draw_indirect: draw-count offset " + std::to_string(draw.draw_count_offset) +
+                    " is not a multiple of 4");
+    m.bind_target(m.fbo, m.width, m.height);
+    m.draw_list(draw);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    check_gl("draw_indirect");
 }
 
 namespace {

@@ -31,7 +31,10 @@ using namespace detail;
 
 struct PatchRenderer::Impl {
     GLuint vao = 0;
-    GLuint mark_program = 0;  // the patch program with PATCHCULL_MARK_FRONT (patch.frag.glsl)
+    GLuint mark_program = 0;          // the patch program with PATCHCULL_MARK_FRONT (patch.frag.glsl)
+    GLuint list_program = 0;          // the patch program with PATCHCULL_DRAW_LIST (patch.vert.glsl): draw_indirect
+    bool indirect_count = false;      // glMultiDrawArraysIndirectCount is there (GL 4.6 or the extension)
+    bool indirect_count_arb = false;  // ... as GL_ARB_indirect_parameters' function
     GLuint draw_program = 0, occluder_program = 0;
     GLuint control_points = 0, cull_flags = 0, max_displacement = 0, texcoords = 0, ranges = 0;
     GLuint occluder_vertices = 0, tangents = 0;
@@ -79,13 +82,13 @@ struct PatchRenderer::Impl {
                      glGetUniformLocation(p, "u_has_margins")};
         }
     };
-    DrawUniforms draw_loc{}, mark_loc{};
+    DrawUniforms draw_loc{}, mark_loc{}, list_loc{};
     struct {
         GLint object_to_clip, eye;
     } occluder_loc{};
 
     ~Impl() {
-        for (GLuint p : {draw_program, mark_program, occluder_program}) glDeleteProgram(p);
+        for (GLuint p : {draw_program, mark_program, list_program, occluder_program}) glDeleteProgram(p);
         const GLuint buffers[] = {control_points,    cull_flags, max_displacement, texcoords,   ranges,
                                   occluder_vertices, tangents,   drawn_marks,      front_marks, tess_scale};
         glDeleteBuffers(10, buffers);
@@ -230,7 +233,8 @@ struct PatchRenderer::Impl {
         // The front-facing test evaluates the undisplaced patch: displaced patches are drawn
         // two-sided (no back-patch test bounds them; backpatch.h); patch_displaced.h says which.
         const bool one_sided = params.discard_back_facing;
-        for (const auto& [dp, loc] : {std::pair{draw_program, &draw_loc}, std::pair{mark_program, &mark_loc}}) {
+        for (const auto& [dp, loc] : {std::pair{draw_program, &draw_loc}, std::pair{mark_program, &mark_loc},
+                                      std::pair{list_program, &list_loc}}) {
             glProgramUniform1f(dp, loc->tess_level, static_cast<float>(level));
             glProgramUniform1i(dp, loc->adaptive, params.adaptive_tess ? 1 : 0);
             glProgramUniform1f(dp, loc->tess_reference,
@@ -244,7 +248,7 @@ struct PatchRenderer::Impl {
             glProgramUniform1i(dp, loc->has_tangents, has_tangents ? 1 : 0);
             glProgramUniform1i(dp, loc->discard_back_facing, one_sided ? 1 : 0);
             glProgramUniform1i(dp, loc->has_margins, has_max_displacement ? 1 : 0);
-            glProgramUniform1i(dp, loc->mark_drawn, dp == draw_program && mark_drawn ? 1 : 0);
+            glProgramUniform1i(dp, loc->mark_drawn, dp != mark_program && mark_drawn ? 1 : 0);
         }
         if (mark_drawn && count > 0)
             glClearNamedBufferData(drawn_marks, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -315,14 +319,16 @@ struct PatchRenderer::Impl {
         glUseProgram(0);
     }
 
-    // Draws the patches whose flag word w has (w & mask) == value (into the bound framebuffer)
-    // with the draw program, or with the mark program (mark_front: marks into front_marks).
-    // spans: only those patches (PatchSpan, validated by the caller); null: every patch.
-    void draw_patches(int level, GLuint mask, GLuint value, bool mark_front = false,
-                      const std::vector<PatchSpan>* spans = nullptr) {
-        if (count == 0) return;
-        const GLuint dp = mark_front ? mark_program : draw_program;
-        const DrawUniforms& loc = mark_front ? mark_loc : draw_loc;
+    // llvmpipe workaround 2 (header): at most 65536 / (L+1)^2 patches per sub-draw, L the largest
+    // level of the set at `level` (depth scales included).
+    std::size_t patches_per_draw(int level) const {
+        const int top = std::min(64, static_cast<int>(static_cast<float>(level) * max_tess_scale));
+        return std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((top + 1) * (top + 1)));
+    }
+
+    // Binds program dp (its selection mask and value set) with the buffers, marks, texture and
+    // patch size of every patch draw.
+    void begin_patch_draw(GLuint dp, const DrawUniforms& loc, GLuint mask, GLuint value, bool mark_front) {
         glProgramUniform1ui(dp, loc.draw_mask, mask);
         glProgramUniform1ui(dp, loc.draw_value, value);
         glUseProgram(dp);
@@ -331,10 +337,17 @@ struct PatchRenderer::Impl {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchMarks, mark_front ? front_marks : drawn_marks);
         glBindTextureUnit(sh::kTextureUnitDisplacement, displacement_texture);
         glPatchParameteri(GL_PATCH_VERTICES, kPatchPoints);
-        // llvmpipe workaround 2 (header): at most 65536 / (L+1)^2 patches per sub-draw, L the
-        // largest level of the set (depth scales included).
-        const int top = std::min(64, static_cast<int>(static_cast<float>(level) * max_tess_scale));
-        const std::size_t per_draw = std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((top + 1) * (top + 1)));
+    }
+
+    // Draws the patches whose flag word w has (w & mask) == value (into the bound framebuffer)
+    // with the draw program, or with the mark program (mark_front: marks into front_marks).
+    // spans: only those patches (PatchSpan, validated by the caller); null: every patch.
+    void draw_patches(int level, GLuint mask, GLuint value, bool mark_front = false,
+                      const std::vector<PatchSpan>* spans = nullptr) {
+        if (count == 0) return;
+        begin_patch_draw(mark_front ? mark_program : draw_program, mark_front ? mark_loc : draw_loc, mask, value,
+                         mark_front);
+        const std::size_t per_draw = patches_per_draw(level);
         std::vector<GLint> firsts;
         std::vector<GLsizei> counts;
         const std::vector<PatchSpan> all{{0, count}};
@@ -347,6 +360,32 @@ struct PatchRenderer::Impl {
         }
         if (!firsts.empty())
             glMultiDrawArrays(GL_PATCHES, firsts.data(), counts.data(), static_cast<GLsizei>(firsts.size()));
+        glBindVertexArray(0);
+        glUseProgram(0);
+    }
+
+    // The compacted draw (PatchRenderer::draw_indirect, validated by the caller): the list
+    // program (every listed patch drawn: selection 0, 0) over d's commands.
+    void draw_list(const IndirectDraw& d) {
+        if (count == 0 || d.command_count == 0) return;
+        begin_patch_draw(list_program, list_loc, 0u, 0u, false);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingDrawList, d.list);
+        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, d.commands);
+        const auto* offset = reinterpret_cast<const void*>(static_cast<std::uintptr_t>(d.first_command * 16));
+        const auto max_draws = static_cast<GLsizei>(d.command_count);
+        if (d.draw_count && indirect_count) {
+            glBindBuffer(GL_PARAMETER_BUFFER_ARB, d.draw_count);
+            if (indirect_count_arb)
+                glMultiDrawArraysIndirectCountARB(GL_PATCHES, offset, static_cast<GLintptr>(d.draw_count_offset),
+                                                  max_draws, 0);
+            else
+                glMultiDrawArraysIndirectCount(GL_PATCHES, offset, static_cast<GLintptr>(d.draw_count_offset),
+                                               max_draws, 0);
+            glBindBuffer(GL_PARAMETER_BUFFER_ARB, 0);
+        } else {
+            glMultiDrawArraysIndirect(GL_PATCHES, offset, max_draws, 0);
+        }
+        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
         glBindVertexArray(0);
         glUseProgram(0);
     }

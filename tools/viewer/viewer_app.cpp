@@ -270,6 +270,7 @@ int run_viewer(ViewerConfig& config) {
         params.bound = settings.bound;
         params.cone = settings.cone;
         params.frustum = config.frustum;
+        params.draw = config.draw;
         if (settings.backpatch && !world.one_sided() && config.interactive && !warned_open_backpatch) {
             // As `render --cull backpatch` on an open surface: kept, with one warning.
             warned_open_backpatch = true;
@@ -342,9 +343,10 @@ int run_viewer(ViewerConfig& config) {
         if (print_frames) {
             std::printf(
                 "frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
-                "(displaced %zu); %.1f ms\n",
+                "(displaced %zu); submitted %zu + %zu (%s); %.1f ms\n",
                 f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled, stats.backpatch_culled,
-                stats.occlusion_culled, stats.displaced_occlusion_culled, stats.total_ms);
+                stats.occlusion_culled, stats.displaced_occlusion_culled, stats.pass1_submitted, stats.pass2_submitted,
+                gl::draw_mode_name(stats.draw), stats.total_ms);
             if (settings.cull_auto)
                 std::printf("%s\n", gl::auto_summary_line(world.names(), policy.decisions()).c_str());
             if (world.object_level().enabled())

@@ -35,6 +35,7 @@
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/displaced_bounds.h"
 #include "patchcull/core/patch.h"
+#include "patchcull/gl/gl_compaction.h"
 #include "patchcull/gl/gl_passes.h"
 #include "patchcull/gl/gl_renderer.h"
 
@@ -48,6 +49,16 @@ enum class TimingMethod {
     off,          ///< no timing (every *_ms is 0)
 };
 const char* timing_method_name(TimingMethod method);  ///< "automatic", "wall-clock", "timer-query", "off"
+
+/// How a frame's draw passes issue their patches.
+/// flags: every patch of the drawn spans is issued (vertex shader for its 16 points, TCS once),
+/// and the TCS gives the ones the pass does not keep tessellation levels 0 (patchcull_tcs.h).
+/// indirect: before each draw, CompactPass (gl_compaction.h) lists the patches the pass keeps
+/// (the same (mask, value) selection), and PatchRenderer::draw_indirect draws only those: a culled
+/// patch costs nothing in the draw. The same patches are tessellated either way, so the image,
+/// the flag words and the counters are the same.
+enum class DrawMode { flags, indirect };
+const char* draw_mode_name(DrawMode mode);  ///< "flags", "indirect"
 
 /// Parameters of one frame of the culling pipeline.
 struct FrameParams {
@@ -160,6 +171,19 @@ struct PipelineParams {
     /// are drawn after it), then the Hi-Z pyramid is built and the chain and pass 2 run on the
     /// objects it drew. Its time counts in FrameStats::pass1_ms (one pass: the chain's too).
     ObjectPass* object_pass = nullptr;
+    /// How the draw passes issue patches (DrawMode). indirect: each draw pass compacts its
+    /// selection over its spans, one CompactPass range per span (an object's active spans, the
+    /// gaps), into the pipeline's own list and command buffers (one set per draw pass: pass 1 =
+    /// tagged visible by the previous frame, pass 2 = newly visible; the one-pass frame has one),
+    /// with at most PatchRenderer::patches_per_draw() patches per command, then draws what it
+    /// compacted in one multi-draw: glMultiDrawArraysIndirectCount with the range's draw count
+    /// when the draw is one span and the context has it, else glMultiDrawArraysIndirect over all
+    /// the commands of its spans (those past a range's survivors are empty). An ObjectPass's draws
+    /// (CHC++'s included) compact and draw each object when it draws it. Nothing is read back
+    /// for the draws; only FrameStats's read-back (after the frame) sums the commands.
+    DrawMode draw = DrawMode::flags;
+    /// The compaction of DrawMode::indirect (both give the same set; gl_compaction.h).
+    CompactMethod compact = CompactMethod::prefix_scan;
 };
 
 /// What one frame did. Counts are patches; each patch has exactly one of: frustum_culled,
@@ -170,8 +194,9 @@ struct FrameStats {
     std::size_t object_culled = 0;     ///< in PipelineParams::object_culled, or of objects the ObjectPass left out
     std::size_t objects_left_out = 0;  ///< objects the ObjectPass did not draw (0 without one)
     bool two_pass = false;             ///< the mode includes occlusion (Niessner & Loop §3's pipeline)
-    // Every pass issues all patches to the TCS (Niessner & Loop §6.3's RT_0 cost per pass); "drawn" =
-    // tessellated (levels > 0), the others get levels 0 there.
+    // "drawn" = tessellated (levels > 0). With DrawMode::flags every pass issues all patches of
+    // its spans to the TCS (Niessner & Loop §6.3's RT_0 cost per pass), the others get levels 0
+    // there; with DrawMode::indirect only the drawn ones are issued (pass*_submitted).
     std::size_t pass1_drawn = 0;     ///< patches drawn (tessellated) in the first pass
     std::size_t pass2_drawn = 0;     ///< ... in the second pass (newly visible; 0 when aggressive)
     std::size_t frustum_culled = 0;  ///< by a frustum test (a displaced patch's bound included)
@@ -180,8 +205,14 @@ struct FrameStats {
     std::size_t displaced_occlusion_culled = 0;  ///< of occlusion_culled: displaced patches
     std::size_t visible = 0;                     ///< passed every test of the mode
     std::size_t newly_visible = 0;               ///< passed, and were not tagged visible before (not drawn in pass 1)
+    DrawMode draw = DrawMode::flags;             ///< PipelineParams::draw
+    /// Patches issued to the vertex shader and TCS by each draw pass: flags, every patch of the
+    /// spans drawn; indirect, the listed ones (read back from the commands after the frame).
+    /// One pass: pass1 only; aggressive: pass2_submitted 0.
+    std::size_t pass1_submitted = 0, pass2_submitted = 0;
     /// Per-pass times in milliseconds. Two-pass: pass1 (clear, occluders, patches tagged visible),
-    /// hiz (build), cull (the whole flag chain), pass2 (newly visible). One pass (no occlusion):
+    /// hiz (build), cull (the whole flag chain), pass2 (newly visible); a draw pass's time includes
+    /// its compaction (DrawMode::indirect). One pass (no occlusion):
     /// cull first, then pass1 draws the patches that passed; hiz = pass2 = 0.
     double pass1_ms = 0, hiz_ms = 0, cull_ms = 0, pass2_ms = 0, total_ms = 0;
     /// Of cull_ms: the back-patch pass alone (0 when the mode has no back-patch test, or when the

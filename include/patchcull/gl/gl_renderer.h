@@ -49,7 +49,8 @@
 // 2. llvmpipe emits garbage when one 4096-vertex chunk yields more than 65536 tessellated vertices:
 //    every draw is split with glMultiDrawArrays into sub-draws of at most
 //    max(1, 65536 / (L+1)^2) patches (809 at L = 8, 226 at L = 16, 15 at L = 64), L the uniform
-//    level or the adaptive maximum.
+//    level or the adaptive maximum (patches_per_draw(); the indirect draws of compacted lists are
+//    split by their commands: CompactPass's patches_per_command).
 //
 // Threads, lifetime and errors as gl_context.h: renderers are created, used and destroyed on their
 // context's thread while it lives (destroy them before it), are move-only, and throw
@@ -106,6 +107,17 @@ struct PatchAttributes {
     /// input of the displaced pass (gl_passes.h's DisplacedPass, Niessner & Loop §4.2's bounds), uploaded
     /// as vec2 per patch (range_buffer()). A patch with range (0, 0) is not displaced.
     std::vector<DisplacementRange> displacement_ranges;
+};
+
+/// A compacted draw (PatchRenderer::draw_indirect): GL buffer names of a list and the indirect
+/// commands CompactPass (gl_compaction.h) wrote.
+struct IndirectDraw {
+    std::uint32_t list = 0;             ///< the draw list (uint patch indices)
+    std::uint32_t commands = 0;         ///< DrawArraysIndirectCommands over the list
+    std::size_t first_command = 0;      ///< the first command drawn (an index, 16 bytes each)
+    std::size_t command_count = 0;      ///< commands drawn (the maxdrawcount with a draw count)
+    std::uint32_t draw_count = 0;       ///< optional (0: none): the draw count's buffer
+    std::size_t draw_count_offset = 0;  ///< bytes, a multiple of 4
 };
 
 /// Parameters of one frame.
@@ -257,6 +269,24 @@ public:
     /// draw_selected restricted to the patches of spans (disjoint, any order, within the set, else
     /// throws): the patches of objects culled whole are never issued, so they cost no TCS work.
     void draw_selected(std::uint32_t mask, std::uint32_t value, const std::vector<PatchSpan>& spans);
+    /// draw_selected's compacted form (gl_compaction.h): draws, over what is there, the patches of
+    /// a list CompactPass wrote, without issuing the others: the commands [first_command,
+    /// first_command + command_count) of draw.commands (DrawArraysIndirectCommand), each vertex
+    /// pulling its control point by its list entry (shaders/patchcull_draw_list.h), every listed
+    /// patch tessellated (no flag check) and recorded for read_drawn_patches as draw_selected's
+    /// are. With draw.draw_count and has_indirect_count(): glMultiDrawArraysIndirectCount(ARB)
+    /// (drawcount from that buffer at draw_count_offset, at most command_count); else
+    /// glMultiDrawArraysIndirect of all command_count commands. Throws patchcull::Error when the
+    /// list or command buffer is 0, the commands leave their buffer, or the draw-count offset is
+    /// not a multiple of 4. For the llvmpipe note above, write the list with at most
+    /// patches_per_draw() patches per command.
+    void draw_indirect(const IndirectDraw& draw);
+    /// At most this many patches in one sub-draw at begin_frame's tessellation (the llvmpipe
+    /// workaround 2 above): the split of draw_selected, and CompactPass's patches_per_command for
+    /// draw_indirect.
+    std::size_t patches_per_draw() const;
+    /// glMultiDrawArraysIndirectCount is there (GL 4.6 or GL_ARB_indirect_parameters).
+    bool has_indirect_count() const;
 
     /// Visualisation (Niessner & Loop, Fig. 2's statuses): renders every patch, ignoring the flags, with a
     /// colour from its flag word, and the occluders in grey, seen through `view` (its camera, size
