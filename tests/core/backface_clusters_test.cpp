@@ -97,6 +97,7 @@ std::vector<Vec3> test_eyes(std::mt19937& rng, const BackfaceCluster& c, Vec3 ce
     std::uniform_real_distribution<float> u(-1, 1);
     std::normal_distribution<double> nd;
     std::vector<Vec3> eyes;
+    eyes.reserve(6 * static_cast<std::size_t>(n));  // n in the box, up to 5 per ray
     for (int i = 0; i < n; ++i) eyes.push_back(centre + Vec3{radius * u(rng), radius * u(rng), radius * u(rng)});
     for (int i = 0; i < n; ++i) {
         double dir[3] = {nd(rng), nd(rng), nd(rng)};

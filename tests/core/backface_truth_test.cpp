@@ -50,7 +50,10 @@ TEST(BackfaceTruth, TangentPlaneIsNormalAndPositionForPolynomialPatches) {
     std::mt19937 rng(9);
     std::uniform_real_distribution<float> c(-1, 1);
     BezierPatch p;
-    for (int k = 0; k < 16; ++k) p.cp[k] = {float(k % 4) + 0.3f * c(rng), float(k / 4) + 0.3f * c(rng), c(rng), 1};
+    for (int k = 0; k < 16; ++k) {
+        const int col = k % 4, row = k / 4;
+        p.cp[k] = {float(col) + 0.3f * c(rng), float(row) + 0.3f * c(rng), c(rng), 1};
+    }
     const auto planes = planes_of(p, 5);
     for (int j = 0; j < 5; ++j)
         for (int i = 0; i < 5; ++i) {
@@ -71,7 +74,8 @@ TEST(BackfaceTruth, RationalWeightsScaleThePlaneNotItsSide) {
     for (int trial = 0; trial < 50; ++trial) {
         BezierPatch p, q;
         for (int k = 0; k < 16; ++k) {
-            p.cp[k] = homogeneous({float(k % 4) + 0.4f * c(rng), float(k / 4) + 0.4f * c(rng), 0.6f * c(rng)}, w(rng));
+            const int col = k % 4, row = k / 4;
+            p.cp[k] = homogeneous({float(col) + 0.4f * c(rng), float(row) + 0.4f * c(rng), 0.6f * c(rng)}, w(rng));
             q.cp[k] = p.cp[k] * 3.0f;
         }
         const auto a = planes_of(p, 9), b = planes_of(q, 9);

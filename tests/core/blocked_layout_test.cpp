@@ -242,6 +242,7 @@ TEST(BlockedLayout, PrefetchChangesNoDecision) {
     set_plain_prefetch_distance(0);
     set_blocked_prefetch_distance(0);
     const std::vector<NamedKernel> ks = kernels();
+    want.reserve(ks.size());
     for (const NamedKernel& k : ks) want.push_back(run(k.fn, batch.view()));
     for (std::size_t distance : {std::size_t{16}, std::size_t{128}, std::size_t{100000}}) {
         set_plain_prefetch_distance(distance);

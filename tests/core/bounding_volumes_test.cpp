@@ -153,6 +153,7 @@ std::vector<P3> sample(std::mt19937& rng, const Sphere& s, int n) {
 std::vector<P3> sample(std::mt19937& rng, const Bounds& b, int n) {
     std::uniform_real_distribution<double> unit(0, 1);
     std::vector<P3> pts;
+    pts.reserve(8 + static_cast<std::size_t>(n));
     for (int i = 0; i < 8; ++i)
         pts.push_back({(i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y, (i & 4) ? b.max.z : b.min.z});
     for (int i = 0; i < n; ++i) {
@@ -166,6 +167,7 @@ std::vector<P3> sample(std::mt19937& rng, const Bounds& b, int n) {
 std::vector<P3> sample(std::mt19937& rng, const Obb& o, int n) {
     std::uniform_real_distribution<double> u(-1, 1);
     std::vector<P3> pts;
+    pts.reserve(8 + static_cast<std::size_t>(n));
     auto at = [&](double t0, double t1, double t2) {
         const double t[3] = {t0, t1, t2};
         P3 p = p3(o.center);
@@ -237,8 +239,9 @@ void run_ground_truth(P3 offset, double scale, unsigned seed) {
             const P3 c = random_centre(rng, cam);
             const double s = random_size(rng, cam);
             std::uniform_real_distribution<double> u(-1, 1);
-            std::vector<Vec3> pts;
             const int n = 1 + i * 3;
+            std::vector<Vec3> pts;
+            pts.reserve(n);
             for (int k = 0; k < n; ++k) pts.push_back(to_f(c + P3{u(rng), (i % 4 == 0) ? 0.0 : u(rng), u(rng)} * s));
             const bool any_in = any_point_in_clip_volume(cam.world_to_clip, pts.data(), pts.size());
             const bool all_in =
@@ -525,6 +528,7 @@ TEST(BoundingVolumes, ObbOfStretchedCloudIsTighterThanAabb) {
     std::uniform_real_distribution<double> u(-1, 1);
     const P3 dir = P3{1, 1, 1} * (1 / std::sqrt(3.0));
     std::vector<Vec3> pts;
+    pts.reserve(500);
     for (int i = 0; i < 500; ++i) pts.push_back(to_f(dir * (10 * u(rng)) + P3{u(rng), u(rng), u(rng)} * 0.2));
     const Obb ob = obb_of_points(pts.data(), pts.size());
     const Obb ab = obb_of_aabb(aabb_of_points(pts.data(), pts.size()));

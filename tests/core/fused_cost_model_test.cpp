@@ -5,6 +5,7 @@
 // real kernel runs, that whatever it chooses decides exactly as the fixed plans do.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <string>
 #include <vector>
@@ -40,7 +41,7 @@ FusedProfile make_profile(double cf, double cb, double ch, double pf, double pb,
         double survive = 1;
         for (int st = 0; st < 3; ++st)
             if (s & (1u << st)) survive *= 1 - alone[st];
-        p.decided[s] = static_cast<std::uint64_t>((1 - survive) * static_cast<double>(groups) + 0.5);
+        p.decided[s] = static_cast<std::uint64_t>(std::llround((1 - survive) * static_cast<double>(groups)));
         p.patches_culled_by[s] = p.decided[s] * 16;
     }
     return p;
@@ -154,7 +155,10 @@ TEST(FusedCostModel, WhateverItChoosesTheDecisionsAreTheFixedPlans) {
     std::vector<BezierPatch> patches(300);
     for (BezierPatch& p : patches) {
         const Vec3 c{4 * u(rng), 4 * u(rng), -6 + 4 * u(rng)};
-        for (int k = 0; k < 16; ++k) p.cp[k] = homogeneous(c + Vec3{(k % 4) * 0.2f, (k / 4) * 0.2f, 0.1f * u(rng)});
+        for (int k = 0; k < 16; ++k) {
+            const int col = k % 4, row = k / 4;
+            p.cp[k] = homogeneous(c + Vec3{col * 0.2f, row * 0.2f, 0.1f * u(rng)});
+        }
     }
     const PatchBatch batch = make_batch(patches);
     std::vector<float> depth(64 * 48);

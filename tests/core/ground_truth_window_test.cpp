@@ -95,6 +95,7 @@ Outcomes compare_over_views(const std::vector<TruthCase>& cases, const Displacem
     PatchTruthWindow window(capacity, grid, d, true, true);
     ViewGenerator generator(bounds_of(cases), mode, seed);
     std::vector<Camera> cameras;
+    cameras.reserve(views);
     for (int v = 0; v < views; ++v) cameras.push_back(generator.next());
     Outcomes o;
     std::uint64_t expected_samplings = 0;

@@ -97,39 +97,39 @@ TEST(NonFinite, NoKernelCullsAPatchWithANonFiniteCoordinate) {
                                     cull_frustum_disp_simd(v, zero_margin.data(), m, depth, d);
                                 });
         for (const BezierPatch* base : {&outside, &behind_wall}) {
-            const std::string which = base == &outside ? " outside" : " occluded";
+            const std::string where = (base == &outside ? " outside" : " occluded") + tag;
             expect_only_base_culled(
-                ("occlusion scalar" + which + tag).c_str(), *base,
+                ("occlusion scalar" + where).c_str(), *base,
                 [&](const PatchBatchView& v, std::uint8_t* d) { cull_occlusion_scalar(v, m, depth, hiz, d); });
             expect_only_base_culled(
-                ("occlusion simd" + which + tag).c_str(), *base,
+                ("occlusion simd" + where).c_str(), *base,
                 [&](const PatchBatchView& v, std::uint8_t* d) { cull_occlusion_simd(v, m, depth, hiz, d); });
             const FusedCullSetup setup = make_fused_setup(m, depth, camera.eye, BackPatchCone::tcone, &hiz);
             FusedPlan plans[6];
             const int count = fused_plans_of(7u, plans);
             for (int i = 0; i < count; ++i) {
-                const std::string plan = " fused " + fused_plan_name(plans[i]);
-                expect_only_base_culled(("scalar" + plan + which + tag).c_str(), *base,
+                std::string plan = " fused " + fused_plan_name(plans[i]);
+                plan += where;
+                expect_only_base_culled(("scalar" + plan).c_str(), *base,
                                         [&](const PatchBatchView& v, std::uint8_t* d) {
                                             cull_fused_scalar(v, setup, plans[i], d, nullptr);
                                         });
-                expect_only_base_culled(
-                    ("simd" + plan + which + tag).c_str(), *base,
-                    [&](const PatchBatchView& v, std::uint8_t* d) { cull_fused_simd(v, setup, plans[i], d, nullptr); });
+                expect_only_base_culled(("simd" + plan).c_str(), *base, [&](const PatchBatchView& v, std::uint8_t* d) {
+                    cull_fused_simd(v, setup, plans[i], d, nullptr);
+                });
             }
             const DisplacedCullView dview = make_displaced_cull_view(camera.view(), proj, depth);
             for (DisplacedBoundKind kind : {DisplacedBoundKind::caf, DisplacedBoundKind::oobb}) {
-                const std::string k = kind == DisplacedBoundKind::caf ? " caf" : " oobb";
-                expect_only_base_culled(("displaced occlusion" + k + which + tag).c_str(), *base,
-                                        [&](const PatchBatchView& v, std::uint8_t* d) {
-                                            cull_displaced_occlusion(v, nullptr, kind, NormalConeKind::full, dview, hiz,
-                                                                     d);
-                                        });
+                const bool caf = kind == DisplacedBoundKind::caf;
+                const std::string occlusion = (caf ? "displaced occlusion caf" : "displaced occlusion oobb") + where;
+                const std::string frustum = (caf ? "displaced frustum caf" : "displaced frustum oobb") + tag;
+                expect_only_base_culled(occlusion.c_str(), *base, [&](const PatchBatchView& v, std::uint8_t* d) {
+                    cull_displaced_occlusion(v, nullptr, kind, NormalConeKind::full, dview, hiz, d);
+                });
                 if (base == &outside)
-                    expect_only_base_culled(
-                        ("displaced frustum" + k + tag).c_str(), *base, [&](const PatchBatchView& v, std::uint8_t* d) {
-                            cull_displaced_frustum(v, nullptr, kind, NormalConeKind::full, dview, d);
-                        });
+                    expect_only_base_culled(frustum.c_str(), *base, [&](const PatchBatchView& v, std::uint8_t* d) {
+                        cull_displaced_frustum(v, nullptr, kind, NormalConeKind::full, dview, d);
+                    });
             }
         }
     }

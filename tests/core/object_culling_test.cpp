@@ -118,7 +118,10 @@ TEST(ObjectCuller, CpuFrustumKernelSkipsCulledSpans) {
     // by the object level, so it tests 6 patches and reports 4 culled.
     std::vector<BezierPatch> patches(10);
     for (BezierPatch& p : patches)
-        for (int k = 0; k < kPatchPoints; ++k) p.cp[k] = {float(k % 4) * 0.1f, float(k / 4) * 0.1f, 0, 1};
+        for (int k = 0; k < kPatchPoints; ++k) {
+            const int col = k % 4, row = k / 4;
+            p.cp[k] = {float(col) * 0.1f, float(row) * 0.1f, 0, 1};
+        }
     const PatchBatch batch = make_batch(patches);
     ObjectCullResult result;
     result.culled_patches = {{2, 3}, {7, 1}};

@@ -394,6 +394,7 @@ TEST(OcclusionHorizon, StreetCanyonCullsBehindTallBuilding) {
                 box({-2, 0, -61}, {2, 3, -60.5f}),              // 4: just behind the building across
             };
             std::vector<Bounds> objects;
+            objects.reserve(objects0.size());
             for (Bounds& b : occluders) b = shifted(b, offset);
             for (const Bounds& b : objects0) objects.push_back(shifted(b, offset));
             OcclusionHorizon horizon;

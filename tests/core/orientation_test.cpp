@@ -267,6 +267,7 @@ TEST(OrientationShells, NestedSpheresAlternateByNestingParity) {
     const float radii[4] = {4, 3, 2, 1};
     for (int written = 0; written < 16; ++written) {  // every combination of written orientations
         std::vector<ControlMesh> parts;
+        parts.reserve(4);
         for (int s = 0; s < 4; ++s)
             parts.push_back(sphere({0.05f * float(s), 0, 0}, radii[s], (written >> s & 1) != 0));
         expect_oriented(parts, {+1, -1, +1, -1}, ("written " + std::to_string(written)).c_str());
@@ -328,7 +329,8 @@ TEST(OrientationShells, ManyHollowCubesEachWithItsCavity) {
     std::vector<ControlMesh> parts;
     std::vector<int> signs;
     for (int i = 0; i < 12 * 12 * 12; ++i) {
-        const Vec3 corner{float(i % 12) * 3, float(i / 12 % 12) * 3, float(i / 144) * 3};
+        const int x = i % 12, y = i / 12 % 12, z = i / 144;
+        const Vec3 corner{float(x) * 3, float(y) * 3, float(z) * 3};
         ControlMesh outer = box(2, 2, 2, corner), inner = box(1, 1, 1, corner + Vec3{0.5f, 0.5f, 0.5f});
         if (i % 3 == 1) outer.reverse_faces();
         if (i % 2 == 1) inner.reverse_faces();

@@ -310,7 +310,7 @@ TEST(PatchSource, BezierPointsAnyLayoutDecideAsTheBatch) {
             const PatchBatch batch = make_batch(patches);
             for (std::size_t p : {std::size_t{0}, std::size_t{500}, patches.size() - 1}) {
                 const BezierPatch q = source_bezier_patch(src.view, p);
-                for (int k = 0; k < 16; ++k) EXPECT_EQ(std::memcmp(&q.cp[k], &patches[p].cp[k], sizeof(Vec4)), 0);
+                for (int k = 0; k < 16; ++k) EXPECT_TRUE(test_patches::bit_identical(q.cp[k], patches[p].cp[k]));
             }
             std::map<std::string, std::size_t> culled;
             expect_same_decisions(src.view, batch.view(), s, culled);
@@ -323,6 +323,7 @@ TEST(PatchSource, GatherWritesOneBlockWithZeroPadding) {
     const Scene s = make_scene(3, ClipDepth::zero_to_one);
     std::mt19937 rng(5);
     std::vector<std::array<Vec4, 16>> grids;
+    grids.reserve(21);
     for (int i = 0; i < 21; ++i) grids.push_back(random_grid(rng, s, false));
     const Source src = make_source(grids, {3, 20, 4, true}, PatchBasis::bezier);
     std::vector<float> block(kBlockFloats, 7.0f);
@@ -347,7 +348,8 @@ TEST(PatchSource, NonFinitePointsAreNeverCulled) {
     const Scene s = make_scene(21, ClipDepth::zero_to_one);
     BezierPatch base;
     for (int k = 0; k < 16; ++k) {
-        const Vec4 w4 = s.to_world * Vec4{-50.0f + static_cast<float>(k % 4), static_cast<float>(k / 4), -5, 1};
+        const int col = k % 4, row = k / 4;
+        const Vec4 w4 = s.to_world * Vec4{-50.0f + static_cast<float>(col), static_cast<float>(row), -5, 1};
         base.cp[k] = {w4.x, w4.y, w4.z, 1};
     }
     std::vector<BezierPatch> patches = test_patches::poisoned_copies(base);
@@ -493,7 +495,10 @@ TEST(PatchSource, BsplineInteriorOfAFlatGridIsItsMiddleAndBoundaryInterpolates) 
     // Uniform grid points x = col, y = row: the interior span covers [1, 2] x [1, 2]; with a
     // boundary at u = 0 the span's edge is the points' column 1 itself.
     std::array<Vec4, 16> g;
-    for (int k = 0; k < 16; ++k) g[k] = {float(k % 4), float(k / 4), 0, 1};
+    for (int k = 0; k < 16; ++k) {
+        const int col = k % 4, row = k / 4;
+        g[k] = {float(col), float(row), 0, 1};
+    }
     Source src = make_source(std::vector<std::array<Vec4, 16>>{g, g}, {3, 12, 0, false}, PatchBasis::bspline);
     std::vector<std::uint8_t> masks = {0, 8};
     src.view.boundary_mask = masks.data();
@@ -635,7 +640,7 @@ TEST(PatchSource, GregoryNeverCullsAVisibleSampleAndCullsWhatIsOutside) {
             cull_fused(src.view, make_fused_setup(s.view, BackPatchCone::ncone, &s.hiz), FusedPlan{}, fused.data());
             std::size_t n_frustum = 0, n_occluded = 0, n_box = 0;
             for (std::size_t p = 0; p < patches.size(); ++p) {
-                EXPECT_EQ(back[p], 0) << "back-patch methods never cull a Gregory patch";
+                EXPECT_EQ(back[p], 0) << "ptp never culls a Gregory patch";
                 EXPECT_EQ(frustum[p] == 1, occlusion[p] == kHiZFrustumCulled) << "patch " << p;
                 // The fused plan frustum, back-patch, Hi-Z: cull_occlusion's decisions.
                 EXPECT_EQ(fused[p], occlusion[p]) << "patch " << p;
@@ -717,30 +722,116 @@ TEST(PatchSource, GregoryOfABezierPatchDecidesAsTheBezierBatch) {
             cull_frustum_disp_parallel(src.view, d, s.view, got.data());
             EXPECT_EQ(want, got);
         }
-        // The fused kernel: the plan without its back-patch stage (which never culls a Gregory
-        // patch) on the batch; a plan of back-patch alone keeps every patch.
+        // The Gregory cone of such a patch has the tangent cone's vectors (the face-point
+        // differences are 0 and skipped, the others repeat the Bezier net's), so its cone test is
+        // tcone's on the batch, for the cone methods (ptp never culls a Gregory patch).
+        const std::size_t polynomial = static_cast<std::size_t>(
+            std::count_if(bez.begin(), bez.end(), [](const BezierPatch& b) { return b.cp[0].w == 1.0f; }));
+        cull_backpatch(BackpatchMethod::tcone, batch.view(), s.view, {}, want.data());
+        EXPECT_GT(std::count(want.begin(), want.end(), 1), 0);
+        for (BackpatchMethod id : {BackpatchMethod::tcone, BackpatchMethod::ncone}) {
+            cull_backpatch(id, src.view, s.view, {}, got.data());
+            EXPECT_EQ(want, got) << backpatch_method_name(id);
+            cull_backpatch_parallel(id, src.view, s.view, {}, got.data());
+            EXPECT_EQ(want, got) << backpatch_method_name(id) << " parallel";
+        }
+        EXPECT_LT(polynomial, bez.size()) << "some rational patches, which no cone culls";
+        cull_backpatch(BackpatchMethod::ptp, src.view, s.view, {}, got.data());
+        EXPECT_EQ(std::count(got.begin(), got.end(), 0), static_cast<std::ptrdiff_t>(got.size()));
+        // The fused kernel with the tcone stage: the batch's decisions, in every plan.
         const FusedCullSetup setup = make_fused_setup(s.view, BackPatchCone::tcone, &s.hiz);
         FusedPlan plans[6];
         const int count = fused_plans_of(7, plans);
         for (int k = 0; k < count; ++k) {
-            FusedPlan without;
-            without.count = 0;
-            for (int pos = 0; pos < plans[k].count; ++pos)
-                if (plans[k].stages[pos] != FusedStage::backpatch)
-                    without.stages[without.count++] = plans[k].stages[pos];
-            cull_fused_simd(batch.view(), setup, without, want.data());
+            cull_fused_simd(batch.view(), setup, plans[k], want.data());
             cull_fused(src.view, setup, plans[k], got.data());
             EXPECT_EQ(want, got) << fused_plan_name(plans[k]);
             EXPECT_GT(std::count(want.begin(), want.end(), kFusedOccluded), 0);
+            EXPECT_GT(std::count(want.begin(), want.end(), kFusedBackPatchCulled), 0);
             cull_fused_parallel(src.view, setup, plans[k], got.data());
             EXPECT_EQ(want, got) << fused_plan_name(plans[k]) << " parallel";
         }
+    }
+}
+
+// The Gregory cone (tcone and ncone over a Gregory source) against the surface: no culled patch
+// has a sample, on a 25 x 25 grid, whose normal faces the eye. The patches include face points
+// pulled far apart along the normal and along the tangents, where the interior blend's own
+// derivative (the cone's last four vectors per direction) turns the normal.
+TEST(PatchSource, GregoryConeNeverCullsAFacingSample) {
+    std::size_t culled_total = 0, tested_total = 0;
+    for (ClipDepth depth : {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed}) {
+        const Scene s = make_scene(131 + static_cast<std::uint32_t>(depth), depth);
+        ASSERT_TRUE(s.view.has_eye);
+        std::mt19937 rng(141);
+        std::uniform_real_distribution<float> u(-1, 1);
+        std::vector<std::array<Vec4, 20>> patches;
+        for (int i = 0; i < 1500; ++i) {
+            BezierPatch b;
+            const std::array<Vec4, 16> g = random_grid(rng, s, false);
+            std::copy(g.begin(), g.end(), b.cp);
+            const Vec3 c0 = cartesian(b.cp[0]), c3 = cartesian(b.cp[3]), c12 = cartesian(b.cp[12]);
+            const float size = length(c3 - c0);
+            std::array<Vec4, 20> q = gregory_of(b, &rng, (i % 4) * 0.1f * size);
+            if (i % 3 == 0) {
+                // F+ and F- of each corner pulled apart along the patch normal and a tangent.
+                const Vec3 n = normalize(cross(c3 - c0, c12 - c0)), t = normalize(c3 - c0);
+                for (int c = 0; c < 4; ++c) {
+                    const float a = 0.4f * size * u(rng), k = 0.4f * size * u(rng);
+                    Vec4& fp = q[5 * c + 3];
+                    Vec4& fm = q[5 * c + 4];
+                    fp = {fp.x + a * n.x + k * t.x, fp.y + a * n.y + k * t.y, fp.z + a * n.z + k * t.z, 1};
+                    fm = {fm.x - a * n.x - k * t.x, fm.y - a * n.y - k * t.y, fm.z - a * n.z - k * t.z, 1};
+                }
+            }
+            patches.push_back(q);
+        }
+        const Source src = make_source(patches, {3, 16, 4, true}, PatchBasis::gregory);
+        std::vector<std::uint8_t> tcone(patches.size()), ncone(patches.size()), fused(patches.size());
+        cull_backpatch(BackpatchMethod::tcone, src.view, s.view, {}, tcone.data());
+        cull_backpatch(BackpatchMethod::ncone, src.view, s.view, {}, ncone.data());
+        EXPECT_EQ(tcone, ncone) << "one Gregory cone for both cone methods";
         FusedPlan back_only;
         back_only.stages[0] = FusedStage::backpatch;
         back_only.count = 1;
-        cull_fused(src.view, setup, back_only, got.data());
-        EXPECT_EQ(std::count(got.begin(), got.end(), kFusedVisible), static_cast<std::ptrdiff_t>(got.size()));
+        cull_fused(src.view, make_fused_setup(s.view, BackPatchCone::ncone, nullptr), back_only, fused.data());
+        const Vec3 e = s.view.eye;
+        std::size_t culled = 0;
+        for (std::size_t p = 0; p < patches.size(); ++p) {
+            EXPECT_EQ(fused[p], tcone[p] ? kFusedBackPatchCulled : kFusedVisible) << "patch " << p;
+            if (!tcone[p]) continue;
+            ++culled;
+            constexpr double h = 1e-5;
+            for (int a = 0; a <= 24; ++a)
+                for (int b = 0; b <= 24; ++b) {
+                    const double u0 = a / 24.0, v0 = b / 24.0;
+                    const double ul = std::max(0.0, u0 - h), uh = std::min(1.0, u0 + h);
+                    const double vl = std::max(0.0, v0 - h), vh = std::min(1.0, v0 + h);
+                    const auto pu1 = eval_gregory(patches[p], uh, v0), pu0 = eval_gregory(patches[p], ul, v0);
+                    const auto pv1 = eval_gregory(patches[p], u0, vh), pv0 = eval_gregory(patches[p], u0, vl);
+                    const auto pt = eval_gregory(patches[p], u0, v0);
+                    double su[3], sv[3], to_eye[3];
+                    for (int c = 0; c < 3; ++c) {
+                        su[c] = (pu1[c] - pu0[c]) / (uh - ul);
+                        sv[c] = (pv1[c] - pv0[c]) / (vh - vl);
+                    }
+                    to_eye[0] = e.x - pt[0];
+                    to_eye[1] = e.y - pt[1];
+                    to_eye[2] = e.z - pt[2];
+                    const double n[3] = {su[1] * sv[2] - su[2] * sv[1], su[2] * sv[0] - su[0] * sv[2],
+                                         su[0] * sv[1] - su[1] * sv[0]};
+                    const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+                    const double ne = std::sqrt(to_eye[0] * to_eye[0] + to_eye[1] * to_eye[1] + to_eye[2] * to_eye[2]);
+                    const double facing = n[0] * to_eye[0] + n[1] * to_eye[1] + n[2] * to_eye[2];
+                    ASSERT_LE(facing, 1e-6 * nn * ne) << clip_depth_name(depth) << ": patch " << p
+                                                      << " culled, its sample (" << a << ", " << b << ") faces the eye";
+                }
+        }
+        EXPECT_GT(culled, patches.size() / 50) << clip_depth_name(depth);
+        culled_total += culled;
+        tested_total += patches.size();
     }
+    EXPECT_LT(culled_total, tested_total);
 }
 
 TEST(PatchSource, GregoryOutsideOrHiddenIsCulledAndNonFiniteIsNot) {
@@ -748,7 +839,8 @@ TEST(PatchSource, GregoryOutsideOrHiddenIsCulledAndNonFiniteIsNot) {
     const auto placed = [&](float x, float y, float z) {
         BezierPatch b;
         for (int k = 0; k < 16; ++k) {
-            const Vec4 w4 = s.to_world * Vec4{x + 0.1f * float(k % 4), y + 0.1f * float(k / 4), z, 1};
+            const int col = k % 4, row = k / 4;
+            const Vec4 w4 = s.to_world * Vec4{x + 0.1f * float(col), y + 0.1f * float(row), z, 1};
             b.cp[k] = {w4.x, w4.y, w4.z, 1};
         }
         return b;
@@ -901,6 +993,7 @@ TEST(PatchSource, BadViewsAreRefusedWithAMessage) {
     const Scene s = make_scene(101, ClipDepth::zero_to_one);
     std::mt19937 rng(1);
     std::vector<std::array<Vec4, 16>> grids;
+    grids.reserve(3);
     for (int i = 0; i < 3; ++i) grids.push_back(random_grid(rng, s, false));
     Source src = make_source(grids, {3, 16, 4, true}, PatchBasis::bezier);
     PatchSourceView v = src.view;

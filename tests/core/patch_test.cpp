@@ -88,6 +88,7 @@ TEST(Patch, SplitTangentPatchesFollowTheParent) {
 TEST(Patch, BatchRoundTripsAndPadsWithZeros) {
     std::mt19937 rng(5);
     std::vector<BezierPatch> patches;
+    patches.reserve(21);
     for (int i = 0; i < 21; ++i) patches.push_back(random_patch(rng, true));
     const PatchBatch batch = make_batch(patches);
     EXPECT_EQ(batch.size(), 21u);

@@ -374,6 +374,7 @@ TEST(PtpTable, MutatedTablesFailTheTangentPlaneCheck) {
     std::mt19937 rng(12);
     const std::vector<TableTerm> table = compiled_table();
     std::vector<BezierPatch> patches;
+    patches.reserve(6);
     for (int n = 0; n < 6; ++n) patches.push_back(sheet(rng, {0, 0, 0}, 2.0f, 0.5f, 0.5f, 2.0f));
     for (int m = 0; m < 516; m += 7) {
         for (int kind = 0; kind < 3; ++kind) {
@@ -603,6 +604,7 @@ TEST(PtpKernel, CullsOnlyBackFacingPatchesRandomViews) {
     ConservativeStats stats;
     for (int v = 0; v < 12; ++v) {
         std::vector<BezierPatch> patches;
+        patches.reserve(300);
         for (int n = 0; n < 300; ++n) patches.push_back(random_patch(rng, 4.0f));
         const Vec3 eye{12 * u(rng), 12 * u(rng), 12 * u(rng)};
         const Mat4 model = v < 4 ? Mat4{} : model_matrix(rng, v % 2 == 1);  // half of these mirror

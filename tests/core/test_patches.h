@@ -1,7 +1,10 @@
 // Patches the core and GL tests share: the teapot split into smaller patches, the bounds of
-// control points, a flat patch, and a patch's copies with one coordinate made non-finite.
+// control points, a flat patch, a patch's copies with one coordinate made non-finite, and
+// bit-for-bit comparison of points and patches.
 #pragma once
 
+#include <bit>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -54,6 +57,23 @@ inline std::vector<BezierPatch> poisoned_copies(const BezierPatch& base) {
                 out.push_back(p);
             }
     return out;
+}
+
+/// Whether a and b are the same bit for bit, coordinate by coordinate (0 and -0 differ, a NaN
+/// equals the same NaN): what a memcmp of the structs checked, said per float.
+inline bool bit_identical(float a, float b) {
+    return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
+}
+inline bool bit_identical(const Vec3& a, const Vec3& b) {
+    return bit_identical(a.x, b.x) && bit_identical(a.y, b.y) && bit_identical(a.z, b.z);
+}
+inline bool bit_identical(const Vec4& a, const Vec4& b) {
+    return bit_identical(a.x, b.x) && bit_identical(a.y, b.y) && bit_identical(a.z, b.z) && bit_identical(a.w, b.w);
+}
+inline bool bit_identical(const BezierPatch& a, const BezierPatch& b) {
+    for (int k = 0; k < kPatchPoints; ++k)
+        if (!bit_identical(a.cp[k], b.cp[k])) return false;
+    return true;
 }
 
 }  // namespace patchcull::test_patches

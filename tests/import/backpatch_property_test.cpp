@@ -128,6 +128,7 @@ TEST(BackpatchProperty, BigGuyAccWholeObjectFreeAndCloseViews) {
     expect_no_facing_triangles(m.rest, close_eyes(m.rest, 60, 3));
     ViewGenerator views(patch_bounds(m.rest), ViewMode::contain, 4);
     std::vector<Camera> cams;
+    cams.reserve(20);
     for (int i = 0; i < 20; ++i) cams.push_back(views.next());
     expect_no_facing_triangles(m.rest, cams);
 }

@@ -68,7 +68,8 @@ PatchFrame teapot_lattice(int copies) {
     PatchFrame frame;
     const int side = static_cast<int>(std::ceil(std::cbrt(double(copies))));
     for (int c = 0; c < copies; ++c) {
-        const Vec4 offset{4.0f * float(c % side), 4.0f * float((c / side) % side), 4.0f * float(c / (side * side)), 0};
+        const int x = c % side, y = (c / side) % side, z = c / (side * side);  // lattice cell
+        const Vec4 offset{4.0f * float(x), 4.0f * float(y), 4.0f * float(z), 0};
         for (BezierPatch p : teapot) {
             for (Vec4& q : p.cp) q = q + offset;
             frame.patches.push_back(p);

@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <set>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "patchcull/core/error.h"
@@ -244,13 +246,19 @@ TEST(ObjTags, NoBoundaryInterpolationLeavesTheSameFacesOutWithBothSchemes) {
     // Face 5 split into two triangles (faces 5 and 6; the faces after it move up by one).
     std::istringstream lines(grid_obj(4));
     std::string split;
+    const auto add_face = [&split](std::initializer_list<std::string_view> corners) {
+        split += 'f';
+        for (std::string_view c : corners) (split += ' ') += c;
+        split += '\n';
+    };
     int face = 0;
     for (std::string line; std::getline(lines, line);) {
         if (line.starts_with("f ") && face++ == 5) {
             std::istringstream corners(line.substr(2));
             std::string a, b, c, d;
             corners >> a >> b >> c >> d;
-            split += "f " + a + " " + b + " " + c + "\nf " + a + " " + c + " " + d + "\n";
+            add_face({a, b, c});
+            add_face({a, c, d});
         } else {
             split += line + "\n";
         }

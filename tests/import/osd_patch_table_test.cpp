@@ -199,7 +199,9 @@ D3 source_surface(const PatchSourceView& src, std::size_t p, double s, double t)
     if (src.basis == PatchBasis::gregory) {
         D3 g[20];
         for (int k = 0; k < 20; ++k) g[k] = source_point(src, src.indices[20 * p + static_cast<std::size_t>(k)]);
-        const auto put = [&](int i, int j, D3 q) { bez[static_cast<std::size_t>(4 * j + i)] = {q.x, q.y, q.z, 1}; };
+        const auto put = [&](int i, int j, D3 q) {
+            bez[4 * static_cast<std::size_t>(j) + static_cast<std::size_t>(i)] = {q.x, q.y, q.z, 1};
+        };
         // Boundary: corner c's P at (0,0), (3,0), (3,3), (0,3); E+ along the edge leaving c
         // counter-clockwise, E- along the edge arriving.
         const int at[12][3] = {{0, 0, 0},  {1, 0, 1},  {0, 1, 2},  {3, 0, 5},  {3, 1, 6},  {2, 0, 7},
@@ -217,9 +219,9 @@ D3 source_surface(const PatchSourceView& src, std::size_t p, double s, double t)
         for (int k = 0; k < 16; ++k) bez[static_cast<std::size_t>(k)] = {b.cp[k].x, b.cp[k].y, b.cp[k].z, b.cp[k].w};
     }
     double h[4] = {0, 0, 0, 0};
-    for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i)
-            for (int k = 0; k < 4; ++k) h[k] += bs[i] * bt[j] * bez[static_cast<std::size_t>(4 * j + i)][k];
+    for (std::size_t j = 0; j < 4; ++j)
+        for (std::size_t i = 0; i < 4; ++i)
+            for (int k = 0; k < 4; ++k) h[k] += bs[i] * bt[j] * bez[4 * j + i][k];
     return {h[0] / h[3], h[1] / h[3], h[2] / h[3]};
 }
 
@@ -313,7 +315,8 @@ Truth far_truth(const Case& c) {
 
 struct Counts {
     std::size_t frustum = 0, occluded = 0, gregory_frustum = 0, gregory_occluded = 0, box = 0, gregory_box = 0;
-    std::size_t fused_back = 0;  // patches whose fused decision is the back-patch stage
+    std::size_t fused_back = 0;    // patches whose fused decision is the back-patch stage
+    std::size_t gregory_back = 0;  // Gregory patches culled by a back-patch cone (tcone, ncone)
     std::vector<std::size_t> backpatch = std::vector<std::size_t>(backpatch_method_ids().size(), 0);
     int failures = 0;
 };
@@ -473,7 +476,12 @@ void check_view(const Case& c, const Truth& truth, std::mt19937& rng, ClipDepth 
         for (std::size_t p = 0; p < n; ++p) {
             if (!back[p]) continue;
             ++counts.backpatch[static_cast<std::size_t>(id)];
-            EXPECT_FALSE(is_gregory(p)) << "Gregory patches are never back-patch culled";
+            // Gregory patches: only the cone methods cull them (the Gregory tangent cone).
+            if (is_gregory(p)) {
+                EXPECT_TRUE(backpatch_method_info(id).fusable)
+                    << backpatch_method_name(id) << " culled a Gregory patch";
+                ++counts.gregory_back;
+            }
             const Sample* ps = samples + p * kGrid * kGrid;
             for (int k = 0; k < kGrid * kGrid; ++k) {
                 const D3 to_eye = e - ps[k].p;
@@ -517,6 +525,7 @@ void expect_teeth(const Counts& counts) {
     EXPECT_GT(counts.gregory_occluded, 0u);
     EXPECT_GT(counts.box, 0u);
     EXPECT_GT(counts.gregory_box, 0u);
+    EXPECT_GT(counts.gregory_back, 0u);
     EXPECT_GT(counts.fused_back, 0u);
     for (BackpatchMethod id : backpatch_method_ids())
         EXPECT_GT(counts.backpatch[static_cast<std::size_t>(id)], 0u) << backpatch_method_name(id);

@@ -233,7 +233,7 @@ struct Reference {
         ptex_faces = Far::PtexIndices(*refiner).GetNumFaces();
 
         const int total = refiner->GetNumVerticesTotal();
-        verts.resize(static_cast<std::size_t>(total + table->GetNumLocalPoints()));
+        verts.resize(static_cast<std::size_t>(total) + static_cast<std::size_t>(table->GetNumLocalPoints()));
         for (std::size_t v = 0; v < m.positions.size(); ++v)
             verts[v] = {m.positions[v].x, m.positions[v].y, m.positions[v].z};
         Far::PrimvarRefinerReal<double> primvar(*refiner);

@@ -5,9 +5,9 @@
 // follow pose()'s: one mesh per (model, effective time); rigid instances share the rest mesh.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <vector>
 
+#include "core/test_patches.h"
 #include "patchcull/core/error.h"
 #include "patchcull/import/builtin_scenes.h"
 #include "patchcull/import/model_loader.h"
@@ -45,7 +45,7 @@ void expect_tables_reproduce_pose(const Scene& scene, float t) {
                 const int source = mirrored ? 4 * (k % 4) + k / 4 : k;
                 mine.cp[k] = meshes.to_world[i] * homogeneous(rows[16 * p + static_cast<std::size_t>(source)]);
             }
-            mismatches += std::memcmp(&mine, &posed[next], sizeof(BezierPatch)) != 0 ? 1 : 0;
+            mismatches += test_patches::bit_identical(mine, posed[next]) ? 0 : 1;
             const std::int32_t tb = table.tangent_index[p];
             ASSERT_EQ(tb >= 0, reference.tangent_index()[next] >= 0);
             if (tb < 0) continue;
@@ -62,8 +62,8 @@ void expect_tables_reproduce_pose(const Scene& scene, float t) {
                     du = linear(meshes.to_world[i], src[k]);
                     dv = linear(meshes.to_world[i], src[12 + k]);
                 }
-                mismatches += std::memcmp(&du, &expected.du[k], sizeof(Vec3)) != 0 ? 1 : 0;
-                mismatches += std::memcmp(&dv, &expected.dv[k], sizeof(Vec3)) != 0 ? 1 : 0;
+                mismatches += test_patches::bit_identical(du, expected.du[k]) ? 0 : 1;
+                mismatches += test_patches::bit_identical(dv, expected.dv[k]) ? 0 : 1;
             }
         }
     }

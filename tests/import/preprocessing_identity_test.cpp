@@ -129,10 +129,11 @@ ControlMesh cube_grid(int n) {
     ControlMesh m;
     m.name = "cube_grid";
     std::vector<std::int64_t> key_to_vertex;
-    const int s = n + 1;
-    key_to_vertex.assign(static_cast<std::size_t>(s * s * s), -1);
+    const std::size_t s = static_cast<std::size_t>(n) + 1;  // points along an edge
+    key_to_vertex.assign(s * s * s, -1);
     const auto vertex = [&](int x, int y, int z) {
-        std::int64_t& v = key_to_vertex[static_cast<std::size_t>((x * s + y) * s + z)];
+        const auto u = [](int i) { return static_cast<std::size_t>(i); };
+        std::int64_t& v = key_to_vertex[(u(x) * s + u(y)) * s + u(z)];
         if (v < 0) {
             v = static_cast<std::int64_t>(m.positions.size());
             // Slightly uneven spacing so that no weight meets a lucky cancellation.

@@ -42,7 +42,7 @@ std::string motion_error(const Scene& scene, int frames, double limit = kMaxSing
     try {
         check_scene_motion(scene, "a.json", frames, kSecondsPerFrame, limit);
     } catch (const Error& e) {
-        const std::string what = e.what();
+        std::string what = e.what();  // not const: returned by move
         EXPECT_EQ(what.find('\n'), std::string::npos) << what;
         return what;
     }

@@ -32,6 +32,7 @@ TEST(SceneOcclusion, BoxOccludersAreTheClosedBoxes) {
     add_environment_box(scene, "box", {0, 0, 0}, {1, 2, 3});
     // A box without its top: its two top triangles left out.
     std::vector<Vec3> v;
+    v.reserve(8);
     for (int c = 0; c < 8; ++c) v.push_back({(c & 4) ? 1.0f : 0.0f, (c & 2) ? 1.0f : 0.0f, (c & 1) ? 1.0f : 0.0f});
     add_environment_object(scene, "open", v,
                            {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3},
