@@ -8,7 +8,9 @@
 // patches (any w != 1) are never culled. A link of the flag chain (flag_chain.h): patches culled
 // earlier are skipped, and so are displaced ones (margin > 0: a displaced surface is not bounded by
 // the base patch's normals, Loop, Niessner & Eisenacher §8); a culled patch gets kCullBackPatch.
-// With PC_PATCH_SOURCE the 16 points come from the caller's patch source (patch_source.h).
+// With PC_PATCH_SOURCE the 16 points come from the caller's patch source (patch_source.h); with
+// PC_PATCH_SOURCE_GREGORY a Gregory patch's 20 points give its Gregory tangent cone
+// (tangent_cone_gregory of cones_internal.h) whichever cone method runs.
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
@@ -39,6 +41,13 @@ void main() {
     const uint p = cones.first_patch + gl_GlobalInvocationID.x;
     if (gl_GlobalInvocationID.x >= cones.patch_count || pc_chain_culled(p)) return;
     if (pc_margin(p, cones.has_margins) > 0.0) return;
+#ifdef PC_PATCH_SOURCE_GREGORY
+    // A Gregory patch: its own tangent cone (either cone method) and the sphere of its 20 points.
+    if (!pc_gather_source(p)) return;
+    const PcCone cone = pc_tangent_cone_gregory(pc_source_points);
+    const PcSphere sphere = pc_sphere_of_gregory_points(pc_source_points);
+    const bool polynomial = pc_is_polynomial_gregory(pc_source_points);
+#else
     vec4 P[16];
 #ifdef PC_PATCH_SOURCE
     if (!pc_gather_source(p)) return;
@@ -48,7 +57,9 @@ void main() {
 #endif
     const PcCone cone = PC_PASS_CONE(P);
     const PcSphere sphere = pc_sphere_of_points(P);
-    if (pc_is_polynomial(P) && pc_back_facing(cone, sphere, cones.eye.xyz)) pc_chain_cull(p, kCullBackPatch);
+    const bool polynomial = pc_is_polynomial(P);
+#endif
+    if (polynomial && pc_back_facing(cone, sphere, cones.eye.xyz)) pc_chain_cull(p, kCullBackPatch);
     if (cones.write_cones != 0u) {
         const uint o = kConeValues * p;
         cone_values[o] = cone.axis.x;

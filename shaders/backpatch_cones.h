@@ -27,6 +27,7 @@
 #define kNormalRoundoff uintBitsToFloat(0x368637BDu)   // 4e-6f
 #define kRadiusScale uintBitsToFloat(0x3F800008u)      // 1 + 2^-20
 #define kFacingSlack uintBitsToFloat(0x3727C5ACu)      // 1e-5f
+#define kGregoryWidenScale uintBitsToFloat(0x3E63C71Cu) // 2 (1 + 2^-10) / 9
 
 #define kPcInf uintBitsToFloat(0x7F800000u)
 
@@ -147,6 +148,74 @@ PcCone pc_tangent_cone(vec4 P[16]) {
     const PcCone t = pc_cone_of_vectors(12, U, no_widen, false);
     const PcCone b = pc_cone_of_vectors(12, V, no_widen, false);
     return pc_combine_cones(t, b);
+}
+
+/// gregory_direction_cone of cones_internal.h over a Gregory patch's 20 points: the 22 net
+/// differences and the 4 blend differences of the s direction (s_direction) or the t direction,
+/// as its kGregoryNet* / kGregoryBlend* tables ({to, from} pairs, flattened).
+PcCone pc_gregory_direction_cone(vec4 G[20], const bool s_direction) {
+    const int net_s[44] = int[44](1, 0, 7, 1, 5, 7, 17, 15, 11, 17, 10, 11, 3, 2, 4, 2, 8, 3, 8, 4, 9, 3, 9, 4, 6, 8,
+                                  6, 9, 18, 16, 19, 16, 13, 18, 13, 19, 14, 18, 14, 19, 12, 13, 12, 14);
+    const int net_t[44] = int[44](2, 0, 16, 2, 15, 16, 6, 5, 12, 6, 10, 12, 3, 1, 4, 1, 18, 3, 18, 4, 19, 3, 19, 4,
+                                  17, 18, 17, 19, 8, 7, 9, 7, 13, 8, 13, 9, 14, 8, 14, 9, 11, 13, 11, 14);
+    const int blend_s[8] = int[8](3, 4, 8, 9, 14, 13, 19, 18);
+    const int blend_t[8] = int[8](4, 3, 8, 9, 13, 14, 19, 18);
+    precise float moved = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        const int to = s_direction ? blend_s[2 * k] : blend_t[2 * k];
+        const int from = s_direction ? blend_s[2 * k + 1] : blend_t[2 * k + 1];
+        precise vec3 d = vec3(G[to].x - G[from].x, G[to].y - G[from].y, G[to].z - G[from].z);
+        moved = moved + pc_sqrt(pc_dot3(d, d));
+    }
+    precise float widen_each = moved * kGregoryWidenScale;
+    vec3 v[36];
+    float widen[36];
+    for (int k = 0; k < 36; ++k) {
+        v[k] = vec3(0.0);
+        widen[k] = 0.0;
+    }
+    for (int k = 0; k < 22; ++k) {
+        const int to = s_direction ? net_s[2 * k] : net_t[2 * k];
+        const int from = s_direction ? net_s[2 * k + 1] : net_t[2 * k + 1];
+        precise vec3 d = vec3(G[to].x - G[from].x, G[to].y - G[from].y, G[to].z - G[from].z);
+        v[k] = d;
+        widen[k] = widen_each;
+    }
+    return pc_cone_of_vectors(22, v, widen, true);
+}
+
+/// tangent_cone_gregory of cones_internal.h.
+PcCone pc_tangent_cone_gregory(vec4 G[20]) {
+    return pc_combine_cones(pc_gregory_direction_cone(G, true), pc_gregory_direction_cone(G, false));
+}
+
+/// sphere_of_gregory_points of cones_internal.h (sphere_of over the 20 points).
+PcSphere pc_sphere_of_gregory_points(vec4 G[20]) {
+    precise vec3 lo = G[0].xyz;
+    precise vec3 hi = lo;
+    for (int k = 1; k < 20; ++k) {
+        const vec3 q = G[k].xyz;
+        lo = vec3(pc_min_like(lo.x, q.x), pc_min_like(lo.y, q.y), pc_min_like(lo.z, q.z));
+        hi = vec3(pc_max_like(hi.x, q.x), pc_max_like(hi.y, q.y), pc_max_like(hi.z, q.z));
+    }
+    precise vec3 c = vec3((lo.x + hi.x) * 0.5, (lo.y + hi.y) * 0.5, (lo.z + hi.z) * 0.5);
+    precise float r2 = 0.0;
+    for (int k = 0; k < 20; ++k) {
+        const vec3 q = G[k].xyz;
+        precise vec3 d = vec3(q.x - c.x, q.y - c.y, q.z - c.z);
+        r2 = pc_max_like(r2, pc_dot3(d, d));
+    }
+    PcSphere sphere;
+    sphere.center = c;
+    precise float r = pc_sqrt(r2) * kRadiusScale;
+    sphere.radius = r;
+    return sphere;
+}
+
+bool pc_is_polynomial_gregory(vec4 G[20]) {
+    bool all_one = true;
+    for (int k = 0; k < 20; ++k) all_one = all_one && G[k].w == 1.0;
+    return all_one;
 }
 
 /// normal_patch_vectors + normal_cone_polynomial (NCONE).

@@ -16,8 +16,8 @@
 // With PC_PATCH_SOURCE the points come from the caller's patch source (patch_source.h: Bezier or
 // converted B-spline points, gathered once per patch); with PC_PATCH_SOURCE_GREGORY a Gregory
 // patch's 20 points feed the frustum and Hi-Z tests (a point whose NDC coordinate is NaN leaves
-// the patch unoccluded, as occlusion.comp.glsl) and the cone test never runs (cull_fused over a
-// PatchSourceView: the back-patch stage never culls a Gregory patch).
+// the patch unoccluded, as occlusion.comp.glsl) and the cone test is the Gregory tangent cone
+// (backpatch_cones.h's pc_tangent_cone_gregory, as cull_fused over a PatchSourceView).
 #version 450 core
 #include "shared.h"
 #include "pass_params.h"
@@ -138,7 +138,17 @@ void main() {
         pc_chain_cull(p, kCullFrustum);
         return;
     }
-#ifndef PC_PATCH_SOURCE_GREGORY
+#ifdef PC_PATCH_SOURCE_GREGORY
+    if (cone_tested) {
+        // A Gregory patch: its own tangent cone (either cone method), as BackpatchConePass.
+        const PcCone cone = pc_tangent_cone_gregory(pc_source_points);
+        const PcSphere sphere = pc_sphere_of_gregory_points(pc_source_points);
+        if (pc_is_polynomial_gregory(pc_source_points) && pc_back_facing(cone, sphere, fused.eye.xyz)) {
+            pc_chain_cull(p, kCullBackPatch);
+            return;
+        }
+    }
+#else
     if (cone_tested) {
         vec4 P[16];
         for (int k = 0; k < 16; ++k) P[k] = PC_PATCH_POINT(p, uint(k));

@@ -148,6 +148,63 @@ PATCHCULL_CONES_INLINE NormalCone tangent_cone_polynomial(const BezierPatch& p) 
     return combine_cones(t, b);
 }
 
+/// Gregory patches (patch_source.h's GREGORY_BASIS layout, 20 points g). The surface is the
+/// bicubic Bezier patch whose interior points blend the corners' face points:
+/// Q11 = (s g3 + t g4) / (s + t), Q21 = (t g8 + (1-s) g9) / (t + 1-s),
+/// Q22 = ((1-s) g13 + (1-t) g14) / (2-s-t), Q12 = ((1-t) g18 + s g19) / (1-t + s). Its s-tangent is
+/// 3 x a convex combination of the 22 net differences kGregoryNetS (the frozen net's derivative:
+/// an interior point's difference lies in the hull of its face points' differences) plus the
+/// interior points' own derivatives, c_k(s, t) kGregoryBlendS[k] with 0 <= c_k <= 1/3 inside the
+/// patch. So S_s / 3 is a convex combination of the net differences each moved by at most
+/// R = (sum of |blend differences|) / 9; likewise S_t. The derivation is in docs/METHODS.md,
+/// "Gregory patches".
+inline constexpr int kGregoryPoints = 20;
+inline constexpr int kGregoryNetVectors = 22;
+inline constexpr int kGregoryBlendVectors = 4;
+/// {to, from}: the vector g[to] - g[from].
+inline constexpr int kGregoryNetS[kGregoryNetVectors][2] = {
+    {1, 0}, {7, 1}, {5, 7}, {17, 15}, {11, 17}, {10, 11}, {3, 2},   {4, 2},   {8, 3},   {8, 4},   {9, 3},
+    {9, 4}, {6, 8}, {6, 9}, {18, 16}, {19, 16}, {13, 18}, {13, 19}, {14, 18}, {14, 19}, {12, 13}, {12, 14}};
+inline constexpr int kGregoryNetT[kGregoryNetVectors][2] = {
+    {2, 0},  {16, 2},  {15, 16}, {6, 5}, {12, 6}, {10, 12}, {3, 1},  {4, 1},  {18, 3}, {18, 4},  {19, 3},
+    {19, 4}, {17, 18}, {17, 19}, {8, 7}, {9, 7},  {13, 8},  {13, 9}, {14, 8}, {14, 9}, {11, 13}, {11, 14}};
+inline constexpr int kGregoryBlendS[kGregoryBlendVectors][2] = {{3, 4}, {8, 9}, {14, 13}, {19, 18}};
+inline constexpr int kGregoryBlendT[kGregoryBlendVectors][2] = {{4, 3}, {8, 9}, {13, 14}, {19, 18}};
+/// cone_of_vectors' widen for a move of at most R: 2 R covers sin + sin^2 of the angle it turns a
+/// vector of length >= R by (docs/METHODS.md); the factor covers the rounding of R.
+inline constexpr float kGregoryWidenScale = 2.0f * (1.0f + 0x1p-10f) / 9.0f;
+
+/// The cone of one direction's tangents: net and blend are kGregoryNet* and kGregoryBlend*.
+PATCHCULL_CONES_INLINE NormalCone gregory_direction_cone(const Vec3 g[kGregoryPoints],
+                                                         const int net[kGregoryNetVectors][2],
+                                                         const int blend[kGregoryBlendVectors][2]) {
+    const auto diff = [g](const int* pair) {
+        const Vec3 a = g[pair[0]], b = g[pair[1]];
+        return Vec3{a.x - b.x, a.y - b.y, a.z - b.z};
+    };
+    float moved = 0.0f;
+    for (int k = 0; k < kGregoryBlendVectors; ++k) {
+        const Vec3 d = diff(blend[k]);
+        moved = moved + std::sqrt(dot3(d, d));
+    }
+    const float widen_each = moved * kGregoryWidenScale;
+    Vec3 v[kGregoryNetVectors];
+    float widen[kGregoryNetVectors];
+    for (int k = 0; k < kGregoryNetVectors; ++k) {
+        v[k] = diff(net[k]);
+        widen[k] = widen_each;
+    }
+    return cone_of_vectors<kGregoryNetVectors>(v, widen);
+}
+
+/// The normal cone of a Gregory patch from its 20 Cartesian points: Sederberg & Meyers' cone of
+/// its s- and t-tangent cones (gregory_direction_cone). With F+ = F- at every corner it is
+/// tangent_cone_polynomial's cone of the equivalent Bezier patch.
+PATCHCULL_CONES_INLINE NormalCone tangent_cone_gregory(const Vec3 g[kGregoryPoints]) {
+    return combine_cones(gregory_direction_cone(g, kGregoryNetS, kGregoryBlendS),
+                         gregory_direction_cone(g, kGregoryNetT, kGregoryBlendT));
+}
+
 /// Binomial weights folded into the tangent control vectors: U'_ab = C(2,a) C(3,b) U_ab,
 /// V'_cd = C(3,c) C(2,d) V_cd.
 inline constexpr float kC2[3] = {1, 2, 1};
@@ -206,29 +263,39 @@ PATCHCULL_CONES_INLINE NormalCone normal_cone_polynomial(const BezierPatch& p) {
     return cone_of_vectors<36>(nv, widen);
 }
 
-/// Centre of the box of the (Cartesian) control points; radius = max distance * kRadiusScale.
-/// kDivide: divide by w (rational patches); false for polynomial patches (same values).
-template <bool kDivide>
-PATCHCULL_CONES_INLINE PatchSphere sphere_of_points(const BezierPatch& p) {
-    auto point = [&p](int k) {
-        const Vec4 q = p.cp[k];
-        if constexpr (kDivide) return Vec3{q.x / q.w, q.y / q.w, q.z / q.w};
-        return Vec3{q.x, q.y, q.z};
-    };
+/// Centre of the box of n points point(0) .. point(n - 1); radius = max distance * kRadiusScale.
+template <int n, class Point>
+PATCHCULL_CONES_INLINE PatchSphere sphere_of(const Point& point) {
     Vec3 lo = point(0), hi = lo;
-    for (int k = 1; k < kPatchPoints; ++k) {
+    for (int k = 1; k < n; ++k) {
         const Vec3 q = point(k);
         lo = {min_like_simd(lo.x, q.x), min_like_simd(lo.y, q.y), min_like_simd(lo.z, q.z)};
         hi = {max_like_simd(hi.x, q.x), max_like_simd(hi.y, q.y), max_like_simd(hi.z, q.z)};
     }
     const Vec3 c{(lo.x + hi.x) * 0.5f, (lo.y + hi.y) * 0.5f, (lo.z + hi.z) * 0.5f};
     float r2 = 0.0f;
-    for (int k = 0; k < kPatchPoints; ++k) {
+    for (int k = 0; k < n; ++k) {
         const Vec3 q = point(k);
         const Vec3 d{q.x - c.x, q.y - c.y, q.z - c.z};
         r2 = max_like_simd(r2, dot3(d, d));
     }
     return {c, std::sqrt(r2) * kRadiusScale};
+}
+
+/// The sphere of a patch's (Cartesian) control points. kDivide: divide by w (rational patches);
+/// false for polynomial patches (same values).
+template <bool kDivide>
+PATCHCULL_CONES_INLINE PatchSphere sphere_of_points(const BezierPatch& p) {
+    return sphere_of<kPatchPoints>([&p](int k) {
+        const Vec4 q = p.cp[k];
+        if constexpr (kDivide) return Vec3{q.x / q.w, q.y / q.w, q.z / q.w};
+        return Vec3{q.x, q.y, q.z};
+    });
+}
+
+/// The sphere of a Gregory patch's 20 points (the surface lies in their convex hull).
+PATCHCULL_CONES_INLINE PatchSphere sphere_of_gregory_points(const Vec3 g[kGregoryPoints]) {
+    return sphere_of<kGregoryPoints>([g](int k) { return g[k]; });
 }
 
 /// The perspective back-facing test (derivation in cones.cpp): with d = e - c, L = |d|,

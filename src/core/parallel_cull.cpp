@@ -111,9 +111,8 @@ void cull_backpatch_parallel(BackpatchMethod id, const PatchSourceView& source, 
                              const BackpatchOptions& options, std::uint8_t* culled) {
     check_patch_source(source, "cull_backpatch_parallel");
     const BackpatchMethodInfo& method = backpatch_method_info(id);  // Error for an unknown id
-    const BackpatchKernel kernel = method.simd ? method.simd : method.scalar;
     for_each_index_range(source.count, kComputeBoundMinPatches, [&](std::size_t first, std::size_t last) {
-        detail::source_backpatch(kernel, source, first, last, view, options, culled);
+        detail::source_backpatch(method, source, first, last, view, options, culled);
     });
 }
 

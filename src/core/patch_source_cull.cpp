@@ -8,6 +8,7 @@
 #include <cstring>
 #include <string>
 
+#include "core/cones_internal.h"
 #include "core/frustum_box_internal.h"
 #include "core/patch_source_internal.h"
 #include "patchcull/core/error.h"
@@ -18,7 +19,7 @@ namespace patchcull {
 
 namespace {
 
-constexpr int kGregoryPoints = 20;
+using cones_detail::kGregoryPoints;
 
 // Calls body(block view, first) for every block of kBlockPatches patches of source patches
 // [begin, end) of a Bezier or B-spline source, gathered into one 4 KiB stack block.
@@ -98,6 +99,20 @@ bool gregory_occluded(const FrustumPlanes& planes, const HiZPyramid& hiz, const 
     return hiz_rect_max(hiz, rect) < zmin;
 }
 
+// The cone test of a Gregory patch (cones_internal.h's tangent_cone_gregory, its 20-point sphere and
+// back_facing); never culls a patch with a point of w != 1.
+bool gregory_back_facing(const float pts[kGregoryPoints][4], Vec3 eye) {
+    Vec3 g[kGregoryPoints];
+    bool polynomial = true;
+    for (int k = 0; k < kGregoryPoints; ++k) {
+        g[k] = {pts[k][0], pts[k][1], pts[k][2]};
+        polynomial = polynomial && pts[k][3] == 1.0f;
+    }
+    const NormalCone cone = cones_detail::tangent_cone_gregory(g);
+    const PatchSphere sphere = cones_detail::sphere_of_gregory_points(g);
+    return polynomial && cones_detail::back_facing(cone, sphere, eye);
+}
+
 }  // namespace
 
 namespace detail {
@@ -132,12 +147,23 @@ void source_frustum_disp(const PatchSourceView& source, std::size_t first, std::
     });
 }
 
-void source_backpatch(BackpatchKernel kernel, const PatchSourceView& source, std::size_t first, std::size_t last,
-                      const CullView& view, const BackpatchOptions& options, std::uint8_t* culled) {
+void source_backpatch(const BackpatchMethodInfo& method, const PatchSourceView& source, std::size_t first,
+                      std::size_t last, const CullView& view, const BackpatchOptions& options, std::uint8_t* culled) {
     if (source.basis == PatchBasis::gregory) {
-        if (last > first) std::memset(culled + first, 0, last - first);
+        // The cone methods (fusable) get the Gregory cone test; the others never cull.
+        const bool cone = method.fusable && view.has_eye;
+        float pts[kGregoryPoints][4];
+        for (std::size_t p = first; p < last; ++p) {
+            bool out = false;
+            if (cone) {
+                gregory_points(source, p, pts);
+                out = gregory_back_facing(pts, view.eye);
+            }
+            culled[p] = out ? 1 : 0;
+        }
         return;
     }
+    const BackpatchKernel kernel = method.simd ? method.simd : method.scalar;
     for_each_block(source, first, last,
                    [&](const PatchBatchView& block, std::size_t f) { kernel(block, view, options, culled + f); });
 }
@@ -156,7 +182,7 @@ void source_fused(const PatchSourceView& source, std::size_t first, std::size_t 
                     d = kFusedFrustumCulled;
                 if (stage == FusedStage::occlusion && gregory_occluded(setup.planes, *setup.hiz, pts))
                     d = kFusedOccluded;
-                // FusedStage::backpatch: never culls a Gregory patch.
+                if (stage == FusedStage::backpatch && gregory_back_facing(pts, setup.eye)) d = kFusedBackPatchCulled;
                 if (stats && d != kFusedVisible) ++stats->patches_culled[static_cast<int>(stage)];
             }
             decision[p] = d;
@@ -197,7 +223,7 @@ void cull_backpatch(BackpatchMethod id, const PatchSourceView& source, const Cul
                     const BackpatchOptions& options, std::uint8_t* culled) {
     check_patch_source(source, "cull_backpatch");
     const BackpatchMethodInfo& method = backpatch_method_info(id);
-    detail::source_backpatch(method.simd ? method.simd : method.scalar, source, 0, source.count, view, options, culled);
+    detail::source_backpatch(method, source, 0, source.count, view, options, culled);
 }
 
 void cull_occlusion(const PatchSourceView& source, const CullView& view, const HiZPyramid& hiz,

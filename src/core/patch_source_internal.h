@@ -27,8 +27,10 @@ void source_frustum(const PatchSourceView& source, std::size_t first, std::size_
 /// planes: make_frustum_planes(view.object_to_clip, view.depth), made once by the caller.
 void source_frustum_disp(const PatchSourceView& source, std::size_t first, std::size_t last,
                          const float* max_displacement, const FrustumPlanes& planes, std::uint8_t* culled);
-void source_backpatch(BackpatchKernel kernel, const PatchSourceView& source, std::size_t first, std::size_t last,
-                      const CullView& view, const BackpatchOptions& options, std::uint8_t* culled);
+/// method's kernel over Bezier and B-spline sources; over a Gregory source the Gregory cone test
+/// for the cone methods (method.fusable, with view.has_eye), else no cull.
+void source_backpatch(const BackpatchMethodInfo& method, const PatchSourceView& source, std::size_t first,
+                      std::size_t last, const CullView& view, const BackpatchOptions& options, std::uint8_t* culled);
 /// plan valid, setup.hiz checked when the plan has occlusion.
 void source_fused(const PatchSourceView& source, std::size_t first, std::size_t last, const FusedCullSetup& setup,
                   const FusedPlan& plan, std::uint8_t* decision, FusedCullStats* stats);

@@ -43,13 +43,14 @@ void BackpatchConePass::run(const GpuPatchSource& source, BackpatchMethod method
     if (cone_values)
         detail::check_buffer_size("BackpatchConePass", "cone-value", cone_values,
                                   (source.first + source.count) * shared::kConeValues * sizeof(float));
-    if (source.count == 0 || source.basis == PatchBasis::gregory) return;  // Gregory: never back-patch culled
+    if (source.count == 0) return;
     pp::BackpatchConeParams params;
     params.eye = {eye.x, eye.y, eye.z, 1.0f};
     params.has_margins = source.margins ? 1u : 0u;
     params.write_cones = cone_values ? 1u : 0u;
     params.zero = 0.0f;
-    const bool ncone = method == BackpatchMethod::ncone;
+    // A Gregory source has one cone for both methods (the Gregory program ignores PATCHCULL_NCONE).
+    const bool ncone = method == BackpatchMethod::ncone && source.basis != PatchBasis::gregory;
     glUseProgram(impl_->context.program(
         "backpatch_cones.comp.glsl",
         std::string(ncone ? "#define PATCHCULL_NCONE 1\n" : "") + detail::patch_source_defines(source)));

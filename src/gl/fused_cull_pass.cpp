@@ -69,7 +69,7 @@ void FusedCullPass::run(const GpuPatchSource& source, std::uint32_t tests, const
     const pp::PatchSourceParams source_params = detail::check_patch_source("FusedCullPass", impl_->context, source);
     pp::FusedCullParams params = fused_params(tests, any_object_to_clip, depth, method, eye, hiz, source.margins != 0);
     if (source.count == 0 || tests == 0) return;
-    // A Gregory program has no cone test (never back-patch culled): one program for both cones.
+    // A Gregory program has one cone for both methods (its Gregory tangent cone).
     const bool ncone = (tests & shared::kCullBackPatch) != 0 && method == BackpatchMethod::ncone &&
                        source.basis != PatchBasis::gregory;
     const std::string defines =

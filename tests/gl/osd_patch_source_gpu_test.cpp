@@ -228,6 +228,7 @@ void make_view(const Subject& s, std::mt19937& rng, ClipDepth depth, ViewCase& o
 
 struct Tally {
     std::size_t tested = 0, viewed = 0, frustum = 0, occluded = 0, back = 0, gregory_culled = 0;
+    std::size_t gregory_back = 0;  // Gregory patches the CPU culls by a back-patch cone
     std::size_t box = 0, fused_frustum = 0, fused_back = 0, fused_occluded = 0;  // the second test's
     int mismatches = 0;
 };
@@ -254,6 +255,7 @@ void expect_flags(const Subject& s, const char* what, ClipDepth depth, const std
         ++tally.tested;
         const std::uint32_t w = want(i);
         if (w != 0 && s.gregory[i]) ++tally.gregory_culled;
+        if ((w & kCullBackPatch) != 0 && s.gregory[i]) ++tally.gregory_back;
         if (got[i] != w && ++tally.mismatches <= 8)
             ADD_FAILURE() << s.name << ", " << what << ", " << clip_depth_name(depth) << ": patch " << i
                           << (s.gregory[i] ? " (gregory)" : "") << " has flag word " << got[i] << ", the CPU says "
@@ -611,6 +613,7 @@ void check_tables(Compared compared) {
     EXPECT_GT(tally.occluded, tally.viewed / 100) << "occlusion culls";
     EXPECT_GT(tally.back, tally.viewed / 10) << "back-patch culls (the four methods together)";
     EXPECT_GT(tally.gregory_culled, 10u);
+    EXPECT_GT(tally.gregory_back, 0u) << "Gregory patches culled by the Gregory cone";
 }
 
 // ---- Plain sources ----------------------------------------------------------------------------
@@ -952,7 +955,7 @@ TEST(OsdPatchSourceGpu, BadSourcesAreOneLineErrors) {
               }).find("GL: FrustumDispPass: plane-value buffer of 8 bytes, 48 needed"),
               std::string::npos);
     glDeleteTextures(1, &hiz.texture);
-    // A Gregory source is never back-patch culled: validated, nothing runs.
+    // ptp never culls a Gregory source: validated, nothing runs.
     g = good();
     g.basis = PatchBasis::gregory;
     g.count = 1;

@@ -40,8 +40,11 @@
 //   gregoryBasis.h and patchBasis.cpp draw the layout). The surface is a bicubic Bezier patch
 //   whose 4 interior points are convex blends of the corners' face points F+ and F- (weights
 //   s/(s+t), t/(s+t) at corner 0 and likewise at the others), so it lies in the convex hull of its
-//   20 points: frustum and occlusion test all 20. Back-patch methods never cull a Gregory patch
-//   (a normal cone valid for the rational blend is future work).
+//   20 points: frustum and occlusion test all 20. The cone methods (tcone, ncone, the fused
+//   kernel's cone stage) test a Gregory patch's own normal cone: Sederberg & Meyers' cone of
+//   its s- and t-tangent cones, each the cone of the frozen Bezier net's differences widened by
+//   the most the blend's own derivative can turn them (docs/METHODS.md, "Gregory patches"); ptp
+//   and registered methods never cull a Gregory patch.
 //
 // ---- Costs and errors ----------------------------------------------------------------------------
 // The entries check the view once, before their loop (check_patch_source: every index, one pass),
@@ -127,8 +130,11 @@ void cull_frustum(const PatchSourceView& source, const float* max_displacement, 
                   std::uint8_t* culled);
 
 /// Back-patch method id (backpatch_methods.h) over source: culled holds source.count bytes.
-/// Bezier and B-spline: equals cull_backpatch on the converted patches. Gregory: never culls
-/// (writes 0). Throws Error before the loop for a bad view or an unknown id.
+/// Bezier and B-spline: equals cull_backpatch on the converted patches. Gregory: the cone methods
+/// (BackpatchMethodInfo::fusable) test the patch's Gregory tangent cone and the sphere of its 20
+/// points (with F+ = F- at every corner, tcone's decision on the equivalent Bezier patch); a patch
+/// with a point of w != 1, a view without an eye and the other methods never cull (write 0).
+/// Throws Error before the loop for a bad view or an unknown id.
 void cull_backpatch(BackpatchMethod id, const PatchSourceView& source, const CullView& view,
                     const BackpatchOptions& options, std::uint8_t* culled);
 
@@ -157,7 +163,8 @@ void cull_occlusion(const PatchSourceView& source, const CullView& view, const H
 /// cull_fused_simd's on the converted patches, and stats (optional) counts as cull_fused_simd's
 /// on them. Gregory: the frustum stage is cull_frustum's 20-point test (no displacement), the
 /// occlusion stage cull_occlusion's (not projectable, or a NaN box, -> not occluded), and the
-/// back-patch stage never culls (stats count one group per patch, as cull_fused_scalar's). Throws
+/// back-patch stage the Gregory cone test of cull_backpatch (either cone; stats count one group
+/// per patch, as cull_fused_scalar's). Throws
 /// Error before the loop for a bad view, a plan valid_fused_plan refuses, or a plan with occlusion
 /// whose setup.hiz is null, never built or of the other depth direction than setup.planes.
 void cull_fused(const PatchSourceView& source, const FusedCullSetup& setup, const FusedPlan& plan,

@@ -188,9 +188,10 @@ struct PatchBuffers {
 /// bit for bit: the shaders gather
 /// each patch as gather_bezier does (shaders/patch_source.h) and run the passes' own tests on it
 /// (subnormal coordinates excepted: GPUs and llvmpipe flush them to zero, gl_backpatch.h (1)).
-/// Gregory sources: the frustum, frustum-disp and occlusion tests take all 20 points; the
-/// back-patch passes never cull them (they run nothing and leave the flags as they are), nor does
-/// FusedCullPass's cone test (its program over a Gregory source has none).
+/// Gregory sources: the frustum, frustum-disp and occlusion tests take all 20 points; the cone
+/// tests (BackpatchConePass, FusedCullPass's cone stage) take the Gregory tangent cone of
+/// core/patch_source.h's cull_backpatch, whichever cone method; BackpatchPtpPass never culls them
+/// (it runs nothing and leaves the flags as they are).
 /// Not an aggregate (a braced list names a PatchBuffers): set the members by name.
 struct GpuPatchSource {
     GpuPatchSource() = default;
@@ -356,7 +357,7 @@ public:
     /// 0) at 12p.
     void run(const PatchBuffers& patches, BackpatchMethod method, Vec3 eye, std::uint32_t cone_values = 0);
     /// The same over a patch source (cull_backpatch of core/patch_source.h on the GPU); a
-    /// Gregory source is validated and nothing runs (never back-patch culled).
+    /// Gregory source gets its Gregory tangent cone for either method (cone_values as above).
     void run(const GpuPatchSource& source, BackpatchMethod method, Vec3 eye, std::uint32_t cone_values = 0);
 
 private:
@@ -443,7 +444,7 @@ public:
     /// without margins each flag word's reason is cull_fused's decision (core/patch_source.h) with
     /// the plan of `tests` in the chain's order (frustum, back-patch, Hi-Z; a plan for every mask
     /// but those with Hi-Z and no frustum) on the same matrix, eye, cone and pyramid. A Gregory
-    /// patch: frustum and Hi-Z over its 20 points, never back-patch culled. Throws Error (one
+    /// patch: frustum and Hi-Z over its 20 points, its Gregory tangent cone. Throws Error (one
     /// line) for a bad source (see GpuPatchSource) and for what the run above refuses, before
     /// anything runs.
     void run(const GpuPatchSource& source, std::uint32_t tests, const Mat4& object_to_clip, ClipDepth depth,
