@@ -124,7 +124,8 @@ std::string osd_patch_type_name(OpenSubdiv::Far::PatchDescriptor::Type type);
 void cull_frustum(const OsdPatchTableSource& table, const float* max_displacement, const CullView& view,
                   std::uint8_t* culled);
 
-/// cull_backpatch over every array (Gregory end caps are never back-patch culled: 0).
+/// cull_backpatch over every array (Gregory end caps: their Gregory cone with the cone methods,
+/// never culled by ptp; core/patch_source.h).
 void cull_backpatch(BackpatchMethod id, const OsdPatchTableSource& table, const CullView& view,
                     const BackpatchOptions& options, std::uint8_t* culled);
 
@@ -138,7 +139,8 @@ void cull_frustum_disp(const OsdPatchTableSource& table, const float* max_displa
                        std::uint8_t* culled);
 
 /// cull_fused (core/patch_source.h) over every array: decision[i] (FusedDecision) for the table's
-/// patch i, the plan's first stage that culls it (Gregory end caps: never the back-patch stage).
+/// patch i, the plan's first stage that culls it (Gregory end caps: the back-patch stage tests
+/// their Gregory cone).
 /// The plan and the pyramid are checked before any array is culled.
 void cull_fused(const OsdPatchTableSource& table, const FusedCullSetup& setup, const FusedPlan& plan,
                 std::uint8_t* decision, FusedCullStats* stats = nullptr);
