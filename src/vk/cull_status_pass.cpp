@@ -15,7 +15,7 @@ void record_status(PassContext::Impl& context, VkCommandBuffer cmd, const PatchB
     context.check_range(who, "counter", counters, shared::kCounterCount * 4, true);
     if (patches.count == 0) return;
     const detail::Pipeline& p =
-        context.pipeline("cull_status.comp.glsl",
+        context.pipeline("cull_status.comp.glsl", "",
                          {shared::kBindingCullFlags, shared::kBindingMaxDisplacement, shared::kBindingCullCounters},
                          sizeof(pp::CullStatusParams));
     pp::CullStatusParams params;

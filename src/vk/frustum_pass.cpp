@@ -15,7 +15,7 @@ void FrustumPass::run(VkCommandBuffer cmd, const PatchBuffers& patches, const Fr
     context.check_range(who, "margin", patches.margins, end * 4, true);
     context.check_range(who, "plane-value", plane_values, end * 6 * sizeof(float), true);
     if (patches.count == 0) return;
-    const detail::Pipeline& p = context.pipeline("frustum.comp.glsl",
+    const detail::Pipeline& p = context.pipeline("frustum.comp.glsl", "",
                                                  {shared::kBindingControlPoints, shared::kBindingCullFlags,
                                                   shared::kBindingMaxDisplacement, shared::kBindingPlaneValues},
                                                  sizeof(pp::FrustumParams));

@@ -13,6 +13,9 @@ namespace patchcull::vk {
 // The C++ parameter structs are the std140 push-constant blocks (shaders/api.h, pass_params.h).
 static_assert(sizeof(pp::FrustumParams) == 128);
 static_assert(sizeof(pp::CullStatusParams) == 16);
+static_assert(sizeof(pp::FrustumDispParams) == 96);
+static_assert(sizeof(pp::BackpatchConeParams) == 48);
+static_assert(sizeof(pp::BackpatchPtpParams) == 80);
 
 namespace detail {
 
@@ -145,16 +148,18 @@ PassContext::~PassContext() = default;
 bool PassContext::fma_via_double() const { return impl_->fma_via_double; }
 PassContext::Impl& PassContext::impl() { return *impl_; }
 
-const detail::Pipeline& PassContext::Impl::pipeline(const char* shader, std::initializer_list<std::uint32_t> bindings,
+const detail::Pipeline& PassContext::Impl::pipeline(const char* shader, const char* variant,
+                                                    std::initializer_list<std::uint32_t> bindings,
                                                     std::uint32_t push_constant_bytes) {
-    auto it = pipelines.find(shader);
+    const std::string key = std::string(shader) + " " + variant;
+    auto it = pipelines.find(key);
     if (it != pipelines.end()) return it->second;
     if (push_constant_bytes > limits.maxPushConstantsSize)
         throw Error(std::string("Vulkan: ") + shader + ": its " + std::to_string(push_constant_bytes) +
                     "-byte parameter block exceeds maxPushConstantsSize (" +
                     std::to_string(limits.maxPushConstantsSize) + ")");
-    const detail::SpirvModule* module = detail::find_spirv_module(shader, fma_via_double);
-    if (!module) throw Error(std::string("Vulkan: ") + shader + " has no SPIR-V module");
+    const detail::SpirvModule* module = detail::find_spirv_module(shader, variant, fma_via_double);
+    if (!module) throw Error(std::string("Vulkan: ") + shader + " " + variant + " has no SPIR-V module");
 
     detail::Pipeline p;
     p.push_constant_bytes = push_constant_bytes;
@@ -205,7 +210,7 @@ const detail::Pipeline& PassContext::Impl::pipeline(const char* shader, std::ini
         if (p.set_layout) vk.DestroyDescriptorSetLayout(device, p.set_layout, nullptr);
         throw;
     }
-    return pipelines.emplace(shader, p).first->second;
+    return pipelines.emplace(key, p).first->second;
 }
 
 void PassContext::Impl::check_range(const char* who, const char* what, const BufferRange& range, VkDeviceSize bytes,

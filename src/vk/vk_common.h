@@ -81,14 +81,15 @@ struct PassContext::Impl {
     VkPhysicalDeviceLimits limits{};
     VkBuffer placeholder = VK_NULL_HANDLE;  // 256 bytes, bound for an empty optional range
     VkDeviceMemory placeholder_memory = VK_NULL_HANDLE;
-    std::map<std::string, detail::Pipeline> pipelines;  // key: shader name
+    std::map<std::string, detail::Pipeline> pipelines;  // key: shader name + " " + variant
 
     ~Impl();
-    /// The pipeline of compute shader `shader` (its SPIR-V module in this context's fma variant)
-    /// reading storage buffers at `bindings` and push constants of push_constant_bytes; created
-    /// on first use. Throws Error when the block exceeds maxPushConstantsSize.
-    const detail::Pipeline& pipeline(const char* shader, std::initializer_list<std::uint32_t> bindings,
-                                     std::uint32_t push_constant_bytes);
+    /// The pipeline of compute shader `shader` in `variant` ("" or the define of a variant; its
+    /// SPIR-V module in this context's fma mode) reading storage buffers at `bindings` and push
+    /// constants of push_constant_bytes; created on first use. Throws Error when the block
+    /// exceeds maxPushConstantsSize.
+    const detail::Pipeline& pipeline(const char* shader, const char* variant,
+                                     std::initializer_list<std::uint32_t> bindings, std::uint32_t push_constant_bytes);
     /// Throws (one line naming who and what) unless range is in a buffer, holds at least bytes
     /// bytes, starts at a multiple of minStorageBufferOffsetAlignment and fits maxStorageBufferRange.
     /// An optional range may be empty (buffer VK_NULL_HANDLE, size 0).

@@ -52,23 +52,34 @@ inline RandomCase random_case(std::uint32_t seed, std::size_t count, ClipDepth d
     return c;
 }
 
-/// cull_frustum_scalar's decisions as the flag words a chain begin -> frustum leaves on words
-/// that held no reason: kCullFrustum or 0.
-inline std::vector<std::uint32_t> cpu_frustum_words(const RandomCase& c, const FrustumPlanes& planes) {
-    PatchBatch batch(c.patches.size());
-    for (std::size_t p = 0; p < c.patches.size(); ++p)
+/// The patches as a structure-of-arrays batch, unchecked (the CPU kernels' input).
+inline PatchBatch patch_batch(const std::vector<BezierPatch>& patches) {
+    PatchBatch batch(patches.size());
+    for (std::size_t p = 0; p < patches.size(); ++p)
         for (int k = 0; k < kPatchPoints; ++k) {
-            const Vec4& P = c.patches[p].cp[k];
+            const Vec4& P = patches[p].cp[k];
             batch.component(k, 0)[p] = P.x;
             batch.component(k, 1)[p] = P.y;
             batch.component(k, 2)[p] = P.z;
             batch.component(k, 3)[p] = P.w;
         }
-    std::vector<std::uint8_t> culled(c.patches.size());
-    cull_frustum_scalar(batch.view(), c.margins.empty() ? nullptr : c.margins.data(), planes, culled.data());
+    return batch;
+}
+
+/// A CPU kernel's decisions as the flag words a pass of the chain leaves on words that held no
+/// reason: `reason` or 0.
+inline std::vector<std::uint32_t> words_of(const std::vector<std::uint8_t>& culled, std::uint32_t reason) {
     std::vector<std::uint32_t> words(culled.size());
-    for (std::size_t p = 0; p < culled.size(); ++p) words[p] = culled[p] ? kCullFrustum : 0u;
+    for (std::size_t p = 0; p < culled.size(); ++p) words[p] = culled[p] ? reason : 0u;
     return words;
+}
+
+/// cull_frustum_scalar's decisions as flag words (kCullFrustum or 0).
+inline std::vector<std::uint32_t> cpu_frustum_words(const RandomCase& c, const FrustumPlanes& planes) {
+    std::vector<std::uint8_t> culled(c.patches.size());
+    cull_frustum_scalar(patch_batch(c.patches).view(), c.margins.empty() ? nullptr : c.margins.data(), planes,
+                        culled.data());
+    return words_of(culled, kCullFrustum);
 }
 
 /// The case's buffers on the test device: control points, flags (zero), margins when the case has them.

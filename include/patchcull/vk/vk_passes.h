@@ -6,9 +6,12 @@
 //
 //   test                   CPU kernel (scalar)            pass               shader
 //   frustum                cull_frustum_scalar            FrustumPass        frustum.comp.glsl
+//   frustum-disp (AABB)    cull_frustum_disp_scalar       FrustumDispPass    frustum_disp.comp.glsl
+//   back-patch tcone/ncone cull_tcone/ncone_scalar        BackpatchConePass  backpatch_cones.comp.glsl
+//   back-patch ptp         cull_ptp_scalar                BackpatchPtpPass   backpatch_ptp.comp.glsl
 //   (ends of the chain)    -                              CullStatusPass     cull_status.comp.glsl
-// The other passes of gl_passes.h (frustum-disp, back-patch, Hi-Z, displaced, fused, compaction)
-// and the passes over a GpuPatchSource have no Vulkan twin yet (docs/ENGINE.md, "Vulkan").
+// The other passes of gl_passes.h (Hi-Z build, occlusion, displaced, fused, compaction) and the
+// passes over a GpuPatchSource have no Vulkan twin yet (docs/ENGINE.md, "Vulkan").
 //
 // Buffers: the layouts of gl_passes.h (control points 16 vec4 per patch in patch.h order, 256
 // bytes; the flag word, core/cull_flags.h, one uint per patch; margins one float per patch;
@@ -22,8 +25,9 @@
 //   vkCmdBindPipeline(VK_PIPELINE_BIND_POINT_COMPUTE, its pipeline)
 //   vkCmdPushDescriptorSetKHR(set 0): the caller's ranges as storage-buffer descriptors at the
 //     binding numbers of shaders/shared.h (kBindingControlPoints 0, kBindingCullFlags 1,
-//     kBindingMaxDisplacement 2, kBindingPlaneValues 4, kBindingCullCounters 6); an optional
-//     range left empty is replaced by a small buffer of the PassContext (never read)
+//     kBindingMaxDisplacement 2, kBindingPlaneValues 4, kBindingCullCounters 6,
+//     kBindingPtpPlanes 13, kBindingConeValues 14); an optional range left empty is replaced by
+//     a small buffer of the PassContext (never read)
 //   per dispatch: vkCmdPushConstants (its pass_params.h block, std140, at offset 0) and
 //     vkCmdDispatch; ranges of more than 65535 work groups are split into several
 //   vkCmdPipelineBarrier: one VkMemoryBarrier from VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT /
@@ -70,8 +74,12 @@
 #include <cstdint>
 #include <memory>
 
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/backpatch_methods.h"
+#include "patchcull/core/clip_space.h"
 #include "patchcull/core/cull_view.h"
 #include "patchcull/core/frustum.h"
+#include "patchcull/core/math.h"
 
 namespace patchcull::vk {
 
@@ -166,6 +174,61 @@ public:
              const BufferRange& plane_values = {});
     /// The same on one view's CullView (view.planes).
     void run(VkCommandBuffer cmd, const PatchBuffers& patches, const CullView& view,
+             const BufferRange& plane_values = {});
+
+private:
+    PassContext::Impl* context_;
+};
+
+/// cull_frustum_disp_scalar on the GPU (Sathe, "View Frustum Culling of Catmull-Clark Patches in
+/// DirectX 11", Game Programming Gems 8): reason kCullFrustum for a patch whose Cartesian
+/// control-point AABB, grown by its margin on every side, has all 8 corners outside one clip
+/// plane of object_to_clip; gl_passes.h's FrustumDispPass, the same shader. A drop-in for
+/// FrustumPass in the chain that tests displaced patches too.
+class FrustumDispPass {
+public:
+    explicit FrustumDispPass(PassContext& context);
+    /// depth: the convention of object_to_clip (converted with to_zero_to_one, as the CPU kernel
+    /// does; a matrix contradicting it: Error). plane_values (optional, diagnostics): >= 6 floats
+    /// per patch; a tested patch p gets the six maxima over the corners at 6p.
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, const Mat4& object_to_clip, ClipDepth depth,
+             const BufferRange& plane_values = {});
+    /// The same on one view's CullView (view.object_to_clip in view.depth).
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, const CullView& view,
+             const BufferRange& plane_values = {});
+
+private:
+    PassContext::Impl* context_;
+};
+
+/// cull_tcone_scalar / cull_ncone_scalar on the GPU (eye in object space): reason kCullBackPatch.
+/// Displaced patches (margin > 0) are skipped, as in the GL chain.
+class BackpatchConePass {
+public:
+    explicit BackpatchConePass(PassContext& context);
+    /// method: tcone or ncone (any other: Error). cone_values (optional, diagnostics): >= 12
+    /// floats per patch; a tested patch p gets (axis.xyz, cos, sin, valid 1/0, sphere centre.xyz,
+    /// radius, 0, 0) at 12p.
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, BackpatchMethod method, Vec3 eye,
+             const BufferRange& cone_values = {});
+
+private:
+    PassContext::Impl* context_;
+};
+
+/// cull_ptp_scalar on the GPU (Loop, Niessner & Eisenacher, "Effective Back-Patch Culling for
+/// Hardware Tessellation", §6: 16 invocations per patch): reason kCullBackPatch. object_to_clip =
+/// projection * view (* model), alpha = clip_space_eye_alpha(projection); a y-down projection
+/// (y row negated) flips det and so the orientation sign the pass folds into the rows: the same
+/// decisions. Displaced patches are skipped, as in the GL chain.
+class BackpatchPtpPass {
+public:
+    explicit BackpatchPtpPass(PassContext& context);
+    /// plane_values (optional, diagnostics): >= 128 floats per patch; a tested patch p gets its 64
+    /// control plane z values and their 64 rounding-error margins at 128p. Returns false and
+    /// records nothing when alpha or det(object_to_clip) is zero or not finite (nothing may be
+    /// culled).
+    bool run(VkCommandBuffer cmd, const PatchBuffers& patches, const Mat4& object_to_clip, float alpha, PtpRule rule,
              const BufferRange& plane_values = {});
 
 private:

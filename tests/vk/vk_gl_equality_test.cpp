@@ -1,0 +1,253 @@
+// The Vulkan passes against their OpenGL twins and the CPU scalar kernels on the same inputs, in
+// one process (lavapipe with the validation layers, llvmpipe on a headless EGL context): the
+// chain begin -> frustum -> end leaves the same flag words and counters on both APIs, equal to
+// cull_frustum_scalar's decisions, and the frustum pass's six plane maxima are bit-identical, in
+// every ClipDepth convention, with and without margins; the frustum-disp, tcone, ncone and ptp
+// passes leave the same words on both APIs, equal to their CPU scalar kernels'. Built only with
+// PATCHCULL_WITH_GL.
+#include <gtest/gtest.h>
+
+#if PATCHCULL_VK_TEST_GL
+
+#include <epoxy/gl.h>
+
+#include <cstring>
+#include <functional>
+#include <random>
+
+#include "core/test_patches.h"
+#include "patchcull/core/backpatch.h"
+#include "patchcull/core/clip_space.h"
+#include "patchcull/core/teapot.h"
+#include "patchcull/gl/gl_context.h"
+#include "patchcull/gl/gl_passes.h"
+#include "shared.h"
+#include "vk/vk_cases.h"
+
+using namespace patchcull;
+using namespace patchcull::vk::test;
+namespace shared = patchcull::gl::shared;
+
+namespace {
+
+gl::GlContext& gl_context() {
+    static gl::GlContext context = gl::GlContext::create_headless();
+    return context;
+}
+
+gl::PassContext& gl_passes() {
+    gl_context().make_current();
+    static gl::PassContext passes;
+    return passes;
+}
+
+GLuint gl_buffer(std::size_t bytes, const void* data) {
+    GLuint b = 0;
+    glCreateBuffers(1, &b);
+    glNamedBufferData(b, static_cast<GLsizeiptr>(std::max<std::size_t>(bytes, 16)), nullptr, GL_DYNAMIC_DRAW);
+    if (data)
+        glNamedBufferSubData(b, 0, static_cast<GLsizeiptr>(bytes), data);
+    else {
+        const std::vector<std::uint8_t> zeros(std::max<std::size_t>(bytes, 16), 0);
+        glNamedBufferSubData(b, 0, static_cast<GLsizeiptr>(zeros.size()), zeros.data());
+    }
+    return b;
+}
+
+template <class T>
+std::vector<T> gl_read(GLuint buffer, std::size_t count) {
+    std::vector<T> out(count);
+    glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(count * sizeof(T)), out.data());
+    return out;
+}
+
+struct ChainResult {
+    std::vector<std::uint32_t> words;
+    std::vector<float> plane_values;
+    std::vector<std::uint32_t> counters;
+};
+
+// The frame's chain on GL: begin, frustum, end with counters.
+ChainResult gl_chain(const RandomCase& c, const FrustumPlanes& planes, const std::vector<std::uint32_t>& words) {
+    gl::PassContext& passes = gl_passes();
+    const std::size_t n = c.patches.size();
+    gl::PatchBuffers b;
+    b.control_points = gl_buffer(n * sizeof(BezierPatch), c.patches.data());
+    b.flags = gl_buffer(n * 4, words.data());
+    if (!c.margins.empty()) b.margins = gl_buffer(n * 4, c.margins.data());
+    b.count = n;
+    const GLuint values = gl_buffer(n * 6 * sizeof(float), nullptr);
+    const GLuint counters = gl_buffer(shared::kCounterCount * 4, nullptr);
+    gl::CullStatusPass status(passes);
+    gl::FrustumPass frustum(passes);
+    status.begin(b);
+    frustum.run(b, planes, values);
+    status.end(b, counters);
+    ChainResult r{gl_read<std::uint32_t>(b.flags, n), gl_read<float>(values, 6 * n),
+                  gl_read<std::uint32_t>(counters, shared::kCounterCount)};
+    const GLuint names[] = {b.control_points, b.flags, b.margins, values, counters};
+    glDeleteBuffers(5, names);
+    return r;
+}
+
+// The same chain on Vulkan.
+ChainResult vk_chain(Context& vk, const RandomCase& c, const FrustumPlanes& planes,
+                     const std::vector<std::uint32_t>& words) {
+    const std::size_t n = c.patches.size();
+    CaseBuffers b(c);
+    b.flags.write(words.data(), n * 4);
+    HostBuffer values(n * 6 * sizeof(float));
+    HostBuffer counters(shared::kCounterCount * 4);
+    vk::CullStatusPass status(vk.passes());
+    vk::FrustumPass frustum(vk.passes());
+    vk.submit([&](VkCommandBuffer cmd) {
+        status.begin(cmd, b.patch_buffers());
+        frustum.run(cmd, b.patch_buffers(), planes, values.range());
+        status.end(cmd, b.patch_buffers(), counters.range());
+    });
+    return {b.flags.read<std::uint32_t>(n), values.read<float>(6 * n),
+            counters.read<std::uint32_t>(shared::kCounterCount)};
+}
+
+// begin -> one test pass on GL buffers holding the case (words with no reason); the flag words.
+std::vector<std::uint32_t> gl_words(const RandomCase& c, const std::function<void(const gl::PatchBuffers&)>& run) {
+    gl_context().make_current();
+    const std::size_t n = c.patches.size();
+    gl::PatchBuffers b;
+    b.control_points = gl_buffer(n * sizeof(BezierPatch), c.patches.data());
+    b.flags = gl_buffer(n * 4, nullptr);
+    if (!c.margins.empty()) b.margins = gl_buffer(n * 4, c.margins.data());
+    b.count = n;
+    gl::CullStatusPass status(gl_passes());
+    status.begin(b);
+    run(b);
+    std::vector<std::uint32_t> words = gl_read<std::uint32_t>(b.flags, n);
+    const GLuint names[] = {b.control_points, b.flags, b.margins};
+    glDeleteBuffers(3, names);
+    return words;
+}
+
+// The same on Vulkan.
+std::vector<std::uint32_t> vk_words(Context& vk, const RandomCase& c,
+                                    const std::function<void(VkCommandBuffer, const vk::PatchBuffers&)>& record) {
+    CaseBuffers b(c);
+    vk::CullStatusPass status(vk.passes());
+    vk.submit([&](VkCommandBuffer cmd) {
+        status.begin(cmd, b.patch_buffers());
+        record(cmd, b.patch_buffers());
+    });
+    return b.flags.read<std::uint32_t>(c.patches.size());
+}
+
+// The teapot split twice and its originals, a third rational, seen from a random eye.
+RandomCase teapot_case(std::uint32_t seed) {
+    RandomCase c;
+    c.patches = test_patches::split_teapot(2);
+    for (const BezierPatch& p : teapot_patches()) c.patches.push_back(p);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> w(0.5f, 2.0f), u(-1.0f, 1.0f);
+    for (std::size_t p = 0; p < c.patches.size(); p += 3)
+        for (Vec4& cp : c.patches[p].cp) {
+            const float k = w(rng);
+            cp = {cp.x * k, cp.y * k, cp.z * k, k};
+        }
+    c.camera.eye = Vec3{u(rng), u(rng), u(rng)} * 6.0f;
+    c.camera.target = {0, 0, 1};
+    return c;
+}
+
+class VkGlEquality : public VkTest {};
+
+}  // namespace
+
+TEST_F(VkGlEquality, FrustumChainWordsEqualGlAndCpuInEveryConvention) {
+    std::size_t culled = 0, total = 0;
+    for (const ClipDepth depth :
+         {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed, ClipDepth::reversed_infinite})
+        for (std::uint32_t seed = 21; seed <= 22; ++seed) {
+            const RandomCase c = random_case(seed, 1500, depth, seed % 2 == 1);
+            const FrustumPlanes planes = make_frustum_planes(c.camera.view_projection(), depth);
+            // Last frame's statuses of every kind, and stale reasons that begin clears.
+            std::vector<std::uint32_t> words(c.patches.size());
+            for (std::size_t p = 0; p < words.size(); ++p)
+                words[p] = (p % 3 == 0 ? kStatusVisible : 0u) | (p % 5 == 0 ? kCullBackPatch : 0u);
+            const ChainResult on_gl = gl_chain(c, planes, words);
+            const ChainResult on_vk = vk_chain(vk(), c, planes, words);
+            const std::vector<std::uint32_t> cpu = cpu_frustum_words(c, planes);
+            const std::string where = std::string(clip_depth_name(depth)) + " seed " + std::to_string(seed);
+            ASSERT_EQ(on_vk.words.size(), on_gl.words.size());
+            for (std::size_t p = 0; p < cpu.size(); ++p) {
+                ASSERT_EQ(on_vk.words[p], on_gl.words[p]) << where << " patch " << p;
+                // The CPU kernel's decision, and the status end gives an uncull one.
+                const bool was_visible = (words[p] & kStatusVisible) != 0;
+                const std::uint32_t expected =
+                    cpu[p] ? cpu[p] : kStatusVisible | (was_visible ? 0u : kStatusNewlyVisible);
+                ASSERT_EQ(on_vk.words[p], expected) << where << " patch " << p;
+                culled += cpu[p] != 0;
+            }
+            total += cpu.size();
+            EXPECT_EQ(on_vk.counters, on_gl.counters) << where;
+            ASSERT_EQ(on_vk.plane_values.size(), on_gl.plane_values.size());
+            EXPECT_EQ(std::memcmp(on_vk.plane_values.data(), on_gl.plane_values.data(), on_vk.plane_values.size() * 4),
+                      0)
+                << where;
+        }
+    EXPECT_GT(culled, total / 10);
+    EXPECT_LT(culled, total * 9 / 10);
+}
+
+TEST_F(VkGlEquality, FrustumDispConeAndPtpWordsEqualGlAndCpu) {
+    // frustum-disp in every convention, with margins.
+    for (const ClipDepth depth :
+         {ClipDepth::zero_to_one, ClipDepth::minus_one_to_one, ClipDepth::reversed, ClipDepth::reversed_infinite}) {
+        const RandomCase c = random_case(41, 1500, depth, true);
+        const Mat4 m = c.camera.view_projection();
+        gl::FrustumDispPass gl_pass(gl_passes());
+        vk::FrustumDispPass vk_pass(vk().passes());
+        const std::vector<std::uint32_t> on_gl =
+            gl_words(c, [&](const gl::PatchBuffers& b) { gl_pass.run(b, m, depth); });
+        const std::vector<std::uint32_t> on_vk =
+            vk_words(vk(), c, [&](VkCommandBuffer cmd, const vk::PatchBuffers& b) { vk_pass.run(cmd, b, m, depth); });
+        std::vector<std::uint8_t> cpu(c.patches.size());
+        cull_frustum_disp_scalar(patch_batch(c.patches).view(), c.margins.data(), m, depth, cpu.data());
+        EXPECT_EQ(on_vk, on_gl) << "frustum-disp " << clip_depth_name(depth);
+        EXPECT_EQ(on_vk, words_of(cpu, kCullFrustum)) << "frustum-disp " << clip_depth_name(depth);
+    }
+    // tcone and ncone, ptp with both rules.
+    const RandomCase c = teapot_case(3);
+    const Vec3 eye = c.camera.eye;
+    const PatchBatch batch = patch_batch(c.patches);
+    for (const BackpatchMethod method : {BackpatchMethod::tcone, BackpatchMethod::ncone}) {
+        gl::BackpatchConePass gl_pass(gl_passes());
+        vk::BackpatchConePass vk_pass(vk().passes());
+        const std::vector<std::uint32_t> on_gl =
+            gl_words(c, [&](const gl::PatchBuffers& b) { gl_pass.run(b, method, eye); });
+        const std::vector<std::uint32_t> on_vk = vk_words(
+            vk(), c, [&](VkCommandBuffer cmd, const vk::PatchBuffers& b) { vk_pass.run(cmd, b, method, eye); });
+        std::vector<std::uint8_t> cpu(c.patches.size());
+        if (method == BackpatchMethod::tcone)
+            cull_tcone_scalar(batch.view(), eye, cpu.data());
+        else
+            cull_ncone_scalar(batch.view(), eye, cpu.data());
+        EXPECT_EQ(on_vk, on_gl) << backpatch_method_name(method);
+        EXPECT_EQ(on_vk, words_of(cpu, kCullBackPatch)) << backpatch_method_name(method);
+    }
+    const Mat4 projection = c.camera.projection();
+    const Mat4 m = projection * c.camera.view();
+    const float alpha = clip_space_eye_alpha(projection);
+    for (const PtpRule rule : {PtpRule::ncnt, PtpRule::pcnt}) {
+        gl::BackpatchPtpPass gl_pass(gl_passes());
+        vk::BackpatchPtpPass vk_pass(vk().passes());
+        const std::vector<std::uint32_t> on_gl =
+            gl_words(c, [&](const gl::PatchBuffers& b) { EXPECT_TRUE(gl_pass.run(b, m, alpha, rule)); });
+        const std::vector<std::uint32_t> on_vk = vk_words(vk(), c, [&](VkCommandBuffer cmd, const vk::PatchBuffers& b) {
+            EXPECT_TRUE(vk_pass.run(cmd, b, m, alpha, rule));
+        });
+        std::vector<std::uint8_t> cpu(c.patches.size());
+        cull_ptp_scalar(batch.view(), m, alpha, rule, cpu.data());
+        EXPECT_EQ(on_vk, on_gl) << "ptp " << static_cast<int>(rule);
+        EXPECT_EQ(on_vk, words_of(cpu, kCullBackPatch)) << "ptp " << static_cast<int>(rule);
+    }
+}
+
+#endif  // PATCHCULL_VK_TEST_GL
