@@ -104,58 +104,56 @@ constexpr int perm_sign(int j, int k, int /*l*/, int x, int y, int z) {
 
 constexpr Schedule make() {
     Schedule s;
-    // Candidate pairs (index into {(j,k), (j,l), (k,l)}) per term; corner terms handled apart.
-    std::array<std::array<bool, 3>, kTermCount> allowed{};
-    std::array<bool, 120> chosen{};
+    // Built for clang's constant evaluator, which gives up after 2^20 steps (-fconstexpr-steps; GCC's
+    // limit is far higher): the scratch arrays are built-in arrays (each std::array::operator[] call
+    // costs several steps), each term's candidate pairs are computed once, and the greedy passes visit
+    // only the terms still uncovered. About 0.3 million steps (the plain version: over 2 million).
+    // Candidate pairs per term: cand[t][q] is the pair index (pair_index) of {(j,k), (j,l), (k,l)}[q]
+    // when both its points lie on the destination's edge, else -1; corner terms handled apart.
+    int cand[kTermCount][3] = {};
+    bool chosen[120] = {};
     for (int t = 0; t < kTermCount; ++t) {
         const TableRow& r = kTable[t];
         const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
-        for (int q = 0; q < 3; ++q) allowed[t][q] = on_dest_edge(r.dest, pa[q][0]) && on_dest_edge(r.dest, pa[q][1]);
+        for (int q = 0; q < 3; ++q)
+            cand[t][q] =
+                on_dest_edge(r.dest, pa[q][0]) && on_dest_edge(r.dest, pa[q][1]) ? pair_index(pa[q][0], pa[q][1]) : -1;
     }
     // Greedy set cover: forced pairs first, then repeatedly the pair covering most uncovered terms
-    // (ties: lowest pair index). Deterministic.
-    std::array<bool, kTermCount> covered{};
+    // (ties: lowest pair index). Deterministic. open[0, n_open): the terms not yet covered (a chosen
+    // candidate pair covers a term for good), the non-corner terms at first, compacted on every pass.
+    int open[kTermCount] = {};
+    int n_open = 0;
     for (int t = 0; t < kTermCount; ++t) {
-        if (is_corner_dest(kTable[t].dest)) {
-            covered[t] = true;
-            continue;
-        }
+        if (is_corner_dest(kTable[t].dest)) continue;
+        open[n_open++] = t;
         int n = 0, only = -1;
         for (int q = 0; q < 3; ++q)
-            if (allowed[t][q]) ++n, only = q;
+            if (cand[t][q] >= 0) ++n, only = q;
         if (n == 0) throw "ptp schedule: boundary term without an edge pair";
-        if (n == 1) {
-            const TableRow& r = kTable[t];
-            const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
-            chosen[pair_index(pa[only][0], pa[only][1])] = true;
-        }
+        if (n == 1) chosen[cand[t][only]] = true;
     }
-    auto term_covered = [&](int t) {
-        const TableRow& r = kTable[t];
-        const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
-        for (int q = 0; q < 3; ++q)
-            if (allowed[t][q] && chosen[pair_index(pa[q][0], pa[q][1])]) return true;
-        return false;
-    };
     for (;;) {
-        std::array<int, 120> count{};
-        bool any = false;
-        for (int t = 0; t < kTermCount; ++t) {
-            if (covered[t] || term_covered(t)) continue;
-            any = true;
-            const TableRow& r = kTable[t];
-            const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
+        int count[120] = {};
+        int kept = 0;
+        for (int i = 0; i < n_open; ++i) {
+            const int t = open[i];
+            bool covered = false;
+            for (int q = 0; q < 3 && !covered; ++q) covered = cand[t][q] >= 0 && chosen[cand[t][q]];
+            if (covered) continue;
+            open[kept++] = t;
             for (int q = 0; q < 3; ++q)
-                if (allowed[t][q]) ++count[pair_index(pa[q][0], pa[q][1])];
+                if (cand[t][q] >= 0) ++count[cand[t][q]];
         }
-        if (!any) break;
+        n_open = kept;
+        if (n_open == 0) break;
         int best = 0;
         for (int p = 1; p < 120; ++p)
             if (count[p] > count[best]) best = p;
         chosen[best] = true;
     }
     // Dense numbering of the chosen pairs, in pair index order.
-    std::array<int, 120> slot{};
+    int slot[120] = {};
     for (int a = 0; a < 16; ++a)
         for (int b = a + 1; b < 16; ++b)
             if (chosen[pair_index(a, b)]) {
@@ -184,14 +182,13 @@ constexpr Schedule make() {
                            static_cast<std::uint8_t>(other[0]), static_cast<std::uint8_t>(other[1]), sign > 0 ? w : -w};
                 continue;
             }
-            const int pa[3][2] = {{r.j, r.k}, {r.j, r.l}, {r.k, r.l}};
             const int third[3] = {r.l, r.k, r.j};
             const int sign[3] = {1, -1, 1};  // det[j,k,l] = det[j,k,l] = -det[j,l,k] = det[k,l,j]
             int q = -1;
             for (int e = 0; e < 3 && q < 0; ++e)
-                if (allowed[t][e] && chosen[pair_index(pa[e][0], pa[e][1])]) q = e;
-            s.steps[n++] = Step{static_cast<std::uint8_t>(slot[pair_index(pa[q][0], pa[q][1])]),
-                                static_cast<std::uint8_t>(third[q]), sign[q] > 0 ? w : -w};
+                if (cand[t][e] >= 0 && chosen[cand[t][e]]) q = e;
+            s.steps[n++] = Step{static_cast<std::uint8_t>(slot[cand[t][q]]), static_cast<std::uint8_t>(third[q]),
+                                sign[q] > 0 ? w : -w};
         }
     }
     s.dest_first[64] = static_cast<std::uint16_t>(n);

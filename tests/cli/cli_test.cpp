@@ -281,7 +281,7 @@ TEST(Cli, StrictFlagsStillTakeEveryValidValue) {
 // whole job and then exited 3 ("internal error: filesystem error").
 TEST(Cli, OutputPathsAreCheckedBeforeTheWork) {
     const std::string file = write_file("a_file", "x");
-    const std::string dir = scratch_dir();
+    const std::string& dir = scratch_dir();
     std::filesystem::create_directories(dir + "/blocked/frame.png");  // a directory where a file goes
     // demo: the directory cannot be created, its parent is a file, or one of its files cannot be written.
     expect_one_line_error(run("demo --out-dir /proc/nonexistent"),
@@ -292,16 +292,27 @@ TEST(Cli, OutputPathsAreCheckedBeforeTheWork) {
     expect_one_line_error(run("demo --out-dir " + dir + "/blocked"),
                           "--out-dir: cannot write '" + dir + "/blocked/frame.png': is a directory");
     // render --out and view --screenshot: a missing directory, a directory, a file as the parent, empty.
+    // "FLAG: cannot write 'PATH': WHY"
+    const auto cannot_write = [](const std::string& flag, const std::string& path, const char* why) {
+        std::string message = flag;
+        message += ": cannot write '";
+        message += path;
+        message += "': ";
+        message += why;
+        return message;
+    };
     for (const std::string command : {"render teapot --frames 1 --size 8x8", "view teapot --frames 1 --size 8x8"}) {
         const std::string flag = command.rfind("render", 0) == 0 ? "--out" : "--screenshot";
         SCOPED_TRACE(command);
-        expect_one_line_error(run(command + " " + flag + " /nonexistent/dir/x.png"),
-                              flag + ": cannot write '/nonexistent/dir/x.png': No such file or directory");
-        expect_one_line_error(run(command + " " + flag + " " + dir),
-                              flag + ": cannot write '" + dir + "': is a directory");
-        expect_one_line_error(run(command + " " + flag + " " + file + "/x.png"),
-                              flag + ": cannot write '" + file + "/x.png': Not a directory");
-        expect_one_line_error(run(command + " " + flag + " ''"), flag + ": empty path");
+        std::string with_flag = command;  // "COMMAND FLAG "
+        with_flag += ' ';
+        with_flag += flag;
+        with_flag += ' ';
+        expect_one_line_error(run(with_flag + "/nonexistent/dir/x.png"),
+                              cannot_write(flag, "/nonexistent/dir/x.png", "No such file or directory"));
+        expect_one_line_error(run(with_flag + dir), cannot_write(flag, dir, "is a directory"));
+        expect_one_line_error(run(with_flag + file + "/x.png"), cannot_write(flag, file + "/x.png", "Not a directory"));
+        expect_one_line_error(run(with_flag + "''"), flag + ": empty path");
     }
 }
 

@@ -17,9 +17,14 @@ namespace {
 
 std::string box_obj(const std::string& half) {
     std::string obj;
-    for (int i = 0; i < 8; ++i)
-        obj += "v " + std::string(i & 1 ? "" : "-") + half + " " + (i & 2 ? "" : "-") + half + " " +
-               (i & 4 ? "" : "-") + half + "\n";
+    for (int i = 0; i < 8; ++i) {
+        obj += 'v';
+        for (int bit : {1, 2, 4}) {
+            obj += i & bit ? " " : " -";
+            obj += half;
+        }
+        obj += '\n';
+    }
     obj += "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
     return obj;
 }

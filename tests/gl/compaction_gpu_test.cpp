@@ -359,12 +359,14 @@ TEST(GpuCompaction, CompactedDrawGivesTheFlagPathsIdImage) {
     // does not depend on the order of the list).
     std::vector<float> points(16 * 4 * kPatches);
     for (std::size_t p = 0; p < kPatches; ++p) {
-        const float x0 = -1.0f + 2.0f * static_cast<float>(p % kCols) / kCols;
-        const float y0 = -1.0f + 2.0f * static_cast<float>(p / kCols) / kRows;
+        const std::size_t cell_col = p % kCols, cell_row = p / kCols;
+        const float x0 = -1.0f + 2.0f * static_cast<float>(cell_col) / kCols;
+        const float y0 = -1.0f + 2.0f * static_cast<float>(cell_row) / kRows;
         for (int k = 0; k < 16; ++k) {
             float* v = &points[4 * (16 * p + static_cast<std::size_t>(k))];
-            v[0] = x0 + (2.0f / kCols) * static_cast<float>(k % 4) / 3.0f;
-            v[1] = y0 + (2.0f / kRows) * static_cast<float>(k / 4) / 3.0f;
+            const int col = k % 4, row = k / 4;
+            v[0] = x0 + (2.0f / kCols) * static_cast<float>(col) / 3.0f;
+            v[1] = y0 + (2.0f / kRows) * static_cast<float>(row) / 3.0f;
             v[2] = 0.0f;
             v[3] = 1.0f;
         }

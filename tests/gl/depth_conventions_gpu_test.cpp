@@ -214,15 +214,15 @@ TEST(DepthConventionsGpu, NoPassCullsAPatchWithANonFiniteCoordinate) {
             "FrustumDispPass" + tag, outside, 0.25f, [&](const PatchBuffers& b) { frustum_disp.run(b, m, depth); },
             true);
         for (const BezierPatch* base : {&outside, &behind_wall}) {
-            const std::string which = base == &outside ? " outside" : " occluded";
-            expect_only_base_culled("OcclusionPass" + which + tag, *base, 0.0f,
+            const std::string where = (base == &outside ? " outside" : " occluded") + tag;
+            expect_only_base_culled("OcclusionPass" + where, *base, 0.0f,
                                     [&](const PatchBuffers& b) { occlusion.run(b, m, depth, hiz, true); });
-            expect_only_base_culled("FusedCullPass" + which + tag, *base, 0.0f, [&](const PatchBuffers& b) {
+            expect_only_base_culled("FusedCullPass" + where, *base, 0.0f, [&](const PatchBuffers& b) {
                 fused.run(b, shared::kCullFrustum | shared::kCullBackPatch | shared::kCullOcclusion, m, depth,
                           BackpatchMethod::tcone, camera.eye, &hiz);
             });
             const DisplacedCullView view = make_displaced_cull_view(camera.view(), proj, depth);
-            expect_only_base_culled("DisplacedPass" + which + tag, *base, 0.0f, [&](const PatchBuffers& b) {
+            expect_only_base_culled("DisplacedPass" + where, *base, 0.0f, [&](const PatchBuffers& b) {
                 displaced.run(b, 0, DisplacedBoundKind::caf, NormalConeKind::full, view, &hiz, false);
             });
         }

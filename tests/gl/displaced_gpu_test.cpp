@@ -406,6 +406,7 @@ TEST(DisplacedGpu, ReadsTheRenderersPatchBuffer) {
     const std::vector<BezierPatch> patches = test::split_teapot(1);
     std::mt19937 rng(3);
     std::vector<DisplacementRange> ranges;
+    ranges.reserve(patches.size());
     for (const BezierPatch& p : patches) ranges.push_back(random_range(rng, patch_size(p)));
     PatchRenderer renderer(test::context());
     renderer.set_patches(patches);

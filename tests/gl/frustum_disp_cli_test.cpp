@@ -92,9 +92,10 @@ TEST(FrustumDispCli, ViewRunsTheChosenTest) {
     const std::string scene = half_out_scene("acc");
     std::size_t culled[2] = {};
     int i = 0;
+    const std::string common = scene + " --frames 2 --size 64x36 --tess 2 --cull frustum --frustum ";
     for (const std::string test : {"hull", "aabb"}) {
         SCOPED_TRACE(test);
-        const std::string args = scene + " --frames 2 --size 64x36 --tess 2 --cull frustum --frustum " + test;
+        const std::string args = common + test;
         const CliRun v = run("view " + args, "xvfb-run -a -s '-screen 0 1280x1024x24'");
         ASSERT_EQ(v.status, 0) << v.err;
         const CliRun r = run("render " + args + " --json");

@@ -200,8 +200,10 @@ TEST(GpuFrustumDispCull, MarginIsUsedAndCatchesAZeroBuffer) {
         // The left plane at z = 0 is x = -5 tan(fovy/2) aspect; place the patch's right edge outside it.
         const float edge = -planes.rows[0].w / planes.rows[0].x;  // x where w + x = 0 on the z = 0 plane (y = 0)
         const float gap = 0.05f * static_cast<float>(i + 1);
-        for (int k = 0; k < 16; ++k)
-            patch.cp[k] = homogeneous(Vec3{edge - gap - 0.1f * (k % 4), 0.1f * (k / 4) - 0.15f, 0.0f});
+        for (int k = 0; k < 16; ++k) {
+            const int col = k % 4, row = k / 4;
+            patch.cp[k] = homogeneous(Vec3{edge - gap - 0.1f * col, 0.1f * row - 0.15f, 0.0f});
+        }
         patches.push_back(patch);
         margins.push_back(i % 2 ? 0.6f : 0.0f);
     }

@@ -200,7 +200,10 @@ TEST(GpuFrustumCull, MarginIsUsedAndBeginClearsStaleReasons) {
     Camera cam;  // at (0,0,5) looking at the origin
     const Mat4 vp = cam.view_projection();
     BezierPatch patch;
-    for (int k = 0; k < 16; ++k) patch.cp[k] = homogeneous(Vec3{-5.0f - 0.1f * (k % 4), 0.1f * (k / 4), 0.0f});
+    for (int k = 0; k < 16; ++k) {
+        const int col = k % 4, row = k / 4;
+        patch.cp[k] = homogeneous(Vec3{-5.0f - 0.1f * col, 0.1f * row, 0.0f});
+    }
     PatchRenderer r(test::context());
     r.set_patches({patch, patch}, test::margins_only({0.0f, 10.0f}));
     const std::uint8_t stale[2] = {0, 1};

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_test_util.h"
+#include "core/test_patches.h"
 #include "gl_test_util.h"
 #include "patchcull/core/error.h"
 #include "patchcull/gl/gl_pipeline.h"
@@ -119,7 +120,7 @@ void expect_identical_poses(const Scene& scene, const std::vector<float>& times,
         const std::vector<BezierPatch> back = read_buffer<BezierPatch>(r.patch_buffer(), posed.size());
         std::size_t differing = 0;
         for (std::size_t p = 0; p < posed.size(); ++p)
-            differing += std::memcmp(&back[p], &posed[p], sizeof(BezierPatch)) != 0 ? 1 : 0;
+            differing += test_patches::bit_identical(back[p], posed[p]) ? 0 : 1;
         EXPECT_EQ(differing, 0u) << scene.name << " t=" << t << ": patches differing from the CPU pose";
         if (gpu.has_tangents()) {
             const std::vector<Vec4> expected = tangent_layout(cpu, posed.size());

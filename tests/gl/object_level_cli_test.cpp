@@ -264,6 +264,7 @@ TEST(ObjectLevelGpu, VerifyCatchesAFalseObjectCull) {
     std::vector<Vec3> v;
     std::vector<std::uint32_t> idx;
     const Vec3 lo{2.2f, -0.5f, 0.0f}, hi{3.2f, 0.5f, 1.0f};
+    v.reserve(8);
     for (int i = 0; i < 8; ++i) v.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
     const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
                                        {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};

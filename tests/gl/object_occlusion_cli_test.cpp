@@ -85,8 +85,9 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
 
     std::vector<std::string> expected_names{"none"};
     expected_names.insert(expected_names.end(), methods.begin(), methods.end());
-    const std::vector<json> rows(j["methods"].begin(), j["methods"].end());
+    std::vector<json> rows(j["methods"].begin(), j["methods"].end());  // not const: returned by move
     std::vector<std::string> names;
+    names.reserve(rows.size());
     for (const json& row : rows) names.push_back(row.value("name", "?"));
     if (!methods.empty()) {
         EXPECT_EQ(names, expected_names) << args;
@@ -112,8 +113,9 @@ std::vector<json> eval_scene(const std::string& scene, const SceneFacts& facts, 
                                          "frame_ratio",
                                          "false_culls"};
     const std::set<std::string> ms_keys{"object_cpu", "pass1", "hiz", "cull", "pass2", "frame"};
+    const std::string what_prefix = args + ": ";
     for (const json& row : rows) {
-        const std::string name = row.value("name", "?"), what = args + ": " + name;
+        const std::string name = row.value("name", "?"), what = what_prefix + name;
         if (json_keys(row) != row_keys || json_keys(row["ms"]) != ms_keys) {
             ADD_FAILURE() << what << ": keys " << row.dump();
             continue;
@@ -247,6 +249,7 @@ TEST(ObjectOcclusionCli, EvalSceneTwoRoomsEveryMethod) {
     const std::vector<json> rows =
         eval_scene(two_rooms(), {"two_rooms", kRoomsObjects, kRoomsCharacters, kRoomsPatches}, {}, 4, 2);
     std::vector<std::string> names;
+    names.reserve(rows.size());
     for (const json& r : rows) names.push_back(r["name"]);
     const std::vector<std::string> all{
         "none",    "hiz",   "stop-and-wait", "stop-and-wait+hiz", "batched",     "batched+hiz", "chc",

@@ -68,7 +68,8 @@ TEST(PatchRenderer, TeapotFillsIdDepthAndColourBuffers) {
     std::size_t knob_pixels = 0;
     for (std::size_t i = 0; i < ids.size(); ++i)
         if (ids[i] >= 21 && ids[i] <= 24) {
-            knob_rows += static_cast<double>(i / 256);
+            const std::size_t row = i / 256;  // the image is 256 wide
+            knob_rows += static_cast<double>(row);
             ++knob_pixels;
         }
     ASSERT_GT(knob_pixels, 0u);

@@ -61,7 +61,10 @@ TEST(Visibility, InsideOutClosedMeshIsCulledWithItsOutwardSide) {
         const std::string path = edited_bigguy(
             std::string("bigguy_") + edit + ".obj",
             reversed ? unchanged : [](int, double& x, double&, double&) { x = -x; }, reversed);
-        const CliRun r = run("render " + path + args + " --verify --json");
+        std::string command = "render " + path;
+        command += args;
+        command += " --verify --json";
+        const CliRun r = run(command);
         ASSERT_EQ(r.status, 0) << edit << ": " << r.err;
         EXPECT_NE(r.err.find("oriented inward"), std::string::npos) << edit << ": " << r.err;
         const auto j = nlohmann::json::parse(r.out);
