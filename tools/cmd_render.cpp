@@ -353,7 +353,7 @@ Runner add_render_command(CLI::App& app) {
                 ms["object_level"] = object_level->object_level_ms();  // CPU, before the GPU frame
                 ms["cpu_frustum_after_objects"] = object_level->cpu_frustum_ms();
             }
-            std::size_t false_culls = 0, depth_ties = 0;
+            std::size_t false_culls = 0, depth_ties = 0, differing_pixels = 0;
             std::vector<std::uint32_t> false_culled;  // patch indices, ascending
             ObjectVerification object_check;
             if (state->verify) {
@@ -367,6 +367,7 @@ Runner add_render_command(CLI::App& app) {
                 false_culled = object_check.patch_false_culls;
                 false_culls = false_culled.size() + object_check.false_culled_triangles;
                 depth_ties = cmp.depth_ties;
+                differing_pixels = cmp.differing_pixels;
                 ms["reference"] = reference.ms;
             }
             total_false += false_culls;
@@ -392,6 +393,7 @@ Runner add_render_command(CLI::App& app) {
                               {"fused_pass", stats.fused_pass},
                               {"submitted", {{"pass1", stats.pass1_submitted}, {"pass2", stats.pass2_submitted}}}});
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
+            if (state->verify) frames.back()["differing_pixels"] = differing_pixels;
             if (automatic) frames.back()["auto_objects"] = auto_objects_json(objects, policy.decisions());
             {
                 nlohmann::json& o = frames.back()["objects"] = object_level->frame_json();
