@@ -10,8 +10,9 @@
 //   back-patch tcone/ncone cull_tcone/ncone_scalar        BackpatchConePass  backpatch_cones.comp.glsl
 //   back-patch ptp         cull_ptp_scalar                BackpatchPtpPass   backpatch_ptp.comp.glsl
 //   (ends of the chain)    -                              CullStatusPass     cull_status.comp.glsl
-// The other passes of gl_passes.h (Hi-Z build, occlusion, displaced, fused, compaction) and the
-// passes over a GpuPatchSource have no Vulkan twin yet (docs/ENGINE.md, "Vulkan").
+//   (after the chain)      -                              CompactPass        compact.comp.glsl
+// The other passes of gl_passes.h (Hi-Z build, occlusion, displaced, fused) and the passes over a
+// GpuPatchSource have no Vulkan twin yet (docs/ENGINE.md, "Vulkan").
 //
 // Buffers: the layouts of gl_passes.h (control points 16 vec4 per patch in patch.h order, 256
 // bytes; the flag word, core/cull_flags.h, one uint per patch; margins one float per patch;
@@ -26,10 +27,12 @@
 //   vkCmdPushDescriptorSetKHR(set 0): the caller's ranges as storage-buffer descriptors at the
 //     binding numbers of shaders/shared.h (kBindingControlPoints 0, kBindingCullFlags 1,
 //     kBindingMaxDisplacement 2, kBindingPlaneValues 4, kBindingCullCounters 6,
-//     kBindingPtpPlanes 13, kBindingConeValues 14); an optional range left empty is replaced by
-//     a small buffer of the PassContext (never read)
+//     kBindingPtpPlanes 13, kBindingConeValues 14; CompactPass: kBindingDrawList 26,
+//     kBindingDrawCommands 27, kBindingDrawCount 28, kBindingCompactSums 29); an optional range
+//     left empty is replaced by a small buffer of the PassContext (never read)
 //   per dispatch: vkCmdPushConstants (its pass_params.h block, std140, at offset 0) and
-//     vkCmdDispatch; ranges of more than 65535 work groups are split into several
+//     vkCmdDispatch; ranges of more than 65535 work groups are split into several (CompactPass:
+//     its steps, with a compute-to-compute VkMemoryBarrier between them)
 //   vkCmdPipelineBarrier: one VkMemoryBarrier from VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT /
 //     VK_ACCESS_SHADER_WRITE_BIT to PassContextOptions::after_stages / after_access (default:
 //     every stage and access), so the next pass of the chain, a draw's tessellation control
@@ -230,6 +233,54 @@ public:
     /// culled).
     bool run(VkCommandBuffer cmd, const PatchBuffers& patches, const Mat4& object_to_clip, float alpha, PtpRule rule,
              const BufferRange& plane_values = {});
+
+private:
+    PassContext::Impl* context_;
+};
+
+/// How CompactPass builds the list; both give the same set of patches (gl_compaction.h's).
+enum class CompactMethod {
+    atomic_append,  ///< one atomicAdd per work group: the list's order may change from run to run
+    prefix_scan,    ///< a prefix scan over work-group sums: ascending patch index, every run
+};
+
+/// The commands CompactPass writes for a range of count patches with at most patches_per_command
+/// patches each (0: no limit): max(1, ceil(count / patches_per_command)); the maxDrawCount of the
+/// range's vkCmdDrawIndirectCount.
+std::size_t compact_command_count(std::size_t count, std::size_t patches_per_command);
+/// The bytes of CompactPass's scratch range for a range of count patches: 4 for the append; for the
+/// scan 4 per 2048 patches (a work group's) plus 4.
+std::size_t compact_scratch_bytes(std::size_t count, CompactMethod method);
+
+/// Where CompactPass writes (the caller's ranges, each bound from its offset).
+struct DrawListRanges {
+    BufferRange list;            ///< required: uint entries, at least list_first + count of them
+    std::size_t list_first = 0;  ///< the range's first entry of the list
+    /// required: compact_command_count(count, patches_per_command) VkDrawIndirectCommands (16
+    /// bytes each; the buffer also needs VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT to be drawn from)
+    BufferRange command;
+    BufferRange draw_count;               ///< optional: one uint, the draw count (vkCmdDrawIndirectCount's countBuffer)
+    BufferRange scratch;                  ///< required: compact_scratch_bytes(count, method) bytes the pass overwrites
+    std::size_t patches_per_command = 0;  ///< K: at most this many patches per command (0: one command)
+};
+
+/// gl_compaction.h's CompactPass on Vulkan: the patches of a range whose flag word satisfies
+/// (flag & mask) == value, as a list of patch indices and indirect draw commands over it, for a
+/// draw of only the survivors (vkCmdDrawIndirectCount, or vkCmdDrawIndirect over all C commands:
+/// those past the survivors draw 0 vertices). Command c is {16 m, 1, 16 (list_first + c K), 0}
+/// with m = min(K, n - c K) where positive, else 0 (VkDrawIndirectCommand's vertexCount,
+/// instanceCount, firstVertex, firstInstance); the draw count is ceil(n / K) (one command without a
+/// limit: 1 when n > 0, else 0). The vertex shader pulls point gl_VertexIndex % 16 of patch
+/// list[gl_VertexIndex / 16]. The pass creates nothing per call: the scan's sums live in the
+/// caller's scratch range.
+class CompactPass {
+public:
+    explicit CompactPass(PassContext& context);
+    /// Records the steps; a range of 0 patches writes the one command {0, 1, 16 list_first, 0} and
+    /// draw count 0. Error (one line) for a range too small or misaligned, or list_first + count
+    /// past 2^28.
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, std::uint32_t mask, std::uint32_t value,
+             const DrawListRanges& out, CompactMethod method = CompactMethod::prefix_scan);
 
 private:
     PassContext::Impl* context_;
