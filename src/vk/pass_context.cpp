@@ -103,6 +103,19 @@ PassContext::PassContext(VkPhysicalDevice physical_device, VkDevice device, cons
     load(get, device, c.CmdPushConstants, "vkCmdPushConstants");
     load(get, device, c.CmdDispatch, "vkCmdDispatch");
     load(get, device, c.CmdPipelineBarrier, "vkCmdPipelineBarrier");
+    load(get, device, c.CreateSampler, "vkCreateSampler");
+    load(get, device, c.DestroySampler, "vkDestroySampler");
+
+    VkSamplerCreateInfo sampler_info{};
+    sampler_info.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
+    sampler_info.magFilter = VK_FILTER_NEAREST;
+    sampler_info.minFilter = VK_FILTER_NEAREST;
+    sampler_info.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    sampler_info.addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    sampler_info.addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    sampler_info.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    sampler_info.maxLod = VK_LOD_CLAMP_NONE;
+    check_vk(c.CreateSampler(device, &sampler_info, nullptr, &m.sampler), "PassContext", "vkCreateSampler");
 
     // The placeholder: 256 bytes of storage, device-local where a memory type offers it.
     VkBufferCreateInfo buffer_info{};
@@ -138,6 +151,7 @@ PassContext::Impl::~Impl() {
         vk.DestroyPipelineLayout(device, p.layout, nullptr);
         vk.DestroyDescriptorSetLayout(device, p.set_layout, nullptr);
     }
+    if (vk.DestroySampler) vk.DestroySampler(device, sampler, nullptr);
     if (vk.DestroyBuffer) vk.DestroyBuffer(device, placeholder, nullptr);
     if (vk.FreeMemory) vk.FreeMemory(device, placeholder_memory, nullptr);
 }
@@ -149,7 +163,7 @@ bool PassContext::fma_via_double() const { return impl_->fma_via_double; }
 PassContext::Impl& PassContext::impl() { return *impl_; }
 
 const detail::Pipeline& PassContext::Impl::pipeline(const char* shader, const char* variant,
-                                                    std::initializer_list<std::uint32_t> bindings,
+                                                    std::initializer_list<detail::Slot> slots,
                                                     std::uint32_t push_constant_bytes) {
     const std::string key = std::string(shader) + " " + variant;
     auto it = pipelines.find(key);
@@ -167,9 +181,9 @@ const detail::Pipeline& PassContext::Impl::pipeline(const char* shader, const ch
     try {
         std::array<VkDescriptorSetLayoutBinding, detail::kMaxBindings> layout_bindings{};
         std::uint32_t n = 0;
-        for (const std::uint32_t b : bindings) {
-            layout_bindings[n].binding = b;
-            layout_bindings[n].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        for (const detail::Slot& slot : slots) {
+            layout_bindings[n].binding = slot.binding;
+            layout_bindings[n].descriptorType = slot.type;
             layout_bindings[n].descriptorCount = 1;
             layout_bindings[n].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
             ++n;

@@ -49,6 +49,8 @@ struct DeviceCommands {
     PFN_vkCmdPushConstants CmdPushConstants = nullptr;
     PFN_vkCmdDispatch CmdDispatch = nullptr;
     PFN_vkCmdPipelineBarrier CmdPipelineBarrier = nullptr;
+    PFN_vkCreateSampler CreateSampler = nullptr;
+    PFN_vkDestroySampler DestroySampler = nullptr;
 };
 
 /// One cached compute pipeline: its push-descriptor set layout (storage buffers at `bindings`),
@@ -67,6 +69,13 @@ struct Binding {
     BufferRange range;
 };
 
+/// A descriptor of a pipeline's set 0: its binding number and type (a storage buffer unless said).
+struct Slot {
+    Slot(std::uint32_t b, VkDescriptorType t = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) : binding(b), type(t) {}
+    std::uint32_t binding;
+    VkDescriptorType type;
+};
+
 /// The most storage buffers one pass binds.
 inline constexpr std::size_t kMaxBindings = 8;
 
@@ -81,15 +90,16 @@ struct PassContext::Impl {
     VkPhysicalDeviceLimits limits{};
     VkBuffer placeholder = VK_NULL_HANDLE;  // 256 bytes, bound for an empty optional range
     VkDeviceMemory placeholder_memory = VK_NULL_HANDLE;
+    VkSampler sampler = VK_NULL_HANDLE;                 // nearest, clamp to edge: the Hi-Z passes' texelFetch
     std::map<std::string, detail::Pipeline> pipelines;  // key: shader name + " " + variant
 
     ~Impl();
     /// The pipeline of compute shader `shader` in `variant` ("" or the define of a variant; its
-    /// SPIR-V module in this context's fma mode) reading storage buffers at `bindings` and push
+    /// SPIR-V module in this context's fma mode) reading the descriptors `slots` of set 0 and push
     /// constants of push_constant_bytes; created on first use. Throws Error when the block
     /// exceeds maxPushConstantsSize.
-    const detail::Pipeline& pipeline(const char* shader, const char* variant,
-                                     std::initializer_list<std::uint32_t> bindings, std::uint32_t push_constant_bytes);
+    const detail::Pipeline& pipeline(const char* shader, const char* variant, std::initializer_list<detail::Slot> slots,
+                                     std::uint32_t push_constant_bytes);
     /// Throws (one line naming who and what) unless range is in a buffer, holds at least bytes
     /// bytes, starts at a multiple of minStorageBufferOffsetAlignment and fits maxStorageBufferRange.
     /// An optional range may be empty (buffer VK_NULL_HANDLE, size 0).

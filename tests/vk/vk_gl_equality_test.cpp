@@ -3,7 +3,8 @@
 // chain begin -> frustum -> end leaves the same flag words and counters on both APIs, equal to
 // cull_frustum_scalar's decisions, and the frustum pass's six plane maxima are bit-identical, in
 // every ClipDepth convention, with and without margins; the frustum-disp, tcone, ncone and ptp
-// passes leave the same words on both APIs, equal to their CPU scalar kernels'. Built only with
+// passes leave the same words on both APIs, equal to their CPU scalar kernels'; the compaction
+// pass writes the same list (the scan's order), commands and draw count. Built only with
 // PATCHCULL_WITH_GL.
 #include <gtest/gtest.h>
 
@@ -19,6 +20,7 @@
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/clip_space.h"
 #include "patchcull/core/teapot.h"
+#include "patchcull/gl/gl_compaction.h"
 #include "patchcull/gl/gl_context.h"
 #include "patchcull/gl/gl_passes.h"
 #include "shared.h"
@@ -248,6 +250,58 @@ TEST_F(VkGlEquality, FrustumDispConeAndPtpWordsEqualGlAndCpu) {
         EXPECT_EQ(on_vk, on_gl) << "ptp " << static_cast<int>(rule);
         EXPECT_EQ(on_vk, words_of(cpu, kCullBackPatch)) << "ptp " << static_cast<int>(rule);
     }
+}
+
+TEST_F(VkGlEquality, CompactionWritesTheSameListCommandsAndCount) {
+    std::mt19937 rng(8);
+    const std::size_t n = 6000, first = 5, count = 5900, list_first = 3, k = 500;
+    std::vector<std::uint32_t> words(n);
+    for (std::uint32_t& w : words) w = rng() % 3 == 0 ? kCullOcclusion : (rng() % 2 ? kStatusVisible : 0u);
+    const std::size_t commands = vk::compact_command_count(count, k);
+    ASSERT_EQ(commands, gl::compact_command_count(count, k));
+    // GL.
+    gl_passes();
+    gl::PatchBuffers gb;
+    gb.flags = gl_buffer(n * 4, words.data());
+    gb.first = first;
+    gb.count = count;
+    gl::DrawListBuffers gout;
+    gout.list = gl_buffer((list_first + count) * 4, nullptr);
+    gout.list_first = list_first;
+    gout.command = gl_buffer(commands * 16, nullptr);
+    gout.draw_count = gl_buffer(4, nullptr);
+    gout.patches_per_command = k;
+    gl::CompactPass gl_pass(gl_passes());
+    gl_pass.run(gb, shared::kDrawMaskUnculled, shared::kDrawValueUnculled, gout, gl::CompactMethod::prefix_scan);
+    const std::vector<std::uint32_t> gl_list = gl_read<std::uint32_t>(gout.list, list_first + count);
+    const std::vector<std::uint32_t> gl_commands = gl_read<std::uint32_t>(gout.command, commands * 4);
+    const std::uint32_t gl_count = gl_read<std::uint32_t>(gout.draw_count, 1)[0];
+    const GLuint names[] = {gb.flags, gout.list, gout.command, gout.draw_count};
+    glDeleteBuffers(4, names);
+    // Vulkan.
+    HostBuffer flags(n * 4), list((list_first + count) * 4), command(commands * 16), draw_count(4),
+        scratch(vk::compact_scratch_bytes(count, vk::CompactMethod::prefix_scan));
+    flags.write(words.data(), n * 4);
+    vk::PatchBuffers vb;
+    vb.flags = flags.range();
+    vb.first = first;
+    vb.count = count;
+    vk::DrawListRanges vout;
+    vout.list = list.range();
+    vout.list_first = list_first;
+    vout.command = command.range();
+    vout.draw_count = draw_count.range();
+    vout.scratch = scratch.range();
+    vout.patches_per_command = k;
+    vk::CompactPass vk_pass(vk().passes());
+    vk().submit([&](VkCommandBuffer cmd) {
+        vk_pass.run(cmd, vb, shared::kDrawMaskUnculled, shared::kDrawValueUnculled, vout,
+                    vk::CompactMethod::prefix_scan);
+    });
+    EXPECT_EQ(list.read<std::uint32_t>(list_first + count), gl_list);
+    EXPECT_EQ(command.read<std::uint32_t>(commands * 4), gl_commands);
+    EXPECT_EQ(draw_count.read<std::uint32_t>(1)[0], gl_count);
+    EXPECT_GT(gl_count, 1u);
 }
 
 #endif  // PATCHCULL_VK_TEST_GL

@@ -11,7 +11,8 @@
 //   back-patch ptp         cull_ptp_scalar                BackpatchPtpPass   backpatch_ptp.comp.glsl
 //   (ends of the chain)    -                              CullStatusPass     cull_status.comp.glsl
 //   (after the chain)      -                              CompactPass        compact.comp.glsl
-// The other passes of gl_passes.h (Hi-Z build, occlusion, displaced, fused) and the passes over a
+//   Hi-Z pyramid           HiZPyramid::build              HiZBuildPass       hiz_build.comp.glsl
+// The other passes of gl_passes.h (occlusion, displaced, fused) and the passes over a
 // GpuPatchSource have no Vulkan twin yet (docs/ENGINE.md, "Vulkan").
 //
 // Buffers: the layouts of gl_passes.h (control points 16 vec4 per patch in patch.h order, 256
@@ -73,6 +74,7 @@
 
 #include <vulkan/vulkan.h>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -82,6 +84,7 @@
 #include "patchcull/core/clip_space.h"
 #include "patchcull/core/cull_view.h"
 #include "patchcull/core/frustum.h"
+#include "patchcull/core/hiz.h"
 #include "patchcull/core/math.h"
 
 namespace patchcull::vk {
@@ -281,6 +284,58 @@ public:
     /// past 2^28.
     void run(VkCommandBuffer cmd, const PatchBuffers& patches, std::uint32_t mask, std::uint32_t value,
              const DrawListRanges& out, CompactMethod method = CompactMethod::prefix_scan);
+
+private:
+    PassContext::Impl* context_;
+};
+
+/// The caller's depth attachment as HiZBuildPass reads it: a 2D view of its depth aspect alone,
+/// the layout it is in while the pass runs (VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+/// VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL or VK_IMAGE_LAYOUT_GENERAL) and its format
+/// (VK_FORMAT_D32_SFLOAT or VK_FORMAT_D32_SFLOAT_S8_UINT; the 24-bit formats are not taken yet).
+struct DepthImage {
+    VkImageView view = VK_NULL_HANDLE;
+    VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    VkFormat format = VK_FORMAT_D32_SFLOAT;
+};
+
+/// The Hi-Z pyramid of a width x height depth buffer in the caller's image, made from
+/// hiz_image_create_info(width, height): VK_FORMAT_R32_SFLOAT, HiZPyramid::level_count(width,
+/// height) mip levels, level l holding hiz.h's level l in its first W_l x H_l texels (texel (x,
+/// y) at image row y). all_levels: a 2D view of every level (sampled); level_views[l]: a 2D view
+/// of level l alone (storage), one per level. The image is in VK_IMAGE_LAYOUT_GENERAL while the
+/// passes use it.
+struct HiZImage {
+    VkImage image = VK_NULL_HANDLE;
+    VkImageView all_levels = VK_NULL_HANDLE;
+    std::array<VkImageView, HiZPyramid::kMaxLevels> level_views{};
+    int width = 0, height = 0;  ///< the depth buffer's size
+    bool reversed = false;      ///< set by HiZBuildPass::run: texels are minus the depths (hiz.h's keys)
+};
+
+/// The VkImageCreateInfo of the pyramid of a width x height depth buffer (each in [1, 8192], else
+/// Error): R32_SFLOAT, extent bit_ceil(ceil(width / 2)) x bit_ceil(ceil(height / 2)),
+/// HiZPyramid::level_count(width, height) levels, usage storage | sampled | transfer source,
+/// optimal tiling. The caller creates the image, its memory and views.
+VkImageCreateInfo hiz_image_create_info(int width, int height);
+
+/// Niessner & Loop §4.1's pyramid: level 0 = max over 2x2 texels of the depth image, level l = max
+/// over 2x2 texels of level l-1; bit-identical to HiZPyramid::build on the same depths, image row
+/// r read as the depth array's row r. With Vulkan's y-down projection (its y row negated) image
+/// row 0 is NDC y = -1 of that projection, as the depth array's row 0 is GL's, so a pyramid built
+/// here and the flipped projection go together.
+class HiZBuildPass {
+public:
+    explicit HiZBuildPass(PassContext& context);
+    /// Records the build of hiz from depth, written in convention (its keys: -depth for the
+    /// reversed ones), and sets hiz.reversed. Binds (push descriptors, set 0) the level written
+    /// as a storage image at kImageUnitHiZOut, the depth view and hiz.all_levels as combined
+    /// image samplers (the context's nearest sampler) at kTextureUnitDepth and kTextureUnitHiZ;
+    /// one dispatch per level, an image barrier (compute write -> compute read, GENERAL) after
+    /// each but the last, then the barrier of the header. The caller orders the depth writes
+    /// (fragment tests) before the compute shader and leaves depth in depth.layout. Error for
+    /// another depth format or a missing view.
+    void run(VkCommandBuffer cmd, const DepthImage& depth, HiZImage& hiz, ClipDepth convention);
 
 private:
     PassContext::Impl* context_;
