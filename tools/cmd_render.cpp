@@ -58,8 +58,8 @@
 // time of posing and uploading; done_ms: until glFinish returns; meshes_ms: of cpu_ms, animating
 // the control meshes (gpu); bytes_uploaded: bytes copied to GL).
 // --draw flags|indirect ("draw" in the JSON; gl_pipeline.h's DrawMode): how the draw passes issue
-// patches: flags (every patch of the drawn objects; the TCS gives the culled ones levels 0) or
-// indirect (CompactPass lists each pass's survivors and indirect draws issue only those). Every
+// patches: indirect (the default: CompactPass lists each pass's survivors and indirect draws issue
+// only those) or flags (every patch of the drawn objects; the TCS gives the culled ones levels 0). Every
 // frame gains "submitted":{"pass1","pass2"}: the patches each draw pass issued (pass2 0 in one
 // pass and when aggressive). With --patch-source osd-table only flags (its JSON says "draw").
 // --patch-source bezier|osd-table ("patch_source" in the JSON): bezier (the default) draws the
@@ -128,7 +128,7 @@ Runner add_render_command(CLI::App& app) {
         std::string clip_depth = "zero-to-one";
         std::string pose = "cpu";
         bool fused_pass = false;
-        std::string draw = "flags";
+        std::string draw = "indirect";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -162,8 +162,8 @@ Runner add_render_command(CLI::App& app) {
     command->add_flag("--fused-pass", state->fused_pass,
                       "frustum, back-patch (tcone/ncone) and Hi-Z tests in one compute pass");
     add_choice_option(*command, "--draw", state->draw, {"flags", "indirect"},
-                      "how the draw passes issue patches: flags (every patch, the TCS drops the culled) or indirect "
-                      "(the survivors compacted into indirect draws: a culled patch is never issued)");
+                      "how the draw passes issue patches: indirect (the default: the survivors compacted into indirect "
+                      "draws, a culled patch is never issued) or flags (every patch, the TCS drops the culled)");
     add_choice_option(*command, "--pose", state->pose, {"cpu", "gpu"},
                       "where animated patches are evaluated: cpu, or gpu (stencils in a compute pass, bit-identical)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");

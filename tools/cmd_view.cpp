@@ -50,7 +50,7 @@ Runner add_view_command(CLI::App& app) {
         std::string cull = "all";
         std::string backpatch = "tcone";
         std::string frustum = "hull";
-        std::string draw = "flags";
+        std::string draw = "indirect";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -79,8 +79,8 @@ Runner add_view_command(CLI::App& app) {
     add_choice_option(*command, "--frustum", state->frustum, {"hull", "aabb"},
                       "frustum test: hull (control points, Niessner & Loop) or aabb (box grown by max |D|, Sathe)");
     add_choice_option(*command, "--draw", state->draw, {"flags", "indirect"},
-                      "how the draw passes issue patches: flags (every patch, the TCS drops the culled) or indirect "
-                      "(the survivors compacted into indirect draws)");
+                      "how the draw passes issue patches: indirect (the default: the survivors compacted into indirect "
+                      "draws) or flags (every patch, the TCS drops the culled)");
     add_clip_depth_option(*command, state->clip_depth);
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
