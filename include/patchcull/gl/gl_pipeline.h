@@ -175,7 +175,9 @@ struct PipelineParams {
     /// selection over its spans, one CompactPass range per span (an object's active spans, the
     /// gaps), into the pipeline's own list and command buffers (one set per draw pass: pass 1 =
     /// tagged visible by the previous frame, pass 2 = newly visible; the one-pass frame has one),
-    /// with at most PatchRenderer::patches_per_draw() patches per command, then draws what it
+    /// with at most PatchRenderer::patches_per_draw() patches per command (a sixteenth of that on
+    /// a software rasterizer, PassContext::is_software: llvmpipe tessellates large draws more
+    /// slowly per patch), then draws what it
     /// compacted in one multi-draw: glMultiDrawArraysIndirectCount with the range's draw count
     /// when the draw is one span and the context has it, else glMultiDrawArraysIndirect over all
     /// the commands of its spans (those past a range's survivors are empty). An ObjectPass's draws
