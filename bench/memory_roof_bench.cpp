@@ -18,11 +18,16 @@
 //   thread: the sweep that chose the default distances.
 // entry/<kernel>/<plain|blocked>/<1_thread|all_threads>/N: the parallel entries (parallel_cull.h)
 //   at 1450, 65536 and 1M patches, default prefetching, in a oneTBB arena of one thread or of all.
+// entry_avx2/<kernel>/plain/<1_thread|all_threads>/N: the same with Highway forced to AVX2 (skipped
+//   without it): on an AVX-512 machine, the code valgrind runs and counts (it has no AVX-512). Also
+//   at N = 65552 and 1M + 16, whose plain component arrays are not a multiple of 4 KiB apart (at
+//   65536 and 1M they are, and share one L1 set).
 //
 // Run (docs/PERFORMANCE.md, "Batches at the memory roof"):
 //   build/bench/patchcull_bench --benchmark_filter='^(roof|layout)/' --benchmark_repetitions=3
 //       --benchmark_min_time=0.2 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
+#include <hwy/targets.h>
 #include <immintrin.h>
 #include <tbb/task_arena.h>
 
@@ -353,7 +358,15 @@ void run_entry(const Workload& w, Kernel k, const PatchBatchView& v, std::uint8_
 }
 
 // A parallel entry in an arena of one thread or of every core (an engine's own arena).
-void bm_entry(benchmark::State& state, Kernel k, bool blocked, bool all_threads) {
+// forced_target: 0 = normal dispatch, else a Highway target bit (HWY_AVX2).
+void bm_entry(benchmark::State& state, Kernel k, bool blocked, bool all_threads, std::int64_t forced_target = 0) {
+    if (forced_target != 0) {
+        if ((hwy::SupportedTargets() & forced_target) == 0) {
+            state.SkipWithError("target not supported on this CPU");
+            return;
+        }
+        hwy::SetSupportedTargetsForTest(forced_target);
+    }
     const std::size_t n = static_cast<std::size_t>(state.range(0));
     Workload& w = workload(n);
     const PatchBatchView all = blocked ? w.blocked.view() : w.plain.view();
@@ -367,6 +380,8 @@ void bm_entry(benchmark::State& state, Kernel k, bool blocked, bool all_threads)
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * n));
     state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * n * kBytesPerPatch));
     state.counters["threads"] = arena.max_concurrency();
+    state.SetLabel(simd_target_name());
+    if (forced_target != 0) hwy::SetSupportedTargetsForTest(0);
 }
 
 int register_all() {
@@ -398,6 +413,16 @@ int register_all() {
                 for (std::int64_t n : {1450, 65536, 1 << 20}) b->Arg(n);
                 b->UseRealTime()->Unit(benchmark::kMicrosecond);
             }
+    for (Kernel k : {Kernel::kFrustum, Kernel::kFrustumDisp, Kernel::kTcone, Kernel::kNcone, Kernel::kPtp,
+                     Kernel::kOcclusion, Kernel::kFused})
+        for (bool mt : {false, true}) {
+            const std::string name =
+                std::string("entry_avx2/") + kernel_name(k) + "/plain/" + (mt ? "all_threads" : "1_thread");
+            auto* b = benchmark::RegisterBenchmark(name.c_str(),
+                                                   [=](benchmark::State& s) { bm_entry(s, k, false, mt, HWY_AVX2); });
+            for (std::int64_t n : {1450, 65536, 65552, 1 << 20, (1 << 20) + 16}) b->Arg(n);
+            b->UseRealTime()->Unit(benchmark::kMicrosecond);
+        }
     for (Kernel k : {Kernel::kFrustum, Kernel::kFrustumDisp, Kernel::kTcone, Kernel::kNcone, Kernel::kPtp,
                      Kernel::kOcclusion, Kernel::kFused})
         for (bool mt : {false, true}) {
