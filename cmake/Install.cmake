@@ -4,7 +4,7 @@
 #                                         eval_gl and gl_osd with GL) and the generated include/patchcull/version.h
 #   include/patchcull/glsl/*.h            GLSL headers an engine's shaders include (with GL)
 #   lib/libpatchcull_<layer>.a            one static library per layer (patchcull_gl, patchcull_eval_gl,
-#                                         patchcull_gl_osd with GL)
+#                                         patchcull_gl_osd with GL; patchcull_vk with Vulkan)
 #   lib/cmake/patchcull/                  patchcullConfig.cmake, patchcullConfigVersion.cmake, targets
 #   share/patchcull/{models,scenes}/      the shipped models and scenes (patchcull_DATA_DIR)
 #   share/doc/patchcull/                  LICENSE, NOTICE
@@ -13,8 +13,8 @@
 # find_package(patchcull CONFIG COMPONENTS ...) gives one target per layer asked for (and the
 # layers it needs): patchcull::core (the kernels: TBB and Highway), patchcull::objects,
 # patchcull::import (OpenSubdiv, stb), patchcull::eval and, when the package was built with GL,
-# patchcull::gl, patchcull::eval_gl and patchcull::gl_osd (OpenSubdiv's osdGPU)
-# (patchcullConfig.cmake.in).
+# patchcull::gl, patchcull::eval_gl and patchcull::gl_osd (OpenSubdiv's osdGPU), and, when it
+# was built with PATCHCULL_WITH_VULKAN, patchcull::vk (patchcullConfig.cmake.in).
 include(CMakePackageConfigHelpers)
 set(PATCHCULL_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/patchcull)
 
@@ -34,6 +34,9 @@ if(PATCHCULL_WITH_GL)
   set(patchcull_header_excludes)
 else()
   set(patchcull_header_excludes PATTERN "gl" EXCLUDE PATTERN "eval_gl" EXCLUDE PATTERN "gl_osd" EXCLUDE)
+endif()
+if(NOT TARGET patchcull_vk)
+  list(APPEND patchcull_header_excludes PATTERN "vk" EXCLUDE)
 endif()
 install(DIRECTORY include/patchcull DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
   FILES_MATCHING PATTERN "*.h" ${patchcull_header_excludes})
@@ -57,6 +60,11 @@ if(PATCHCULL_WITH_GL)
   # shaders/.
   install(FILES ${PROJECT_BINARY_DIR}/src/gl/shaders/shipped/shared.h shaders/patchcull_tcs.h
     shaders/patchcull_draw_list.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/patchcull/glsl)
+endif()
+if(TARGET patchcull_vk)
+  # The Vulkan passes (PATCHCULL_WITH_VULKAN): their headers and library; the SPIR-V is inside it.
+  install(TARGETS patchcull_vk EXPORT patchcullVkTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(EXPORT patchcullVkTargets NAMESPACE patchcull:: DESTINATION ${PATCHCULL_INSTALL_CMAKEDIR})
 endif()
 if(TARGET patchcull_cli)
   install(TARGETS patchcull_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})

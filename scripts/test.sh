@@ -8,8 +8,8 @@
 # the SIMD kernels for the wide targets and the portable one only (AVX2, AVX-512, EMU128: their
 # group tails are where a stray load would be); all five targets run again in the Release suite,
 # the only other build of the core tests. The import, CLI, GL and tools suites are built once, in
-# Release. The CPU-only package test checks the sanitizer tree (PATCHCULL_WITH_GL=OFF) rather
-# than building the CPU layers again.
+# Release. The CPU-only package test checks the sanitizer tree (no GL, no Vulkan) rather than
+# building the CPU layers again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS="$(nproc)"
@@ -37,7 +37,7 @@ configure() {
 
 echo "== core tests under ASan + UBSan =="
 configure build-asan -DCMAKE_BUILD_TYPE=Debug -DPATCHCULL_SANITIZE=ON \
-  -DPATCHCULL_WITH_GL=OFF -DPATCHCULL_BUILD_BENCHMARKS=OFF -DPATCHCULL_BUILD_EXAMPLES=OFF \
+  -DPATCHCULL_WITH_GL=OFF -DPATCHCULL_WITH_VULKAN=OFF -DPATCHCULL_BUILD_BENCHMARKS=OFF -DPATCHCULL_BUILD_EXAMPLES=OFF \
   -DPATCHCULL_BUILD_TOOLS=OFF -DPATCHCULL_WIDE_SIMD_TARGETS_ONLY=ON
 cmake --build build-asan -j"$JOBS" --target patchcull_core_tests
 ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-asan -j"$JOBS" -L core --output-on-failure

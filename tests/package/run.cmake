@@ -11,7 +11,8 @@
 #     find_package(patchcull NEXT_MINOR) must refuse the package (version file).
 #   cmake -DMODE=cpu -DCPU_BUILD_DIR=... -DWORK=... -DSOURCE_DIR=... -DCXX=... -P run.cmake
 #     configures SOURCE_DIR in CPU_BUILD_DIR (a new tree, or one configured before: its build type
-#     and sanitizers kept) with PATCHCULL_WITH_GL=OFF and find_package(OpenGL/glfw3) disabled
+#     and sanitizers kept) with PATCHCULL_WITH_GL=OFF, PATCHCULL_WITH_VULKAN=OFF and
+#     find_package(OpenGL/glfw3) disabled
 #     (a REQUIRED search for them is then an error), checks that nothing of GL was searched for
 #     and no GL target exists while the core tests do, builds and installs the CPU layers alone
 #     (CPU_BUILD_DIR is kept between runs: incremental), runs core_consumer and import_consumer
@@ -84,6 +85,9 @@ function(build_consumer name prefix consumer_gl consumer_import)
   elseif(NOT consumer_gl)
     expect_no_model_search("${name}" "${dir}/CMakeCache.txt")
   endif()
+  if(EXISTS "${dir}/vk_consumer")
+    run("${name}: vk_consumer" "${dir}/vk_consumer")
+  endif()
   if(EXISTS "${dir}/gl_osd_consumer")
     run("${name}: gl_osd_consumer" "${dir}/gl_osd_consumer")
   endif()
@@ -128,7 +132,12 @@ if(MODE STREQUAL "install")
   set(prefix "${moved}")
   run("moved CLI: cull bigguy" ${CMAKE_COMMAND} -E env --unset=PATCHCULL_DATA_DIR "${prefix}/bin/patchcull" cull bigguy
       --views 2)
-  build_consumer(consumer "${prefix}" ON ON -DCONSUMER_GL_OSD=ON)
+  # The Vulkan passes when the build has them (PATCHCULL_WITH_VULKAN, on where Vulkan is found).
+  set(consumer_vk OFF)
+  if(EXISTS "${prefix}/lib/cmake/patchcull/patchcullVkTargets.cmake")
+    set(consumer_vk ON)
+  endif()
+  build_consumer(consumer "${prefix}" ON ON -DCONSUMER_GL_OSD=ON -DCONSUMER_VK=${consumer_vk})
   expect_files("consumer" "${WORK}/consumer/gl_osd_consumer")
   # The kernels alone: no GL, OpenSubdiv or stb package searched for.
   build_consumer(consumer_kernels_only "${prefix}" OFF OFF)
@@ -158,7 +167,7 @@ elseif(MODE STREQUAL "cpu")
     endif()
   endif()
   run("cpu-only: configure" ${CMAKE_COMMAND} -S "${SOURCE_DIR}" -B "${CPU_BUILD_DIR}"
-      ${cpu_build_type} -DCMAKE_CXX_COMPILER=${CXX} -DPATCHCULL_WITH_GL=OFF
+      ${cpu_build_type} -DCMAKE_CXX_COMPILER=${CXX} -DPATCHCULL_WITH_GL=OFF -DPATCHCULL_WITH_VULKAN=OFF
       -DPATCHCULL_BUILD_TESTS=ON -DPATCHCULL_BUILD_BENCHMARKS=ON -DPATCHCULL_BUILD_TOOLS=ON
       -DPATCHCULL_BUILD_EXAMPLES=ON -DPATCHCULL_BUILD_FUZZERS=OFF
       -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON)
@@ -171,7 +180,7 @@ elseif(MODE STREQUAL "cpu")
       message(FATAL_ERROR "cpu-only: no target ${target}")
     endif()
   endforeach()
-  foreach(target patchcull_gl patchcull_cli patchcull_shaders patchcull_gl_tests patchcull_bench)
+  foreach(target patchcull_gl patchcull_cli patchcull_shaders patchcull_gl_tests patchcull_bench patchcull_vk)
     if(targets MATCHES "(\\.\\.\\. |\n)${target}(: phony)?\n")
       message(FATAL_ERROR "cpu-only: target ${target} exists without GL")
     endif()
@@ -183,7 +192,8 @@ elseif(MODE STREQUAL "cpu")
     "${prefix}/include/patchcull/core/frustum.h"
     "${prefix}/lib/cmake/patchcull/patchcullConfig.cmake")
   expect_no_files("cpu-only: install" "${prefix}/lib/libpatchcull_gl.a" "${prefix}/include/patchcull/gl"
-    "${prefix}/lib/libpatchcull_gl_osd.a" "${prefix}/include/patchcull/gl_osd"
+    "${prefix}/lib/libpatchcull_gl_osd.a" "${prefix}/include/patchcull/gl_osd" "${prefix}/lib/libpatchcull_vk.a"
+    "${prefix}/include/patchcull/vk"
     "${prefix}/include/patchcull/glsl" "${prefix}/lib/cmake/patchcull/patchcullGLTargets.cmake")
   build_consumer(consumer_cpu "${prefix}" OFF ON
     -DCMAKE_DISABLE_FIND_PACKAGE_OpenGL=ON -DCMAKE_DISABLE_FIND_PACKAGE_glfw3=ON ${consumer_link_flags})
