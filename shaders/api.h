@@ -1,28 +1,37 @@
-// shaders/api.h (GLSL only; included by pass_params.h): what differs between the two APIs the
-// cull passes' compute shaders are compiled for, in one place. Every pass has one GLSL source
-// (shaders/*.comp.glsl); the OpenGL layer (src/gl) compiles it at run time as it is, the Vulkan
-// layer (src/vk) compiles it to SPIR-V at build time with glslangValidator -V and PC_VULKAN
-// defined, plus PC_VK_PUSH_<Block> naming the one parameter block the pass reads.
+// shaders/api.h (GLSL, included by pass_params.h; and C++, the Vulkan layer's numbers): what
+// differs between the two APIs the cull passes' compute shaders are compiled for, in one place.
+// Every pass has one GLSL source (shaders/*.comp.glsl); the OpenGL layer (src/gl) compiles it at
+// run time as it is, the Vulkan layer (src/vk) compiles it to SPIR-V at build time with
+// glslangValidator -V and PC_VULKAN defined, plus PC_VK_PUSH_<Block> or PC_VK_UNIFORM_<Block>
+// naming the one parameter block the pass reads (src/vk/CMakeLists.txt's module list).
 //
 // - Parameter blocks (pass_params.h's PC_PARAMS). OpenGL: a std140 uniform block at its binding
-//   (kUniformPassParams). Vulkan: the pass's own block (PC_VK_PUSH_<Block>) is the push-constant
-//   block (std140 layout, the same bytes as the C++ struct; a stage has at most one), and every
-//   other block of pass_params.h becomes a plain global struct the shader never reads, so no
-//   descriptor stands for it. The blocks above 128 bytes (maxPushConstantsSize's guaranteed
-//   minimum) are refused by the Vulkan layer where the device's limit is smaller.
+//   (kUniformPassParams). Vulkan: the pass's own block is the push-constant block
+//   (PC_VK_PUSH_<Block>: std140, the same bytes as the C++ struct; a stage has at most one) when
+//   it fits the 128 bytes every device offers, else a std140 uniform buffer at set 0, binding
+//   PC_VK_PARAMS_BINDING (PC_VK_UNIFORM_<Block>), which the pass writes with vkCmdUpdateBuffer;
+//   every other block of pass_params.h becomes a plain global struct the shader never reads, so
+//   no descriptor stands for it.
 // - Storage buffers. Both APIs use shared.h's binding numbers; under Vulkan they are bindings
 //   of descriptor set 0 (GLSL's default set), which the Vulkan passes fill with push descriptors.
-//   No uniform block or sampler of a Vulkan pass shares set 0 with them.
+// - Textures and images. GL's units (kTextureUnit*, kImageUnit*) share numbers with the storage
+//   bindings; under Vulkan the Hi-Z pyramid's moves where a shader has both (below), in set 0.
 // - Clip conventions. None in the shaders: the C++ side hands every pass its planes and rows
 //   (FrustumPlanes, to_zero_to_one, to_depth_key of the caller's matrix in its ClipDepth), and a
 //   Vulkan projection's y-down clip space (y negated) leaves the frustum planes' set unchanged
 //   (w + y and w - y swap), so the decisions do not depend on it (docs/ENGINE.md, "Vulkan").
-// - Not (yet) under Vulkan: the passes over a GpuPatchSource (a second parameter block) and the
-//   passes that sample textures or write images (their units are not set-0 bindings here).
+// - Not (yet) under Vulkan: the passes over a GpuPatchSource (a second parameter block).
 #ifndef PATCHCULL_SHADERS_API_H
 #define PATCHCULL_SHADERS_API_H
 
-#ifdef PC_VULKAN
+#ifdef __cplusplus
+// The Vulkan layer's numbers for the C++ side (src/vk), the same as the GLSL macros below.
+#include <cstdint>
+namespace patchcull::vk::api {
+inline constexpr std::uint32_t kParamsBinding = 4u;
+inline constexpr std::uint32_t kTextureHiZBinding = 3u;  // occlusion, fused, displaced (not hiz_build)
+}  // namespace patchcull::vk::api
+#elif defined(PC_VULKAN)
 
 #ifdef PC_PATCH_SOURCE
 #error "api.h: the passes over a patch source are not compiled for Vulkan"
@@ -30,53 +39,87 @@
 
 #define PC_PARAMS(name, slot) PC_VK_PARAMS_##name
 
-#ifdef PC_VK_PUSH_FrustumParams
+// The binding of a parameter block read as a uniform buffer (PC_VK_UNIFORM_<Block>): a number no
+// storage buffer or texture of those passes (occlusion, fused, displaced) uses.
+#define PC_VK_PARAMS_BINDING 4
+
+// Textures: in the passes with per-patch storage buffers (occlusion, fused, displaced) the Hi-Z
+// pyramid's unit (2, kBindingMaxDisplacement's number in GL) becomes set-0 binding 3, which no
+// storage buffer of theirs uses; the name then stands for it in the shader that follows (declared
+// once in shared.h as a const). hiz_build.comp.glsl, with no buffers, keeps shared.h's units 0, 1
+// and 2 (lavapipe 22.3 crashed recording its dispatch with them at 4, 5, 6 or 33, 34, 40).
+#if defined(PC_VK_UNIFORM_OcclusionParams) || defined(PC_VK_UNIFORM_FusedCullParams) || \
+    defined(PC_VK_UNIFORM_DisplacedParams)
+#define kTextureUnitHiZ 3u
+#endif
+
+#if defined(PC_VK_PUSH_FrustumParams)
 #define PC_VK_PARAMS_FrustumParams layout(push_constant, std140) uniform FrustumParams
+#elif defined(PC_VK_UNIFORM_FrustumParams)
+#define PC_VK_PARAMS_FrustumParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform FrustumParams
 #else
 #define PC_VK_PARAMS_FrustumParams struct FrustumParams
 #endif
-#ifdef PC_VK_PUSH_FrustumDispParams
+#if defined(PC_VK_PUSH_FrustumDispParams)
 #define PC_VK_PARAMS_FrustumDispParams layout(push_constant, std140) uniform FrustumDispParams
+#elif defined(PC_VK_UNIFORM_FrustumDispParams)
+#define PC_VK_PARAMS_FrustumDispParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform FrustumDispParams
 #else
 #define PC_VK_PARAMS_FrustumDispParams struct FrustumDispParams
 #endif
-#ifdef PC_VK_PUSH_OcclusionParams
+#if defined(PC_VK_PUSH_OcclusionParams)
 #define PC_VK_PARAMS_OcclusionParams layout(push_constant, std140) uniform OcclusionParams
+#elif defined(PC_VK_UNIFORM_OcclusionParams)
+#define PC_VK_PARAMS_OcclusionParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform OcclusionParams
 #else
 #define PC_VK_PARAMS_OcclusionParams struct OcclusionParams
 #endif
-#ifdef PC_VK_PUSH_HiZBuildParams
+#if defined(PC_VK_PUSH_HiZBuildParams)
 #define PC_VK_PARAMS_HiZBuildParams layout(push_constant, std140) uniform HiZBuildParams
+#elif defined(PC_VK_UNIFORM_HiZBuildParams)
+#define PC_VK_PARAMS_HiZBuildParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform HiZBuildParams
 #else
 #define PC_VK_PARAMS_HiZBuildParams struct HiZBuildParams
 #endif
-#ifdef PC_VK_PUSH_BackpatchConeParams
+#if defined(PC_VK_PUSH_BackpatchConeParams)
 #define PC_VK_PARAMS_BackpatchConeParams layout(push_constant, std140) uniform BackpatchConeParams
+#elif defined(PC_VK_UNIFORM_BackpatchConeParams)
+#define PC_VK_PARAMS_BackpatchConeParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform BackpatchConeParams
 #else
 #define PC_VK_PARAMS_BackpatchConeParams struct BackpatchConeParams
 #endif
-#ifdef PC_VK_PUSH_BackpatchPtpParams
+#if defined(PC_VK_PUSH_BackpatchPtpParams)
 #define PC_VK_PARAMS_BackpatchPtpParams layout(push_constant, std140) uniform BackpatchPtpParams
+#elif defined(PC_VK_UNIFORM_BackpatchPtpParams)
+#define PC_VK_PARAMS_BackpatchPtpParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform BackpatchPtpParams
 #else
 #define PC_VK_PARAMS_BackpatchPtpParams struct BackpatchPtpParams
 #endif
-#ifdef PC_VK_PUSH_DisplacedParams
+#if defined(PC_VK_PUSH_DisplacedParams)
 #define PC_VK_PARAMS_DisplacedParams layout(push_constant, std140) uniform DisplacedParams
+#elif defined(PC_VK_UNIFORM_DisplacedParams)
+#define PC_VK_PARAMS_DisplacedParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform DisplacedParams
 #else
 #define PC_VK_PARAMS_DisplacedParams struct DisplacedParams
 #endif
-#ifdef PC_VK_PUSH_CullStatusParams
+#if defined(PC_VK_PUSH_CullStatusParams)
 #define PC_VK_PARAMS_CullStatusParams layout(push_constant, std140) uniform CullStatusParams
+#elif defined(PC_VK_UNIFORM_CullStatusParams)
+#define PC_VK_PARAMS_CullStatusParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform CullStatusParams
 #else
 #define PC_VK_PARAMS_CullStatusParams struct CullStatusParams
 #endif
-#ifdef PC_VK_PUSH_CompactParams
+#if defined(PC_VK_PUSH_CompactParams)
 #define PC_VK_PARAMS_CompactParams layout(push_constant, std140) uniform CompactParams
+#elif defined(PC_VK_UNIFORM_CompactParams)
+#define PC_VK_PARAMS_CompactParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform CompactParams
 #else
 #define PC_VK_PARAMS_CompactParams struct CompactParams
 #endif
-#ifdef PC_VK_PUSH_FusedCullParams
+#if defined(PC_VK_PUSH_FusedCullParams)
 #define PC_VK_PARAMS_FusedCullParams layout(push_constant, std140) uniform FusedCullParams
+#elif defined(PC_VK_UNIFORM_FusedCullParams)
+#define PC_VK_PARAMS_FusedCullParams layout(std140, set = 0, binding = PC_VK_PARAMS_BINDING) uniform FusedCullParams
 #else
 #define PC_VK_PARAMS_FusedCullParams struct FusedCullParams
 #endif

@@ -1,5 +1,6 @@
 // PassContext of the Vulkan passes (patchcull/vk/vk_passes.h): device commands, the pipeline
 // cache, the placeholder buffer, the range checks and the recording shared by every pass.
+#include <algorithm>
 #include <cstring>
 #include <string>
 #include <utility>
@@ -16,6 +17,7 @@ static_assert(sizeof(pp::CullStatusParams) == 16);
 static_assert(sizeof(pp::FrustumDispParams) == 96);
 static_assert(sizeof(pp::BackpatchConeParams) == 48);
 static_assert(sizeof(pp::BackpatchPtpParams) == 80);
+static_assert(sizeof(pp::OcclusionParams) == 144);
 
 namespace detail {
 
@@ -45,6 +47,35 @@ bool has_extension(VkPhysicalDevice physical_device, const char* name) {
     for (const VkExtensionProperties& e : extensions)
         if (std::strcmp(e.extensionName, name) == 0) return true;
     return false;
+}
+
+void create_buffer(PassContext::Impl& m, VkDeviceSize size, VkBufferUsageFlags usage, VkBuffer& buffer,
+                   VkDeviceMemory& memory) {
+    const detail::DeviceCommands& c = m.vk;
+    VkBufferCreateInfo buffer_info{};
+    buffer_info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+    buffer_info.size = size;
+    buffer_info.usage = usage;
+    buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    check_vk(c.CreateBuffer(m.device, &buffer_info, nullptr, &buffer), "PassContext", "vkCreateBuffer");
+    VkMemoryRequirements requirements{};
+    c.GetBufferMemoryRequirements(m.device, buffer, &requirements);
+    VkPhysicalDeviceMemoryProperties properties{};
+    vkGetPhysicalDeviceMemoryProperties(m.physical_device, &properties);
+    std::uint32_t type = properties.memoryTypeCount;
+    for (std::uint32_t i = 0; i < properties.memoryTypeCount && type == properties.memoryTypeCount; ++i)
+        if ((requirements.memoryTypeBits & (1u << i)) &&
+            (properties.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
+            type = i;
+    for (std::uint32_t i = 0; i < properties.memoryTypeCount && type == properties.memoryTypeCount; ++i)
+        if (requirements.memoryTypeBits & (1u << i)) type = i;
+    if (type == properties.memoryTypeCount) throw Error("Vulkan: PassContext: no memory type for its buffers");
+    VkMemoryAllocateInfo allocate{};
+    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    allocate.allocationSize = requirements.size;
+    allocate.memoryTypeIndex = type;
+    check_vk(c.AllocateMemory(m.device, &allocate, nullptr, &memory), "PassContext", "vkAllocateMemory");
+    check_vk(c.BindBufferMemory(m.device, buffer, memory, 0), "PassContext", "vkBindBufferMemory");
 }
 
 }  // namespace
@@ -103,6 +134,7 @@ PassContext::PassContext(VkPhysicalDevice physical_device, VkDevice device, cons
     load(get, device, c.CmdPushConstants, "vkCmdPushConstants");
     load(get, device, c.CmdDispatch, "vkCmdDispatch");
     load(get, device, c.CmdPipelineBarrier, "vkCmdPipelineBarrier");
+    load(get, device, c.CmdUpdateBuffer, "vkCmdUpdateBuffer");
     load(get, device, c.CreateSampler, "vkCreateSampler");
     load(get, device, c.DestroySampler, "vkDestroySampler");
 
@@ -117,31 +149,11 @@ PassContext::PassContext(VkPhysicalDevice physical_device, VkDevice device, cons
     sampler_info.maxLod = VK_LOD_CLAMP_NONE;
     check_vk(c.CreateSampler(device, &sampler_info, nullptr, &m.sampler), "PassContext", "vkCreateSampler");
 
-    // The placeholder: 256 bytes of storage, device-local where a memory type offers it.
-    VkBufferCreateInfo buffer_info{};
-    buffer_info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
-    buffer_info.size = 256;
-    buffer_info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    check_vk(c.CreateBuffer(device, &buffer_info, nullptr, &m.placeholder), "PassContext", "vkCreateBuffer");
-    VkMemoryRequirements requirements{};
-    c.GetBufferMemoryRequirements(device, m.placeholder, &requirements);
-    VkPhysicalDeviceMemoryProperties memory{};
-    vkGetPhysicalDeviceMemoryProperties(physical_device, &memory);
-    std::uint32_t type = memory.memoryTypeCount;
-    for (std::uint32_t i = 0; i < memory.memoryTypeCount && type == memory.memoryTypeCount; ++i)
-        if ((requirements.memoryTypeBits & (1u << i)) &&
-            (memory.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
-            type = i;
-    for (std::uint32_t i = 0; i < memory.memoryTypeCount && type == memory.memoryTypeCount; ++i)
-        if (requirements.memoryTypeBits & (1u << i)) type = i;
-    if (type == memory.memoryTypeCount) throw Error("Vulkan: PassContext: no memory type for a storage buffer");
-    VkMemoryAllocateInfo allocate{};
-    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-    allocate.allocationSize = requirements.size;
-    allocate.memoryTypeIndex = type;
-    check_vk(c.AllocateMemory(device, &allocate, nullptr, &m.placeholder_memory), "PassContext", "vkAllocateMemory");
-    check_vk(c.BindBufferMemory(device, m.placeholder, m.placeholder_memory, 0), "PassContext", "vkBindBufferMemory");
+    // The placeholder (256 bytes of storage) and the parameter buffer, device-local where a
+    // memory type offers it.
+    create_buffer(m, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, m.placeholder, m.placeholder_memory);
+    create_buffer(m, Impl::kParamBufferBytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                  m.param_buffer, m.param_memory);
 }
 
 PassContext::Impl::~Impl() {
@@ -152,8 +164,14 @@ PassContext::Impl::~Impl() {
         vk.DestroyDescriptorSetLayout(device, p.set_layout, nullptr);
     }
     if (vk.DestroySampler) vk.DestroySampler(device, sampler, nullptr);
-    if (vk.DestroyBuffer) vk.DestroyBuffer(device, placeholder, nullptr);
-    if (vk.FreeMemory) vk.FreeMemory(device, placeholder_memory, nullptr);
+    if (vk.DestroyBuffer) {
+        vk.DestroyBuffer(device, placeholder, nullptr);
+        vk.DestroyBuffer(device, param_buffer, nullptr);
+    }
+    if (vk.FreeMemory) {
+        vk.FreeMemory(device, placeholder_memory, nullptr);
+        vk.FreeMemory(device, param_memory, nullptr);
+    }
 }
 
 PassContext::PassContext(PassContext&&) noexcept = default;
@@ -200,7 +218,7 @@ const detail::Pipeline& PassContext::Impl::pipeline(const char* shader, const ch
         layout_info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
         layout_info.setLayoutCount = 1;
         layout_info.pSetLayouts = &p.set_layout;
-        layout_info.pushConstantRangeCount = 1;
+        layout_info.pushConstantRangeCount = push_constant_bytes ? 1 : 0;
         layout_info.pPushConstantRanges = &range;
         check_vk(vk.CreatePipelineLayout(device, &layout_info, nullptr, &p.layout), shader, "vkCreatePipelineLayout");
         VkShaderModuleCreateInfo module_info{};
@@ -262,6 +280,18 @@ void PassContext::Impl::bind(VkCommandBuffer cmd, const detail::Pipeline& p, con
     vk.CmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     vk.CmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0,
                                static_cast<std::uint32_t>(binding_count), writes.data());
+}
+
+void PassContext::Impl::update_params(VkCommandBuffer cmd, const void* data, std::size_t bytes) const {
+    vk.CmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                          nullptr, 0, nullptr);
+    vk.CmdUpdateBuffer(cmd, param_buffer, 0, bytes, data);
+    VkMemoryBarrier barrier{};
+    barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_UNIFORM_READ_BIT;
+    vk.CmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0,
+                          nullptr, 0, nullptr);
 }
 
 void PassContext::Impl::barrier_after(VkCommandBuffer cmd) const {

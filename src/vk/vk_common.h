@@ -13,6 +13,7 @@
 #include <map>
 #include <string>
 
+#include "api.h"
 #include "pass_params.h"
 #include "patchcull/core/error.h"
 #include "patchcull/vk/vk_passes.h"
@@ -49,6 +50,7 @@ struct DeviceCommands {
     PFN_vkCmdPushConstants CmdPushConstants = nullptr;
     PFN_vkCmdDispatch CmdDispatch = nullptr;
     PFN_vkCmdPipelineBarrier CmdPipelineBarrier = nullptr;
+    PFN_vkCmdUpdateBuffer CmdUpdateBuffer = nullptr;
     PFN_vkCreateSampler CreateSampler = nullptr;
     PFN_vkDestroySampler DestroySampler = nullptr;
 };
@@ -76,7 +78,7 @@ struct Slot {
     VkDescriptorType type;
 };
 
-/// The most storage buffers one pass binds.
+/// The most descriptors one pass binds.
 inline constexpr std::size_t kMaxBindings = 8;
 
 }  // namespace detail
@@ -90,7 +92,12 @@ struct PassContext::Impl {
     VkPhysicalDeviceLimits limits{};
     VkBuffer placeholder = VK_NULL_HANDLE;  // 256 bytes, bound for an empty optional range
     VkDeviceMemory placeholder_memory = VK_NULL_HANDLE;
-    VkSampler sampler = VK_NULL_HANDLE;                 // nearest, clamp to edge: the Hi-Z passes' texelFetch
+    VkSampler sampler = VK_NULL_HANDLE;  // nearest, clamp to edge: the Hi-Z passes' texelFetch
+    // The parameter block of the passes whose block exceeds 128 bytes (shaders/api.h's
+    // PC_VK_UNIFORM_*): kParamBufferBytes of uniform buffer, written by vkCmdUpdateBuffer.
+    static constexpr VkDeviceSize kParamBufferBytes = 512;
+    VkBuffer param_buffer = VK_NULL_HANDLE;
+    VkDeviceMemory param_memory = VK_NULL_HANDLE;
     std::map<std::string, detail::Pipeline> pipelines;  // key: shader name + " " + variant
 
     ~Impl();
@@ -126,6 +133,11 @@ struct PassContext::Impl {
     void bind(VkCommandBuffer cmd, const detail::Pipeline& p, const detail::Binding* bindings,
               std::size_t binding_count) const;
     void barrier_after(VkCommandBuffer cmd) const;
+    /// Records the update of the parameter buffer with bytes (a multiple of 4, at most
+    /// kParamBufferBytes) between two barriers: the compute shaders recorded before it finish
+    /// first (they may read the buffer), and its transfer write is visible to the uniform reads of
+    /// the compute shaders after it.
+    void update_params(VkCommandBuffer cmd, const void* data, std::size_t bytes) const;
 };
 
 }  // namespace patchcull::vk

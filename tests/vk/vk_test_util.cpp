@@ -1,6 +1,8 @@
 // The Vulkan tests' context (vk_test_util.h).
 #include "vk/vk_test_util.h"
 
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <stdexcept>
 

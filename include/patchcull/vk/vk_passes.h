@@ -12,8 +12,9 @@
 //   (ends of the chain)    -                              CullStatusPass     cull_status.comp.glsl
 //   (after the chain)      -                              CompactPass        compact.comp.glsl
 //   Hi-Z pyramid           HiZPyramid::build              HiZBuildPass       hiz_build.comp.glsl
-// The other passes of gl_passes.h (occlusion, displaced, fused) and the passes over a
-// GpuPatchSource have no Vulkan twin yet (docs/ENGINE.md, "Vulkan").
+//   Hi-Z occlusion         cull_occlusion_scalar          OcclusionPass      occlusion.comp.glsl
+// The other passes of gl_passes.h (displaced, fused) and the passes over a GpuPatchSource have no
+// Vulkan twin yet (docs/ENGINE.md, "Vulkan").
 //
 // Buffers: the layouts of gl_passes.h (control points 16 vec4 per patch in patch.h order, 256
 // bytes; the flag word, core/cull_flags.h, one uint per patch; margins one float per patch;
@@ -329,13 +330,39 @@ public:
     explicit HiZBuildPass(PassContext& context);
     /// Records the build of hiz from depth, written in convention (its keys: -depth for the
     /// reversed ones), and sets hiz.reversed. Binds (push descriptors, set 0) the level written
-    /// as a storage image at kImageUnitHiZOut, the depth view and hiz.all_levels as combined
-    /// image samplers (the context's nearest sampler) at kTextureUnitDepth and kTextureUnitHiZ;
+    /// as a storage image at binding 0, the depth view and hiz.all_levels as combined image
+    /// samplers (the context's nearest sampler) at bindings 1 and 2 (shared.h's units);
     /// one dispatch per level, an image barrier (compute write -> compute read, GENERAL) after
     /// each but the last, then the barrier of the header. The caller orders the depth writes
     /// (fragment tests) before the compute shader and leaves depth in depth.layout. Error for
     /// another depth format or a missing view.
     void run(VkCommandBuffer cmd, const DepthImage& depth, HiZImage& hiz, ClipDepth convention);
+
+private:
+    PassContext::Impl* context_;
+};
+
+/// cull_occlusion_scalar on the GPU against a pyramid of HiZBuildPass: with_frustum, the frustum
+/// test first (reason kCullFrustum, with the margins); then, for patches with margin 0, hiz.h's
+/// test (reason kCullOcclusion). Without margins the decisions equal the CPU kernel's on the same
+/// matrix and pyramid (kHiZFrustumCulled <-> kCullFrustum, kHiZOccluded <-> kCullOcclusion).
+/// The screen is the pyramid's depth buffer (viewport 0, 0, W, H), its row r the depth image's
+/// row r: with a y-down projection, image row 0 is NDC y = -1, as HiZBuildPass says.
+class OcclusionPass {
+public:
+    explicit OcclusionPass(PassContext& context);
+    /// Records the test of the range. depth: the convention of object_to_clip; the pyramid must
+    /// have been built in a convention of the same direction (else Error), and a matrix
+    /// contradicting depth is an Error (check_clip_depth). Its 144-byte parameter block goes to
+    /// the PassContext's uniform buffer (binding 4 of set 0) by vkCmdUpdateBuffer before each
+    /// dispatch, between an execution barrier (the compute shaders recorded before finish first)
+    /// and a transfer-to-uniform-read barrier: record the runs of one PassContext on one queue.
+    /// The pyramid is bound as a combined image sampler (binding 3, GENERAL layout).
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, const Mat4& object_to_clip, ClipDepth depth,
+             const HiZImage& hiz, bool with_frustum = true);
+    /// The same on one view's CullView (view.object_to_clip in view.depth).
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, const CullView& view, const HiZImage& hiz,
+             bool with_frustum = true);
 
 private:
     PassContext::Impl* context_;
