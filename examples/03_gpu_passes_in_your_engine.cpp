@@ -39,12 +39,19 @@
 //
 // Usage: 03_gpu_passes_in_your_engine [--frames N] [--size WxH] [--aggressive]
 //            [--backpatch tcone|ncone|ptp] [--bound caf|oobb] [--cone full|acon|con] [--backpatch-open]
+//            [--draw flags|indirect]
 //   --frames N    frames per camera position (3 positions, the camera moving), N in 1..1000, default 4
 //   --size WxH    framebuffer (and window) size, each in 1..8192, default 320x240
 //   --aggressive  skip pass 2 (Niessner & Loop §3.1's aggressive variant: newly visible patches appear a
 //                 frame late). NOT conservative: shows that the check catches missing patches.
 //   --backpatch   the back-patch test of bigguy (default tcone; ptp with the ncnt rule)
 //   --bound, --cone  the displaced bound of the frog and its cone of normals (default caf, acon)
+//   --draw        flags (default): each pass issues every patch, our TCS drops the ones it does not
+//                 keep (patchcull_tcs.h); indirect: CompactPass (gl_compaction.h) lists the patches
+//                 each pass keeps into OUR list and indirect-command buffers, and one
+//                 glMultiDrawArraysIndirectCount draws them with our own shaders (a vertex shader
+//                 that pulls each point by the list, patchcull_draw_list.h): a culled patch is
+//                 never issued (docs/ENGINE.md, "Draw only what survives").
 //   --backpatch-open  give the open teapot to the back-patch pass too. NOT conservative (from
 //                 above, the inside of its far side shows through the lid gap): shows that the
 //                 check catches a back-patch test on a surface it does not hold for.
@@ -83,6 +90,7 @@
 #include "patchcull/core/math.h"
 #include "patchcull/core/patch.h"
 #include "patchcull/core/teapot.h"
+#include "patchcull/gl/gl_compaction.h"
 #include "patchcull/gl/gl_passes.h"
 #include "patchcull/import/model_loader.h"
 #include "shared.h"  // shaders/shared.h: C++ and GLSL at once
@@ -121,12 +129,13 @@ struct Options {
     pc::gl::BackpatchMethod backpatch = pc::gl::BackpatchMethod::tcone;
     pc::DisplacedBoundKind bound = pc::DisplacedBoundKind::caf;
     pc::NormalConeKind cone = pc::NormalConeKind::acon;
+    bool indirect = false;  // --draw indirect
 };
 
 Options parse_options(int argc, char** argv) {
     const std::string usage =
         "(usage: [--frames N] [--size WxH] [--aggressive] [--backpatch tcone|ncone|ptp] [--bound caf|oobb] "
-        "[--cone full|acon|con] [--backpatch-open])";
+        "[--cone full|acon|con] [--backpatch-open] [--draw flags|indirect])";
     Options o;
     for (int i = 1; i < argc; ++i) {
         const std::string flag = argv[i];
@@ -138,7 +147,8 @@ Options parse_options(int argc, char** argv) {
             o.backpatch_open = true;
             continue;
         }
-        if (flag != "--frames" && flag != "--size" && flag != "--backpatch" && flag != "--bound" && flag != "--cone")
+        if (flag != "--frames" && flag != "--size" && flag != "--backpatch" && flag != "--bound" && flag != "--cone" &&
+            flag != "--draw")
             setup_error("unknown option " + pc::quote_input(flag) + " " + usage);
         if (i + 1 >= argc) setup_error(flag + ": missing value");
         const std::string value = argv[++i];
@@ -159,6 +169,10 @@ Options parse_options(int argc, char** argv) {
                 o.backpatch = pc::gl::BackpatchMethod::ptp;
             else
                 setup_error("--backpatch: expected tcone, ncone or ptp, got " + pc::quote_input(value));
+        } else if (flag == "--draw") {
+            if (value != "flags" && value != "indirect")
+                setup_error("--draw: expected flags or indirect, got " + pc::quote_input(value));
+            o.indirect = value == "indirect";
         } else if (flag == "--bound") {
             if (!pc::parse_displaced_bound(value.c_str(), o.bound))
                 setup_error("--bound: expected caf or oobb, got " + pc::quote_input(value));
@@ -229,6 +243,22 @@ flat out uint vs_patch;
 void main() {
     vs_point = a_point;
     vs_patch = uint(gl_VertexID) / 16u;
+}
+)";
+
+// --draw indirect: the vertex shader of a compacted draw (gl_compaction.h's CompactPass wrote the
+// list). No vertex attributes: vertex gl_VertexID is point gl_VertexID % 16 of patch
+// list[gl_VertexID / 16], pulled from the patch buffer (patchcull_draw_list.h); the patch index
+// passed on is the flag buffer's, as above, so the rest of the program is the same.
+const char* const kListVertexShader = R"(#version 450 core
+#include "shared.h"
+#include "patchcull_draw_list.h"
+layout(std430, binding = kBindingControlPoints) readonly buffer ControlPoints { vec4 control_points[]; };
+out vec4 vs_point;
+flat out uint vs_patch;
+void main() {
+    vs_patch = patchcull_draw_list_patch(gl_VertexID);
+    vs_point = control_points[16u * vs_patch + patchcull_draw_list_point(gl_VertexID)];
 }
 )";
 
@@ -351,9 +381,10 @@ GLuint compile(GLenum stage, const std::string& source, const char* name) {
     return shader;
 }
 
-GLuint link_patch_program() {
+GLuint link_patch_program(bool draw_list = false) {
     const GLuint program = glCreateProgram();
-    const GLuint stages[] = {compile(GL_VERTEX_SHADER, kVertexShader, "vertex"),
+    const GLuint stages[] = {draw_list ? compile(GL_VERTEX_SHADER, expand_includes(kListVertexShader), "list vertex")
+                                       : compile(GL_VERTEX_SHADER, kVertexShader, "vertex"),
                              compile(GL_TESS_CONTROL_SHADER, expand_includes(kControlShader), "control"),
                              compile(GL_TESS_EVALUATION_SHADER, expand_includes(kEvaluationShader), "evaluation"),
                              compile(GL_FRAGMENT_SHADER, expand_includes(kFragmentShader), "fragment")};
@@ -489,10 +520,11 @@ struct Renderer {
     int width = 0, height = 0;
     GLuint fbo = 0, color = 0, ids = 0, depth = 0;
     GLuint vao = 0, program = 0;
-    GLint loc_level = -1, loc_mask = -1, loc_value = -1, loc_object_to_clip = -1, loc_eye = -1;
-    GLint loc_one_sided = -1, loc_scale = -1, loc_midlevel = -1;
     GLuint patch_buffer = 0, flag_buffer = 0, texcoord_buffer = 0, margin_buffer = 0, height_texture = 0;
     std::size_t patch_count = 0;
+    // --draw indirect: the list program (kListVertexShader) and CompactPass's outputs, ours too.
+    GLuint list_program = 0, draw_list = 0, draw_commands = 0, draw_count = 0;
+    bool indirect_count = false;  // glMultiDrawArraysIndirectCount: GL 4.6 or GL_ARB_indirect_parameters
     Object one_sided{"none"};
     float level = 6, displacement_scale = 0, displacement_midlevel = 0.5f;
 
@@ -505,8 +537,15 @@ struct Renderer {
         glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &far_depth);
     }
 
-    // One draw of every patch; the TCS keeps those whose flag word w has (w & mask) == value.
-    void draw(const View& v, std::uint32_t mask, std::uint32_t value) const {
+    // llvmpipe garbles a 4096-vertex chunk that yields more than 65536 tessellated vertices
+    // (gl_renderer.h): sub-draws of at most 65536 / (level + 1)^2 patches avoid it.
+    std::size_t per_draw() const {
+        return std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((level + 1) * (level + 1)));
+    }
+
+    // The state and uniforms of a patch draw with program prog; the TCS keeps the patches whose
+    // flag word w has (w & mask) == value.
+    void begin_draw(GLuint prog, const View& v, std::uint32_t mask, std::uint32_t value) const {
         // The passes leave their own program, buffers and textures bound (gl_passes.h's state
         // contract): a draw sets everything it needs itself.
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
@@ -518,17 +557,17 @@ struct Renderer {
         // No hardware face culling: the open and displaced objects are two-sided, and the closed
         // one is made one-sided by its exact surface in the fragment shader, not by its triangles.
         glDisable(GL_CULL_FACE);
-        glUseProgram(program);
+        glUseProgram(prog);
         const pc::Mat4 object_to_clip = v.projection * v.view;
-        glUniformMatrix4fv(loc_object_to_clip, 1, GL_FALSE, object_to_clip.m);
-        glUniform3f(loc_eye, v.eye.x, v.eye.y, v.eye.z);
-        glUniform1f(loc_level, level);
-        glUniform1ui(loc_mask, mask);
-        glUniform1ui(loc_value, value);
-        glUniform2ui(loc_one_sided, static_cast<GLuint>(one_sided.first),
+        glUniformMatrix4fv(glGetUniformLocation(prog, "u_object_to_clip"), 1, GL_FALSE, object_to_clip.m);
+        glUniform3f(glGetUniformLocation(prog, "u_eye"), v.eye.x, v.eye.y, v.eye.z);
+        glUniform1f(glGetUniformLocation(prog, "u_level"), level);
+        glUniform1ui(glGetUniformLocation(prog, "u_draw_mask"), mask);
+        glUniform1ui(glGetUniformLocation(prog, "u_draw_value"), value);
+        glUniform2ui(glGetUniformLocation(prog, "u_one_sided"), static_cast<GLuint>(one_sided.first),
                      static_cast<GLuint>(one_sided.first + one_sided.count));
-        glUniform1f(loc_scale, displacement_scale);
-        glUniform1f(loc_midlevel, displacement_midlevel);
+        glUniform1f(glGetUniformLocation(prog, "u_displacement_scale"), displacement_scale);
+        glUniform1f(glGetUniformLocation(prog, "u_displacement_midlevel"), displacement_midlevel);
         glBindVertexArray(vao);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullFlags, flag_buffer);           // read by the TCS
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingControlPoints, patch_buffer);      // fragment shader
@@ -536,19 +575,59 @@ struct Renderer {
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingPatchTexcoords, texcoord_buffer);  // TES
         glBindTextureUnit(sh::kTextureUnitDisplacement, height_texture);
         glPatchParameteri(GL_PATCH_VERTICES, 16);
-        // llvmpipe garbles a 4096-vertex chunk that yields more than 65536 tessellated vertices
-        // (gl_renderer.h): sub-draws of at most 65536 / (level + 1)^2 patches avoid it.
-        const std::size_t per_draw =
-            std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((level + 1) * (level + 1)));
-        for (std::size_t first = 0; first < patch_count; first += per_draw)
-            glDrawArrays(GL_PATCHES, static_cast<GLint>(16 * first),
-                         static_cast<GLsizei>(16 * std::min(per_draw, patch_count - first)));
+    }
+
+    void end_draw() const {
         glBindVertexArray(0);
         glUseProgram(0);
         // Unbind: the depth texture is sampled next (HiZBuildPass), never while it is attached to
         // the draw framebuffer. Framebuffer writes are visible to later texture fetches without
         // a barrier (only shader stores need glMemoryBarrier).
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    }
+
+    // One draw of every patch; the TCS keeps those whose flag word w has (w & mask) == value.
+    void draw(const View& v, std::uint32_t mask, std::uint32_t value) const {
+        begin_draw(program, v, mask, value);
+        const std::size_t k = per_draw();
+        for (std::size_t first = 0; first < patch_count; first += k)
+            glDrawArrays(GL_PATCHES, static_cast<GLint>(16 * first),
+                         static_cast<GLsizei>(16 * std::min(k, patch_count - first)));
+        end_draw();
+    }
+
+    // --draw indirect: the same selection, but only the patches it keeps are issued. CompactPass
+    // lists them (their flag-buffer indices, in ascending order) into our list, with commands of
+    // at most per_draw() patches each (the llvmpipe limit above) and their draw count, on the
+    // GPU; one multi-draw then draws the list with the list program (its TCS given the selection
+    // (0, 0): every listed patch is drawn). Nothing is read back. Returns nothing; the commands
+    // hold how many patches were issued (issued() reads them, for the printout only).
+    void draw_compacted(pc::gl::CompactPass& compact, const pc::gl::PatchBuffers& all, const View& v,
+                        std::uint32_t mask, std::uint32_t value) const {
+        const std::size_t k = per_draw();
+        compact.run(all, mask, value, {draw_list, 0, draw_commands, 0, draw_count, 0, k});
+        begin_draw(list_program, v, 0u, 0u);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingDrawList, draw_list);  // read by the vertex shader
+        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, draw_commands);
+        const auto commands = static_cast<GLsizei>(pc::gl::compact_command_count(patch_count, k));
+        if (indirect_count) {
+            glBindBuffer(GL_PARAMETER_BUFFER_ARB, draw_count);
+            glMultiDrawArraysIndirectCountARB(GL_PATCHES, nullptr, 0, commands, 0);
+            glBindBuffer(GL_PARAMETER_BUFFER_ARB, 0);
+        } else {
+            glMultiDrawArraysIndirect(GL_PATCHES, nullptr, commands, 0);  // the empty commands draw nothing
+        }
+        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+        end_draw();
+    }
+
+    // The patches the last draw_compacted issued (a read-back, for the printout).
+    std::size_t issued() const {
+        std::vector<pc::gl::DrawArraysIndirectCommand> c(pc::gl::compact_command_count(patch_count, per_draw()));
+        glGetNamedBufferSubData(draw_commands, 0, static_cast<GLsizeiptr>(c.size() * sizeof c[0]), c.data());
+        std::size_t n = 0;
+        for (const pc::gl::DrawArraysIndirectCommand& command : c) n += command.count / 16;
+        return n;
     }
 
     template <class T>
@@ -715,14 +794,21 @@ int run(const Options& options) {
 
     // 4. The engine's patch program, its TCS with patchcull_tcs.h.
     r.program = link_patch_program();
-    r.loc_level = glGetUniformLocation(r.program, "u_level");
-    r.loc_mask = glGetUniformLocation(r.program, "u_draw_mask");
-    r.loc_value = glGetUniformLocation(r.program, "u_draw_value");
-    r.loc_object_to_clip = glGetUniformLocation(r.program, "u_object_to_clip");
-    r.loc_eye = glGetUniformLocation(r.program, "u_eye");
-    r.loc_one_sided = glGetUniformLocation(r.program, "u_one_sided");
-    r.loc_scale = glGetUniformLocation(r.program, "u_displacement_scale");
-    r.loc_midlevel = glGetUniformLocation(r.program, "u_displacement_midlevel");
+    // --draw indirect: the list program and CompactPass's outputs (a list entry per patch, the
+    // commands of the whole set, one draw count).
+    if (options.indirect) {
+        r.list_program = link_patch_program(true);
+        r.indirect_count = epoxy_gl_version() >= 46 || epoxy_has_gl_extension("GL_ARB_indirect_parameters");
+        glCreateBuffers(1, &r.draw_list);
+        glNamedBufferStorage(r.draw_list, static_cast<GLsizeiptr>(4 * std::max<std::size_t>(n, 1)), nullptr, 0);
+        glCreateBuffers(1, &r.draw_commands);
+        glNamedBufferStorage(r.draw_commands,
+                             static_cast<GLsizeiptr>(sizeof(pc::gl::DrawArraysIndirectCommand) *
+                                                     pc::gl::compact_command_count(n, r.per_draw())),
+                             nullptr, 0);
+        glCreateBuffers(1, &r.draw_count);
+        glNamedBufferStorage(r.draw_count, 4, nullptr, 0);
+    }
     check_gl("in setup");
 
     // 5. The passes, on the context current now. The Hi-Z pyramid texture is ours too.
@@ -734,6 +820,7 @@ int run(const Options& options) {
     pc::gl::OcclusionPass occlusion(passes);
     pc::gl::DisplacedPass displaced(passes);
     pc::gl::HiZBuildPass hiz_build(passes);
+    pc::gl::CompactPass compact(passes);  // --draw indirect
     const pc::gl::HiZTexture hiz = pc::gl::create_hiz_texture(r.width, r.height);
     // All patches, with the margin buffer: the passes then know the displaced ones (margin > 0):
     // FrustumPass moves their control points out by the margin, OcclusionPass and the back-patch
@@ -747,10 +834,11 @@ int run(const Options& options) {
                   pc::normal_cone_name(options.cone));
     std::printf(
         "%s, %zu patches (teapot %zu two-sided, bigguy %zu one-sided, frog %zu displaced), %dx%d, "
-        "tessellation level %g, back-patch %s, displaced bound %s, %d frames at 3 camera positions\n",
+        "tessellation level %g, back-patch %s, displaced bound %s, %d frames at 3 camera positions, draw %s\n",
         reinterpret_cast<const char*>(glGetString(GL_RENDERER)), n, scene.teapot.count, scene.bigguy.count,
         scene.frog.count, r.width, r.height, static_cast<double>(r.level), backpatch_name, bound_name,
-        3 * options.frames);
+        3 * options.frames,
+        options.indirect ? (r.indirect_count ? "indirect (glMultiDrawArraysIndirectCount)" : "indirect") : "flags");
     const float aspect = static_cast<float>(r.width) / static_cast<float>(r.height);
     int mismatched = 0;
     std::size_t total_frustum = 0, total_backpatch = 0, total_occlusion = 0, total_displaced = 0;
@@ -765,7 +853,13 @@ int run(const Options& options) {
         // ---- the culled frame: Niessner & Loop §3's two passes ----
         // Pass 1: the patches the previous frame tagged visible.
         r.clear();
-        r.draw(v, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
+        std::size_t issued[2] = {n, options.aggressive ? 0 : n};  // patches issued per pass (the flags: all)
+        if (options.indirect) {
+            r.draw_compacted(compact, all, v, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
+            issued[0] = r.issued();  // a read-back for the printout only
+        } else {
+            r.draw(v, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
+        }
         // Hi-Z pyramid of pass 1's depth (max per texel: a conservative occluder depth).
         hiz_build.run(r.depth, hiz);
         // The flag chain. Each pass skips the patches an earlier one culled and writes its own
@@ -800,7 +894,12 @@ int run(const Options& options) {
         for (std::size_t o = 0; o < 3; ++o) status.end(objects[o]->range(all), counters, o * stride);
         // Pass 2: the patches newly visible (passed now, not drawn in pass 1), into the same
         // colour, id and depth.
-        if (!options.aggressive) r.draw(v, sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass);
+        if (!options.aggressive && options.indirect) {
+            r.draw_compacted(compact, all, v, sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass);
+            issued[1] = r.issued();
+        } else if (!options.aggressive) {
+            r.draw(v, sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass);
+        }
 
         Counts c;
         for (std::size_t o = 0; o < 3; ++o)
@@ -840,12 +939,13 @@ int run(const Options& options) {
         std::printf(
             "frame %d (camera %d): culled frustum %u (teapot %u, bigguy %u, frog %u), back-patch %u "
             "(bigguy %u), occlusion %u (teapot %u, bigguy %u), displaced occlusion %u (frog); "
-            "drawn pass 1 %u, pass 2 %u%s; %s\n",
+            "drawn pass 1 %u, pass 2 %u%s; issued %zu + %zu (%s); %s\n",
             f, f / options.frames, c.total(sh::kCounterFrustum), c.slot[0][sh::kCounterFrustum],
             c.slot[1][sh::kCounterFrustum], c.slot[2][sh::kCounterFrustum], c.total(sh::kCounterBackPatch),
             c.slot[1][sh::kCounterBackPatch], occlusion_hiz, c.slot[0][sh::kCounterOcclusion],
             c.slot[1][sh::kCounterOcclusion], displaced_hiz, c.total(sh::kCounterWasVisible),
-            c.total(sh::kCounterNewlyVisible), options.aggressive ? " (skipped: --aggressive)" : "", verdict.c_str());
+            c.total(sh::kCounterNewlyVisible), options.aggressive ? " (skipped: --aggressive)" : "", issued[0],
+            issued[1], options.indirect ? "indirect" : "flags", verdict.c_str());
         std::fflush(stdout);
         glfwSwapBuffers(window);
         glfwPollEvents();
@@ -858,6 +958,9 @@ int run(const Options& options) {
     glDeleteFramebuffers(1, &r.fbo);
     glDeleteVertexArrays(1, &r.vao);
     glDeleteProgram(r.program);
+    glDeleteProgram(r.list_program);
+    const GLuint list_buffers[] = {r.draw_list, r.draw_commands, r.draw_count};
+    glDeleteBuffers(3, list_buffers);
     // The passes (destroyed at scope end) need the context: the window goes after them (main).
     if (mismatched) {
         std::printf("FAILED: %d of %d frames differ from the unculled draw\n", mismatched, frames);
