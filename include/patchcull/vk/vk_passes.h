@@ -13,8 +13,9 @@
 //   (after the chain)      -                              CompactPass        compact.comp.glsl
 //   Hi-Z pyramid           HiZPyramid::build              HiZBuildPass       hiz_build.comp.glsl
 //   Hi-Z occlusion         cull_occlusion_scalar          OcclusionPass      occlusion.comp.glsl
-// The other passes of gl_passes.h (displaced, fused) and the passes over a GpuPatchSource have no
-// Vulkan twin yet (docs/ENGINE.md, "Vulkan").
+//   frustum + cone + Hi-Z  (the three above, in one)      FusedCullPass      fused_cull.comp.glsl
+// The displaced pass of gl_passes.h and the passes over a GpuPatchSource have no Vulkan twin yet
+// (docs/ENGINE.md, "Vulkan").
 //
 // Buffers: the layouts of gl_passes.h (control points 16 vec4 per patch in patch.h order, 256
 // bytes; the flag word, core/cull_flags.h, one uint per patch; margins one float per patch;
@@ -363,6 +364,26 @@ public:
     /// The same on one view's CullView (view.object_to_clip in view.depth).
     void run(VkCommandBuffer cmd, const PatchBuffers& patches, const CullView& view, const HiZImage& hiz,
              bool with_frustum = true);
+
+private:
+    PassContext::Impl* context_;
+};
+
+/// gl_passes.h's FusedCullPass on Vulkan: FrustumPass, BackpatchConePass and OcclusionPass
+/// (with_frustum = false) in one dispatch, one invocation per patch, the tests of `tests` in the
+/// chain's order, stopping at the first that culls: each patch gets the reason that chain gives
+/// it (displaced patches: the frustum test with their margin only). Its 160-byte parameter block
+/// goes to the PassContext's uniform buffer as OcclusionPass's does.
+class FusedCullPass {
+public:
+    explicit FusedCullPass(PassContext& context);
+    /// tests: a mask of kCullFrustum, kCullBackPatch, kCullOcclusion (0 records nothing). method:
+    /// tcone or ncone, used with kCullBackPatch (ptp: Error). eye: object space. hiz: a built
+    /// pyramid in GENERAL layout, bound in every run (the shader declares it) and read with
+    /// kCullOcclusion, then built in depth's direction (else Error). depth: the convention of
+    /// object_to_clip.
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, std::uint32_t tests, const Mat4& object_to_clip,
+             ClipDepth depth, BackpatchMethod method, Vec3 eye, const HiZImage& hiz);
 
 private:
     PassContext::Impl* context_;
