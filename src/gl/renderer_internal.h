@@ -371,6 +371,8 @@ struct PatchRenderer::Impl {
         begin_patch_draw(list_program, list_loc, 0u, 0u, false);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingDrawList, d.list);
         glBindBuffer(GL_DRAW_INDIRECT_BUFFER, d.commands);
+        // GL takes the byte offset into the bound indirect buffer as a pointer.
+        // NOLINTNEXTLINE(performance-no-int-to-ptr)
         const auto* offset = reinterpret_cast<const void*>(static_cast<std::uintptr_t>(d.first_command * 16));
         const auto max_draws = static_cast<GLsizei>(d.command_count);
         if (d.draw_count && indirect_count) {
