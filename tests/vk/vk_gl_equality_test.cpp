@@ -4,14 +4,16 @@
 // cull_frustum_scalar's decisions, and the frustum pass's six plane maxima are bit-identical, in
 // every ClipDepth convention, with and without margins; the frustum-disp, tcone, ncone and ptp
 // passes leave the same words on both APIs, equal to their CPU scalar kernels'; the compaction
-// pass writes the same list (the scan's order), commands and draw count. Built only with
-// PATCHCULL_WITH_GL.
+// pass writes the same list (the scan's order), commands and draw count; from the same depths
+// the Hi-Z pyramids are bit-identical and the occlusion and fused passes leave the same words.
+// Built only with PATCHCULL_WITH_GL.
 #include <gtest/gtest.h>
 
 #if PATCHCULL_VK_TEST_GL
 
 #include <epoxy/gl.h>
 
+#include <algorithm>
 #include <cstring>
 #include <functional>
 #include <random>
@@ -25,6 +27,7 @@
 #include "patchcull/gl/gl_passes.h"
 #include "shared.h"
 #include "vk/vk_cases.h"
+#include "vk/vk_images.h"
 
 using namespace patchcull;
 using namespace patchcull::vk::test;
@@ -302,6 +305,61 @@ TEST_F(VkGlEquality, CompactionWritesTheSameListCommandsAndCount) {
     EXPECT_EQ(command.read<std::uint32_t>(commands * 4), gl_commands);
     EXPECT_EQ(draw_count.read<std::uint32_t>(1)[0], gl_count);
     EXPECT_GT(gl_count, 1u);
+}
+
+TEST_F(VkGlEquality, HiZOcclusionAndFusedEqualGl) {
+    const int w = 96, h = 64;
+    for (const ClipDepth depth : {ClipDepth::zero_to_one, ClipDepth::reversed_infinite}) {
+        RandomCase c = random_case(71, 1500, depth, false);
+        for (int i = 0; i < 200; ++i)
+            c.patches.push_back(test_patches::flat_patch(static_cast<float>(i % 20) - 10.0f,
+                                                         static_cast<float>(i / 20) - 5.0f, 0.5f, i % 2 == 0));
+        const Mat4 m = c.camera.view_projection();
+        const Vec3 eye = c.camera.eye;
+        const std::vector<float> depths = wall_depths(c, m, depth, w, h);
+        const std::uint32_t all = kCullFrustum | kCullBackPatch | kCullOcclusion;
+        // GL: the depth texture, the pyramid, the occlusion pass and the fused pass.
+        gl::PassContext& passes = gl_passes();
+        GLuint depth_texture = 0;
+        glCreateTextures(GL_TEXTURE_2D, 1, &depth_texture);
+        glTextureStorage2D(depth_texture, 1, GL_DEPTH_COMPONENT32F, w, h);
+        glTextureSubImage2D(depth_texture, 0, 0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depths.data());
+        gl::HiZTexture gl_hiz = gl::create_hiz_texture(w, h);
+        gl::HiZBuildPass(passes).run(depth_texture, gl_hiz, depth);
+        const std::vector<float> gl_pyramid = gl::read_hiz_texture(gl_hiz);
+        std::vector<std::uint32_t> gl_occlusion, gl_fused;
+        gl_occlusion =
+            gl_words(c, [&](const gl::PatchBuffers& b) { gl::OcclusionPass(passes).run(b, m, depth, gl_hiz); });
+        gl_fused = gl_words(c, [&](const gl::PatchBuffers& b) {
+            gl::FusedCullPass(passes).run(b, all, m, depth, BackpatchMethod::tcone, eye, &gl_hiz);
+        });
+        glDeleteTextures(1, &depth_texture);
+        glDeleteTextures(1, &gl_hiz.texture);
+        // Vulkan.
+        CaseBuffers occlusion_buffers(c), fused_buffers(c);
+        vk::CullStatusPass status(vk().passes());
+        vk::OcclusionPass occlusion(vk().passes());
+        vk::FusedCullPass fused(vk().passes());
+        bool reversed = false;
+        const std::vector<float> vk_pyramid_texels =
+            vk_pyramid(vk(), depths, w, h, depth, &reversed, [&](VkCommandBuffer cmd, const vk::HiZImage& hiz) {
+                status.begin(cmd, occlusion_buffers.patch_buffers());
+                occlusion.run(cmd, occlusion_buffers.patch_buffers(), m, depth, hiz);
+                status.begin(cmd, fused_buffers.patch_buffers());
+                fused.run(cmd, fused_buffers.patch_buffers(), all, m, depth, BackpatchMethod::tcone, eye, hiz);
+            });
+        ASSERT_EQ(vk_pyramid_texels.size(), gl_pyramid.size());
+        EXPECT_EQ(std::memcmp(vk_pyramid_texels.data(), gl_pyramid.data(), gl_pyramid.size() * 4), 0)
+            << clip_depth_name(depth);
+        EXPECT_EQ(occlusion_buffers.flags.read<std::uint32_t>(c.patches.size()), gl_occlusion)
+            << clip_depth_name(depth);
+        EXPECT_EQ(fused_buffers.flags.read<std::uint32_t>(c.patches.size()), gl_fused) << clip_depth_name(depth);
+        const std::size_t occluded =
+            static_cast<std::size_t>(std::count(gl_fused.begin(), gl_fused.end(), kCullOcclusion));
+        const std::size_t back = static_cast<std::size_t>(std::count(gl_fused.begin(), gl_fused.end(), kCullBackPatch));
+        EXPECT_GT(occluded, 50u) << clip_depth_name(depth);
+        EXPECT_GT(back, 20u) << clip_depth_name(depth);
+    }
 }
 
 #endif  // PATCHCULL_VK_TEST_GL

@@ -19,29 +19,6 @@ using namespace patchcull::vk::test;
 
 namespace {
 
-// A w x h depth buffer in `depth`'s convention: the far end everywhere but a wall over the left
-// two thirds (with pinholes) at the window depth of the 40th percentile of the patches' first points, so that
-// many patches lie behind it.
-std::vector<float> wall_depths(const RandomCase& c, const Mat4& m, ClipDepth depth, int w, int h) {
-    const Mat4 key = to_depth_key(m, depth);
-    std::vector<float> window;
-    for (const BezierPatch& p : c.patches) {
-        const Vec4 q = key * p.cp[0];
-        if (q.w <= 0) continue;
-        const float d = is_reversed(depth) ? -q.z / q.w : q.z / q.w;
-        if (d > 0.0f && d < 1.0f) window.push_back(d);
-    }
-    std::sort(window.begin(), window.end());
-    const float wall = window.empty() ? 0.5f : window[window.size() * 2 / 5];
-    const float far = is_reversed(depth) ? 0.0f : 1.0f;
-    std::vector<float> d(static_cast<std::size_t>(w) * h, far);
-    // The wall has pinholes (far pixels) on a grid, so that a box's level and footprint matter.
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < 2 * w / 3; ++x)
-            if (x % 9 != 4 || y % 7 != 3) d[static_cast<std::size_t>(y) * w + x] = wall;
-    return d;
-}
-
 class VkOcclusion : public VkTest {};
 
 }  // namespace
