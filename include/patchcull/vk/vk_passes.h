@@ -14,8 +14,8 @@
 //   Hi-Z pyramid           HiZPyramid::build              HiZBuildPass       hiz_build.comp.glsl
 //   Hi-Z occlusion         cull_occlusion_scalar          OcclusionPass      occlusion.comp.glsl
 //   frustum + cone + Hi-Z  (the three above, in one)      FusedCullPass      fused_cull.comp.glsl
-// The displaced pass of gl_passes.h and the passes over a GpuPatchSource have no Vulkan twin yet
-// (docs/ENGINE.md, "Vulkan").
+//   displaced bounds       cull_displaced_frustum/_occlusion DisplacedPass   displaced.comp.glsl
+// The passes over a GpuPatchSource have no Vulkan twin yet (docs/ENGINE.md, "Vulkan").
 //
 // Buffers: the layouts of gl_passes.h (control points 16 vec4 per patch in patch.h order, 256
 // bytes; the flag word, core/cull_flags.h, one uint per patch; margins one float per patch;
@@ -85,6 +85,8 @@
 #include "patchcull/core/backpatch_methods.h"
 #include "patchcull/core/clip_space.h"
 #include "patchcull/core/cull_view.h"
+#include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/displacement.h"
 #include "patchcull/core/frustum.h"
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/math.h"
@@ -384,6 +386,28 @@ public:
     /// object_to_clip.
     void run(VkCommandBuffer cmd, const PatchBuffers& patches, std::uint32_t tests, const Mat4& object_to_clip,
              ClipDepth depth, BackpatchMethod method, Vec3 eye, const HiZImage& hiz);
+
+private:
+    PassContext::Impl* context_;
+};
+
+/// gl_passes.h's DisplacedPass on Vulkan: cull_displaced_frustum / cull_displaced_occlusion
+/// (Niessner & Loop §4.2): the bound (caf or oobb) of each displaced patch from its range and cone,
+/// tested against the frustum and, with occlusion, the pyramid: reasons kCullFrustum,
+/// kCullOcclusion. Its 336-byte parameter block goes to the PassContext's uniform buffer as
+/// OcclusionPass's does; one pipeline per cone kind.
+class DisplacedPass {
+public:
+    explicit DisplacedPass(PassContext& context);
+    /// ranges: the DisplacementRange (vec2) per patch (empty: every patch undisplaced). hiz: a
+    /// pyramid in GENERAL layout, bound in every run (the shader declares it) and read with
+    /// occlusion, then built in view.depth's direction (else Error). only_displaced: patches whose
+    /// range is (0, 0) are left to the other passes; false: every patch of the range is tested, as
+    /// the CPU kernels do. bounds (optional, diagnostics): >= 8 floats per patch (gl_passes.h's
+    /// layout).
+    void run(VkCommandBuffer cmd, const PatchBuffers& patches, const BufferRange& ranges, DisplacedBoundKind bound,
+             NormalConeKind cone, const DisplacedCullView& view, const HiZImage& hiz, bool occlusion,
+             bool only_displaced, const BufferRange& bounds = {});
 
 private:
     PassContext::Impl* context_;
