@@ -1,8 +1,10 @@
 // PassContext of the Vulkan passes (patchcull/vk/vk_passes.h): device commands, the pipeline
 // cache, the placeholder buffer, the range checks and the recording shared by every pass.
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -183,7 +185,12 @@ PassContext::Impl& PassContext::impl() { return *impl_; }
 const detail::Pipeline& PassContext::Impl::pipeline(const char* shader, const char* variant,
                                                     std::initializer_list<detail::Slot> slots,
                                                     std::uint32_t push_constant_bytes) {
-    const std::string key = std::string(shader) + " " + variant;
+    // The key in a buffer on the stack (a run allocates nothing once its pipeline exists).
+    char key_text[128];
+    const int key_length = std::snprintf(key_text, sizeof key_text, "%s %s", shader, variant);
+    if (key_length < 0 || static_cast<std::size_t>(key_length) >= sizeof key_text)
+        throw Error(std::string("Vulkan: ") + shader + ": a pipeline key too long");
+    const std::string_view key(key_text, static_cast<std::size_t>(key_length));
     auto it = pipelines.find(key);
     if (it != pipelines.end()) return it->second;
     if (push_constant_bytes > limits.maxPushConstantsSize)
@@ -242,24 +249,25 @@ const detail::Pipeline& PassContext::Impl::pipeline(const char* shader, const ch
         if (p.set_layout) vk.DestroyDescriptorSetLayout(device, p.set_layout, nullptr);
         throw;
     }
-    return pipelines.emplace(key, p).first->second;
+    return pipelines.emplace(std::string(key), p).first->second;
 }
 
 void PassContext::Impl::check_range(const char* who, const char* what, const BufferRange& range, VkDeviceSize bytes,
                                     bool optional) const {
-    const std::string prefix = std::string("Vulkan: ") + who + ": the " + what + " range ";
+    // The message is made only on failure: a run allocates nothing on the host.
+    auto prefix = [&] { return std::string("Vulkan: ") + who + ": the " + what + " range "; };
     if (range.buffer == VK_NULL_HANDLE) {
         if (optional && range.size == 0) return;
-        throw Error(prefix + "has no buffer");
+        throw Error(prefix() + "has no buffer");
     }
-    if (range.size == VK_WHOLE_SIZE) throw Error(prefix + "has size VK_WHOLE_SIZE (give its size)");
+    if (range.size == VK_WHOLE_SIZE) throw Error(prefix() + "has size VK_WHOLE_SIZE (give its size)");
     if (range.size < bytes)
-        throw Error(prefix + "holds " + std::to_string(range.size) + " bytes, " + std::to_string(bytes) + " needed");
+        throw Error(prefix() + "holds " + std::to_string(range.size) + " bytes, " + std::to_string(bytes) + " needed");
     if (range.offset % limits.minStorageBufferOffsetAlignment != 0)
-        throw Error(prefix + "starts at " + std::to_string(range.offset) + ", not a multiple of " +
+        throw Error(prefix() + "starts at " + std::to_string(range.offset) + ", not a multiple of " +
                     std::to_string(limits.minStorageBufferOffsetAlignment) + " (minStorageBufferOffsetAlignment)");
     if (range.size > limits.maxStorageBufferRange)
-        throw Error(prefix + "of " + std::to_string(range.size) + " bytes exceeds maxStorageBufferRange (" +
+        throw Error(prefix() + "of " + std::to_string(range.size) + " bytes exceeds maxStorageBufferRange (" +
                     std::to_string(limits.maxStorageBufferRange) + ")");
 }
 

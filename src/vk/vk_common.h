@@ -9,6 +9,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <initializer_list>
 #include <map>
 #include <string>
@@ -98,7 +99,7 @@ struct PassContext::Impl {
     static constexpr VkDeviceSize kParamBufferBytes = 512;
     VkBuffer param_buffer = VK_NULL_HANDLE;
     VkDeviceMemory param_memory = VK_NULL_HANDLE;
-    std::map<std::string, detail::Pipeline> pipelines;  // key: shader name + " " + variant
+    std::map<std::string, detail::Pipeline, std::less<>> pipelines;  // key: shader name + " " + variant
 
     ~Impl();
     /// The pipeline of compute shader `shader` in `variant` ("" or the define of a variant; its
