@@ -362,4 +362,87 @@ TEST_F(VkGlEquality, HiZOcclusionAndFusedEqualGl) {
     }
 }
 
+TEST_F(VkGlEquality, TwoFramesOfTheChainLeaveTheSameWordsAndCounts) {
+    // Two frames of begin -> frustum -> tcone -> Hi-Z occlusion (no frustum) -> end on one flag
+    // buffer, the second from a moved camera: statuses carry over, and every word and counter
+    // equals GL's after each frame.
+    const int w = 96, h = 64;
+    const ClipDepth depth = ClipDepth::reversed;
+    RandomCase c = random_case(91, 1500, depth, true);
+    for (int i = 0; i < 200; ++i)
+        c.patches.push_back(test_patches::flat_patch(static_cast<float>(i % 20) - 10.0f,
+                                                     static_cast<float>(i / 20) - 5.0f, 0.5f, i % 2 == 0));
+    c.margins.resize(c.patches.size(), 0.0f);
+    Camera cameras[2] = {c.camera, c.camera};
+    cameras[1].eye = cameras[1].eye + Vec3{0.3f, -0.2f, 0.1f};
+    const std::vector<float> depths = wall_depths(c, cameras[0].view_projection(), depth, w, h);
+    const std::size_t n = c.patches.size();
+    // GL.
+    gl::PassContext& passes = gl_passes();
+    GLuint depth_texture = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &depth_texture);
+    glTextureStorage2D(depth_texture, 1, GL_DEPTH_COMPONENT32F, w, h);
+    glTextureSubImage2D(depth_texture, 0, 0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, depths.data());
+    gl::HiZTexture gl_hiz = gl::create_hiz_texture(w, h);
+    gl::HiZBuildPass(passes).run(depth_texture, gl_hiz, depth);
+    gl::PatchBuffers gb;
+    gb.control_points = gl_buffer(n * sizeof(BezierPatch), c.patches.data());
+    gb.flags = gl_buffer(n * 4, nullptr);
+    gb.margins = gl_buffer(n * 4, c.margins.data());
+    gb.count = n;
+    std::vector<std::uint32_t> gl_frame_words[2], gl_frame_counters[2];
+    for (int f = 0; f < 2; ++f) {
+        const GLuint counters = gl_buffer(shared::kCounterCount * 4, nullptr);
+        const Mat4 m = cameras[f].view_projection();
+        gl::CullStatusPass(passes).begin(gb);
+        gl::FrustumPass(passes).run(gb, make_frustum_planes(m, depth));
+        gl::BackpatchConePass(passes).run(gb, BackpatchMethod::tcone, cameras[f].eye);
+        gl::OcclusionPass(passes).run(gb, m, depth, gl_hiz, false);
+        gl::CullStatusPass(passes).end(gb, counters);
+        gl_frame_words[f] = gl_read<std::uint32_t>(gb.flags, n);
+        gl_frame_counters[f] = gl_read<std::uint32_t>(counters, shared::kCounterCount);
+        glDeleteBuffers(1, &counters);
+    }
+    const GLuint names[] = {gb.control_points, gb.flags, gb.margins};
+    glDeleteBuffers(3, names);
+    glDeleteTextures(1, &depth_texture);
+    glDeleteTextures(1, &gl_hiz.texture);
+    // Vulkan: both frames in one command buffer, each frame's words copied out after its end.
+    CaseBuffers b(c);
+    HostBuffer counters[2] = {HostBuffer(shared::kCounterCount * 4), HostBuffer(shared::kCounterCount * 4)};
+    HostBuffer words[2] = {HostBuffer(n * 4), HostBuffer(n * 4)};
+    vk::CullStatusPass status(vk().passes());
+    vk::FrustumPass frustum(vk().passes());
+    vk::BackpatchConePass cones(vk().passes());
+    vk::OcclusionPass occlusion(vk().passes());
+    bool reversed = false;
+    vk_pyramid(vk(), depths, w, h, depth, &reversed, [&](VkCommandBuffer cmd, const vk::HiZImage& hiz) {
+        for (int f = 0; f < 2; ++f) {
+            const Mat4 m = cameras[f].view_projection();
+            status.begin(cmd, b.patch_buffers());
+            frustum.run(cmd, b.patch_buffers(), make_frustum_planes(m, depth));
+            cones.run(cmd, b.patch_buffers(), BackpatchMethod::tcone, cameras[f].eye);
+            occlusion.run(cmd, b.patch_buffers(), m, depth, hiz, false);
+            status.end(cmd, b.patch_buffers(), counters[f].range());
+            const VkBufferCopy copy{0, 0, n * 4};
+            vkCmdCopyBuffer(cmd, b.flags.range().buffer, words[f].range().buffer, 1, &copy);
+            VkMemoryBarrier barrier{};
+            barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+            barrier.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+            barrier.dstAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
+                                 &barrier, 0, nullptr, 0, nullptr);
+        }
+    });
+    for (int f = 0; f < 2; ++f) {
+        EXPECT_EQ(words[f].read<std::uint32_t>(n), gl_frame_words[f]) << "frame " << f;
+        EXPECT_EQ(counters[f].read<std::uint32_t>(shared::kCounterCount), gl_frame_counters[f]) << "frame " << f;
+    }
+    // Every reason and both statuses occur.
+    const std::vector<std::uint32_t>& last = gl_frame_words[1];
+    for (const std::uint32_t word :
+         {kCullFrustum, kCullBackPatch, kCullOcclusion, kStatusVisible, kStatusVisible | kStatusNewlyVisible})
+        EXPECT_GT(std::count(last.begin(), last.end(), word), 0) << "word " << word;
+}
+
 #endif  // PATCHCULL_VK_TEST_GL
