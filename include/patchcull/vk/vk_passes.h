@@ -31,18 +31,25 @@
 //     binding numbers of shaders/shared.h (kBindingControlPoints 0, kBindingCullFlags 1,
 //     kBindingMaxDisplacement 2, kBindingPlaneValues 4, kBindingCullCounters 6,
 //     kBindingPtpPlanes 13, kBindingConeValues 14; CompactPass: kBindingDrawList 26,
-//     kBindingDrawCommands 27, kBindingDrawCount 28, kBindingCompactSums 29); an optional range
-//     left empty is replaced by a small buffer of the PassContext (never read)
+//     kBindingDrawCommands 27, kBindingDrawCount 28, kBindingCompactSums 29; DisplacedPass:
+//     kBindingDisplacementRanges 8, kBindingDisplacedBounds 9); an optional range left empty is
+//     replaced by a small buffer of the PassContext (never read); the Hi-Z passes' images and
+//     the uniform buffer as their classes say
 //   per dispatch: vkCmdPushConstants (its pass_params.h block, std140, at offset 0) and
 //     vkCmdDispatch; ranges of more than 65535 work groups are split into several (CompactPass:
-//     its steps, with a compute-to-compute VkMemoryBarrier between them)
+//     its steps, with a compute-to-compute VkMemoryBarrier between them; HiZBuildPass: one per
+//     level, an image barrier between them). The blocks over 128 bytes (OcclusionPass,
+//     FusedCullPass, DisplacedPass) go instead to the PassContext's uniform buffer by
+//     vkCmdUpdateBuffer, between an execution barrier (compute -> transfer) and a transfer-write
+//     -> uniform-read barrier
 //   vkCmdPipelineBarrier: one VkMemoryBarrier from VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT /
 //     VK_ACCESS_SHADER_WRITE_BIT to PassContextOptions::after_stages / after_access (default:
 //     every stage and access), so the next pass of the chain, a draw's tessellation control
 //     shader, an indirect draw or a copy back sees the writes.
 // It leaves the command buffer's compute pipeline, compute push descriptors (set 0) and push
 // constants as it set them (rebind yours after), changes no graphics state, records no render
-// pass, and must be recorded outside a render pass instance. It creates no Vulkan object after
+// pass, and must be recorded outside a render pass instance. Record the passes of one PassContext
+// on one queue (the uniform buffer is shared by its passes, ordered by those barriers). It creates no Vulkan object after
 // the pipeline of its shader exists (first use per PassContext) and allocates nothing on the
 // host per call.
 // Before a pass, the caller orders its own earlier work on the ranges: writes (uploads, copies,
@@ -64,9 +71,10 @@
 // Clip conventions: Vulkan draws in ClipDepth::zero_to_one or, reversed, ClipDepth::reversed /
 // reversed_infinite (clip_space.h); the passes take the convention wherever a decision depends on
 // depth (FrustumPlanes is made with one). Vulkan's y-down clip space (a projection whose y row is
-// negated, or a viewport of negative height) needs nothing: the frustum planes w + y >= 0 and
-// w - y >= 0 are the same pair, so every decision is the same for the flipped and the unflipped
-// projection of one camera.
+// negated) needs nothing in the frustum and back-patch tests: the frustum planes w + y >= 0 and
+// w - y >= 0 are the same pair and ptp takes the flip from the determinant, so every decision is
+// the same for the flipped and the unflipped projection of one camera. The Hi-Z tests read the
+// pyramid's row r as the depth image's row r (HiZBuildPass).
 //
 // Threads and lifetime: a PassContext and its passes are used from one thread at a time; command
 // buffers recorded with them must have finished executing before the PassContext is destroyed.
