@@ -49,8 +49,9 @@
 // It leaves the command buffer's compute pipeline, compute push descriptors (set 0) and push
 // constants as it set them (rebind yours after), changes no graphics state, records no render
 // pass, and must be recorded outside a render pass instance. Record the passes of one PassContext
-// on one queue (the uniform buffer is shared by its passes, ordered by those barriers). It creates no Vulkan object
-// after the pipeline of its shader exists (first use per PassContext) and allocates nothing on the host per call.
+// on one queue (the uniform buffer is shared by its passes, ordered by those barriers). It
+// creates no Vulkan object after the pipeline of its shader exists (first use per PassContext)
+// and allocates nothing on the host per call.
 // Before a pass, the caller orders its own earlier work on the ranges: writes (uploads, copies,
 // its shaders) made available and visible to VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT with
 // VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, and earlier reads of the buffers the
