@@ -5,7 +5,8 @@ Usage: python3 scripts/gpu_figures.py [BUILD_DIR]   (default: build)
 
 1. Default scene: frame time with culling (cull all, tcone) against without (cull none), per
    tessellation level, as a ratio (the payoff in Fig. 9 of Niessner & Loop, "Patch-Based Occlusion
-   Culling for Hardware Tessellation").
+   Culling for Hardware Tessellation"), with the culled patches issued at level 0 (--draw flags)
+   and left out of compacted indirect draws (--draw indirect), side by side.
 2. Hi-Z build time against resolution (default scene, cull occlusion).
 3. Cull-pass time against patch count (MonsterFrog and BigGuy split 0..2: closed solids, so that
    `all` includes the back-patch pass; cull occlusion alone, and all with each back-patch method;
@@ -45,14 +46,19 @@ def main():
     first = render("teapot", "--frames", 1, "--size", "8x8")
     print(f"renderer: {first['renderer']}\n")
 
-    print("1. Default scene (8226 patches), 640x360, 5 frames: frame time (ms) without / with culling")
-    print(f"{'tess':>5} {'none':>9} {'all':>9} {'ratio':>7} {'culled':>7}")
+    print("1. Default scene (8226 patches), 640x360, 5 frames: frame time (ms) without culling, with")
+    print("   culling drawn with flags (culled patches issued at level 0) and drawn indirect (compacted)")
+    print(f"{'tess':>5} {'none':>9} {'flags':>9} {'indirect':>9} {'flags/none':>10} {'ind/none':>9} {'culled':>7}")
     for tess in (1, 2, 4, 8, 16):
-        none = render("default", "--frames", 5, "--tess", tess, "--cull", "none")
-        cull = render("default", "--frames", 5, "--tess", tess, "--cull", "all", "--backpatch", "tcone")
-        culled = sum(mean_count(cull, k) for k in ("frustum_culled", "backpatch_culled", "occlusion_culled"))
-        t0, t1 = mean_ms(none, "total"), mean_ms(cull, "total")
-        print(f"{tess:>5} {t0:>9.1f} {t1:>9.1f} {t1 / t0:>7.2f} {100 * culled / cull['patches']:>6.1f}%")
+        none = render("default", "--frames", 5, "--tess", tess, "--cull", "none", "--draw", "flags")
+        flags = render("default", "--frames", 5, "--tess", tess, "--cull", "all", "--backpatch", "tcone",
+                       "--draw", "flags")
+        indirect = render("default", "--frames", 5, "--tess", tess, "--cull", "all", "--backpatch", "tcone",
+                          "--draw", "indirect")
+        culled = sum(mean_count(flags, k) for k in ("frustum_culled", "backpatch_culled", "occlusion_culled"))
+        t0, t1, t2 = mean_ms(none, "total"), mean_ms(flags, "total"), mean_ms(indirect, "total")
+        print(f"{tess:>5} {t0:>9.1f} {t1:>9.1f} {t2:>9.1f} {t1 / t0:>10.2f} {t2 / t0:>9.2f} "
+              f"{100 * culled / flags['patches']:>6.1f}%")
 
     print("\n2. Hi-Z build time (ms) against resolution (default scene, cull occlusion, level 1, 4 frames)")
     print(f"{'size':>10} {'levels':>6} {'hiz ms':>8}")
