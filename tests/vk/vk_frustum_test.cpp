@@ -202,3 +202,33 @@ TEST_F(VkFrustum, RefusesRangesThatAreTooSmallOrMissing) {
     });
     EXPECT_EQ(message, "Vulkan: CullStatusPass: the flag range has no buffer");
 }
+
+TEST_F(VkFrustum, LargeRangesAreSplitIntoDispatchesOfAtMost65535Groups) {
+    // 65535 work groups of 64 patches cover 4,194,240 patches: CullStatusPass::end over 4.3M
+    // (flags only, 17 MB) runs two dispatches, the second from first_patch 4,194,240 + first.
+    const std::size_t n = 4300000, first = 3;
+    std::vector<std::uint32_t> words(n);
+    for (std::size_t p = 0; p < n; ++p)
+        words[p] = (p % 3 == 0 ? kStatusVisible : 0u) | (p % 7 == 0 ? kCullFrustum : 0u);
+    HostBuffer flags(n * 4), counters(shared::kCounterCount * 4);
+    flags.write(words.data(), n * 4);
+    PatchBuffers b;
+    b.flags = flags.range();
+    b.first = first;
+    b.count = n - first;
+    CullStatusPass status(vk().passes());
+    vk().submit([&](VkCommandBuffer cmd) { status.end(cmd, b, counters.range()); });
+    const std::vector<std::uint32_t> got = flags.read<std::uint32_t>(n);
+    std::uint32_t visible = 0;
+    for (std::size_t p = 0; p < n; ++p) {
+        std::uint32_t expected = words[p];
+        if (p >= first) {
+            const std::uint32_t reason = words[p] & kCullReasonMask;
+            const bool was_visible = (words[p] & kStatusVisible) != 0;
+            expected = reason != 0 ? reason : kStatusVisible | (was_visible ? 0u : kStatusNewlyVisible);
+            visible += reason == 0;
+        }
+        ASSERT_EQ(got[p], expected) << "patch " << p;
+    }
+    EXPECT_EQ(counters.read<std::uint32_t>(shared::kCounterCount)[shared::kCounterVisible], visible);
+}
