@@ -34,10 +34,13 @@ TEST_F(VkFused, WordsEqualTheChainAndTheCpuKernels) {
         for (const BackpatchMethod method : {BackpatchMethod::tcone, BackpatchMethod::ncone}) {
             // Random patches and, for the cones, flat ones facing every way.
             RandomCase c = random_case(depth == ClipDepth::reversed ? 61 : 62, 1500, depth, false);
-            for (int i = 0; i < 300; ++i)
-                c.patches.push_back(test_patches::flat_patch(static_cast<float>(i % 20) - 10.0f,
-                                                             static_cast<float>(i / 20) - 7.0f,
+            c.patches.reserve(c.patches.size() + 300);
+            for (int i = 0; i < 300; ++i) {
+                const int column = i % 20, row = i / 20;  // a 20 x 15 grid of flat patches
+                c.patches.push_back(test_patches::flat_patch(static_cast<float>(column) - 10.0f,
+                                                             static_cast<float>(row) - 7.0f,
                                                              static_cast<float>(i % 7) - 3.0f, i % 2 == 0));
+            }
             const Mat4 m = c.camera.view_projection();
             const Vec3 eye = c.camera.eye;
             const std::vector<float> depths = wall_depths(c, m, depth, w, h);

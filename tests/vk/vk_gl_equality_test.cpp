@@ -311,9 +311,12 @@ TEST_F(VkGlEquality, HiZOcclusionAndFusedEqualGl) {
     const int w = 96, h = 64;
     for (const ClipDepth depth : {ClipDepth::zero_to_one, ClipDepth::reversed_infinite}) {
         RandomCase c = random_case(71, 1500, depth, false);
-        for (int i = 0; i < 200; ++i)
-            c.patches.push_back(test_patches::flat_patch(static_cast<float>(i % 20) - 10.0f,
-                                                         static_cast<float>(i / 20) - 5.0f, 0.5f, i % 2 == 0));
+        c.patches.reserve(c.patches.size() + 200);
+        for (int i = 0; i < 200; ++i) {
+            const int column = i % 20, row = i / 20;  // a 20 x 10 grid of flat patches
+            c.patches.push_back(test_patches::flat_patch(static_cast<float>(column) - 10.0f,
+                                                         static_cast<float>(row) - 5.0f, 0.5f, i % 2 == 0));
+        }
         const Mat4 m = c.camera.view_projection();
         const Vec3 eye = c.camera.eye;
         const std::vector<float> depths = wall_depths(c, m, depth, w, h);
@@ -369,9 +372,12 @@ TEST_F(VkGlEquality, TwoFramesOfTheChainLeaveTheSameWordsAndCounts) {
     const int w = 96, h = 64;
     const ClipDepth depth = ClipDepth::reversed;
     RandomCase c = random_case(91, 1500, depth, true);
-    for (int i = 0; i < 200; ++i)
-        c.patches.push_back(test_patches::flat_patch(static_cast<float>(i % 20) - 10.0f,
-                                                     static_cast<float>(i / 20) - 5.0f, 0.5f, i % 2 == 0));
+    c.patches.reserve(c.patches.size() + 200);
+    for (int i = 0; i < 200; ++i) {
+        const int column = i % 20, row = i / 20;  // a 20 x 10 grid of flat patches
+        c.patches.push_back(test_patches::flat_patch(static_cast<float>(column) - 10.0f, static_cast<float>(row) - 5.0f,
+                                                     0.5f, i % 2 == 0));
+    }
     c.margins.resize(c.patches.size(), 0.0f);
     Camera cameras[2] = {c.camera, c.camera};
     cameras[1].eye = cameras[1].eye + Vec3{0.3f, -0.2f, 0.1f};

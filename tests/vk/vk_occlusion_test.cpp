@@ -65,7 +65,8 @@ TEST_F(VkOcclusion, RefusesAPyramidOfTheOtherDirection) {
     CaseBuffers b(c);
     OcclusionPass pass(vk().passes());
     HiZImage hiz;
-    hiz.all_levels = reinterpret_cast<VkImageView>(std::uintptr_t{1});  // never bound: refused first
+    // NOLINTNEXTLINE(performance-no-int-to-ptr): a dummy non-null handle, never bound (refused first)
+    hiz.all_levels = reinterpret_cast<VkImageView>(std::uintptr_t{1});
     hiz.width = 8;
     hiz.height = 8;
     hiz.reversed = true;
