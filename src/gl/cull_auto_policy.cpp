@@ -69,6 +69,9 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
     if (tess_factors.size() != objects_.size())
         throw std::logic_error("CullAutoPolicy::decide: one tessellation factor per object expected");
     const bool known = costs_ready();
+    // The bootstrap's last frame: the two-pass costs are measured, the draw cost per patch is not
+    // (it comes from a one-pass frame, docs/METHODS.md): nothing is culled.
+    const bool measure = !known && costs_.known() && cost_samples_ >= config_.cost_frames && !tess_one_pass_;
     decisions_.assign(objects_.size(), Decision{});
     bool any_probe = false;
     for (std::size_t i = 0; i < objects_.size(); ++i) {
@@ -76,7 +79,10 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
         Decision& d = decisions_[i];
         d.tess_factor = tess_factors[i];
         d.cull_rate = o.rate;
-        if (!known) {
+        if (measure) {
+            d.cull = false;
+            d.reason = "measure: one unculled pass (the draw cost per patch)";
+        } else if (!known) {
             d.cull = d.probe = true;
             d.reason = "probe: costs not measured yet";
         } else {
@@ -122,8 +128,9 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
                        ", measured " + std::to_string(since) + " frames ago";
         }
     } else if (known) {
-        // The frame rule (docs/METHODS.md): culling anything costs the Hi-Z build and pass 2's issue of
-        // every patch; the culled objects must save more than that.
+        // The frame rule (docs/METHODS.md): culling anything costs the Hi-Z build and pass 2: with
+        // DrawMode::flags its issue of every other patch, with indirect its fixed cost (the culled
+        // objects' patches are not issued); the culled objects must save more than that.
         double saving = 0;
         std::size_t culled_patches = 0;
         for (std::size_t i = 0; i < objects_.size(); ++i) {
@@ -133,13 +140,17 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
                 n * (objects_[i].rate * tess_cost_ms(decisions_[i].tess_factor) - costs_.issue_ms - costs_.cull_ms);
             culled_patches += objects_[i].range.count;
         }
-        const double fixed = costs_.hiz_ms + static_cast<double>(patch_count_ - culled_patches) * costs_.issue_ms;
+        const double fixed =
+            costs_.hiz_ms +
+            (costs_.indirect ? costs_.pass_ms : static_cast<double>(patch_count_ - culled_patches) * costs_.issue_ms);
         if (culled_patches > 0 && !(saving > fixed)) {
             for (Decision& d : decisions_) {
                 if (!d.cull) continue;
                 d.cull = false;
                 d.reason +=
-                    format("; the frame would save %.2f ms <= %.2f ms (Hi-Z build, pass-2 issue)", saving, fixed);
+                    format(costs_.indirect ? "; the frame would save %.2f ms <= %.2f ms (Hi-Z build, pass 2)"
+                                           : "; the frame would save %.2f ms <= %.2f ms (Hi-Z build, pass-2 issue)",
+                           saving, fixed);
             }
         }
     }
@@ -198,10 +209,14 @@ void CullAutoPolicy::observe(const FrameStats& stats) {
 
     // (a) costs, from the pass times.
     if (stats.timing == TimingMethod::off || stats.patches == 0) return;
-    bool& seen = stats.two_pass ? seen_two_pass_ : seen_one_pass_;
-    const bool first_of_kind = !seen;
-    seen = true;
-    if (first_of_kind) return;  // program compilation
+    // Program compilation: the first two-pass frame (the cull passes), and a one-pass frame when it
+    // is the run's first (its draw and status programs are the two-pass frames' own).
+    const bool compiles = stats.two_pass ? !seen_two_pass_ : !(seen_one_pass_ || seen_two_pass_);
+    (stats.two_pass ? seen_two_pass_ : seen_one_pass_) = true;
+    if (compiles) return;
+    // DrawMode::indirect issues only the patches a pass draws: a culled patch costs no draw work
+    // (RT0 = 0), what is left is each draw pass's fixed cost (compaction, draw call, finish).
+    costs_.indirect = stats.draw == DrawMode::indirect;
     const double n = static_cast<double>(stats.patches);
     // Nothing passed (everything culled): the objects' mean weight.
     double wbar = weights > 0 ? weighted / weights : 0;
@@ -217,11 +232,21 @@ void CullAutoPolicy::observe(const FrameStats& stats) {
     if (stats.two_pass) {
         costs_.hiz_ms = average(costs_.hiz_ms, stats.hiz_ms, cw);
         const double a1 = static_cast<double>(stats.pass1_drawn), a2 = static_cast<double>(stats.pass2_drawn);
-        if (a1 - a2 >= 0.1 * n) {
+        // Provisional, until a one-pass frame: pass 1 - pass 2 includes pass 1's clear and occluders
+        // and the cost of visible patches, so it overstates what a culled patch would have cost.
+        if (!tess_one_pass_ && a1 - a2 >= 0.1 * n) {
             const double tess = (stats.pass1_ms - stats.pass2_ms) / (a1 - a2);
             if (tess > 0) costs_.tess_unit_ms = average(costs_.tess_unit_ms, tess / wbar, cw);
         }
-        if (!std::isnan(costs_.tess_unit_ms)) {
+        if (costs_.indirect) {
+            costs_.issue_ms = 0;
+            if (!std::isnan(costs_.tess_unit_ms)) {
+                const double pass = std::max(
+                    0.0, stats.pass2_ms - costs_.tess_unit_ms * wbar * static_cast<double>(stats.pass2_submitted));
+                costs_.pass_ms = pass_measured_ ? average(costs_.pass_ms, pass, cw) : pass;
+                pass_measured_ = true;
+            }
+        } else if (!std::isnan(costs_.tess_unit_ms)) {
             const double issue = std::max(0.0, (stats.pass2_ms - costs_.tess_unit_ms * wbar * a2) / n);
             costs_.issue_ms = average(costs_.issue_ms, issue, cw);
         }
@@ -234,10 +259,18 @@ void CullAutoPolicy::observe(const FrameStats& stats) {
     } else if (culled_patches == 0) {
         costs_.status_ms = status_measured_ ? average(costs_.status_ms, stats.cull_ms / n, cw) : stats.cull_ms / n;
         status_measured_ = true;
+        // The draw cost per patch, from the frame that draws every patch: flags, minus the issue of
+        // each; indirect, minus the pass's fixed cost (the pass drew pass1_submitted patches).
         if (!std::isnan(costs_.issue_ms) && stats.pass1_drawn > 0) {
-            const double tess = (stats.pass1_ms - costs_.issue_ms * n) / static_cast<double>(stats.pass1_drawn);
-            if (tess > 0) costs_.tess_unit_ms = average(costs_.tess_unit_ms, tess / wbar, cw);
+            const double tess = costs_.indirect
+                                    ? (stats.pass1_ms - costs_.pass_ms) / static_cast<double>(stats.pass1_submitted)
+                                    : (stats.pass1_ms - costs_.issue_ms * n) / static_cast<double>(stats.pass1_drawn);
+            if (tess > 0 && std::isfinite(tess)) {
+                // The first one-pass value replaces the provisional two-pass one.
+                costs_.tess_unit_ms = average(tess_one_pass_ ? costs_.tess_unit_ms : kUnknown, tess / wbar, cw);
+            }
         }
+        tess_one_pass_ = true;  // a failed measurement keeps the provisional value
     }
 }
 

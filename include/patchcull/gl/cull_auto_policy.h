@@ -1,9 +1,11 @@
 // patchcull/gl/cull_auto_policy.h: CullAutoPolicy, the per-object culling switch of Niessner &
 // Loop, "Patch-Based Occlusion Culling for Hardware Tessellation", §6.3: culling an object pays
 // when its cull rate exceeds the break-even rate x = (RT0 + CT) / (RT - RT0) (RT: its render time
-// unculled; RT0: with every patch culled, still issued; CT: the cull passes' time). The policy
-// estimates these per patch from the pipeline's own pass times (FrameStats, gl_pipeline.h) and
-// decides, frame by frame, which objects the cull passes run on. Behind the CLI's `--cull auto`.
+// unculled; RT0: with every patch culled; CT: the cull passes' time). The policy estimates these
+// per patch from the pipeline's own pass times (FrameStats, gl_pipeline.h) and decides, frame by
+// frame, which objects the cull passes run on. Behind the CLI's `--cull auto`. RT0 depends on the
+// draw mode (FrameStats::draw): DrawMode::flags issues a culled patch at level 0 (RT0 > 0);
+// DrawMode::indirect does not issue it (RT0 = 0), and charges a fixed cost per draw pass instead.
 //
 // Contract (one policy per patch set and run):
 //   for every frame:  decide(tess factors)  ->  render with objects() and frame_cull_mode()  ->
@@ -11,12 +13,15 @@
 // - It never affects conservativeness: an object it turns off is drawn whole (ObjectRange::cull =
 //   false), an object it turns on gets the ordinary conservative tests. It only decides where the
 //   cull passes run.
-// - Until the costs are measured (Config::cost_frames two-pass frames after the first), every
-//   object is culled ("probe"). Then an object is culled while its cull rate exceeds x at its
-//   tessellation factor, provided the frame's predicted saving exceeds the Hi-Z build plus the
-//   other objects' issue cost in pass 2; an object switched off is probed (culled for one frame)
-//   after its probe interval (Config). A frame with no object culled runs as CullMode::none (one
-//   pass, no Hi-Z).
+// - Bootstrap: until Config::cost_frames two-pass frames after the first are measured, every
+//   object is culled ("probe"); then one frame culls nothing ("measure": one pass, from which the
+//   draw cost per patch, RT - RT0, is taken; the two-pass frames' estimate includes pass 1's fixed
+//   costs). Then an object is culled while its cull rate exceeds x at its tessellation factor,
+//   provided the frame's predicted saving exceeds the Hi-Z build plus pass 2's cost beyond the
+//   culled objects (flags: the other objects' issue; indirect: the pass's fixed cost); an object
+//   switched off is probed (culled for one frame) after its probe interval (Config). A frame with
+//   no object culled runs as CullMode::none (one pass, no Hi-Z). An object whose cull cost per
+//   patch exceeds its draw cost (x >= 1) is never culled for its rate, even a rate of 1.
 // - How the costs, rates and tessellation factors are estimated, the frame rule and the limits:
 //   docs/METHODS.md, "Culling only where it pays".
 // No GL of its own (it reads FrameStats and decides), so it is unit-tested without a context; use
@@ -59,12 +64,17 @@ public:
 
     /// Running per-patch cost estimates in milliseconds; NaN = not measured yet.
     struct Costs {
-        double issue_ms = kUnknown;      ///< RT0 per patch (issued, level 0), one pass
+        double issue_ms = kUnknown;      ///< RT0 per patch, one pass (flags: issued, level 0; indirect: 0)
         double cull_ms = kUnknown;       ///< CT per patch of a culled object
         double tess_unit_ms = kUnknown;  ///< (RT - RT0) per drawn patch, per unit of (c0 + t^2)
         double hiz_ms = kUnknown;        ///< the Hi-Z build, per two-pass frame
         double status_ms = 0;            ///< the status passes per patch (every frame; 0 until a one-pass frame)
-        bool known() const;              ///< issue, cull, tess_unit and hiz are all measured
+        /// DrawMode::indirect (of the frames observed): pass 2's fixed cost per two-pass frame
+        /// (compaction, draw call, finish: pass2_ms less its submitted patches' draw cost), charged
+        /// by the frame rule instead of the other objects' issue. 0 with flags (part of issue_ms).
+        double pass_ms = 0;
+        bool indirect = false;
+        bool known() const;  ///< issue, cull, tess_unit and hiz are all measured
     };
 
     /// One object's decision for a frame.
@@ -99,13 +109,16 @@ public:
     const std::vector<Decision>& decisions() const { return decisions_; }
     const Costs& costs() const { return costs_; }
     /// Replaces the cost estimates (tests, or costs known from an earlier run); they are used at
-    /// once when known() (no Config::cost_frames wait).
+    /// once when known() (no Config::cost_frames wait, no measure frame). Timed frames update
+    /// them as after the bootstrap (tess only from one-pass frames).
     void set_costs(const Costs& costs) {
         costs_ = costs;
         cost_samples_ = config_.cost_frames;
+        tess_one_pass_ = pass_measured_ = true;
     }
-    /// The costs are used: known() and averaged over Config::cost_frames two-pass frames (or set).
-    bool costs_ready() const { return costs_.known() && cost_samples_ >= config_.cost_frames; }
+    /// The costs are used: known(), averaged over Config::cost_frames two-pass frames, and the draw
+    /// cost taken from a one-pass frame (or set).
+    bool costs_ready() const { return costs_.known() && cost_samples_ >= config_.cost_frames && tess_one_pass_; }
     /// tess(t) of the current estimates (NaN while unknown).
     double tess_cost_ms(double tess_factor) const;
     /// The break-even rate x at tessellation factor t (NaN while the costs are not known()).
@@ -129,6 +142,8 @@ private:
     int cost_samples_ = 0;  ///< two-pass frames measured
     bool pending_ = false;
     bool seen_one_pass_ = false, seen_two_pass_ = false, status_measured_ = false;
+    bool tess_one_pass_ = false;  ///< tess_unit measured in a one-pass frame (the two-pass one is provisional)
+    bool pass_measured_ = false;  ///< Costs::pass_ms measured
 };
 
 /// One line for a frame: "auto: culling K of N objects: NAME on (REASON); NAME off (REASON); ...".
