@@ -71,44 +71,13 @@ void DisplacedPass::run(VkCommandBuffer cmd, const PatchBuffers& patches, const 
     params.hiz_levels = occlusion ? HiZPyramid::level_count(hiz.width, hiz.height) : 1;
     params.zero = 0.0f;
 
-    const BufferRange* buffer_ranges[5] = {&patches.control_points, &patches.flags, &patches.margins, &ranges, &bounds};
-    const std::uint32_t buffer_bindings[5] = {shared::kBindingControlPoints, shared::kBindingCullFlags,
-                                              shared::kBindingMaxDisplacement, shared::kBindingDisplacementRanges,
-                                              shared::kBindingDisplacedBounds};
-    VkDescriptorBufferInfo buffers[6]{};
-    VkWriteDescriptorSet writes[7]{};
-    for (int i = 0; i < 5; ++i) {
-        const BufferRange& r = *buffer_ranges[i];
-        buffers[i] = r.buffer ? VkDescriptorBufferInfo{r.buffer, r.offset, r.size}
-                              : VkDescriptorBufferInfo{context.placeholder, 0, VK_WHOLE_SIZE};
-        writes[i].dstBinding = buffer_bindings[i];
-        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        writes[i].pBufferInfo = &buffers[i];
-    }
-    buffers[5] = {context.param_buffer, 0, sizeof params};
-    writes[5].dstBinding = api::kParamsBinding;
-    writes[5].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-    writes[5].pBufferInfo = &buffers[5];
-    const VkDescriptorImageInfo image{context.sampler, hiz.all_levels, VK_IMAGE_LAYOUT_GENERAL};
-    writes[6].dstBinding = api::kTextureHiZBinding;
-    writes[6].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    writes[6].pImageInfo = &image;
-    for (VkWriteDescriptorSet& w : writes) {
-        w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        w.descriptorCount = 1;
-    }
-    context.vk.CmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-    context.vk.CmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 7, writes);
-    const std::size_t per_dispatch = std::size_t{65535} * shared::kDisplacedGroupSize;
-    for (std::size_t offset = 0; offset < patches.count; offset += per_dispatch) {
-        const std::size_t n = std::min(per_dispatch, patches.count - offset);
-        params.first_patch = static_cast<pp::uint>(patches.first + offset);
-        params.patch_count = static_cast<pp::uint>(n);
-        context.update_params(cmd, &params, sizeof params);
-        context.vk.CmdDispatch(
-            cmd, static_cast<std::uint32_t>((n + shared::kDisplacedGroupSize - 1) / shared::kDisplacedGroupSize), 1, 1);
-    }
-    context.barrier_after(cmd);
+    const detail::Binding bindings[] = {{shared::kBindingControlPoints, patches.control_points},
+                                        {shared::kBindingCullFlags, patches.flags},
+                                        {shared::kBindingMaxDisplacement, patches.margins},
+                                        {shared::kBindingDisplacementRanges, ranges},
+                                        {shared::kBindingDisplacedBounds, bounds}};
+    context.record_uniform(cmd, p, bindings, 5, hiz.all_levels, params, patches.first, patches.count,
+                           shared::kDisplacedGroupSize);
 }
 
 }  // namespace patchcull::vk

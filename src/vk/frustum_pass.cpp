@@ -20,14 +20,7 @@ void FrustumPass::run(VkCommandBuffer cmd, const PatchBuffers& patches, const Fr
                                                   shared::kBindingMaxDisplacement, shared::kBindingPlaneValues},
                                                  sizeof(pp::FrustumParams));
     pp::FrustumParams params;
-    params.plane_depth = {planes.near_w, planes.far_w, planes.far_limit, 0.0f};
-    for (int r = 0; r < 4; ++r)
-        params.clip_rows[r] = {planes.clip_rows[r].x, planes.clip_rows[r].y, planes.clip_rows[r].z,
-                               planes.clip_rows[r].w};
-    float nl[8] = {};
-    for (int q = 0; q < 6; ++q) nl[q] = planes.normal_length[q];
-    params.plane_normal_length[0] = {nl[0], nl[1], nl[2], nl[3]};
-    params.plane_normal_length[1] = {nl[4], nl[5], nl[6], nl[7]};
+    detail::store_planes(planes, params);
     params.has_margins = patches.margins.buffer ? 1u : 0u;
     params.write_plane_values = plane_values.buffer ? 1u : 0u;
     const detail::Binding bindings[] = {{shared::kBindingControlPoints, patches.control_points},

@@ -45,14 +45,7 @@ void FusedCullPass::run(VkCommandBuffer cmd, const PatchBuffers& patches, std::u
                                                   {api::kParamsBinding, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}},
                                                  0);
     pp::FusedCullParams params;
-    params.plane_depth = {planes.near_w, planes.far_w, planes.far_limit, 0.0f};
-    for (int r = 0; r < 4; ++r)
-        params.clip_rows[r] = {planes.clip_rows[r].x, planes.clip_rows[r].y, planes.clip_rows[r].z,
-                               planes.clip_rows[r].w};
-    float nl[8] = {};
-    for (int q = 0; q < 6; ++q) nl[q] = planes.normal_length[q];
-    params.plane_normal_length[0] = {nl[0], nl[1], nl[2], nl[3]};
-    params.plane_normal_length[1] = {nl[4], nl[5], nl[6], nl[7]};
+    detail::store_planes(planes, params);
     params.eye = {eye.x, eye.y, eye.z, 1.0f};
     params.has_margins = patches.margins.buffer ? 1u : 0u;
     params.tests = tests;
@@ -63,43 +56,11 @@ void FusedCullPass::run(VkCommandBuffer cmd, const PatchBuffers& patches, std::u
     }
     params.zero = 0.0f;
 
-    const BufferRange* ranges[3] = {&patches.control_points, &patches.flags, &patches.margins};
-    const std::uint32_t buffer_bindings[3] = {shared::kBindingControlPoints, shared::kBindingCullFlags,
-                                              shared::kBindingMaxDisplacement};
-    VkDescriptorBufferInfo buffers[4]{};
-    VkWriteDescriptorSet writes[5]{};
-    for (int i = 0; i < 3; ++i) {
-        const BufferRange& r = *ranges[i];
-        buffers[i] = r.buffer ? VkDescriptorBufferInfo{r.buffer, r.offset, r.size}
-                              : VkDescriptorBufferInfo{context.placeholder, 0, VK_WHOLE_SIZE};
-        writes[i].dstBinding = buffer_bindings[i];
-        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        writes[i].pBufferInfo = &buffers[i];
-    }
-    buffers[3] = {context.param_buffer, 0, sizeof params};
-    writes[3].dstBinding = api::kParamsBinding;
-    writes[3].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-    writes[3].pBufferInfo = &buffers[3];
-    const VkDescriptorImageInfo image{context.sampler, hiz.all_levels, VK_IMAGE_LAYOUT_GENERAL};
-    writes[4].dstBinding = api::kTextureHiZBinding;
-    writes[4].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    writes[4].pImageInfo = &image;
-    for (VkWriteDescriptorSet& w : writes) {
-        w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        w.descriptorCount = 1;
-    }
-    context.vk.CmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-    context.vk.CmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 5, writes);
-    const std::size_t per_dispatch = std::size_t{65535} * shared::kCullGroupSize;
-    for (std::size_t offset = 0; offset < patches.count; offset += per_dispatch) {
-        const std::size_t n = std::min(per_dispatch, patches.count - offset);
-        params.first_patch = static_cast<pp::uint>(patches.first + offset);
-        params.patch_count = static_cast<pp::uint>(n);
-        context.update_params(cmd, &params, sizeof params);
-        context.vk.CmdDispatch(
-            cmd, static_cast<std::uint32_t>((n + shared::kCullGroupSize - 1) / shared::kCullGroupSize), 1, 1);
-    }
-    context.barrier_after(cmd);
+    const detail::Binding bindings[] = {{shared::kBindingControlPoints, patches.control_points},
+                                        {shared::kBindingCullFlags, patches.flags},
+                                        {shared::kBindingMaxDisplacement, patches.margins}};
+    context.record_uniform(cmd, p, bindings, 3, hiz.all_levels, params, patches.first, patches.count,
+                           shared::kCullGroupSize);
 }
 
 }  // namespace patchcull::vk

@@ -272,22 +272,39 @@ void PassContext::Impl::check_range(const char* who, const char* what, const Buf
 }
 
 void PassContext::Impl::bind(VkCommandBuffer cmd, const detail::Pipeline& p, const detail::Binding* bindings,
-                             std::size_t binding_count) const {
+                             std::size_t binding_count, VkDeviceSize param_bytes, VkImageView hiz) const {
     std::array<VkDescriptorBufferInfo, detail::kMaxBindings> infos{};
     std::array<VkWriteDescriptorSet, detail::kMaxBindings> writes{};
-    for (std::size_t i = 0; i < binding_count; ++i) {
-        const BufferRange& r = bindings[i].range;
-        infos[i] = r.buffer ? VkDescriptorBufferInfo{r.buffer, r.offset, r.size}
+    std::size_t n = 0;
+    for (; n < binding_count; ++n) {
+        const BufferRange& r = bindings[n].range;
+        infos[n] = r.buffer ? VkDescriptorBufferInfo{r.buffer, r.offset, r.size}
                             : VkDescriptorBufferInfo{placeholder, 0, VK_WHOLE_SIZE};
+        writes[n].dstBinding = bindings[n].binding;
+        writes[n].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[n].pBufferInfo = &infos[n];
+    }
+    if (param_bytes > 0) {
+        infos[n] = {param_buffer, 0, param_bytes};
+        writes[n].dstBinding = api::kParamsBinding;
+        writes[n].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+        writes[n].pBufferInfo = &infos[n];
+        ++n;
+    }
+    const VkDescriptorImageInfo image{sampler, hiz, VK_IMAGE_LAYOUT_GENERAL};
+    if (hiz != VK_NULL_HANDLE) {
+        writes[n].dstBinding = api::kTextureHiZBinding;
+        writes[n].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        writes[n].pImageInfo = &image;
+        ++n;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
         writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-        writes[i].dstBinding = bindings[i].binding;
         writes[i].descriptorCount = 1;
-        writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        writes[i].pBufferInfo = &infos[i];
     }
     vk.CmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-    vk.CmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0,
-                               static_cast<std::uint32_t>(binding_count), writes.data());
+    vk.CmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, static_cast<std::uint32_t>(n),
+                               writes.data());
 }
 
 void PassContext::Impl::update_params(VkCommandBuffer cmd, const void* data, std::size_t bytes) const {

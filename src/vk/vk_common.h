@@ -82,6 +82,20 @@ struct Slot {
 /// The most descriptors one pass binds.
 inline constexpr std::size_t kMaxBindings = 8;
 
+/// FrustumPlanes into a parameter block's clip_rows, plane_normal_length (packed, pass_params.h)
+/// and plane_depth, as the GL passes store them (src/gl/pass_common.cpp's store_planes).
+template <class Params>
+void store_planes(const FrustumPlanes& planes, Params& params) {
+    params.plane_depth = {planes.near_w, planes.far_w, planes.far_limit, 0.0f};
+    for (int r = 0; r < 4; ++r)
+        params.clip_rows[r] = {planes.clip_rows[r].x, planes.clip_rows[r].y, planes.clip_rows[r].z,
+                               planes.clip_rows[r].w};
+    float nl[8] = {};
+    for (int q = 0; q < 6; ++q) nl[q] = planes.normal_length[q];
+    params.plane_normal_length[0] = {nl[0], nl[1], nl[2], nl[3]};
+    params.plane_normal_length[1] = {nl[4], nl[5], nl[6], nl[7]};
+}
+
 }  // namespace detail
 
 struct PassContext::Impl {
@@ -131,8 +145,29 @@ struct PassContext::Impl {
         }
         barrier_after(cmd);
     }
+    /// Records a pass whose block lives in the parameter buffer (PC_VK_UNIFORM_*) and which reads
+    /// the Hi-Z pyramid view hiz: as record, with the parameter buffer and hiz bound after the
+    /// storage buffers and params written by update_params before each dispatch.
+    template <class Params>
+    void record_uniform(VkCommandBuffer cmd, const detail::Pipeline& p, const detail::Binding* bindings,
+                        std::size_t binding_count, VkImageView hiz, Params& params, std::size_t first,
+                        std::size_t count, std::size_t patches_per_group) const {
+        bind(cmd, p, bindings, binding_count, sizeof(Params), hiz);
+        const std::size_t per_dispatch = 65535 * patches_per_group;
+        for (std::size_t offset = 0; offset < count; offset += per_dispatch) {
+            const std::size_t n = std::min(per_dispatch, count - offset);
+            params.first_patch = static_cast<pp::uint>(first + offset);
+            params.patch_count = static_cast<pp::uint>(n);
+            update_params(cmd, &params, sizeof(Params));
+            vk.CmdDispatch(cmd, static_cast<std::uint32_t>((n + patches_per_group - 1) / patches_per_group), 1, 1);
+        }
+        barrier_after(cmd);
+    }
+    /// Binds p and pushes the storage-buffer descriptors; with param_bytes > 0 also the parameter
+    /// buffer's first param_bytes at api::kParamsBinding, and with hiz the pyramid view and the
+    /// context's sampler at api::kTextureHiZBinding.
     void bind(VkCommandBuffer cmd, const detail::Pipeline& p, const detail::Binding* bindings,
-              std::size_t binding_count) const;
+              std::size_t binding_count, VkDeviceSize param_bytes = 0, VkImageView hiz = VK_NULL_HANDLE) const;
     void barrier_after(VkCommandBuffer cmd) const;
     /// Records the update of the parameter buffer with bytes (a multiple of 4, at most
     /// kParamBufferBytes) between two barriers: the compute shaders recorded before it finish
