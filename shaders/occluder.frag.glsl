@@ -2,8 +2,7 @@
 // grey shaded two-sided by the angle to the eye (flat normal from screen-space derivatives).
 #version 450 core
 #include "shared.h"
-
-uniform vec3 u_eye;  // object-space eye position
+#include "draw_params.h"
 
 in vec3 occ_position;
 flat in uint occ_triangle;

@@ -3,19 +3,18 @@
 // expands the index buffer); the triangle index gl_VertexID / 3 becomes the id.
 #version 450 core
 #include "shared.h"
+#include "draw_params.h"
 
 layout(std430, binding = kBindingOccluderVertices) readonly buffer OccluderVertices {
     vec4 occluder_vertices[];  // xyz object space, w = 1
 };
 
-uniform mat4 u_object_to_clip;
-
 out vec3 occ_position;
 flat out uint occ_triangle;
 
 void main() {
-    const vec4 v = occluder_vertices[gl_VertexID];
+    const vec4 v = occluder_vertices[PC_VERTEX_INDEX];
     occ_position = v.xyz;
-    occ_triangle = uint(gl_VertexID) / 3u;
+    occ_triangle = uint(PC_VERTEX_INDEX) / 3u;
     gl_Position = u_object_to_clip * vec4(v.xyz, 1.0);
 }

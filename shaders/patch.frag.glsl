@@ -18,6 +18,7 @@
 // depth is found, including both sides of a depth tie.
 #version 450 core
 #include "shared.h"
+#include "draw_params.h"
 #define PC_CONTROL_POINTS readonly
 #define PC_CULL_FLAGS readonly
 #define PC_MAX_DISPLACEMENT readonly
@@ -31,10 +32,6 @@
 #ifdef PATCHCULL_MARK_FRONT
 layout(early_fragment_tests) in;
 #endif
-
-uniform vec3 u_eye;  // object-space eye position
-uniform uint u_color_mode;
-uniform bool u_discard_back_facing;
 
 in vec3 tes_position;
 in vec3 tes_normal;

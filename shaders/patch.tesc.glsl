@@ -13,6 +13,7 @@
 // them), so two patches sharing an edge give it the same level.
 #version 450 core
 #include "shared.h"
+#include "draw_params.h"
 #define PC_PATCH_TESS_SCALE readonly
 // Drawn patches of this render (PatchRenderer::read_drawn_patches: what --verify compares).
 #define PC_PATCH_MARKS writeonly
@@ -20,14 +21,6 @@
 #include "patchcull_tcs.h"
 
 layout(vertices = 16) out;
-
-uniform float u_tess_level;    // uniform level (or the adaptive maximum), in [1, 64]
-uniform uint u_draw_mask;
-uniform uint u_draw_value;
-uniform bool u_adaptive;
-uniform float u_tess_reference;  // distance at which the adaptive level is u_tess_level, > 0
-uniform vec3 u_eye;              // object-space eye position
-uniform bool u_mark_drawn;       // record drawn patches in patch_marks
 
 in vec4 vs_point[];
 flat in uint vs_patch[];

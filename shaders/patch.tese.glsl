@@ -7,6 +7,7 @@
 // follows the latter, which the cone bounds of Niessner & Loop §4.2 bound (gl_renderer.h).
 #version 450 core
 #include "shared.h"
+#include "draw_params.h"
 #define PC_MAX_DISPLACEMENT readonly
 #define PC_PATCH_TEXCOORDS readonly
 #define PC_PATCH_TANGENTS readonly
@@ -16,10 +17,6 @@
 
 layout(quads, equal_spacing, ccw) in;
 
-uniform mat4 u_object_to_clip;
-uniform bool u_has_tangents;  // the tangent buffer holds kTangentVec4s entries per patch
-uniform float u_displacement_scale;
-uniform float u_displacement_midlevel;
 layout(binding = kTextureUnitDisplacement) uniform sampler2D u_displacement_map;
 
 in vec4 tcs_point[];

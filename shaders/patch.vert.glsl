@@ -6,6 +6,7 @@
 // the patch index passed on is the same flag-buffer index either way.
 #version 450 core
 #include "shared.h"
+#include "draw_params.h"
 #define PC_CONTROL_POINTS readonly
 #include "patch_buffers.h"
 #ifdef PATCHCULL_DRAW_LIST
@@ -17,10 +18,10 @@ flat out uint vs_patch;  // patch index
 
 void main() {
 #ifdef PATCHCULL_DRAW_LIST
-    vs_patch = patchcull_draw_list_patch(gl_VertexID);
-    vs_point = control_points[kDrawListPatchVertices * vs_patch + patchcull_draw_list_point(gl_VertexID)];
+    vs_patch = patchcull_draw_list_patch(PC_VERTEX_INDEX);
+    vs_point = control_points[kDrawListPatchVertices * vs_patch + patchcull_draw_list_point(PC_VERTEX_INDEX)];
 #else
-    vs_point = control_points[gl_VertexID];
-    vs_patch = uint(gl_VertexID) / 16u;
+    vs_point = control_points[PC_VERTEX_INDEX];
+    vs_patch = uint(PC_VERTEX_INDEX) / 16u;
 #endif
 }

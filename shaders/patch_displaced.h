@@ -1,4 +1,4 @@
-// shaders/patch_displaced.h (GLSL only; include after shared.h and patch_buffers.h, with its block
+// shaders/patch_displaced.h (GLSL only; include after shared.h, draw_params.h and patch_buffers.h, with its block
 // MaxDisplacement: define PC_MAX_DISPLACEMENT readonly): which patches the draw displaces,
 // shared by patch.tese.glsl (displacement) and patch.frag.glsl (one-sided drawing).
 // With a displacement map (u_displace) a patch is displaced unless the per-patch margins are given
@@ -10,8 +10,5 @@
 #ifndef PC_MAX_DISPLACEMENT
 #error patch_displaced.h needs patch_buffers.h's MaxDisplacement (PC_MAX_DISPLACEMENT)
 #endif
-
-uniform bool u_displace;
-uniform bool u_has_margins;
 
 bool patch_is_displaced(uint p) { return u_displace && (!u_has_margins || max_displacement[p] > 0.0); }

@@ -72,42 +72,16 @@
 #include "patchcull/core/hiz.h"
 #include "patchcull/core/math.h"
 #include "patchcull/core/patch.h"
+#include "patchcull/core/render_params.h"
 #include "patchcull/gl/gl_context.h"
 #include "patchcull/gl/gl_cull_flags.h"
 #include "patchcull/gl/gl_passes.h"
 
 namespace patchcull::gl {
 
-/// Per-patch data beyond the control points. Each vector is empty (absent) or has one entry per
-/// patch.
-struct PatchAttributes {
-    /// Cull margin: bound on |D| of the rendered displacement (DisplacementRange::max_abs()), >= 0.
-    /// Read by the GPU frustum pass exactly as cull_frustum_scalar reads max_displacement. Empty:
-    /// the ranges' max_abs() when displacement_ranges is given, else no margins.
-    std::vector<float> max_displacement;
-    /// Corner texcoords at (u,v) = (0,0), (1,0), (0,1), (1,1) (PatchInfo::uv) for displacement;
-    /// absent means those same four values for every patch (PatchInfo's default).
-    std::vector<std::array<Vec2, 4>> texcoords;
-    /// ACC tangent patches (Loop & Schaefer 2008; PatchFrame::tangents and PatchInfo::tangent_index):
-    /// patch p uses tangents[tangent_index[p]] when tangent_index[p] >= 0. The TES then shades
-    /// with their normal du x dv, continuous across extraordinary vertices, instead of the
-    /// patch's own derivatives. Displacement keeps the patch's own normal: Niessner & Loop §4.2's cone
-    /// bounds (displaced_bounds.h), computed from the control points, bound that normal only.
-    /// tangent_index: empty (no tangents) or one per patch.
-    std::vector<std::int32_t> tangent_index;
-    std::vector<TangentPatches> tangents;
-    /// Refinement depth of each patch (PatchInfo::depth), or empty (all 0). With the uniform
-    /// level L a patch of depth d is tessellated at min(64, L * 2^(D - d)), D the largest depth of
-    /// the set: every patch then has the same vertex density along its base edges, so where an
-    /// adaptive (osd) patch meets two of the next depth, its edge vertices are exactly theirs and
-    /// no T-junction crack opens (up to float evaluation of the shared curve). Not applied to
-    /// adaptive_tess, whose levels follow the eye distance.
-    std::vector<std::uint8_t> depth;
-    /// DisplacementRange of each patch (min and max of D over it, displacement.h), or empty: the
-    /// input of the displaced pass (gl_passes.h's DisplacedPass, Niessner & Loop §4.2's bounds), uploaded
-    /// as vec2 per patch (range_buffer()). A patch with range (0, 0) is not displaced.
-    std::vector<DisplacementRange> displacement_ranges;
-};
+/// PatchAttributes and RenderParams are core/render_params.h's (the Vulkan renderer takes them too).
+using patchcull::PatchAttributes;
+using patchcull::RenderParams;
 
 /// A compacted draw (PatchRenderer::draw_indirect): GL buffer names of a list and the indirect
 /// commands CompactPass (gl_compaction.h) wrote.
@@ -118,35 +92,6 @@ struct IndirectDraw {
     std::size_t command_count = 0;      ///< commands drawn (the maxdrawcount with a draw count)
     std::uint32_t draw_count = 0;       ///< optional (0: none): the draw count's buffer
     std::size_t draw_count_offset = 0;  ///< bytes, a multiple of 4
-};
-
-/// Parameters of one frame.
-struct RenderParams {
-    Mat4 view;        ///< world -> view (look_at); also gives the eye position for shading
-    Mat4 projection;  ///< view -> clip (perspective) in convention depth
-    /// The depth convention of projection (clip_space.h); the renderer draws in it: glClipControl
-    /// depth GL_ZERO_TO_ONE (GL_NEGATIVE_ONE_TO_ONE for minus_one_to_one), the depth test GL_LESS
-    /// with depth cleared to 1, or GL_GREATER with depth cleared to 0 for the reversed ones.
-    ClipDepth depth = ClipDepth::zero_to_one;
-    int width = 256;
-    int height = 256;
-    int tess_level = 8;          ///< uniform tessellation level (adaptive: the maximum), clamped to [1, 64]
-    bool use_cull_flags = true;  ///< false: ignore the flags and draw every patch (the reference)
-    bool displace = true;        ///< displace the surface when a displacement map is set
-    /// Adaptive tessellation by distance (Niessner & Loop §6.3): each edge gets
-    /// clamp(tess_level * tess_reference_distance / d, 1, tess_level), d = distance from the eye to
-    /// the midpoint of the edge's two corner points; interior levels the max of opposite edges.
-    /// Shared edges get equal levels (no T-junction cracks). false: tess_level everywhere.
-    bool adaptive_tess = false;
-    float tess_reference_distance = 1.0f;  ///< > 0, object-space units
-    /// One-sided drawing for closed, outward-oriented surfaces (LoadedModel::closed): a fragment
-    /// is kept only where the exact patch at its (u, v) faces the eye, cos(du x dv, to eye) >
-    /// kFrontFacingMinCosine (1e-3, shaders/shared.h); the rest is discarded, whatever the
-    /// triangles' own facing. This is the visibility the back-patch tests (gl_backpatch.h)
-    /// decide on, so they are conservative at every tessellation level (README: "What
-    /// contributes a pixel"). false (default): both sides of every patch are drawn (open
-    /// surfaces such as the teapot). Ignored while displacing (a displaced surface is two-sided).
-    bool discard_back_facing = false;
 };
 
 /// Draws one uploaded set of patches with hardware tessellation into its own framebuffer.
