@@ -230,17 +230,26 @@ void CullPipeline::Impl::draw(int pass, std::uint32_t mask, std::uint32_t value,
         l.used_commands += commands;
         ++l.used_counts;
     }
-    // One span: its own draw count; several: every command of theirs (the empty ones draw nothing).
+    // With glMultiDrawArraysIndirectCount: one per span, each with its own range's draw count
+    // (a span's commands past its survivors are never read). Without it: one
+    // glMultiDrawArraysIndirect over every command of the spans (the empty ones draw nothing).
     IndirectDraw d;
     d.list = l.list;
     d.commands = l.commands;
     d.first_command = first_command;
-    d.command_count = l.used_commands - first_command;
-    if (spans.size() == 1) {
-        d.draw_count = l.counts;
-        d.draw_count_offset = (l.used_counts - 1) * 4;
+    if (!renderer.has_indirect_count()) {
+        d.command_count = l.used_commands - first_command;
+        renderer.draw_indirect(d);
+        return;
     }
-    renderer.draw_indirect(d);
+    d.draw_count = l.counts;
+    d.draw_count_offset = (l.used_counts - spans.size()) * 4;
+    for (const PatchSpan& s : spans) {
+        d.command_count = compact_command_count(s.count, k);
+        renderer.draw_indirect(d);
+        d.first_command += d.command_count;
+        d.draw_count_offset += 4;
+    }
 }
 
 std::size_t CullPipeline::Impl::submitted(int pass, DrawMode mode) const {

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -459,6 +460,102 @@ TEST(GpuCompaction, CompactedDrawGivesTheFlagPathsIdImage) {
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &color);
     glDeleteBuffers(1, &cp);
+}
+
+// Several CompactPass ranges in one command buffer (the pipeline's multi-span draw pass: one range
+// per object), drawn as CullPipeline draws them with glMultiDrawArraysIndirectCount: one
+// PatchRenderer::draw_indirect per range with that range's own draw count. The commands past a
+// range's survivors are poisoned with a command that draws a patch the selection drops, and the
+// counted draws still give the flag path's id image and drawn patches. One draw of every command
+// without the counts (the fallback without the extension) draws the poison, so the test fails if
+// the counts are ignored.
+TEST(GpuCompaction, MultiRangeIndirectDrawHonoursEachRangesCount) {
+    PatchRenderer r(test::context());
+    if (!r.has_indirect_count()) {
+        std::printf("no glMultiDrawArraysIndirectCount: nothing to check\n");
+        return;
+    }
+    constexpr int kCols = 8, kRows = 6;
+    constexpr std::size_t kPatches = kCols * kRows;
+    std::vector<BezierPatch> patches;
+    for (int row = 0; row < kRows; ++row)
+        for (int col = 0; col < kCols; ++col)
+            patches.push_back(test_patches::flat_patch(static_cast<float>(col), static_cast<float>(row), 0.0f, false));
+    r.set_patches(patches);
+    const std::vector<std::uint32_t> flags = random_flags(kPatches, 11);
+    r.set_flag_words(flags);
+    RenderParams params;
+    params.view = look_at({4, 3, 10}, {4, 3, 0}, {0, 1, 0});
+    params.projection = perspective(1.0f, 64.0f / 48.0f, 1.0f, 100.0f);
+    params.width = 64;
+    params.height = 48;
+    params.tess_level = 2;
+    const Selection s = kSelections[1];  // first pass
+    const std::vector<PatchSpan> spans = {{3, 20}, {30, 15}};
+    constexpr std::size_t k = 2;
+    const std::size_t commands[2] = {compact_command_count(spans[0].count, k),
+                                     compact_command_count(spans[1].count, k)};
+
+    // The poison: a patch of neither range's selection, at list entry kPatches (past every range).
+    std::uint32_t poison = 0;
+    while (poison < kPatches && (flags[poison] & s.mask) == s.value) ++poison;
+    ASSERT_LT(poison, kPatches);
+    std::vector<std::uint32_t> list_words(kPatches + 1, 0u);
+    list_words[kPatches] = poison;
+    Buffer list(list_words), command(std::vector<std::uint32_t>(4 * (commands[0] + commands[1]), 0u)),
+        counts(std::vector<std::uint32_t>(2, 0u));
+    CompactPass pass(test::passes());
+    std::size_t command_first = 0;
+    std::vector<IndirectDraw> counted;
+    for (std::size_t i = 0; i < spans.size(); ++i) {
+        PatchBuffers range = r.patch_buffers();
+        range.first = spans[i].first;
+        range.count = spans[i].count;
+        pass.run(range, s.mask, s.value,
+                 {list.name(), spans[i].first, command.name(), command_first * 16, counts.name(), i * 4, k});
+        IndirectDraw d;
+        d.list = list.name();
+        d.commands = command.name();
+        d.first_command = command_first;
+        d.command_count = commands[i];
+        d.draw_count = counts.name();
+        d.draw_count_offset = i * 4;
+        counted.push_back(d);
+        command_first += commands[i];
+    }
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    const std::vector<std::uint32_t> n = counts.read(0, 2);
+    std::size_t poisoned = 0;
+    for (std::size_t i = 0, c0 = 0; i < spans.size(); c0 += commands[i], ++i) {
+        ASSERT_LT(n[i], commands[i]) << "range " << i << " has no command past its survivors";
+        for (std::size_t c = n[i]; c < commands[i]; ++c, ++poisoned) {
+            const std::uint32_t bad[4] = {16u, 1u, 16u * static_cast<std::uint32_t>(kPatches), 0u};
+            glNamedBufferSubData(command.name(), static_cast<GLintptr>((c0 + c) * 16), 16, bad);
+        }
+    }
+    ASSERT_GT(poisoned, 0u);
+
+    r.begin_frame(params);
+    r.draw_selected(s.mask, s.value, spans);
+    const std::vector<std::uint32_t> reference = r.read_ids();
+    const std::vector<std::uint8_t> reference_drawn = r.read_drawn_patches();
+    ASSERT_EQ(reference_drawn[poison], 0);
+    ASSERT_FALSE(test::ids_present(reference).empty());
+
+    r.begin_frame(params);
+    for (const IndirectDraw& d : counted) r.draw_indirect(d);
+    EXPECT_TRUE(r.read_ids() == reference);
+    EXPECT_TRUE(r.read_drawn_patches() == reference_drawn);
+
+    // Without the counts every command is drawn, the poison included: the check above can fail.
+    IndirectDraw all;
+    all.list = list.name();
+    all.commands = command.name();
+    all.command_count = commands[0] + commands[1];
+    r.begin_frame(params);
+    r.draw_indirect(all);
+    EXPECT_EQ(r.read_drawn_patches()[poison], 1);
+    EXPECT_EQ(test::ids_present(r.read_ids()).count(poison + 1), 1u);
 }
 
 }  // namespace patchcull::gl

@@ -178,9 +178,11 @@ struct PipelineParams {
     /// with at most PatchRenderer::patches_per_draw() patches per command (a sixteenth of that on
     /// a software rasterizer, PassContext::is_software: llvmpipe tessellates large draws more
     /// slowly per patch), then draws what it
-    /// compacted in one multi-draw: glMultiDrawArraysIndirectCount with the range's draw count
-    /// when the draw is one span and the context has it, else glMultiDrawArraysIndirect over all
-    /// the commands of its spans (those past a range's survivors are empty). An ObjectPass's draws
+    /// compacted: where the context has glMultiDrawArraysIndirectCount (GL 4.6 or
+    /// GL_ARB_indirect_parameters; PatchRenderer::has_indirect_count), one per span, each with
+    /// its own range's draw count, so no command past a range's survivors is read; else one
+    /// glMultiDrawArraysIndirect over all the commands of its spans (those past a range's
+    /// survivors are empty). An ObjectPass's draws
     /// (CHC++'s included) compact and draw each object when it draws it. Nothing is read back
     /// for the draws; only FrameStats's read-back (after the frame) sums the commands.
     DrawMode draw = DrawMode::flags;
