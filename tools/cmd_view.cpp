@@ -5,7 +5,8 @@
 // FILE drives it by frame number (viewer/viewer_script.h).
 // --frames N without a script plays render's camera path for N frames with no panel (the window
 // shows `render --out`'s images; --screenshot writes the last one), a line per frame.
-// --tess-mode / --tess-distance, --displace, --cull auto, --draw and the object-level flags as `render`.
+// --tess-mode / --tess-distance, --displace, --cull auto, --draw, --compact and the object-level flags as
+// `render`; the panel and a script's `set draw` / `set compact` switch the last two live.
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -51,6 +52,7 @@ Runner add_view_command(CLI::App& app) {
         std::string backpatch = "tcone";
         std::string frustum = "hull";
         std::string draw = "indirect";
+        std::string compact = "scan";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -81,6 +83,7 @@ Runner add_view_command(CLI::App& app) {
     add_choice_option(*command, "--draw", state->draw, {"flags", "indirect"},
                       "how the draw passes issue patches: indirect (the default: the survivors compacted into indirect "
                       "draws) or flags (every patch, the TCS drops the culled)");
+    add_compact_option(*command, state->compact);
     add_clip_depth_option(*command, state->clip_depth);
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
     add_tess_options(*command, state->tess_options);
@@ -117,9 +120,10 @@ Runner add_view_command(CLI::App& app) {
         config.tess_mode = resolve_tess_mode(state->tess_options, scene.camera);
         config.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
         config.clip_depth = parse_clip_depth_option(state->clip_depth);
-        config.draw = state->draw == "indirect" ? gl::DrawMode::indirect : gl::DrawMode::flags;
 
         ViewerSettings& s = config.settings;
+        s.draw = state->draw == "indirect" ? gl::DrawMode::indirect : gl::DrawMode::flags;
+        s.compact = parse_compact_option(state->compact);
         set_cull_toggles(s, applicable_cull_mode(scene, cull, "view"));
         s.cull_auto = automatic;
         s.backpatch_method = parse_backpatch_method("--backpatch", state->backpatch);

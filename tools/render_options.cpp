@@ -1,4 +1,4 @@
-// The tessellation and displacement options of `render` and `view` (render_options.h), and
+// The tessellation, displacement and compaction options of `render` and `view` (render_options.h), and
 // parse_size (commands.h).
 #include <CLI/CLI.hpp>
 
@@ -28,6 +28,20 @@ void add_tess_options(CLI::App& command, TessOptions& options) {
         "adaptive: distance from the eye that gets the full --tess level (default: the camera path's eye-to-target "
         "distance)");
     distance->type_name("REAL >0");
+}
+
+CLI::Option* add_compact_option(CLI::App& command, std::string& target) {
+    return add_choice_option(command, "--compact", target, {"scan", "append"},
+                             "how --draw indirect lists the survivors: scan (the default: a prefix scan, the same list "
+                             "order every frame) or append (atomic appends: the same set, the order may change)");
+}
+
+gl::CompactMethod parse_compact_option(const std::string& text) {
+    return text == "append" ? gl::CompactMethod::atomic_append : gl::CompactMethod::prefix_scan;
+}
+
+const char* compact_option_name(gl::CompactMethod method) {
+    return method == gl::CompactMethod::atomic_append ? "append" : "scan";
 }
 
 void add_displace_options(CLI::App& command, DisplaceOptions& options) {

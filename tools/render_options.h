@@ -1,12 +1,13 @@
-// The tessellation and displacement options of `render` and `view` (--tess-mode, --tess-distance,
-// --displace, --displace-scale, --bound, --cone): registration, checks and what they set
-// (tools/render_options.cpp).
+// The tessellation, displacement and compaction options of `render` and `view` (--tess-mode,
+// --tess-distance, --displace, --displace-scale, --bound, --cone, --compact): registration, checks
+// and what they set (tools/render_options.cpp).
 #pragma once
 
 #include <string>
 
 #include "cli_fwd.h"
 #include "patchcull/core/displaced_bounds.h"
+#include "patchcull/gl/gl_compaction.h"
 #include "patchcull/gl/gl_renderer.h"
 #include "patchcull/import/scene_model.h"
 
@@ -41,6 +42,18 @@ TessMode resolve_tess_mode(const TessOptions& options, const CameraPath& path);
 void apply_tess_mode(const TessMode& mode, gl::RenderParams& params);
 /// Distance from every eye of path to its target: sqrt(distance^2 + height^2).
 float camera_path_eye_distance(const CameraPath& path);
+
+/// --compact scan|append of `render` and `view` (target keeps the text, default "scan"): how
+/// --draw indirect lists each draw pass's survivors (gl_compaction.h's CompactMethod). scan: the
+/// prefix scan, the same list order every frame; append: atomic appends, the same set of
+/// patches in an order that may change from frame to frame. A bad value is one line naming the
+/// flag (exit 2).
+CLI::Option* add_compact_option(CLI::App& command, std::string& target);
+/// The CompactMethod of --compact's text (checked by add_compact_option): "append" is
+/// atomic_append, anything else prefix_scan.
+gl::CompactMethod parse_compact_option(const std::string& text);
+/// --compact's text of a method ("scan", "append"), e.g. for a JSON report.
+const char* compact_option_name(gl::CompactMethod method);
 
 /// --displace, --displace-scale, --bound and --cone of `render` and `view` (Niessner & Loop §4.2, §6):
 /// displaced patches tested against the frustum and the running pipeline's Hi-Z with the chosen

@@ -6,6 +6,7 @@
 #include <stb_image.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -159,6 +160,26 @@ TEST(ViewerSettings, KeysAndSetsChangeTheSameState) {
     const ViewerSettings before = s;
     EXPECT_NE(apply_setting(s, "tess", "3x"), "");
     EXPECT_EQ(s.tess, before.tess);  // unchanged on error
+}
+
+// The draw mode and the compaction (the panel's "draw" and "compaction", `set draw`, `set compact`).
+TEST(ViewerSettings, DrawModeAndCompactionSwitch) {
+    ViewerSettings s;
+    EXPECT_EQ(s.draw, gl::DrawMode::indirect);
+    EXPECT_EQ(s.compact, gl::CompactMethod::prefix_scan);
+    EXPECT_EQ(apply_setting(s, "draw", "flags"), "");
+    EXPECT_EQ(s.draw, gl::DrawMode::flags);
+    EXPECT_EQ(apply_setting(s, "compact", "append"), "");
+    EXPECT_EQ(s.compact, gl::CompactMethod::atomic_append);
+    EXPECT_EQ(apply_setting(s, "draw", "indirect"), "");
+    EXPECT_EQ(apply_setting(s, "compact", "scan"), "");
+    EXPECT_EQ(s.draw, gl::DrawMode::indirect);
+    EXPECT_EQ(s.compact, gl::CompactMethod::prefix_scan);
+    EXPECT_EQ(apply_setting(s, "draw", "list"), "set draw: expected one of flags, indirect, got 'list'");
+    EXPECT_EQ(apply_setting(s, "compact", "atomic"), "set compact: expected one of scan, append, got 'atomic'");
+    EXPECT_EQ(s.draw, gl::DrawMode::indirect);  // unchanged on error
+    EXPECT_EQ(s.compact, gl::CompactMethod::prefix_scan);
+    EXPECT_EQ(parse_error("3 set draw sometimes\n").rfind("s.txt:1: set draw: expected one of flags, indirect", 0), 0u);
 }
 
 TEST(ViewerCamera, OrbitKeepsTheDistanceAndZoomChangesIt) {
@@ -386,4 +407,77 @@ TEST(ViewerCli, ScriptedCameraMoveToggleAndPanelShowInTheScreenshots) {
     // moves the surface: the picture changes although the camera and the animation stand still.
     EXPECT_GT(differing(plain, displaced, 0, 640), pixels / 100);
     EXPECT_NE(r.out.find("objects (bvh)"), std::string::npos) << r.out;
+}
+
+namespace {
+
+// Frame lines of a scripted run: frame number -> (pass 1 + pass 2 submitted, draw mode name).
+struct SubmittedLine {
+    long submitted = -1;
+    std::string draw;
+};
+std::vector<SubmittedLine> submitted_lines(const std::string& out) {
+    std::vector<SubmittedLine> lines;
+    std::size_t at = 0;
+    while ((at = out.find("frame ", at)) != std::string::npos) {
+        const std::size_t end = out.find('\n', at);
+        const std::string line = out.substr(at, end == std::string::npos ? std::string::npos : end - at);
+        at = end == std::string::npos ? out.size() : end;
+        int frame = -1;
+        long p1 = 0, p2 = 0;
+        char mode[16] = {};
+        const std::size_t sub = line.find("submitted ");
+        if (std::sscanf(line.c_str(), "frame %d:", &frame) != 1 || sub == std::string::npos) continue;
+        if (std::sscanf(line.c_str() + sub, "submitted %ld + %ld (%15[a-z])", &p1, &p2, mode) != 3) continue;
+        if (frame != static_cast<int>(lines.size())) continue;
+        lines.push_back({p1 + p2, mode});
+    }
+    return lines;
+}
+
+}  // namespace
+
+// The draw mode and the compaction switched live by a script's `set` (the panel's controls set the
+// same settings): each frame reports its mode and submitted patches (indirect: only the drawn;
+// flags: every patch of the spans drawn, in both passes), and the picture does not change.
+TEST(ViewerCli, ScriptedDrawAndCompactionSwitchesKeepThePicture) {
+    ASSERT_EQ(std::system("command -v xvfb-run >/dev/null 2>&1"), 0)
+        << "xvfb-run is missing: scripts/install-deps.sh installs xvfb";
+    const std::string d = scratch_dir() + "/viewer_draw";
+    std::filesystem::remove_all(d);
+    std::filesystem::create_directories(d);
+    const std::string script = write_file("viewer_draw_script.txt",
+                                          "0 set panel off\n"
+                                          "0 key space\n"
+                                          "2 screenshot " +
+                                              d +
+                                              "/indirect.png\n"
+                                              "3 set draw flags\n"
+                                              "4 screenshot " +
+                                              d +
+                                              "/flags.png\n"
+                                              "5 set draw indirect\n"
+                                              "5 set compact append\n"
+                                              "6 screenshot " +
+                                              d +
+                                              "/append.png\n"
+                                              "6 quit\n");
+    const CliRun r = run_under_xvfb("view " + model("bigguy.obj") + " --size 320x200 --tess 2 --script " + script);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::vector<SubmittedLine> lines = submitted_lines(r.out);
+    ASSERT_EQ(lines.size(), 7u) << r.out;
+    for (int f : {0, 1, 2, 5, 6}) EXPECT_EQ(lines[static_cast<std::size_t>(f)].draw, "indirect") << r.out;
+    for (int f : {3, 4}) EXPECT_EQ(lines[static_cast<std::size_t>(f)].draw, "flags") << r.out;
+    // Flags issue every patch in pass 1 and again in pass 2; indirect only the drawn ones.
+    EXPECT_GT(lines[4].submitted, 2 * lines[2].submitted) << r.out;
+    EXPECT_GT(lines[2].submitted, 0) << r.out;
+    const Rgb indirect = load_rgb(d + "/indirect.png"), flags = load_rgb(d + "/flags.png"),
+              append = load_rgb(d + "/append.png");
+    for (const Rgb* image : {&indirect, &flags, &append}) {
+        ASSERT_EQ(image->width, 320);
+        ASSERT_EQ(image->height, 200);
+    }
+    // The same patches are tessellated: the same picture (paused, unmoved), up to depth ties.
+    EXPECT_LT(differing(indirect, flags, 0, 320), 320u * 200 / 200);
+    EXPECT_LT(differing(indirect, append, 0, 320), 320u * 200 / 200);
 }

@@ -164,6 +164,7 @@ int run_viewer(ViewerConfig& config) {
     ViewerCamera camera(cameras[0], cameras[0].target);
     ViewerControls controls(settings, camera);
     gl::CullAutoPolicy policy(world.ranges(), world.scene().patch_count());
+    gl::DrawMode auto_draw = settings.draw;  // the draw mode policy's costs were measured in
 
     InputQueue queue;
     GLFWwindow* window = context.glfw_window();
@@ -270,7 +271,14 @@ int run_viewer(ViewerConfig& config) {
         params.bound = settings.bound;
         params.cone = settings.cone;
         params.frustum = config.frustum;
-        params.draw = config.draw;
+        params.draw = settings.draw;
+        params.compact = settings.compact;
+        if (settings.cull_auto && settings.draw != auto_draw) {
+            // The policy's costs are of one draw mode (an indirect pass costs no culled patch):
+            // measured again after a switch.
+            policy = gl::CullAutoPolicy(world.ranges(), world.scene().patch_count());
+        }
+        auto_draw = settings.draw;
         if (settings.backpatch && !world.one_sided() && config.interactive && !warned_open_backpatch) {
             // As `render --cull backpatch` on an open surface: kept, with one warning.
             warned_open_backpatch = true;

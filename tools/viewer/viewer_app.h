@@ -27,7 +27,6 @@ struct ViewerConfig {
     bool backpatch_requested = false;                 ///< --cull backpatch given: kept on an open scene, with a warning
     TessMode tess_mode;                               ///< reference distance of adaptive tessellation
     gl::FrustumTest frustum = gl::FrustumTest::hull;  ///< --frustum: the chain's frustum test
-    gl::DrawMode draw = gl::DrawMode::indirect;       ///< --draw: how the draw passes issue patches
     ClipDepth clip_depth = ClipDepth::zero_to_one;    ///< --clip-depth: drawn and culled in it
     std::string final_screenshot;                     ///< --screenshot: after the last of --frames
     std::string screenshot_dir = "out";               ///< the screenshot key's numbered PNGs

@@ -34,6 +34,9 @@ void stats_section(const PanelInfo& info) {
     if (!info.stats) return;
     const gl::FrameStats& s = *info.stats;
     ImGui::Text("patches %zu: drawn %zu (pass 1) + %zu (pass 2)", s.patches, s.pass1_drawn, s.pass2_drawn);
+    // Issued to the vertex shader and TCS: flags, every patch of the spans drawn; indirect, the listed.
+    ImGui::Text("submitted %zu (pass 1) + %zu (pass 2), %s draw", s.pass1_submitted, s.pass2_submitted,
+                gl::draw_mode_name(s.draw));
     if (ImGui::BeginTable("counts", 3, ImGuiTableFlags_SizingFixedFit)) {
         count_row("frustum", s.frustum_culled, s.patches);
         count_row("back-patch", s.backpatch_culled, s.patches);
@@ -87,6 +90,17 @@ void culling_section(ViewerSettings& s, const PanelInfo& info) {
     for (int i = 0; i < 4; ++i)
         if (s.objects == objects[i]) object = i;
     if (combo("object level", object, objects, 4)) s.objects = objects[object];
+    // The draw: indirect (the survivors compacted, only they issued) or flags (every patch issued,
+    // the TCS drops the culled); the same image either way.
+    static const char* const draws[] = {"flags", "indirect"};
+    int draw = s.draw == gl::DrawMode::indirect ? 1 : 0;
+    if (combo("draw", draw, draws, 2)) s.draw = draw == 1 ? gl::DrawMode::indirect : gl::DrawMode::flags;
+    if (s.draw == gl::DrawMode::indirect) {
+        static const char* const compactions[] = {"scan (same order)", "append (any order)"};
+        int compact = s.compact == gl::CompactMethod::atomic_append ? 1 : 0;
+        if (combo("compaction", compact, compactions, 2))
+            s.compact = compact == 1 ? gl::CompactMethod::atomic_append : gl::CompactMethod::prefix_scan;
+    }
 }
 
 void scene_section(ViewerSettings& s) {

@@ -1,7 +1,8 @@
 // The viewer's Dear ImGui panel (`patchcull view`): the cull toggles, methods, bound and
-// cone, tessellation, displacement, view mode and camera, edited in place in ViewerSettings (the
-// same state the keys and a --script's `set` lines change), and the last frame's per-pass times,
-// cull counts and rates. Uses ImGui's GLFW and OpenGL 3 backends on the viewer's window.
+// cone, the draw mode and compaction, tessellation, displacement, view mode and camera, edited in
+// place in ViewerSettings (the same state the keys and a --script's `set` lines change), and the
+// last frame's per-pass times, cull counts and rates, and patches submitted per draw pass. Uses ImGui's GLFW and OpenGL
+// 3 backends on the viewer's window.
 #pragma once
 
 #include <string>

@@ -98,6 +98,12 @@ std::string apply_setting(ViewerSettings& settings, const std::string& name, con
                            {"frustum", std::string("frustum")},
                            {"bvh", std::string("bvh")},
                            {"bvh+backface", std::string("bvh+backface")}});
+    if (name == "draw")
+        return set_choice(settings.draw, name, value,
+                          {{"flags", gl::DrawMode::flags}, {"indirect", gl::DrawMode::indirect}});
+    if (name == "compact")
+        return set_choice(settings.compact, name, value,
+                          {{"scan", gl::CompactMethod::prefix_scan}, {"append", gl::CompactMethod::atomic_append}});
     if (name == "view")
         return set_choice(settings.view, name, value,
                           {{"colour", ViewerView::colour},
@@ -123,7 +129,7 @@ std::string apply_setting(ViewerSettings& settings, const std::string& name, con
     }
     return "unknown setting '" + name +
            "' (cull.frustum, cull.backpatch, cull.occlusion, cull.auto, backpatch, bound, cone, aggressive, tess, "
-           "tess.adaptive, displace, displace.scale, objects, view, camera, pause, panel)";
+           "tess.adaptive, displace, displace.scale, objects, draw, compact, view, camera, pause, panel)";
 }
 
 bool parse_viewer_key(const std::string& name, ViewerKey& key) {

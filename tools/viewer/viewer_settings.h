@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "patchcull/core/displaced_bounds.h"
+#include "patchcull/gl/gl_compaction.h"
 #include "patchcull/gl/gl_passes.h"
+#include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_renderer.h"
 
 namespace patchcull::cli {
@@ -32,6 +34,12 @@ struct ViewerSettings {
     bool displace = false;         ///< the scene's (or --displace's) map applied; else none
     float displace_scale = 0.02f;  ///< world units of a full height step, (0, 1]
     std::string objects = "none";  ///< object level: none, frustum, bvh, bvh+backface
+    /// How the draw passes issue patches (gl_pipeline.h's DrawMode; --draw): indirect draws of the
+    /// compacted survivors, or every patch with the TCS dropping the culled. Same image.
+    gl::DrawMode draw = gl::DrawMode::indirect;
+    /// The compaction of indirect draws (--compact): scan (the same list order every frame) or
+    /// append (the same set, the order may change).
+    gl::CompactMethod compact = gl::CompactMethod::prefix_scan;
     ViewerView view = ViewerView::colour;
     ViewerCameraMode camera = ViewerCameraMode::orbit;
     bool paused = false;  ///< animation stopped (the pipeline still runs every frame)
@@ -41,8 +49,9 @@ struct ViewerSettings {
 /// Applies `set NAME VALUE` (the names README's viewer section lists: cull.frustum on|off,
 /// cull.backpatch, cull.occlusion, cull.auto, backpatch tcone|ncone|ptp, bound caf|oobb,
 /// cone full|acon|con, aggressive on|off, tess 1..64, tess.adaptive on|off, displace on|off,
-/// displace.scale (0,1], objects none|frustum|bvh|bvh+backface, view colour|status|status-second,
-/// camera path|orbit|fly, pause on|off, panel on|off). Returns "" on success, else what is wrong
+/// displace.scale (0,1], objects none|frustum|bvh|bvh+backface, draw flags|indirect,
+/// compact scan|append, view colour|status|status-second, camera path|orbit|fly, pause on|off,
+/// panel on|off). Returns "" on success, else what is wrong
 /// (one line, settings unchanged).
 std::string apply_setting(ViewerSettings& settings, const std::string& name, const std::string& value);
 
