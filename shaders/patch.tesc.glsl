@@ -15,8 +15,12 @@
 #include "shared.h"
 #include "draw_params.h"
 #define PC_PATCH_TESS_SCALE readonly
-// Drawn patches of this render (PatchRenderer::read_drawn_patches: what --verify compares).
+// Drawn patches of this render (PatchRenderer::read_drawn_patches: what --verify compares). Not in
+// the mark-front program (PATCHCULL_MARK_FRONT), whose fragment shader writes the same buffer: no
+// two stages of one pipeline write it.
+#ifndef PATCHCULL_MARK_FRONT
 #define PC_PATCH_MARKS writeonly
+#endif
 #include "patch_buffers.h"
 #include "patchcull_tcs.h"
 
@@ -45,7 +49,9 @@ void main() {
             outer = vec4(edge_level(vs_point[0], vs_point[12]), edge_level(vs_point[0], vs_point[3]),
                          edge_level(vs_point[3], vs_point[15]), edge_level(vs_point[12], vs_point[15]));
         }
+#ifndef PATCHCULL_MARK_FRONT
         if (drawn && u_mark_drawn) patch_marks[p] = 1u;
+#endif
         gl_TessLevelOuter[0] = outer[0];
         gl_TessLevelOuter[1] = outer[1];
         gl_TessLevelOuter[2] = outer[2];

@@ -28,7 +28,12 @@ flat out uint tes_patch;
 out vec2 tes_uv;        // the tessellator's (u, v): the fragment shader re-evaluates the surface there
 // The mark-front pass (PATCHCULL_MARK_FRONT) is another program with the same TES source: the
 // same gl_Position in both, so its GL_EQUAL depth test matches the reference's depth exactly.
+// (Vulkan: the same SPIR-V module in both pipelines; Mesa's SPIR-V reader refuses the Invariant
+// decoration glslang puts on gl_PerVertex's member, and the renderer's verification also counts
+// every patch of the reference's id image as front: vk_renderer.h.)
+#ifndef PC_VULKAN
 invariant gl_Position;
+#endif
 
 // Quadratic Bernstein polynomials.
 vec3 bernstein2(float t) {

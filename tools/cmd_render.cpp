@@ -94,6 +94,7 @@
 #include "render_options.h"
 #include "render_osd_table.h"
 #include "render_support.h"
+#include "render_vulkan.h"
 
 namespace patchcull::cli {
 namespace {
@@ -129,6 +130,9 @@ Runner add_render_command(CLI::App& app) {
         std::string pose = "cpu";
         bool fused_pass = false;
         std::string draw = "indirect";
+        std::string compact = "scan";
+        std::string api = "gl";
+        bool vk_validation = false;
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -164,6 +168,14 @@ Runner add_render_command(CLI::App& app) {
     add_choice_option(*command, "--draw", state->draw, {"flags", "indirect"},
                       "how the draw passes issue patches: indirect (the default: the survivors compacted into indirect "
                       "draws, a culled patch is never issued) or flags (every patch, the TCS drops the culled)");
+    add_compact_option(*command, state->compact);
+    add_choice_option(*command, "--api", state->api, {"gl", "vulkan"},
+                      "graphics API of the renderer and the cull passes: gl (OpenGL 4.5 through EGL) or vulkan "
+                      "(Vulkan 1.3 on a headless device; one object per frame: no --cull auto, --objects, "
+                      "--object-occlusion, --pose gpu, --dump-hiz or --draw-bounds)");
+    command->add_flag("--vk-validation", state->vk_validation,
+                      "with --api vulkan: the Khronos validation layer (with synchronization validation) on; any "
+                      "message it reports fails the run (exit status 1)");
     add_choice_option(*command, "--pose", state->pose, {"cpu", "gpu"},
                       "where animated patches are evaluated: cpu, or gpu (stencils in a compute pass, bit-identical)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
@@ -252,6 +264,61 @@ Runner add_render_command(CLI::App& app) {
         }
         Scene world;  // the placements in world coordinates (without the models), when frames move
         if (rebases) world = rebase_scene_in_place(scene, frame_origins[0]);
+        if (state->vk_validation && state->api != "vulkan") throw Error("--vk-validation: needs --api vulkan");
+        if (state->api == "vulkan") {
+            const std::set<std::string> applies = {
+                "MODEL",           "--scheme",        "--split",    "--frames",
+                "--cull",          "--backpatch",     "--frustum",  "--clip-depth",
+                "--fused-pass",    "--draw",          "--compact",  "--tess",
+                "--tess-mode",     "--tess-distance", "--displace", "--displace-scale",
+                "--bound",         "--cone",          "--size",     "--aggressive",
+                "--verify",        "--out",           "--json",     "--api",
+                "--vk-validation", "--help"};
+            for (const CLI::Option* option : command->get_options())
+                if (option->count() > 0 && !applies.count(option->get_name()))
+                    throw Error("--api vulkan: not with " + option->get_name() +
+                                " (the Vulkan renderer draws the scene as one object, posed on the CPU)");
+            if (automatic) throw Error("--api vulkan: not with --cull auto");
+            const ClipDepth depth = parse_clip_depth_option(state->clip_depth);
+            if (depth == ClipDepth::minus_one_to_one)
+                throw Error(
+                    "--api vulkan: not with --clip-depth minus-one-to-one (Vulkan's clip space has depth 0..1)");
+            VulkanRenderJob job;
+            job.scene = &scene;
+            job.world = rebases ? &world : nullptr;
+            job.frame_origins = frame_origins;
+            job.cameras = scene.camera_path(state->frames, aspect);
+            for (std::size_t f = 0; f < job.cameras.size(); ++f) {
+                if (rebases) job.cameras[f] = world_cameras[f].local(frame_origins[f]);
+                job.cameras[f].depth = depth;
+            }
+            job.width = width;
+            job.height = height;
+            job.tess = state->tess;
+            job.frames = state->frames;
+            job.tess_mode = tess_mode;
+            job.tests = static_cast<std::uint32_t>(applied);
+            job.cull_name = gl::cull_mode_name(cull);
+            job.backpatch_name = backpatch_applied ? gl::backpatch_method_name(backpatch) : "off";
+            job.backpatch = backpatch;
+            job.bound = displace_bound(state->displace);
+            job.cone = displace_cone(state->displace);
+            job.bound_name = state->displace.bound;
+            job.cone_name = state->displace.cone;
+            job.frustum_name = state->frustum;
+            job.frustum_aabb = state->frustum == "aabb";
+            job.fused_pass = state->fused_pass;
+            job.draw_name = state->draw;
+            job.indirect = state->draw == "indirect";
+            job.compact_name = state->compact;
+            job.scan = parse_compact_option(state->compact) == gl::CompactMethod::prefix_scan;
+            job.aggressive = state->aggressive;
+            job.verify = state->verify;
+            job.json = state->json;
+            job.validation = state->vk_validation;
+            job.out = state->out;
+            return run_vulkan_render(job);
+        }
         auto object_level =
             std::make_unique<ObjectLevelRun>(state->objects, scene, one_sided);  // before the occluders go up
         if (automatic && object_level->sets_objects())
@@ -314,6 +381,7 @@ Runner add_render_command(CLI::App& app) {
             params.frustum = state->frustum == "aabb" ? gl::FrustumTest::aabb : gl::FrustumTest::hull;
             params.fused_pass = state->fused_pass;
             params.draw = state->draw == "indirect" ? gl::DrawMode::indirect : gl::DrawMode::flags;
+            params.compact = parse_compact_option(state->compact);
             object_level->apply(poser, *pose, f * kSecondsPerFrame, cameras[static_cast<std::size_t>(f)], height,
                                 params, width);
             if (automatic) {
@@ -427,6 +495,7 @@ Runner add_render_command(CLI::App& app) {
         }
         if (state->json) {
             nlohmann::json out;
+            out["api"] = "gl";
             out["model"] = scene.name;
             out["patch_source"] = "bezier";
             out["patches"] = scene.patch_count();
@@ -447,6 +516,7 @@ Runner add_render_command(CLI::App& app) {
             out["pose"] = state->pose;
             out["fused_pass"] = state->fused_pass;
             out["draw"] = state->draw;
+            out["compact"] = state->compact;
             out["objects_method"] = object_level->method_name();
             out["object_occlusion"] = object_level->occlusion_name();
             out["detail_cull"] = state->objects.detail_pixels;
