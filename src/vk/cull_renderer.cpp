@@ -85,6 +85,7 @@ struct CullRenderer::Impl {
         query.queryCount = kMaxMarks;
         detail::check_renderer(vkCreateQueryPool(dev.device(), &query, nullptr, &timestamps), "vkCreateQueryPool");
         counters.assign(nullptr, sh::kCounterCount * 4);
+        for (HostBuffer& list : lists) list.reserve(4);  // bound by every patch draw (flags too)
         set_displacement_map({});
         flags.assign(nullptr, 4);
         upload_patches(nullptr, 0, {}, false);
