@@ -11,8 +11,12 @@ Usage: python3 scripts/gpu_figures.py [BUILD_DIR]   (default: build)
 3. Cull-pass time against patch count (MonsterFrog and BigGuy split 0..2: closed solids, so that
    `all` includes the back-patch pass; cull occlusion alone, and all with each back-patch method;
    Niessner & Loop's Fig. 7).
+4. The same frames on Vulkan (`render --api vulkan --vk-device gpu`: the Vulkan passes and
+   renderer on the first GPU, else lavapipe), timed by timestamp queries, beside OpenGL's:
+   frame, Hi-Z and cull-chain times per tessellation level, and the cull chain against patch count.
 Every figure is the mean over frames 1..N-1 (frame 0 compiles and primes the statuses). On
-llvmpipe the times are wall clock around glFinish (gl_renderer.h); on a GPU, timer queries.
+llvmpipe the GL times are wall clock around glFinish (gl_renderer.h); on a GPU, timer queries.
+A build without Vulkan (PATCHCULL_WITH_VULKAN=OFF) skips figure 4.
 """
 import json
 import os
@@ -80,6 +84,30 @@ def main():
         name = "monsterfrog" if model == MONSTERFROG else "bigguy"
         print(f"{name + ' /' + str(split):>14} {occ['patches']:>8} {row[0]:>10.2f} "
               + " ".join(f"{v:>8.2f}" for v in row[1:]))
+
+    vulkan = ["--api", "vulkan", "--vk-device", "gpu"]
+    try:
+        probe = render("teapot", "--frames", 1, "--size", "8x8", *vulkan)
+    except subprocess.CalledProcessError as e:
+        print(f"\n4. Vulkan: skipped ({e.stderr.strip()})")
+        return
+    print(f"\n4. Vulkan ({probe['renderer']}, timestamp queries) beside OpenGL: default scene, 640x360, 5 frames,")
+    print("   cull all (tcone), indirect draws; ms per frame (total, hiz, cull chain)")
+    print(f"{'tess':>5} {'gl total':>9} {'vk total':>9} {'vk/gl':>6} {'gl hiz':>7} {'vk hiz':>7} "
+          f"{'gl cull':>8} {'vk cull':>8}")
+    for tess in (1, 4, 8, 16):
+        args = ["default", "--frames", 5, "--tess", tess, "--cull", "all", "--backpatch", "tcone"]
+        g, v = render(*args), render(*args, *vulkan)
+        print(f"{tess:>5} {mean_ms(g, 'total'):>9.1f} {mean_ms(v, 'total'):>9.1f} "
+              f"{mean_ms(v, 'total') / mean_ms(g, 'total'):>6.2f} {mean_ms(g, 'hiz'):>7.2f} {mean_ms(v, 'hiz'):>7.2f} "
+              f"{mean_ms(g, 'cull'):>8.2f} {mean_ms(v, 'cull'):>8.2f}")
+    print("   cull chain (ms) against patch count (256x256, level 1, 4 frames, cull all, tcone)")
+    print(f"{'model':>14} {'patches':>8} {'gl cull':>8} {'vk cull':>8}")
+    for model, split in models:
+        base = [model, "--split", split, "--frames", 4, "--tess", 1, "--size", "256x256", "--cull", "all"]
+        g, v = render(*base), render(*base, *vulkan)
+        name = "monsterfrog" if model == MONSTERFROG else "bigguy"
+        print(f"{name + ' /' + str(split):>14} {g['patches']:>8} {mean_ms(g, 'cull'):>8.2f} {mean_ms(v, 'cull'):>8.2f}")
 
 
 if __name__ == "__main__":

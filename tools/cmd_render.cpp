@@ -133,6 +133,7 @@ Runner add_render_command(CLI::App& app) {
         std::string compact = "scan";
         std::string api = "gl";
         bool vk_validation = false;
+        std::string vk_device = "cpu";
         int tess = 8;
         TessOptions tess_options;
         DisplaceOptions displace;
@@ -176,6 +177,9 @@ Runner add_render_command(CLI::App& app) {
     command->add_flag("--vk-validation", state->vk_validation,
                       "with --api vulkan: the Khronos validation layer (with synchronization validation) on; any "
                       "message it reports fails the run (exit status 1)");
+    add_choice_option(*command, "--vk-device", state->vk_device, {"cpu", "gpu"},
+                      "with --api vulkan: the kind of Vulkan device tried first, cpu (lavapipe: the same runs "
+                      "everywhere) or gpu (for measurements); another device with what is needed otherwise");
     add_choice_option(*command, "--pose", state->pose, {"cpu", "gpu"},
                       "where animated patches are evaluated: cpu, or gpu (stencils in a compute pass, bit-identical)");
     add_int_option(*command, "--tess", state->tess, 1, 64, "tessellation level (adaptive: the maximum)");
@@ -265,6 +269,8 @@ Runner add_render_command(CLI::App& app) {
         Scene world;  // the placements in world coordinates (without the models), when frames move
         if (rebases) world = rebase_scene_in_place(scene, frame_origins[0]);
         if (state->vk_validation && state->api != "vulkan") throw Error("--vk-validation: needs --api vulkan");
+        if (command->get_option("--vk-device")->count() > 0 && state->api != "vulkan")
+            throw Error("--vk-device: needs --api vulkan");
         if (state->api == "vulkan") {
             const std::set<std::string> applies = {
                 "MODEL",           "--scheme",        "--split",    "--frames",
@@ -273,7 +279,7 @@ Runner add_render_command(CLI::App& app) {
                 "--tess-mode",     "--tess-distance", "--displace", "--displace-scale",
                 "--bound",         "--cone",          "--size",     "--aggressive",
                 "--verify",        "--out",           "--json",     "--api",
-                "--vk-validation", "--help"};
+                "--vk-validation", "--vk-device",     "--help"};
             for (const CLI::Option* option : command->get_options())
                 if (option->count() > 0 && !applies.count(option->get_name()))
                     throw Error("--api vulkan: not with " + option->get_name() +
@@ -316,6 +322,7 @@ Runner add_render_command(CLI::App& app) {
             job.verify = state->verify;
             job.json = state->json;
             job.validation = state->vk_validation;
+            job.prefer_gpu = state->vk_device == "gpu";
             job.out = state->out;
             return run_vulkan_render(job);
         }

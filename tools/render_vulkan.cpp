@@ -52,6 +52,7 @@ int run_vulkan_render(const VulkanRenderJob& job) {
     Scene& scene = *job.scene;
     vk::HeadlessDeviceOptions device_options;
     device_options.validation = job.validation;
+    if (job.prefer_gpu) device_options.prefer = vk::HeadlessDeviceOptions::Prefer::gpu;
     vk::HeadlessDevice device(device_options);
     vk::CullRenderer renderer(device);
     ScenePoser poser(scene);

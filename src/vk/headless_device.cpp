@@ -100,9 +100,12 @@ HeadlessDevice::HeadlessDevice(const HeadlessDeviceOptions& options) {
                 VkPhysicalDeviceProperties p{};
                 vkGetPhysicalDeviceProperties(d, &p);
                 const bool cpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+                const bool gpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU ||
+                                 p.deviceType == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU;
+                const bool preferred = options.prefer == HeadlessDeviceOptions::Prefer::cpu ? cpu : gpu;
                 std::uint32_t families = 0;
                 vkGetPhysicalDeviceQueueFamilyProperties(d, &families, nullptr);
-                if (p.apiVersion < VK_API_VERSION_1_3 || graphics_family(d) == families || (pass == 0 && !cpu))
+                if (p.apiVersion < VK_API_VERSION_1_3 || graphics_family(d) == families || (pass == 0 && !preferred))
                     continue;
                 physical_device_ = d;
                 name_ = p.deviceName;

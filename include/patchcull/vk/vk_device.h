@@ -2,11 +2,11 @@
 // patchcull_vk), for its tessellation renderer (vk_renderer.h), the CLI's `--api vulkan` and the
 // tests. An engine does not need it: the passes (vk_passes.h) run on the engine's own device.
 //
-// The device: the first physical device with Vulkan 1.3 and a queue for graphics and compute
-// (lavapipe, Mesa's CPU device, where there is no GPU; a CPU device is preferred so that runs are
-// alike everywhere), created with what the passes and the renderer need: VK_KHR_push_descriptor,
-// shaderFloat64 (the passes' exact fma), tessellationShader, multiDrawIndirect,
-// vertexPipelineStoresAndAtomics and fragmentStoresAndAtomics (the drawn and front marks),
+// The device: the first physical device with Vulkan 1.3 and a queue for graphics and compute, of
+// the kind HeadlessDeviceOptions::prefer asks for when there is one (a CPU device by default:
+// lavapipe, Mesa's CPU driver, so that runs are alike everywhere; a GPU for measurements), created with what the passes
+// and the renderer need: VK_KHR_push_descriptor, shaderFloat64 (the passes' exact fma), tessellationShader,
+// multiDrawIndirect, vertexPipelineStoresAndAtomics and fragmentStoresAndAtomics (the drawn and front marks),
 // drawIndirectCount and dynamicRendering. A device without one of them: Error naming it.
 //
 // Validation (HeadlessDeviceOptions::validation): VK_LAYER_KHRONOS_validation with synchronization
@@ -30,6 +30,9 @@ struct HeadlessDeviceOptions {
     /// Turn on the Khronos validation layer (Error when it is not installed: Debian's
     /// vulkan-validationlayers).
     bool validation = false;
+    /// The kind of physical device tried first (any other with what is needed after it).
+    enum class Prefer { cpu, gpu };
+    Prefer prefer = Prefer::cpu;
 };
 
 class HeadlessDevice {
