@@ -20,6 +20,9 @@
 //   (FrustumPlanes, to_zero_to_one, to_depth_key of the caller's matrix in its ClipDepth), and a
 //   Vulkan projection's y-down clip space (y negated) leaves the frustum planes' set unchanged
 //   (w + y and w - y swap), so the decisions do not depend on it (docs/ENGINE.md, "Vulkan").
+// - Draw parameters (draw_params.h: the patch and occluder draws of the renderers): plain uniforms
+//   on OpenGL; on Vulkan one 128-byte push-constant block shared by every stage, gl_VertexIndex
+//   for gl_VertexID, the displacement map at set-0 binding 31.
 // - Not (yet) under Vulkan: the passes over a GpuPatchSource (a second parameter block).
 #ifndef PATCHCULL_SHADERS_API_H
 #define PATCHCULL_SHADERS_API_H
@@ -124,9 +127,26 @@ inline constexpr std::uint32_t kTextureHiZBinding = 3u;  // occlusion, fused, di
 #define PC_VK_PARAMS_FusedCullParams struct FusedCullParams
 #endif
 
+// The draw shaders' parameters (shaders/draw_params.h, compiled with PC_VK_GRAPHICS: the headless
+// renderer's patch and occluder draws): one std140 push-constant block of every stage; the vertex
+// index; the displacement map's binding, a number no storage buffer of the draws uses.
+#define PC_DRAW_PARAMS_BEGIN layout(push_constant, std140) uniform DrawParams {
+#define PC_DRAW_PARAMS_END };
+#define PC_DRAW_PARAM
+#define PC_VERTEX_INDEX gl_VertexIndex
+#ifdef PC_VK_GRAPHICS
+#define kTextureUnitDisplacement 31u
+#endif
+
 #else  // OpenGL
 
 #define PC_PARAMS(name, slot) layout(std140, binding = slot) uniform name
+// The draw shaders' parameters are plain uniforms, set by name; gl_VertexID counts from the draw's
+// first vertex as gl_VertexIndex does.
+#define PC_DRAW_PARAMS_BEGIN
+#define PC_DRAW_PARAMS_END
+#define PC_DRAW_PARAM uniform
+#define PC_VERTEX_INDEX gl_VertexID
 
 #endif
 
