@@ -207,15 +207,15 @@ Runner add_render_command(CLI::App& app) {
             if (state->scheme != "osd") throw Error("--patch-source osd-table: needs --scheme osd");
             const std::set<std::string> applies = {
                 "MODEL",  "--scheme", "--patch-source", "--frames", "--cull", "--backpatch", "--clip-depth",
-                "--tess", "--size",   "--verify",       "--json",   "--help", "--draw"};
+                "--tess", "--size",   "--verify",       "--json",   "--help", "--draw",      "--compact"};
             for (const CLI::Option* option : command->get_options())
                 if (option->count() > 0 && !applies.count(option->get_name()))
                     throw Error("--patch-source osd-table: not with " + option->get_name());
             if (state->cull == "auto") throw Error("--patch-source osd-table: not with --cull auto");
-            if (state->draw == "indirect" && command->get_option("--draw")->count() > 0)
-                throw Error(
-                    "--patch-source osd-table: not with --draw indirect (OpenSubdiv's patch arrays are drawn "
-                    "with the flags)");
+            // The flag path stays the default here: --draw indirect must be asked for.
+            const bool indirect = state->draw == "indirect" && command->get_option("--draw")->count() > 0;
+            if (!indirect && command->get_option("--compact")->count() > 0)
+                throw Error("--patch-source osd-table: --compact needs --draw indirect");
             OsdTableRender o;
             o.model = state->model;
             o.frames = state->frames;
@@ -225,6 +225,8 @@ Runner add_render_command(CLI::App& app) {
             o.backpatch = parse_backpatch_method("--backpatch", state->backpatch);
             o.depth = parse_clip_depth_option(state->clip_depth);
             o.tess = state->tess;
+            o.indirect = indirect;
+            o.compact = parse_compact_option(state->compact);
             o.verify = state->verify;
             o.json = state->json;
             return run_osd_table_render(o);

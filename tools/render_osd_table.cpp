@@ -17,6 +17,7 @@
 #include "patchcull/gl_osd/osd_gl_draw.h"
 #include "patchcull/import/model_loader.h"
 #include "patchcull/import/osd_patch_table.h"
+#include "render_options.h"
 
 namespace patchcull::cli {
 
@@ -40,6 +41,8 @@ int run_osd_table_render(const OsdTableRender& o) {
     settings.frustum = (tests & gl::kCullFrustum) != 0;
     settings.occlusion = (tests & gl::kCullOcclusion) != 0;
     if (tests & gl::kCullBackPatch) settings.backpatch = o.backpatch;
+    settings.draw = o.indirect ? gl_osd::OsdDrawMode::indirect : gl_osd::OsdDrawMode::flags;
+    settings.compact = o.compact;
 
     gl::GlContext context = gl::GlContext::create_headless();
     struct BufferGuard {  // the vertex buffer, deleted before the context
@@ -73,18 +76,22 @@ int run_osd_table_render(const OsdTableRender& o) {
             view.tess_level = static_cast<float>(o.tess);
             view.one_sided = model.closed;
             std::vector<std::uint32_t> want;
+            std::vector<float> want_depth;
             if (o.verify) {
                 frame.render_unculled(vertices, view);
                 want = frame.read_ids();
+                want_depth = frame.read_depth();
             }
             const gl_osd::OsdFrameStats s = frame.render(vertices, view, settings);
-            std::size_t false_culls = 0, differing = 0;
+            std::size_t false_culls = 0, differing = 0, ties = 0;
             if (o.verify) {
                 const std::vector<std::uint32_t> got = frame.read_ids();
+                const std::vector<float> got_depth = frame.read_depth();
                 std::set<std::uint32_t> present(got.begin(), got.end()), missing;
                 for (std::size_t i = 0; i < got.size(); ++i) {
                     if (got[i] == want[i]) continue;
                     ++differing;
+                    if (got[i] != 0 && want[i] != 0 && got_depth[i] == want_depth[i]) ++ties;
                     if (want[i] != 0 && !present.count(want[i])) missing.insert(want[i]);
                 }
                 false_culls = missing.size();
@@ -93,15 +100,20 @@ int run_osd_table_render(const OsdTableRender& o) {
             frames.push_back({{"frame", f},
                               {"pass1_drawn", s.drawn_pass1},
                               {"pass2_drawn", s.drawn_pass2},
+                              {"submitted", {{"pass1", s.submitted_pass1}, {"pass2", s.submitted_pass2}}},
                               {"frustum_culled", s.frustum},
                               {"backpatch_culled", s.backpatch},
                               {"occlusion_culled", s.occlusion},
                               {"false_culls", false_culls},
-                              {"differing_pixels", differing}});
+                              {"differing_pixels", differing},
+                              {"depth_ties", ties}});
             if (!o.json) {
                 std::printf("frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu", f,
                             s.drawn_pass1, s.drawn_pass2, patches, s.frustum, s.backpatch, s.occlusion);
-                if (o.verify) std::printf("; false culls %zu, differing pixels %zu", false_culls, differing);
+                if (o.indirect) std::printf("; submitted %zu + %zu", s.submitted_pass1, s.submitted_pass2);
+                if (o.verify)
+                    std::printf("; false culls %zu, differing pixels %zu (depth ties %zu)", false_culls, differing,
+                                ties);
                 std::printf("\n");
             }
         }
@@ -112,7 +124,8 @@ int run_osd_table_render(const OsdTableRender& o) {
         out["patches"] = patches;
         out["size"] = {o.width, o.height};
         out["patch_source"] = "osd-table";
-        out["draw"] = "flags";
+        out["draw"] = o.indirect ? "indirect" : "flags";
+        if (o.indirect) out["compact"] = compact_option_name(o.compact);
         out["clip_depth"] = clip_depth_name(o.depth);
         out["tess"] = o.tess;
         out["cull"] = gl::cull_mode_name(o.cull);

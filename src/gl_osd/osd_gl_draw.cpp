@@ -23,6 +23,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <utility>
@@ -60,8 +62,39 @@ mat4 OsdProjectionMatrix() { return ProjectionMatrix; }
 mat4 OsdModelViewProjectionMatrix() { return ProjectionMatrix * ModelViewMatrix; }
 float OsdTessLevel() { return TessLevel; }
 int OsdGregoryQuadOffsetBase() { return 0; }
-int OsdPrimitiveIdBase() { return PrimitiveIdBase; }
 int OsdBaseVertex() { return 0; }
+#ifndef PC_OSD_PULL
+int OsdPrimitiveIdBase() { return PrimitiveIdBase; }
+#endif
+#if defined(PC_OSD_PULL) && defined(PC_OSD_VERTEX)
+// The compacted draw: vertex gl_VertexID is slot gl_VertexID % n of list entry gl_VertexID / n;
+// the table's index buffer names the slot's point, read from the vertex buffer as storage.
+layout(std430, binding = PC_OSD_BINDING_LIST) readonly buffer PcList { uint pc_list[]; };
+layout(std430, binding = PC_OSD_BINDING_INDICES) readonly buffer PcIndices { int pc_indices[]; };
+layout(std430, binding = PC_OSD_BINDING_VERTICES) readonly buffer PcVertices { float pc_vertices[]; };
+uniform int u_pull_first_patch, u_pull_index_base, u_pull_stride, u_pull_offset, u_pull_points;
+out int pc_vs_patch;
+int OsdPrimitiveIdBase() { return 0; }
+vec4 pc_pull_point() {
+    const int patch_index = int(pc_list[uint(gl_VertexID) / uint(PC_OSD_PULL)]);
+    pc_vs_patch = patch_index;
+    const int slot = int(uint(gl_VertexID) % uint(PC_OSD_PULL));
+    const int point = pc_indices[u_pull_index_base + (patch_index - u_pull_first_patch) * PC_OSD_PULL + slot];
+    if (point < 0 || point >= u_pull_points) return vec4(0.0, 0.0, 0.0, 1.0);
+    const int at = point * u_pull_stride + u_pull_offset;
+    return vec4(pc_vertices[at], pc_vertices[at + 1], pc_vertices[at + 2], 1.0);
+}
+// Called right after OpenSubdiv's vertex shader copies its (unbound) attribute.
+#undef OSD_USER_VARYING_PER_VERTEX
+#define OSD_USER_VARYING_PER_VERTEX()        \
+    outpt.v.position = pc_pull_point();      \
+    { OSD_PATCH_CULL_COMPUTE_CLIPFLAGS(outpt.v.position); }
+#endif
+#if defined(PC_OSD_PULL) && defined(PC_OSD_TESS_CONTROL)
+// OsdGetPatchIndex(gl_PrimitiveID) is the listed patch, whatever gl_PrimitiveID is.
+in int pc_vs_patch[];
+int OsdPrimitiveIdBase() { return pc_vs_patch[0] - gl_PrimitiveID; }
+#endif
 #if defined(PC_OSD_TESS_CONTROL) && !defined(OSD_ENABLE_PATCH_CULL)
 uniform uint u_draw_mask, u_draw_value;
 patch out int pc_patch;
@@ -84,6 +117,9 @@ patch out int pc_patch;
 #endif
 #ifdef PC_OSD_TESS_EVAL
 patch in int pc_patch;
+#ifdef PC_OSD_PULL
+int OsdPrimitiveIdBase() { return pc_patch - gl_PrimitiveID; }
+#endif
 flat out int pc_id;
 out float pc_facing;
 // The cosine between the normal and the direction to the eye (eye space: the eye at 0).
@@ -132,9 +168,15 @@ GLuint compile(GLenum stage, const std::string& text, const char* what) {
 }
 
 // One program for a patch type: OpenSubdiv's stages composed as its examples compose them.
-GLuint build_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& options) {
+// pull: the compacted draw's program (the client header's PC_OSD_PULL parts).
+GLuint build_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& options, bool pull) {
     std::string version = "#version 450\n";
     if (options.opensubdiv_patch_cull) version += "#define OSD_ENABLE_PATCH_CULL\n";
+    if (pull)
+        version += "#define PC_OSD_PULL " + std::to_string(type == Far::PatchDescriptor::REGULAR ? 16 : 20) +
+                   "\n#define PC_OSD_BINDING_LIST " + std::to_string(sh::kBindingDrawList) +
+                   "\n#define PC_OSD_BINDING_INDICES " + std::to_string(sh::kBindingSourceIndices) +
+                   "\n#define PC_OSD_BINDING_VERTICES " + std::to_string(sh::kBindingSourceVertices) + "\n";
     if (options.record_tessellated)
         version += "#define PC_OSD_RECORD_TESSELLATED " + std::to_string(sh::kBindingOsdTessellated) + "\n";
     const std::string common = "#define OSD_PATCH_BASIS_GLSL\n" +
@@ -144,7 +186,9 @@ GLuint build_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& opti
     const std::string tcs_include(gl::shipped_glsl("patchcull_tcs.h"));
     const std::string header = client_header();
     const std::array<GLuint, 4> shaders = {
-        compile(GL_VERTEX_SHADER, version + common + header + Osd::GLSLPatchShaderSource::GetVertexShaderSource(type),
+        compile(GL_VERTEX_SHADER,
+                version + "#define PC_OSD_VERTEX\n" + common + header +
+                    Osd::GLSLPatchShaderSource::GetVertexShaderSource(type),
                 "vertex"),
         compile(GL_TESS_CONTROL_SHADER,
                 version + "#define PC_OSD_TESS_CONTROL\n" + common + shared + tcs_include + header +
@@ -174,11 +218,17 @@ struct Program {
     GLuint name = 0;
     GLint model_view = -1, projection = -1, tess_level = -1, primitive_id_base = -1, mask = -1, value = -1,
           one_sided = -1;
+    GLint pull_first_patch = -1, pull_index_base = -1, pull_stride = -1, pull_offset = -1, pull_points = -1;
 };
 
-Program make_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& options) {
+Program make_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& options, bool pull = false) {
     Program p;
-    p.name = build_program(type, options);
+    p.name = build_program(type, options, pull);
+    p.pull_first_patch = glGetUniformLocation(p.name, "u_pull_first_patch");
+    p.pull_index_base = glGetUniformLocation(p.name, "u_pull_index_base");
+    p.pull_stride = glGetUniformLocation(p.name, "u_pull_stride");
+    p.pull_offset = glGetUniformLocation(p.name, "u_pull_offset");
+    p.pull_points = glGetUniformLocation(p.name, "u_pull_points");
     p.model_view = glGetUniformLocation(p.name, "ModelViewMatrix");
     p.projection = glGetUniformLocation(p.name, "ProjectionMatrix");
     p.tess_level = glGetUniformLocation(p.name, "TessLevel");
@@ -189,6 +239,38 @@ Program make_program(Far::PatchDescriptor::Type type, const OsdDrawOptions& opti
     const GLint params = glGetUniformLocation(p.name, "OsdPatchParamBuffer");
     if (params >= 0) glProgramUniform1i(p.name, params, static_cast<GLint>(sh::kTextureUnitOsdPatchParam));
     return p;
+}
+
+// Rescales CompactPass's commands, written for 16 points a patch, to u_n: count and first.
+const char* const kRescaleCommands = R"(#version 450
+layout(local_size_x = 64) in;
+layout(std430, binding = PC_OSD_BINDING_COMMANDS) buffer PcCommands { uint pc_commands[]; };
+uniform uint u_first_word, u_count, u_n;
+void main() {
+    const uint c = gl_GlobalInvocationID.x;
+    if (c >= u_count) return;
+    const uint w = u_first_word + 4u * c;
+    pc_commands[w] = pc_commands[w] / 16u * u_n;
+    pc_commands[w + 2u] = pc_commands[w + 2u] / 16u * u_n;
+}
+)";
+
+GLuint build_rescale_program() {
+    const std::string text =
+        std::string(kRescaleCommands)
+            .insert(13, "#define PC_OSD_BINDING_COMMANDS " + std::to_string(sh::kBindingDrawCommands) + "\n");
+    const GLuint shader = compile(GL_COMPUTE_SHADER, text, "command rescale");
+    const GLuint program = glCreateProgram();
+    glAttachShader(program, shader);
+    glLinkProgram(program);
+    glDeleteShader(shader);
+    GLint ok = 0;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        glDeleteProgram(program);
+        throw Error("GL: the OpenSubdiv command rescale program was rejected");
+    }
+    return program;
 }
 
 }  // namespace
@@ -204,16 +286,40 @@ struct OsdPatchTableDraw::Impl {
     std::vector<Array> arrays;
     GLuint masks = 0, vao = 0, tessellated = 0;
     Program bspline, gregory;
+    // The compacted draw's: programs built at its first draw, a VAO without attributes, the
+    // Gregory-basis commands' rescale (built with the table when it has Gregory-basis patches).
+    Program bspline_pull, gregory_pull;
+    GLuint pull_vao = 0, rescale = 0;
+    GLint rescale_first = -1, rescale_count = -1, rescale_n = -1;
+    OsdDrawOptions options;
+    bool any_bspline = false, any_gregory = false, pulled = false;
+    bool indirect_count = false, indirect_count_arb = false;
     std::size_t patch_count = 0, points_needed = 0;
     bool software = false;
 
     ~Impl() {
-        for (GLuint p : {bspline.name, gregory.name})
+        for (GLuint p : {bspline.name, gregory.name, bspline_pull.name, gregory_pull.name, rescale})
             if (p) glDeleteProgram(p);
         for (GLuint b : {masks, tessellated})
             if (b) glDeleteBuffers(1, &b);
-        if (vao) glDeleteVertexArrays(1, &vao);
+        for (GLuint v : {vao, pull_vao})
+            if (v) glDeleteVertexArrays(1, &v);
     }
+    void build_pull_programs() {
+        if (pulled) return;
+        GLint blocks = 0;
+        glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &blocks);
+        if (blocks < 3)
+            throw Error(
+                "GL: the compacted OpenSubdiv draw reads 3 storage blocks in the vertex shader, the driver allows " +
+                std::to_string(blocks));
+        if (any_bspline) bspline_pull = make_program(Far::PatchDescriptor::REGULAR, options, true);
+        if (any_gregory) gregory_pull = make_program(Far::PatchDescriptor::GREGORY_BASIS, options, true);
+        glCreateVertexArrays(1, &pull_vao);
+        pulled = true;
+        check_gl("after building the OpenSubdiv compacted-draw programs");
+    }
+    std::size_t commands_of(const Array& a, std::size_t k) const { return gl::compact_command_count(a.patches, k); }
 };
 
 OsdPatchTableDraw::OsdPatchTableDraw(gl::PassContext& passes, const Far::PatchTable& table,
@@ -275,6 +381,17 @@ OsdPatchTableDraw::OsdPatchTableDraw(gl::PassContext& passes, const Far::PatchTa
     glEnableVertexArrayAttrib(m.vao, 0);
     if (any_bspline) m.bspline = make_program(Far::PatchDescriptor::REGULAR, options);
     if (any_gregory) m.gregory = make_program(Far::PatchDescriptor::GREGORY_BASIS, options);
+    m.options = options;
+    m.any_bspline = any_bspline;
+    m.any_gregory = any_gregory;
+    m.indirect_count_arb = epoxy_has_gl_extension("GL_ARB_indirect_parameters");
+    m.indirect_count = m.indirect_count_arb || epoxy_gl_version() >= 46;
+    if (any_gregory) {
+        m.rescale = build_rescale_program();
+        m.rescale_first = glGetUniformLocation(m.rescale, "u_first_word");
+        m.rescale_count = glGetUniformLocation(m.rescale, "u_count");
+        m.rescale_n = glGetUniformLocation(m.rescale, "u_n");
+    }
     if (options.record_tessellated) {
         glCreateBuffers(1, &m.tessellated);
         glNamedBufferStorage(m.tessellated, static_cast<GLsizeiptr>(4 * std::max<std::size_t>(m.patch_count, 1)),
@@ -306,6 +423,13 @@ std::size_t OsdPatchTableDraw::tessellated_count() const {
 }
 
 namespace {
+
+// llvmpipe's limit: at most 65536 / (L + 1)^2 patches a draw at level L, L = 2 OsdTessLevel()
+// (OpenSubdiv's uniform level doubles on patches of refinement level 0), at most 64.
+std::size_t max_patches_per_draw(float tess_level) {
+    const int top = std::min(64, static_cast<int>(std::ceil(2.0f * tess_level)));
+    return std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((top + 1) * (top + 1)));
+}
 
 void check_view(const OsdView& view) {
     if (!(view.tess_level >= 1 && view.tess_level <= 16))
@@ -376,9 +500,11 @@ void OsdPatchTableDraw::draw(const OsdVertexBuffer& vertices, std::uint32_t flag
         glUniform1ui(p.value, value);
         glUniform1i(p.one_sided, view.one_sided ? 1 : 0);
         glPatchParameteri(GL_PATCH_VERTICES, a.control_vertices);
-        // llvmpipe restarts gl_PrimitiveID every 1024 / n patches of an indexed draw.
+        // llvmpipe restarts gl_PrimitiveID every 1024 / n patches of an indexed draw, and gets a
+        // draw of more than 65536 / (L + 1)^2 patches at level L wrong (docs/ENGINE.md): L is
+        // OpenSubdiv's largest level, 2 OsdTessLevel() (refinement level 0).
         const std::size_t n = static_cast<std::size_t>(a.control_vertices);
-        const std::size_t step = m.software ? 1024 / n : a.patches;
+        const std::size_t step = m.software ? std::min(1024 / n, max_patches_per_draw(view.tess_level)) : a.patches;
         for (std::size_t at = 0; at < a.patches; at += step) {
             const std::size_t count = std::min(step, a.patches - at);
             glUniform1i(p.primitive_id_base, static_cast<GLint>(a.first_patch + at));
@@ -389,6 +515,136 @@ void OsdPatchTableDraw::draw(const OsdVertexBuffer& vertices, std::uint32_t flag
     glUseProgram(0);
     glBindVertexArray(0);
     check_gl("after drawing the OpenSubdiv patch table");
+}
+
+// ---- The compacted draw --------------------------------------------------------------------------
+
+std::size_t OsdPatchTableDraw::array_count() const { return impl_->arrays.size(); }
+
+std::size_t OsdPatchTableDraw::command_first(std::size_t array, std::size_t patches_per_command) const {
+    const Impl& m = *impl_;
+    std::size_t first = 0;
+    for (std::size_t a = 0; a < array && a < m.arrays.size(); ++a)
+        first += m.commands_of(m.arrays[a], patches_per_command);
+    return first;
+}
+
+std::size_t OsdPatchTableDraw::command_count(std::size_t patches_per_command) const {
+    return command_first(impl_->arrays.size(), patches_per_command);
+}
+
+void OsdPatchTableDraw::compact(gl::CompactPass& pass, std::uint32_t flags, std::uint32_t mask, std::uint32_t value,
+                                const OsdDrawList& out, gl::CompactMethod method) const {
+    const Impl& m = *impl_;
+    if (!out.list || !out.commands)
+        throw Error("OsdPatchTableDraw::compact: the list and the command buffer are required");
+    // 20 vertices a Gregory-basis patch: 20 (list_first + count) must fit 32 bits.
+    if (m.patch_count > 0xFFFFFFFFu / 20)
+        throw Error("OsdPatchTableDraw::compact: " + std::to_string(m.patch_count) + " patches, at most 2^32 / 20");
+    std::size_t command = 0;
+    for (std::size_t a = 0; a < m.arrays.size(); ++a) {
+        const Impl::Array& array = m.arrays[a];
+        const gl::PatchBuffers range{0, flags, 0, array.first_patch, array.patches};
+        pass.run(
+            range, mask, value,
+            {out.list, array.first_patch, out.commands, 16 * command, out.draw_count, 4 * a, out.patches_per_command},
+            method);
+        const std::size_t commands = m.commands_of(array, out.patches_per_command);
+        if (array.control_vertices != 16) {
+            // CompactPass's commands count 16 vertices a patch: rescale count and first to n.
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+            glUseProgram(m.rescale);
+            glUniform1ui(m.rescale_first, static_cast<GLuint>(4 * command));
+            glUniform1ui(m.rescale_count, static_cast<GLuint>(commands));
+            glUniform1ui(m.rescale_n, static_cast<GLuint>(array.control_vertices));
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingDrawCommands, out.commands);
+            glDispatchCompute(static_cast<GLuint>((commands + 63) / 64), 1, 1);
+            glMemoryBarrier(GL_COMMAND_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+            glUseProgram(0);
+        }
+        command += commands;
+    }
+    check_gl("after compacting the OpenSubdiv patch arrays");
+}
+
+void OsdPatchTableDraw::draw_indirect(const OsdVertexBuffer& vertices, std::uint32_t flags, const OsdDrawList& list,
+                                      const OsdView& view) const {
+    Impl& m = *impl_;
+    check_vertices(vertices, m.points_needed);
+    check_view(view);
+    if (!list.list || !list.commands)
+        throw Error("OsdPatchTableDraw::draw_indirect: the list and the command buffer are required");
+    GLint64 bytes = 0;
+    glGetNamedBufferParameteri64v(list.commands, GL_BUFFER_SIZE, &bytes);
+    const std::size_t total = command_count(list.patches_per_command);
+    if (static_cast<GLint64>(16 * total) > bytes)
+        throw Error("OsdPatchTableDraw::draw_indirect: " + std::to_string(total) + " commands need " +
+                    std::to_string(16 * total) + " bytes, the buffer has " + std::to_string(bytes));
+    m.build_pull_programs();
+    glBindVertexArray(m.pull_vao);  // no attributes: OpenSubdiv's vertex shader gets its point pulled
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingCullFlags, flags);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingDrawList, list.list);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingSourceIndices, m.table->GetPatchIndexBuffer());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingSourceVertices, vertices.buffer);
+    glBindTextureUnit(sh::kTextureUnitOsdPatchParam, m.table->GetPatchParamTextureBuffer());
+    if (m.tessellated) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, sh::kBindingOsdTessellated, m.tessellated);
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, list.commands);
+    const bool counted = list.draw_count && m.indirect_count;
+    if (counted) glBindBuffer(GL_PARAMETER_BUFFER_ARB, list.draw_count);
+    std::size_t command = 0;
+    for (std::size_t a = 0; a < m.arrays.size(); ++a) {
+        const Impl::Array& array = m.arrays[a];
+        const std::size_t commands = m.commands_of(array, list.patches_per_command);
+        const std::size_t first_command = command;
+        command += commands;
+        if (array.patches == 0) continue;
+        const Program& p = array.type == Far::PatchDescriptor::REGULAR ? m.bspline_pull : m.gregory_pull;
+        glUseProgram(p.name);
+        glUniformMatrix4fv(p.model_view, 1, GL_FALSE, view.model_view.m);
+        glUniformMatrix4fv(p.projection, 1, GL_FALSE, view.projection.m);
+        glUniform1f(p.tess_level, view.tess_level);
+        glUniform1ui(p.mask, 0u);  // every listed patch passed the selection
+        glUniform1ui(p.value, 0u);
+        glUniform1i(p.one_sided, view.one_sided ? 1 : 0);
+        glUniform1i(p.pull_first_patch, static_cast<GLint>(array.first_patch));
+        glUniform1i(p.pull_index_base, static_cast<GLint>(array.index_base));
+        glUniform1i(p.pull_stride, static_cast<GLint>(vertices.stride_bytes / 4));
+        glUniform1i(p.pull_offset, static_cast<GLint>(vertices.offset_bytes / 4));
+        glUniform1i(p.pull_points, static_cast<GLint>(std::min<std::size_t>(vertices.point_count, 0x7FFFFFFF)));
+        glPatchParameteri(GL_PATCH_VERTICES, array.control_vertices);
+        // GL takes the byte offset into the bound indirect buffer as a pointer.
+        // NOLINTNEXTLINE(performance-no-int-to-ptr)
+        const auto* offset = reinterpret_cast<const void*>(static_cast<std::uintptr_t>(16 * first_command));
+        const auto max_draws = static_cast<GLsizei>(commands);
+        if (counted) {
+            if (m.indirect_count_arb)
+                glMultiDrawArraysIndirectCountARB(GL_PATCHES, offset, static_cast<GLintptr>(4 * a), max_draws, 0);
+            else
+                glMultiDrawArraysIndirectCount(GL_PATCHES, offset, static_cast<GLintptr>(4 * a), max_draws, 0);
+        } else {
+            glMultiDrawArraysIndirect(GL_PATCHES, offset, max_draws, 0);
+        }
+    }
+    if (counted) glBindBuffer(GL_PARAMETER_BUFFER_ARB, 0);
+    glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    glUseProgram(0);
+    glBindVertexArray(0);
+    check_gl("after the compacted draw of the OpenSubdiv patch table");
+}
+
+std::size_t OsdPatchTableDraw::listed_count(const OsdDrawList& list) const {
+    const Impl& m = *impl_;
+    const std::size_t total = command_count(list.patches_per_command);
+    std::vector<gl::DrawArraysIndirectCommand> commands(total);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(list.commands, 0, static_cast<GLsizeiptr>(total * sizeof(gl::DrawArraysIndirectCommand)),
+                            commands.data());
+    check_gl("after reading the OpenSubdiv draw commands");
+    std::size_t n = 0, c = 0;
+    for (const Impl::Array& array : m.arrays)
+        for (std::size_t k = 0; k < m.commands_of(array, list.patches_per_command); ++k, ++c)
+            n += commands[c].count / static_cast<std::uint32_t>(array.control_vertices);
+    return n;
 }
 
 // ---- The frame ----------------------------------------------------------------------------------
@@ -404,15 +660,61 @@ struct OsdCullFrame::Impl {
     gl::BackpatchPtpPass ptp;
     gl::OcclusionPass occlusion;
     gl::HiZBuildPass hiz_build;
+    gl::CompactPass compact;
+    // The compacted draw's buffers per draw pass (made at the first indirect frame, the commands
+    // grown with the patches per command).
+    std::array<GLuint, 2> lists{}, commands{}, counts{};
+    std::size_t command_capacity = 0;
+    bool software = false;
 
     explicit Impl(gl::PassContext& passes)
-        : status(passes), frustum(passes), cones(passes), ptp(passes), occlusion(passes), hiz_build(passes) {}
+        : status(passes),
+          frustum(passes),
+          cones(passes),
+          ptp(passes),
+          occlusion(passes),
+          hiz_build(passes),
+          compact(passes),
+          software(passes.is_software()) {}
     ~Impl() {
         if (fbo) glDeleteFramebuffers(1, &fbo);
         for (GLuint t : {ids, depth, hiz.texture})
             if (t) glDeleteTextures(1, &t);
-        for (GLuint b : {flags, counters})
+        for (GLuint b : {flags, counters, lists[0], lists[1], commands[0], commands[1], counts[0], counts[1]})
             if (b) glDeleteBuffers(1, &b);
+    }
+
+    // K: no limit on a GPU; on llvmpipe a command's tessellated vertices stay about 4096 (as
+    // CullPipeline's indirect draw): 65536 / (L + 1)^2 / 16 patches at OpenSubdiv's largest level
+    // L = 2 OsdTessLevel() (a patch of refinement level 0 gets twice the uniform level).
+    std::size_t patches_per_command(float tess_level) const {
+        return software ? std::max<std::size_t>(1, max_patches_per_draw(tess_level) / 16) : 0;
+    }
+
+    gl_osd::OsdDrawList draw_list(int pass, std::size_t k) {
+        const std::size_t needed = std::max<std::size_t>(draw->command_count(k), 1);
+        if (!lists[0]) {
+            for (int i = 0; i < 2; ++i) {
+                glCreateBuffers(1, &lists[static_cast<std::size_t>(i)]);
+                glNamedBufferStorage(lists[static_cast<std::size_t>(i)],
+                                     static_cast<GLsizeiptr>(4 * std::max<std::size_t>(draw->patch_count(), 1)),
+                                     nullptr, 0);
+                glCreateBuffers(1, &counts[static_cast<std::size_t>(i)]);
+                glNamedBufferStorage(counts[static_cast<std::size_t>(i)],
+                                     static_cast<GLsizeiptr>(4 * std::max<std::size_t>(draw->array_count(), 1)),
+                                     nullptr, 0);
+            }
+        }
+        if (needed > command_capacity) {
+            for (GLuint& c : commands) {
+                if (c) glDeleteBuffers(1, &c);
+                glCreateBuffers(1, &c);
+                glNamedBufferStorage(c, static_cast<GLsizeiptr>(16 * needed), nullptr, 0);
+            }
+            command_capacity = needed;
+        }
+        const auto i = static_cast<std::size_t>(pass);
+        return {lists[i], commands[i], counts[i], k};
     }
 
     // Binds the framebuffer with the view's depth convention and clears it.
@@ -502,19 +804,35 @@ OsdFrameStats OsdCullFrame::render(const OsdVertexBuffer& vertices, const OsdVie
             for (const gl::GpuPatchSource& s : sources) m.occlusion.run(s, cv, m.hiz, /*with_frustum=*/false);
         m.status.end(range, m.counters);
     };
+    const bool indirect = settings.draw == OsdDrawMode::indirect;
+    const std::size_t k = m.patches_per_command(view.tess_level);
+    std::array<OsdDrawList, 2> lists{};
+    if (indirect)
+        for (int i = 0; i < 2; ++i) lists[static_cast<std::size_t>(i)] = m.draw_list(i, k);
+    // One draw pass: with the flags every patch goes and the TCS keeps the selection; indirect,
+    // CompactPass lists the selection per array (after the flags' last writes) and only those go.
+    const auto draw_pass = [&](int pass, std::uint32_t mask, std::uint32_t value) {
+        if (!indirect) {
+            m.draw->draw(vertices, m.flags, mask, value, view);
+            return;
+        }
+        const OsdDrawList& list = lists[static_cast<std::size_t>(pass)];
+        m.draw->compact(m.compact, m.flags, mask, value, list, settings.compact);
+        m.draw->draw_indirect(vertices, m.flags, list, view);
+    };
     if (!settings.occlusion) {
         chain();
         m.begin_targets(view.depth);
-        m.draw->draw(vertices, m.flags, sh::kDrawMaskUnculled, sh::kDrawValueUnculled, view);
+        draw_pass(0, sh::kDrawMaskUnculled, sh::kDrawValueUnculled);
         m.end_targets();
     } else {
         m.begin_targets(view.depth);
-        m.draw->draw(vertices, m.flags, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, view);
+        draw_pass(0, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
         glBindFramebuffer(GL_FRAMEBUFFER, 0);  // the depth texture is sampled next
         m.hiz_build.run(m.depth, m.hiz, view.depth);
         chain();
         glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
-        m.draw->draw(vertices, m.flags, sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass, view);
+        draw_pass(1, sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass);
         m.end_targets();
     }
     std::uint32_t c[sh::kCounterCount] = {};
@@ -526,6 +844,13 @@ OsdFrameStats OsdCullFrame::render(const OsdVertexBuffer& vertices, const OsdVie
     stats.occlusion = c[sh::kCounterOcclusion];
     stats.drawn_pass1 = settings.occlusion ? c[sh::kCounterWasVisible] : c[sh::kCounterVisible];
     stats.drawn_pass2 = settings.occlusion ? c[sh::kCounterNewlyVisible] : 0;
+    if (indirect) {
+        stats.submitted_pass1 = m.draw->listed_count(lists[0]);
+        stats.submitted_pass2 = settings.occlusion ? m.draw->listed_count(lists[1]) : 0;
+    } else {
+        stats.submitted_pass1 = m.draw->patch_count();
+        stats.submitted_pass2 = settings.occlusion ? m.draw->patch_count() : 0;
+    }
     return stats;
 }
 

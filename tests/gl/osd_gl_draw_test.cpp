@@ -11,6 +11,10 @@
 // - the ids name the right patches: every pixel of the unculled draw lies in the window-space box
 //   of its patch's control points (Far's patch index = PrimitiveIdBase + gl_PrimitiveID, which
 //   llvmpipe restarts within a draw: a wrong index shows here);
+// - the compacted draw (OsdDrawMode::indirect: CompactPass's list per array, OpenSubdiv's vertex
+//   shader pulling each control point through it, at an odd stride and offset) gives every frame
+//   the flag path's id buffer pixel for pixel and its counters, issues only the patches drawn, and
+//   a list missing one surviving patch shows in the comparison;
 // - bad input is a one-line Error.
 #include <gtest/gtest.h>
 
@@ -312,6 +316,20 @@ TEST(OsdGlDraw, OpenSubdivPatchCullAndTheTessellatedRecord) {
         const OsdFrameStats stats = plain_frame.render(t.vertices, v, frustum);
         EXPECT_EQ(plain.tessellated_count(), stats.drawn_pass1) << what;
         EXPECT_TRUE(plain_frame.read_ids() == want) << what;
+        // The compacted draw's programs: the record marks the listed patches (the TES's patch
+        // index is the pulled one), OpenSubdiv's clip flags come from the pulled points.
+        OsdCullSettings listed = frustum;
+        listed.draw = OsdDrawMode::indirect;
+        plain.clear_tessellated();
+        const OsdFrameStats plain_listed = plain_frame.render(t.vertices, v, listed);
+        EXPECT_EQ(plain_listed.submitted_pass1, plain_listed.drawn_pass1) << what;
+        EXPECT_EQ(plain.tessellated_count(), plain_listed.drawn_pass1) << what << ": indirect";
+        EXPECT_TRUE(plain_frame.read_ids() == want) << what << ": indirect";
+        native.clear_tessellated();
+        const OsdFrameStats native_listed = native_frame.render(t.vertices, v, listed);
+        EXPECT_LE(native.tessellated_count(), native_listed.drawn_pass1) << what << ": indirect, native";
+        EXPECT_GT(native.tessellated_count(), 0u) << what << ": indirect, native";
+        EXPECT_TRUE(native_frame.read_ids() == want) << what << ": indirect, OSD_ENABLE_PATCH_CULL";
     }
     EXPECT_LT(native_total, plain_total) << "OpenSubdiv's patch cull culled nothing";
     std::printf("OSD_ENABLE_PATCH_CULL tessellated %zu of %zu patches over 3 views\n", native_total, plain_total);
@@ -360,5 +378,188 @@ TEST(OsdGlDraw, BadInputIsAOneLineError) {
     OsdCullFrame frame(passes, draw, 8, 8);
     expect_error([&] { frame.render(t.vertices, view, {}); }, "tess_level");
     expect_error([&] { OsdCullFrame f(passes, draw, 0, 8); }, "size 0x8");
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+namespace {
+
+// Pixels where a and b differ, and of those where the depths are not equal (a depth tie is two
+// patches at exactly the same depth drawn in another order).
+struct IdDiff {
+    std::size_t pixels = 0, not_ties = 0;
+};
+IdDiff diff_ids(const std::vector<std::uint32_t>& a, const std::vector<float>& a_depth,
+                const std::vector<std::uint32_t>& b, const std::vector<float>& b_depth) {
+    IdDiff d;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        if (a[i] == b[i]) continue;
+        ++d.pixels;
+        if (a[i] == 0 || b[i] == 0 || a_depth[i] != b_depth[i]) ++d.not_ties;
+    }
+    return d;
+}
+
+}  // namespace
+
+// The compacted draw against the flag path, frame by frame over the same views (so the flags
+// evolve alike): the scan lists ascending, as the flag path draws, so the ids are equal pixel for
+// pixel; the append lists in any order, so only depth ties may differ. Every mode, closed and
+// open shapes, B-spline and Gregory-basis arrays; on llvmpipe many commands per array.
+TEST(OsdGlDraw, IndirectFramesEqualTheFlagPath) {
+    gl::test::context().make_current();
+    gl::PassContext& passes = gl::test::passes();
+    const struct {
+        const char* shape;
+        int level;
+    } cases[] = {{"catmark_chaikin1", 3}, {"catmark_hole_test1", 4}, {"catmark_cubes_infsharp", 2}};
+    std::size_t frames = 0, culled = 0, listed = 0, all_patches = 0, gregory_listed = 0;
+    for (const auto& c : cases) {
+        const Shape shape = load_shape(c.shape);
+        GpuTable t(shape.mesh, c.level);
+        OsdPatchTableDraw draw(passes, *t.table.table);
+        OsdCullFrame flags(passes, draw, W, H), scan(passes, draw, W, H), append(passes, draw, W, H);
+        for (const Mode& m : modes()) {
+            if (m.closed_only && !shape.closed) continue;
+            OsdCullSettings settings = m.settings;
+            if (std::string(m.name) == "all" && shape.closed) settings.backpatch = BackpatchMethod::tcone;
+            OsdCullSettings scan_settings = settings, append_settings = settings;
+            scan_settings.draw = append_settings.draw = OsdDrawMode::indirect;
+            append_settings.compact = gl::CompactMethod::atomic_append;
+            flags.reset();
+            scan.reset();
+            append.reset();
+            for (int view = 0; view < 2; ++view)
+                for (int f = 0; f < 2; ++f) {
+                    const OsdView v = orbit_view(t, view, f, shape.closed);
+                    const std::string what = std::string(c.shape) + " level " + std::to_string(c.level) + ", " +
+                                             m.name + ", view " + std::to_string(view) + " frame " + std::to_string(f);
+                    const OsdFrameStats a = flags.render(t.vertices, v, settings);
+                    const OsdFrameStats b = scan.render(t.vertices, v, scan_settings);
+                    const OsdFrameStats e = append.render(t.vertices, v, append_settings);
+                    for (const OsdFrameStats* x : {&b, &e}) {
+                        EXPECT_EQ(x->frustum, a.frustum) << what;
+                        EXPECT_EQ(x->backpatch, a.backpatch) << what;
+                        EXPECT_EQ(x->occlusion, a.occlusion) << what;
+                        EXPECT_EQ(x->drawn_pass1, a.drawn_pass1) << what;
+                        EXPECT_EQ(x->drawn_pass2, a.drawn_pass2) << what;
+                        EXPECT_EQ(x->submitted_pass1, x->drawn_pass1) << what << ": pass 1 issued what it drew";
+                        EXPECT_EQ(x->submitted_pass2, x->drawn_pass2) << what << ": pass 2 issued what it drew";
+                    }
+                    EXPECT_EQ(a.submitted_pass1, draw.patch_count()) << what;
+                    EXPECT_EQ(a.submitted_pass2, settings.occlusion ? draw.patch_count() : 0u) << what;
+                    const std::vector<std::uint32_t> want = flags.read_ids();
+                    const std::vector<float> want_depth = flags.read_depth();
+                    const IdDiff ds = diff_ids(want, want_depth, scan.read_ids(), scan.read_depth());
+                    EXPECT_EQ(ds.pixels, 0u) << what << ": the scan's ids differ from the flag path's";
+                    const IdDiff da = diff_ids(want, want_depth, append.read_ids(), append.read_depth());
+                    EXPECT_EQ(da.not_ties, 0u) << what << ": the append's ids differ beyond depth ties";
+                    ++frames;
+                    culled += a.frustum + a.backpatch + a.occlusion;
+                    listed += b.submitted_pass1 + b.submitted_pass2;
+                    all_patches += draw.patch_count();
+                    std::set<std::uint32_t> gregory_ids;
+                    for (std::uint32_t id : want)
+                        for (const OsdPatchArraySource& arr : t.cpu.arrays())
+                            if (id != 0 && arr.source.basis == PatchBasis::gregory && id - 1 >= arr.first_patch &&
+                                id - 1 < arr.first_patch + arr.source.count)
+                                gregory_ids.insert(id);
+                    gregory_listed += gregory_ids.size();
+                }
+        }
+    }
+    EXPECT_GT(culled, 0u);
+    EXPECT_LT(listed, all_patches) << "the compacted draws issued every patch";
+    EXPECT_GT(gregory_listed, frames) << "too few Gregory-basis patches drawn";
+    std::printf("%zu frames: the compacted draws issued %zu patches where the flag path issued %zu per pass\n", frames,
+                listed, all_patches);
+    EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
+}
+
+// OsdPatchTableDraw::compact and draw_indirect by hand: every patch listed draws the unculled
+// picture; the same list with one visible patch's entry overwritten by its neighbour's (a
+// surviving patch dropped) loses exactly that patch's pixels, which the id comparison above sees.
+TEST(OsdGlDraw, ACompactedDrawThatDropsAPatchIsCaught) {
+    gl::test::context().make_current();
+    gl::PassContext& passes = gl::test::passes();
+    const Shape shape = load_shape("catmark_hole_test1");
+    GpuTable t(shape.mesh, 3);
+    OsdPatchTableDraw draw(passes, *t.table.table);
+    OsdCullFrame frame(passes, draw, W, H);
+    const OsdView view = orbit_view(t, 1, 0, shape.closed);
+    frame.render_unculled(t.vertices, view);
+    const std::vector<std::uint32_t> want = frame.read_ids();
+
+    // Targets of our own, the frame's conventions (zero-to-one unless the view says otherwise).
+    GLuint ids = 0, depth = 0, fbo = 0, list = 0, commands = 0, counts = 0, flags = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &ids);
+    glTextureStorage2D(ids, 1, GL_R32UI, W, H);
+    glCreateTextures(GL_TEXTURE_2D, 1, &depth);
+    glTextureStorage2D(depth, 1, GL_DEPTH_COMPONENT32F, W, H);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, ids, 0);
+    glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, depth, 0);
+    const std::size_t k = 7;  // several commands per array
+    glCreateBuffers(1, &list);
+    glNamedBufferStorage(list, static_cast<GLsizeiptr>(4 * draw.patch_count()), nullptr, GL_DYNAMIC_STORAGE_BIT);
+    glCreateBuffers(1, &commands);
+    glNamedBufferStorage(commands, static_cast<GLsizeiptr>(16 * draw.command_count(k)), nullptr, 0);
+    glCreateBuffers(1, &counts);
+    glNamedBufferStorage(counts, static_cast<GLsizeiptr>(4 * draw.array_count()), nullptr, 0);
+    glCreateBuffers(1, &flags);
+    const std::vector<std::uint32_t> zero(draw.patch_count(), 0u);
+    glNamedBufferStorage(flags, static_cast<GLsizeiptr>(4 * zero.size()), zero.data(), 0);
+    const OsdDrawList out{list, commands, counts, k};
+    gl::CompactPass compact(passes);
+    const auto draw_list = [&] {
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glViewport(0, 0, W, H);
+        const bool reversed = is_reversed(view.depth);
+        glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(reversed ? GL_GREATER : GL_LESS);
+        const GLuint clear_id = 0;
+        const float far_depth = reversed ? 0.0f : 1.0f;
+        glClearNamedFramebufferuiv(fbo, GL_COLOR, 0, &clear_id);
+        glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &far_depth);
+        draw.draw_indirect(t.vertices, flags, out, view);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+        glDepthFunc(GL_LESS);
+        glDisable(GL_DEPTH_TEST);
+        std::vector<std::uint32_t> got(static_cast<std::size_t>(W) * H);
+        glGetTextureImage(ids, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, static_cast<GLsizei>(4 * got.size()), got.data());
+        return got;
+    };
+    draw.compact(compact, flags, 0u, 0u, out);
+    EXPECT_EQ(draw.listed_count(out), draw.patch_count());
+    EXPECT_TRUE(draw_list() == want) << "every patch listed: not the unculled picture";
+
+    // Drop the patch at the most pixels: its entry (the scan lists ascending, entry p = patch p
+    // when every patch is listed) becomes a neighbour's.
+    std::map<std::uint32_t, std::size_t> pixels;
+    for (std::uint32_t id : want)
+        if (id) ++pixels[id];
+    ASSERT_FALSE(pixels.empty());
+    const auto top = std::max_element(pixels.begin(), pixels.end(),
+                                      [](const auto& a, const auto& b) { return a.second < b.second; });
+    const std::uint32_t dropped = top->first - 1;
+    std::uint32_t neighbour = dropped;  // another patch of the same array
+    for (const OsdPatchArraySource& a : t.cpu.arrays())
+        if (dropped >= a.first_patch && dropped < a.first_patch + a.source.count)
+            neighbour = dropped > a.first_patch ? dropped - 1 : dropped + 1;
+    ASSERT_NE(neighbour, dropped);
+    glNamedBufferSubData(list, static_cast<GLintptr>(4 * dropped), 4, &neighbour);
+    const std::vector<std::uint32_t> got = draw_list();
+    std::size_t lost = 0, present = 0;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        if (got[i] == dropped + 1) ++present;
+        if (want[i] == dropped + 1 && got[i] != want[i]) ++lost;
+    }
+    EXPECT_EQ(present, 0u) << "the dropped patch " << dropped << " still drew";
+    EXPECT_EQ(lost, top->second) << "the comparison misses the dropped patch's pixels";
+    EXPECT_FALSE(got == want);
+    for (GLuint b : {list, commands, counts, flags}) glDeleteBuffers(1, &b);
+    glDeleteFramebuffers(1, &fbo);
+    for (GLuint x : {ids, depth}) glDeleteTextures(1, &x);
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR));
 }

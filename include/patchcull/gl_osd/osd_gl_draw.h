@@ -28,7 +28,26 @@
 //
 // llvmpipe: gl_PrimitiveID restarts within indexed draws there (patchcull_tcs.h), so on a software
 // rasterizer each array is drawn as sub-draws of at most 1024 / n patches (n = 16 or 20), each
-// with its PrimitiveIdBase; on a GPU one draw per array.
+// with its PrimitiveIdBase, and at most 65536 / (L + 1)^2 at OpenSubdiv's largest level L = 2
+// OsdTessLevel() (llvmpipe gets larger draws wrong: docs/ENGINE.md); on a GPU one draw per array.
+//
+// Drawing only the survivors (OsdDrawMode::indirect), as OpenSubdiv's Metal path draws a patch
+// index buffer (OSD_USE_PATCH_INDEX_BUFFER: the surviving patches appended to a list, drawn
+// indirectly; OpenSubdiv's GLSL has no such hook, so the client header adds one): CompactPass
+// (gl_compaction.h) lists each array's surviving patches (Far's patch indices, ascending with the
+// prefix scan) at the array's own first entry of a list, with indirect commands whose vertex
+// gl_VertexID is point gl_VertexID % n of list entry gl_VertexID / n (a Gregory-basis array's
+// commands, written for 16 points, are rescaled to 20 on the GPU). The draw is non-indexed and
+// has no vertex attributes: a second program per patch type (compiled at the first compacted
+// draw) is OpenSubdiv's same stage sources with a client header that pulls each control point in
+// OpenSubdiv's vertex shader (its OSD_USER_VARYING_PER_VERTEX hook overwrites the attribute
+// position with the point the table's index buffer names for that slot of that patch, read from
+// the vertex buffer as storage) and passes the patch's Far index on; OsdPrimitiveIdBase() returns
+// that index minus gl_PrimitiveID, so OpenSubdiv's OsdGetPatchIndex(gl_PrimitiveID) is the listed
+// patch whatever gl_PrimitiveID a multi-draw or llvmpipe gives. Its TCS checks no flag (every
+// listed patch passed the selection). Its vertex shader reads 3 storage blocks (the list, the index
+// buffer, the vertices): GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS >= 3, which GL 4.5 does not promise
+// (an Error at the first compacted draw otherwise).
 //
 // Threads and lifetime: as gl_passes.h (the context current at construction, on its thread).
 // Errors: patchcull::Error with one line (a table with other patch types, a vertex layout the
@@ -48,6 +67,7 @@
 #include "patchcull/core/clip_space.h"
 #include "patchcull/core/cull_view.h"
 #include "patchcull/core/math.h"
+#include "patchcull/gl/gl_compaction.h"
 #include "patchcull/gl/gl_passes.h"
 
 namespace patchcull::gl_osd {
@@ -92,6 +112,14 @@ struct OsdDrawOptions {
     bool record_tessellated = false;
 };
 
+/// Where OsdPatchTableDraw::compact writes and draw_indirect reads (GL buffer names; see there).
+struct OsdDrawList {
+    std::uint32_t list = 0;               ///< uint per patch of the table
+    std::uint32_t commands = 0;           ///< command_count(patches_per_command) DrawArraysIndirectCommands
+    std::uint32_t draw_count = 0;         ///< uint per array (0: none; then every command is drawn)
+    std::size_t patches_per_command = 0;  ///< K (0: one command per array)
+};
+
 /// A feature-adaptive Far::PatchTable on the GPU with OpenSubdiv's programs for its arrays.
 class OsdPatchTableDraw {
 public:
@@ -118,6 +146,27 @@ public:
     /// VAO bound.
     void draw(const OsdVertexBuffer& vertices, std::uint32_t flags, std::uint32_t mask, std::uint32_t value,
               const OsdView& view) const;
+    /// The compacted draw's buffers (OsdDrawList): the list holds patch_count() entries (array a's
+    /// survivors from its first patch's entry on), the commands command_count(K) (array a's from
+    /// command_first(a, K) on), the draw counts one uint per array.
+    std::size_t array_count() const;
+    std::size_t command_count(std::size_t patches_per_command) const;
+    std::size_t command_first(std::size_t array, std::size_t patches_per_command) const;
+    /// Lists, per array, the patches p with (flags[p] & mask) == value into out (CompactPass::run
+    /// per array, then the Gregory-basis commands rescaled to 20 points a patch). Error for buffers
+    /// too small.
+    void compact(gl::CompactPass& pass, std::uint32_t flags, std::uint32_t mask, std::uint32_t value,
+                 const OsdDrawList& out, gl::CompactMethod method = gl::CompactMethod::prefix_scan) const;
+    /// Draws the listed patches only (as draw() with the selection done by compact()): per array
+    /// glMultiDrawArraysIndirectCount over its commands with its draw count (GL 4.6 or
+    /// GL_ARB_indirect_parameters; else glMultiDrawArraysIndirect over all its commands), the
+    /// pulling programs. Binds the list at kBindingDrawList, the vertex buffer and the table's index
+    /// buffer at kBindingSourceVertices / kBindingSourceIndices; otherwise as draw().
+    void draw_indirect(const OsdVertexBuffer& vertices, std::uint32_t flags, const OsdDrawList& list,
+                       const OsdView& view) const;
+    /// The patches the commands of the last compact() into list issue (reads the commands back: a
+    /// GL sync).
+    std::size_t listed_count(const OsdDrawList& list) const;
     /// record_tessellated only (Error otherwise): zeroes the record; the patches tessellated by
     /// the draws since (each counted once), read back (a GL sync).
     void clear_tessellated() const;
@@ -129,18 +178,29 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+/// How OsdCullFrame's draw passes issue patches (render --draw flags|indirect).
+enum class OsdDrawMode { flags, indirect };
+
 /// Which tests a frame runs (each off by default).
 struct OsdCullSettings {
     bool frustum = false;
     std::optional<BackpatchMethod> backpatch;  ///< tcone, ncone or ptp: one-sided closed shapes only
     PtpRule ptp_rule = PtpRule::ncnt;
     bool occlusion = false;  ///< two-pass Hi-Z occlusion culling
+    /// How each draw pass issues patches: flags (every patch; the TCS gives the culled ones
+    /// levels 0) or indirect (CompactPass lists the pass's survivors per array, only those are
+    /// issued; see the top of this header).
+    OsdDrawMode draw = OsdDrawMode::flags;
+    gl::CompactMethod compact = gl::CompactMethod::prefix_scan;  ///< indirect's list order
 };
 
 /// What one culled frame did (CullStatusPass's counters).
 struct OsdFrameStats {
     std::size_t frustum = 0, backpatch = 0, occlusion = 0;  ///< patches culled per reason
     std::size_t drawn_pass1 = 0, drawn_pass2 = 0;           ///< drawn in pass 1 / pass 2 (or the one pass)
+    /// Issued by each draw pass: flags every patch (pass 2 0 in one pass), indirect the listed
+    /// patches (read back from the commands).
+    std::size_t submitted_pass1 = 0, submitted_pass2 = 0;
 };
 
 /// The frame's targets (an R32UI id texture, a DEPTH32F depth texture, width x height), the flag
