@@ -2,7 +2,7 @@
 // Niessner & Eisenacher's GPU back-patch pass) over an animated scene and a moving camera,
 // optionally verified frame by frame against the unculled render (compare_frames: a patch
 // visible unculled but culled is a false cull). Output (--json), one object:
-//   {"model","patch_source","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
+//   {"api","model","patch_source","patches","size":[w,h],"tess","tess_mode","cull","backpatch","aggressive","verified",
 //    "displace","displace_scale","displaced_patches","bound","cone","frustum",
 //    "frames":[{"frame","pass1_drawn","pass2_drawn","frustum_culled","backpatch_culled",
 //               "occlusion_culled","displaced_occlusion_culled","visible","newly_visible","submitted",
@@ -61,7 +61,11 @@
 // patches: indirect (the default: CompactPass lists each pass's survivors and indirect draws issue
 // only those) or flags (every patch of the drawn objects; the TCS gives the culled ones levels 0). Every
 // frame gains "submitted":{"pass1","pass2"}: the patches each draw pass issued (pass2 0 in one
-// pass and when aggressive). With --patch-source osd-table only flags (its JSON says "draw").
+// pass and when aggressive). --patch-source osd-table draws with the flags unless --draw indirect
+// is given (render_osd_table.h).
+// --compact scan|append ("compact"): how --draw indirect lists the survivors (render_options.h).
+// --api gl|vulkan ("api"): the OpenGL pipeline above, or the same frames on patchcull's headless
+// Vulkan renderer (render_vulkan.h: one object, posed on the CPU; --vk-validation, --vk-device).
 // --patch-source bezier|osd-table ("patch_source" in the JSON): bezier (the default) draws the
 // scheme's Bezier patches through the pipeline above; osd-table (with --scheme osd, a single OBJ
 // model) draws the model's OpenSubdiv patch table with OpenSubdiv's own GLSL patch shaders, culled
