@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -54,10 +55,13 @@ int run_vulkan_render(const VulkanRenderJob& job) {
     device_options.validation = job.validation;
     if (job.prefer_gpu) device_options.prefer = vk::HeadlessDeviceOptions::Prefer::gpu;
     vk::HeadlessDevice device(device_options);
-    vk::CullRenderer renderer(device);
+    auto renderer_owner = std::make_unique<vk::CullRenderer>(device);  // destroyed before the last messages
+    vk::CullRenderer& renderer = *renderer_owner;
     ScenePoser poser(scene);
     const bool one_sided = eval_gl::scene_is_one_sided(scene);
-    renderer.set_patches(poser.pose(0.0f), eval_gl::pose_attributes(poser));
+    // Each pose before its attributes are read (pose_attributes copies the poser's last pose).
+    const std::vector<BezierPatch>& first_pose = poser.pose(0.0f);
+    renderer.set_patches(first_pose, eval_gl::pose_attributes(poser));
     renderer.set_displacement_map(scene.displacement);
     upload_occluders(renderer, scene);
     auto same = [](DVec3 a, DVec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
@@ -70,7 +74,10 @@ int run_vulkan_render(const VulkanRenderJob& job) {
             rebase_scene(*job.world, job.frame_origins[fi], scene);
             upload_occluders(renderer, scene);
         }
-        if (f > 0) renderer.update_patches(poser.pose(f * kSecondsPerFrame), eval_gl::pose_attributes(poser));
+        if (f > 0) {
+            const std::vector<BezierPatch>& pose = poser.pose(f * kSecondsPerFrame);
+            renderer.update_patches(pose, eval_gl::pose_attributes(poser));
+        }
         vk::CullFrameParams params;
         params.render = eval_gl::render_params(job.cameras[fi], job.width, job.height, job.tess, one_sided);
         apply_tess_mode(job.tess_mode, params.render);
@@ -135,7 +142,11 @@ int run_vulkan_render(const VulkanRenderJob& job) {
             std::printf("\n");
         }
     }
-    messages += device.take_messages().size();
+    renderer_owner.reset();  // what the layer says while the renderer goes counts too
+    for (const std::string& m : device.take_messages()) {
+        std::fprintf(stderr, "Vulkan validation: %s\n", m.c_str());
+        ++messages;
+    }
     if (job.json) {
         nlohmann::json out;
         out["api"] = "vulkan";

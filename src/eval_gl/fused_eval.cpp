@@ -55,7 +55,8 @@ FusedEvalResult run_fused_eval(const Scene& scene, const FusedEvalOptions& o, co
     gl::GlContext context = gl::GlContext::create_headless();
     gl::PatchRenderer renderer(context);
     ScenePoser poser(scene);
-    renderer.set_patches(poser.pose(0), pose_attributes(poser));
+    const std::vector<BezierPatch>& first_pose = poser.pose(0);  // before its attributes are read
+    renderer.set_patches(first_pose, pose_attributes(poser));
     renderer.set_displacement_map(scene.displacement);
     upload_scene_occluders(renderer, scene);
     std::vector<Camera> cameras = scene.camera_path(o.frames, float(width) / float(height));
