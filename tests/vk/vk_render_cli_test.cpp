@@ -5,9 +5,12 @@
 // flags and indirect, the fused pass, one pass with each test alone, ptp and ncone, frustum aabb,
 // both schemes, the three Vulkan depth conventions) on the default scene (displaced MonsterFrogs)
 // and the small city, a world 1e5 units out; the check can fail (aggressive); the frustum and
-// back-patch decisions equal the OpenGL pipeline's; the flags Vulkan cannot take are refused.
+// back-patch decisions equal the OpenGL pipeline's, and so do the pictures (the same pose, tangent
+// patches and tessellation scales, drawn by both APIs); the flags Vulkan cannot take are refused.
 #include <gtest/gtest.h>
+#include <stb_image.h>
 
+#include <cstdlib>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -120,6 +123,34 @@ TEST(VulkanRenderCli, FrustumAndBackpatchCountsEqualOpenGLs) {
     for (std::size_t f = 0; f < a["frames"].size(); ++f) {
         EXPECT_EQ(a["frames"][f]["frustum_culled"], b["frames"][f]["frustum_culled"]) << "frame " << f;
         EXPECT_EQ(a["frames"][f]["backpatch_culled"], b["frames"][f]["backpatch_culled"]) << "frame " << f;
+    }
+}
+
+// The pictures equal OpenGL's up to the rasterizers' rounding: every frame draws the frame's own
+// pose with its attributes (a frame drawn with the previous pose's tangent patches, or frame 0
+// without its tessellation scales, differs on the animated characters and at patch edges).
+TEST(VulkanRenderCli, PicturesEqualOpenGLs) {
+    for (const std::string args : {"default --frames 3 --cull none", "bigguy --scheme osd --frames 1 --tess 2"}) {
+        std::vector<unsigned char*> images;
+        int w = 0, h = 0;
+        for (const std::string api : {"gl", "vulkan"}) {
+            const std::string png = scratch_dir() + "/picture_" + api + ".png";
+            const CliRun r = run("render " + args + " --size 192x108 --api " + api + " --out " + png);
+            ASSERT_EQ(r.status, 0) << args << " --api " << api << "\n" << r.err;
+            int channels = 0;
+            images.push_back(stbi_load(png.c_str(), &w, &h, &channels, 4));
+            ASSERT_NE(images.back(), nullptr) << png;
+        }
+        ASSERT_EQ(w * h, 192 * 108);
+        int differing = 0;
+        for (int i = 0; i < w * h; ++i)
+            for (int c = 0; c < 3; ++c)
+                if (std::abs(int(images[0][4 * i + c]) - int(images[1][4 * i + c])) > 8) {
+                    ++differing;
+                    break;
+                }
+        EXPECT_LT(differing, w * h / 500) << args;  // under 0.2% of the pixels
+        for (unsigned char* image : images) stbi_image_free(image);
     }
 }
 
