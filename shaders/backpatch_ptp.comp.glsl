@@ -35,6 +35,7 @@
 #include "patch_buffers.h"
 #include "exact_fma.h"
 #include "ptp_schedule.h"
+#include "ptp_tables.h"
 #include "flag_chain.h"
 #include "patch_source.h"
 

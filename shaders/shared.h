@@ -63,6 +63,7 @@ PATCHCULL_CONST uint kBindingDisplacementRanges = 8u;  // displaced: vec2 (d_min
 PATCHCULL_CONST uint kBindingDisplacedBounds = 9u;     // displaced: diagnostics
 PATCHCULL_CONST uint kBindingPtpPlanes = 13u;          // backpatch_ptp: diagnostics
 PATCHCULL_CONST uint kBindingConeValues = 14u;         // backpatch_cones: diagnostics
+PATCHCULL_CONST uint kBindingPtpTables = 31u;          // backpatch_ptp on Vulkan: the schedule's tables (ptp_tables.h)
 PATCHCULL_CONST uint kBindingProbeIn = 15u;            // backpatch_probe: vec4 in[n]: (a, b, c, unused)
 PATCHCULL_CONST uint kBindingProbeOut = 16u;           // backpatch_probe: float out[n]
 // pose_stencils (gl_posing.h's StencilPoser; outputs at kBindingControlPoints and

@@ -20,10 +20,11 @@ bool BackpatchPtpPass::run(VkCommandBuffer cmd, const PatchBuffers& patches, con
     const int sign = ptp_orientation_sign(object_to_clip, alpha);
     if (sign == 0) return false;
     if (patches.count == 0) return true;
-    const detail::Pipeline& p = context.pipeline("backpatch_ptp.comp.glsl", "",
-                                                 {shared::kBindingControlPoints, shared::kBindingCullFlags,
-                                                  shared::kBindingMaxDisplacement, shared::kBindingPtpPlanes},
-                                                 sizeof(pp::BackpatchPtpParams));
+    const detail::Pipeline& p =
+        context.pipeline("backpatch_ptp.comp.glsl", "",
+                         {shared::kBindingControlPoints, shared::kBindingCullFlags, shared::kBindingMaxDisplacement,
+                          shared::kBindingPtpPlanes, shared::kBindingPtpTables},
+                         sizeof(pp::BackpatchPtpParams));
     pp::BackpatchPtpParams params;
     const float s = static_cast<float>(sign);
     const int src_row[3] = {0, 1, 3};  // x, y, w
@@ -37,8 +38,9 @@ bool BackpatchPtpPass::run(VkCommandBuffer cmd, const PatchBuffers& patches, con
     const detail::Binding bindings[] = {{shared::kBindingControlPoints, patches.control_points},
                                         {shared::kBindingCullFlags, patches.flags},
                                         {shared::kBindingMaxDisplacement, patches.margins},
-                                        {shared::kBindingPtpPlanes, plane_values}};
-    context.record(cmd, p, bindings, 4, params, patches.first, patches.count, shared::kPtpPatchesPerGroup);
+                                        {shared::kBindingPtpPlanes, plane_values},
+                                        {shared::kBindingPtpTables, context.ptp_tables()}};
+    context.record(cmd, p, bindings, 5, params, patches.first, patches.count, shared::kPtpPatchesPerGroup);
     return true;
 }
 

@@ -131,6 +131,8 @@ PassContext::PassContext(VkPhysicalDevice physical_device, VkDevice device, cons
     load(get, device, c.AllocateMemory, "vkAllocateMemory");
     load(get, device, c.FreeMemory, "vkFreeMemory");
     load(get, device, c.BindBufferMemory, "vkBindBufferMemory");
+    load(get, device, c.MapMemory, "vkMapMemory");
+    load(get, device, c.UnmapMemory, "vkUnmapMemory");
     load(get, device, c.CmdBindPipeline, "vkCmdBindPipeline");
     load(get, device, c.CmdPushDescriptorSetKHR, "vkCmdPushDescriptorSetKHR");
     load(get, device, c.CmdPushConstants, "vkCmdPushConstants");
@@ -169,10 +171,12 @@ PassContext::Impl::~Impl() {
     if (vk.DestroyBuffer) {
         vk.DestroyBuffer(device, placeholder, nullptr);
         vk.DestroyBuffer(device, param_buffer, nullptr);
+        vk.DestroyBuffer(device, ptp_table_buffer, nullptr);
     }
     if (vk.FreeMemory) {
         vk.FreeMemory(device, placeholder_memory, nullptr);
         vk.FreeMemory(device, param_memory, nullptr);
+        vk.FreeMemory(device, ptp_table_memory, nullptr);
     }
 }
 

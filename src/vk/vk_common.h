@@ -46,6 +46,8 @@ struct DeviceCommands {
     PFN_vkAllocateMemory AllocateMemory = nullptr;
     PFN_vkFreeMemory FreeMemory = nullptr;
     PFN_vkBindBufferMemory BindBufferMemory = nullptr;
+    PFN_vkMapMemory MapMemory = nullptr;
+    PFN_vkUnmapMemory UnmapMemory = nullptr;
     PFN_vkCmdBindPipeline CmdBindPipeline = nullptr;
     PFN_vkCmdPushDescriptorSetKHR CmdPushDescriptorSetKHR = nullptr;
     PFN_vkCmdPushConstants CmdPushConstants = nullptr;
@@ -114,8 +116,14 @@ struct PassContext::Impl {
     VkBuffer param_buffer = VK_NULL_HANDLE;
     VkDeviceMemory param_memory = VK_NULL_HANDLE;
     std::map<std::string, detail::Pipeline, std::less<>> pipelines;  // key: shader name + " " + variant
+    // The ptp schedule's tables (shaders/ptp_tables.h) in host-visible memory, written once by
+    // ptp_tables() (src/vk/ptp_tables.cpp); made on first use.
+    VkBuffer ptp_table_buffer = VK_NULL_HANDLE;
+    VkDeviceMemory ptp_table_memory = VK_NULL_HANDLE;
 
     ~Impl();
+    /// The range of the ptp tables' buffer (kBindingPtpTables), created and filled on first call.
+    BufferRange ptp_tables();
     /// The pipeline of compute shader `shader` in `variant` ("" or the define of a variant; its
     /// SPIR-V module in this context's fma mode) reading the descriptors `slots` of set 0 and push
     /// constants of push_constant_bytes; created on first use. Throws Error when the block
