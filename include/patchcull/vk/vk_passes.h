@@ -30,7 +30,8 @@
 //   vkCmdPushDescriptorSetKHR(set 0): the caller's ranges as storage-buffer descriptors at the
 //     binding numbers of shaders/shared.h (kBindingControlPoints 0, kBindingCullFlags 1,
 //     kBindingMaxDisplacement 2, kBindingPlaneValues 4, kBindingCullCounters 6,
-//     kBindingPtpPlanes 13, kBindingConeValues 14; CompactPass: kBindingDrawList 26,
+//     kBindingPtpPlanes 13, kBindingConeValues 14; BackpatchPtpPass also its context's ptp tables
+//     at kBindingPtpTables 31, shaders/ptp_tables.h; CompactPass: kBindingDrawList 26,
 //     kBindingDrawCommands 27, kBindingDrawCount 28, kBindingCompactSums 29; DisplacedPass:
 //     kBindingDisplacementRanges 8, kBindingDisplacedBounds 9); an optional range left empty is
 //     replaced by a small buffer of the PassContext (never read); the Hi-Z passes' images and
@@ -140,8 +141,9 @@ struct PassContextOptions {
 
 /// What the passes share on one VkDevice: the device commands, the pipeline cache (one compute
 /// pipeline per shader and variant, with its push-descriptor set layout and pipeline layout,
-/// created on first use), the fma choice, and a 256-byte device buffer bound in place of an
-/// optional range the caller leaves empty.
+/// created on first use), the fma choice, a 256-byte device buffer bound in place of an
+/// optional range the caller leaves empty, and (on BackpatchPtpPass's first run) a host-visible
+/// buffer of the ptp schedule's tables.
 class PassContext {
 public:
     /// physical_device and device: the caller's (device made from physical_device with
