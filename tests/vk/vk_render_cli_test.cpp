@@ -135,7 +135,10 @@ TEST(VulkanRenderCli, PicturesEqualOpenGLs) {
         int w = 0, h = 0;
         for (const std::string api : {"gl", "vulkan"}) {
             const std::string png = scratch_dir() + "/picture_" + api + ".png";
-            const CliRun r = run("render " + args + " --size 192x108 --api " + api + " --out " + png);
+            std::string command = "render " + args;
+            command += " --size 192x108 --api " + api;
+            command += " --out " + png;
+            const CliRun r = run(command);
             ASSERT_EQ(r.status, 0) << args << " --api " << api << "\n" << r.err;
             int channels = 0;
             images.push_back(stbi_load(png.c_str(), &w, &h, &channels, 4));
