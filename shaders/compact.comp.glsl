@@ -19,7 +19,9 @@
 // - kCompactScatter: each survivor at list[list_first + sums[g] + its rank within group g]
 //   (a scan of the invocations' counts, then each writes its run's survivors in order).
 // Both end with kCompactFinish: one invocation per command (group_base: the dispatch's first
-// command; group_count: the word of sums holding n).
+// command; group_count: the word of sums holding n). CullStatusPass's fused append
+// (cull_status.comp.glsl's PC_STATUS_APPEND) ends with it too, its total at word 0 of its own
+// buffer bound at kBindingCompactSums.
 // Two programs: the scan's modes with PC_COMPACT_SCAN, the append's without (on llvmpipe the
 // append ran several times slower in one program with the scan's code: 39-76 ms against 14-17 ms
 // per 1M patches, bench/compaction_bench.cpp under varying load).

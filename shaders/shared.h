@@ -240,6 +240,16 @@ PATCHCULL_CONST uint kBsplinePhantomColumn0 = 0x1111u;
 // (patch_source.cpp's kSixth, kThird).
 PATCHCULL_CONST uint kBsplineSixthBits = 0x3E2AAAABu;
 PATCHCULL_CONST uint kBsplineThirdBits = 0x3EAAAAABu;
+// cull_status.comp.glsl's draw-list append (PC_STATUS_APPEND: CullStatusPass::end with a
+// DrawListBuffers, gl_passes.h): the words of the pass's own buffer at kBindingCompactSums, written
+// before the end's dispatches: the survivor total (0 before; compact.comp.glsl's kCompactFinish then
+// reads it as its word 0), the range's first list entry, and the selection (mask, value) on the
+// new flag word.
+PATCHCULL_CONST uint kStatusAppendTotal = 0u;
+PATCHCULL_CONST uint kStatusAppendListFirst = 1u;
+PATCHCULL_CONST uint kStatusAppendMask = 2u;
+PATCHCULL_CONST uint kStatusAppendValue = 3u;
+PATCHCULL_CONST uint kStatusAppendWords = 4u;
 
 #ifdef __cplusplus
 }  // namespace patchcull::gl::shared

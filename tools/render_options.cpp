@@ -31,16 +31,20 @@ void add_tess_options(CLI::App& command, TessOptions& options) {
 }
 
 CLI::Option* add_compact_option(CLI::App& command, std::string& target) {
-    return add_choice_option(command, "--compact", target, {"scan", "append"},
+    return add_choice_option(command, "--compact", target, {"scan", "append", "fused"},
                              "how --draw indirect lists the survivors: scan (the default: a prefix scan, the same list "
-                             "order every frame) or append (atomic appends: the same set, the order may change)");
+                             "order every frame), append (atomic appends: the same set, the order may change) or fused "
+                             "(the appends of pass 2 and of the one-pass draw done by the chain's last stage, the rest "
+                             "as append)");
 }
 
 gl::CompactMethod parse_compact_option(const std::string& text) {
+    if (text == "fused") return gl::CompactMethod::fused_append;
     return text == "append" ? gl::CompactMethod::atomic_append : gl::CompactMethod::prefix_scan;
 }
 
 const char* compact_option_name(gl::CompactMethod method) {
+    if (method == gl::CompactMethod::fused_append) return "fused";
     return method == gl::CompactMethod::atomic_append ? "append" : "scan";
 }
 

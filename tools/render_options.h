@@ -43,16 +43,17 @@ void apply_tess_mode(const TessMode& mode, gl::RenderParams& params);
 /// Distance from every eye of path to its target: sqrt(distance^2 + height^2).
 float camera_path_eye_distance(const CameraPath& path);
 
-/// --compact scan|append of `render` and `view` (target keeps the text, default "scan"): how
-/// --draw indirect lists each draw pass's survivors (gl_compaction.h's CompactMethod). scan: the
-/// prefix scan, the same list order every frame; append: atomic appends, the same set of
-/// patches in an order that may change from frame to frame. A bad value is one line naming the
-/// flag (exit 2).
+/// --compact scan|append|fused of `render` and `view` (target keeps the text, default "scan"):
+/// how --draw indirect lists each draw pass's survivors (gl_compaction.h's CompactMethod). scan:
+/// the prefix scan, the same list order every frame; append: atomic appends, the same set of
+/// patches in an order that may change from frame to frame; fused: append, done by the flag
+/// chain's last stage for the lists it decides (pass 2, the one-pass draw; gl_pipeline.h's
+/// PipelineParams::compact). A bad value is one line naming the flag (exit 2).
 CLI::Option* add_compact_option(CLI::App& command, std::string& target);
 /// The CompactMethod of --compact's text (checked by add_compact_option): "append" is
-/// atomic_append, anything else prefix_scan.
+/// atomic_append, "fused" fused_append, anything else prefix_scan.
 gl::CompactMethod parse_compact_option(const std::string& text);
-/// --compact's text of a method ("scan", "append"), e.g. for a JSON report.
+/// --compact's text of a method ("scan", "append", "fused"), e.g. for a JSON report.
 const char* compact_option_name(gl::CompactMethod method);
 
 /// --displace, --displace-scale, --bound and --cone of `render` and `view` (Niessner & Loop §4.2, §6):

@@ -12,6 +12,7 @@ namespace patchcull::gl {
 static_assert(sizeof(pp::CompactParams) == 48);
 
 std::string_view compact_method_name(CompactMethod method) {
+    if (method == CompactMethod::fused_append) return "fused";
     return method == CompactMethod::atomic_append ? "atomic" : "scan";
 }
 
@@ -20,6 +21,67 @@ std::size_t compact_command_count(std::size_t count, std::size_t patches_per_com
     return (count + patches_per_command - 1) / patches_per_command;
 }
 
+namespace detail {
+
+// CompactPass's checks of a range and its DrawListBuffers (Error "GL: <who>: ..."), and the
+// parameters of the commands' step (kCompactFinish) for them. CullStatusPass's append uses them
+// too (declared in cull_status_pass.cpp).
+pp::CompactParams check_draw_list(const char* who, PassContext::Impl& context, const PatchBuffers& patches,
+                                  const DrawListBuffers& out) {
+    const std::string prefix = std::string("GL: ") + who + ": ";
+    auto check_offset = [&prefix](const char* what, std::size_t offset) {
+        if (offset % 4 != 0)
+            throw Error(prefix + what + " offset " + std::to_string(offset) + " is not a multiple of 4");
+    };
+    if (out.list_first + patches.count > 0xFFFFFFFFu / 16)
+        throw Error(prefix + "list_first + count past 2^28 entries (16 vertices per patch)");
+    check_offset("command", out.command_offset);
+    check_buffer_size(who, "draw-list", out.list, (out.list_first + patches.count) * 4);
+    const std::size_t commands = compact_command_count(patches.count, out.patches_per_command);
+    check_buffer_size(who, "indirect-command", out.command,
+                      out.command_offset + commands * sizeof(DrawArraysIndirectCommand));
+    if (out.draw_count) {
+        check_offset("draw-count", out.draw_count_offset);
+        check_buffer_size(who, "draw-count", out.draw_count, out.draw_count_offset + 4);
+    }
+    // The flags and the list are read as storage blocks from byte 0: the driver's limit holds them.
+    if (context.max_storage_block < 0) glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &context.max_storage_block);
+    const std::size_t limit =
+        context.max_storage_block > 0 ? static_cast<std::size_t>(context.max_storage_block) : std::size_t{0xFFFFFFFFu};
+    const std::size_t reach = std::max(patches.first, out.list_first) + patches.count;
+    if (reach * 4 > limit)
+        throw Error(prefix + "the flags or the list reach byte " + std::to_string(reach * 4) +
+                    ", past GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + std::to_string(limit) + ")");
+    pp::CompactParams params;
+    params.list_first = static_cast<pp::uint>(out.list_first);
+    params.command_word = static_cast<pp::uint>(out.command_offset / 4);
+    params.count_word = static_cast<pp::uint>(out.draw_count_offset / 4);
+    params.write_count = out.draw_count ? 1u : 0u;
+    // K in [1, max(count, 1)]: the same commands as the header's, and no overflow in the shader.
+    const std::size_t range = std::max<std::size_t>(patches.count, 1);
+    params.patches_per_command =
+        static_cast<pp::uint>(out.patches_per_command == 0 ? range : std::min(out.patches_per_command, range));
+    return params;
+}
+
+// kCompactFinish (the bound program: compact.comp.glsl) over the range's commands, from the total
+// at word total_word of the buffer at kBindingCompactSums: one invocation per command.
+void dispatch_finish(ParamBlock& block, pp::CompactParams& params, std::size_t count, std::size_t commands,
+                     std::size_t total_word) {
+    params.mode = shared::kCompactFinish;
+    params.patch_count = static_cast<pp::uint>(count);
+    params.group_count = static_cast<pp::uint>(total_word);
+    const std::size_t per_dispatch = std::size_t{65535} * shared::kCompactGroupSize;
+    for (std::size_t c = 0; c < commands; c += per_dispatch) {
+        const std::size_t n = std::min(per_dispatch, commands - c);
+        params.group_base = static_cast<pp::uint>(c);
+        block.upload(params);
+        glDispatchCompute(static_cast<GLuint>((n + shared::kCompactGroupSize - 1) / shared::kCompactGroupSize), 1, 1);
+    }
+}
+
+}  // namespace detail
+
 struct CompactPass::Impl {
     explicit Impl(PassContext::Impl& c) : context(c) {}
     ~Impl() { glDeleteBuffers(1, &sums); }
@@ -27,12 +89,6 @@ struct CompactPass::Impl {
     detail::ParamBlock block;
     GLuint sums = 0;  // the scan's work-group sums
     std::size_t sums_capacity = 0;
-
-    static void check_offset(const char* what, std::size_t offset) {
-        if (offset % 4 != 0)
-            throw Error(std::string("GL: CompactPass: ") + what + " offset " + std::to_string(offset) +
-                        " is not a multiple of 4");
-    }
 
     // One dispatch per at most 65535 work groups of `group` patches over the range; group_base
     // counts the groups before.
@@ -59,37 +115,10 @@ struct CompactPass::Impl {
         const char* who = "CompactPass";
         detail::begin_pass(who);
         detail::check_patch_buffers(who, patches, /*with_points=*/false);
-        if (out.list_first + patches.count > 0xFFFFFFFFu / 16)
-            throw Error("GL: CompactPass: list_first + count past 2^28 entries (16 vertices per patch)");
-        check_offset("command", out.command_offset);
-        detail::check_buffer_size(who, "draw-list", out.list, (out.list_first + patches.count) * 4);
-        const std::size_t commands = compact_command_count(patches.count, out.patches_per_command);
-        detail::check_buffer_size(who, "indirect-command", out.command,
-                                  out.command_offset + commands * sizeof(DrawArraysIndirectCommand));
-        if (out.draw_count) {
-            check_offset("draw-count", out.draw_count_offset);
-            detail::check_buffer_size(who, "draw-count", out.draw_count, out.draw_count_offset + 4);
-        }
-        // The flags and the list are read as storage blocks from byte 0: the driver's limit holds them.
-        if (context.max_storage_block < 0)
-            glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &context.max_storage_block);
-        const std::size_t limit = context.max_storage_block > 0 ? static_cast<std::size_t>(context.max_storage_block)
-                                                                : std::size_t{0xFFFFFFFFu};
-        const std::size_t reach = std::max(patches.first, out.list_first) + patches.count;
-        if (reach * 4 > limit)
-            throw Error("GL: CompactPass: the flags or the list reach byte " + std::to_string(reach * 4) +
-                        ", past GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" + std::to_string(limit) + ")");
-        pp::CompactParams params;
+        pp::CompactParams params = detail::check_draw_list(who, context, patches, out);
         params.mask = mask;
         params.value = value;
-        params.list_first = static_cast<pp::uint>(out.list_first);
-        params.command_word = static_cast<pp::uint>(out.command_offset / 4);
-        params.count_word = static_cast<pp::uint>(out.draw_count_offset / 4);
-        params.write_count = out.draw_count ? 1u : 0u;
-        // K in [1, max(count, 1)]: the same commands as the header's, and no overflow in the shader.
-        const std::size_t range = std::max<std::size_t>(patches.count, 1);
-        params.patches_per_command =
-            static_cast<pp::uint>(out.patches_per_command == 0 ? range : std::min(out.patches_per_command, range));
+        const std::size_t commands = compact_command_count(patches.count, out.patches_per_command);
         const bool scan = method == CompactMethod::prefix_scan;
         // Patches per work group: one per invocation in the append, a run of kCompactScanRun in the scan.
         const std::size_t group = shared::kCompactGroupSize * (scan ? shared::kCompactScanRun : 1);
@@ -136,17 +165,7 @@ struct CompactPass::Impl {
         // The commands and the draw count from the total (sums[groups] after the scan, sums[0]
         // after the append), one invocation per command.
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        params.mode = shared::kCompactFinish;
-        params.patch_count = static_cast<pp::uint>(patches.count);
-        params.group_count = static_cast<pp::uint>(scan ? groups : 0);
-        const std::size_t per_dispatch = std::size_t{65535} * shared::kCompactGroupSize;
-        for (std::size_t c = 0; c < commands; c += per_dispatch) {
-            const std::size_t n = std::min(per_dispatch, commands - c);
-            params.group_base = static_cast<pp::uint>(c);
-            block.upload(params);
-            glDispatchCompute(static_cast<GLuint>((n + shared::kCompactGroupSize - 1) / shared::kCompactGroupSize), 1,
-                              1);
-        }
+        detail::dispatch_finish(block, params, patches.count, commands, scan ? groups : 0);
         glMemoryBarrier(GL_COMMAND_BARRIER_BIT);
         detail::finish_pass(who);
     }

@@ -112,6 +112,13 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
     PassClock clock(method, m.timer_queries);
     clock.mark();
     FrameChain chain(m, params, f, plan, clock);
+    // CompactMethod::fused_append: the chain's end lists the draw that follows it where its
+    // dispatch spans are that draw's spans (no object-culled spans); else CompactPass does.
+    auto fusable = [&] {
+        return params.draw == DrawMode::indirect && params.compact == CompactMethod::fused_append &&
+               plan.culled.empty() && r.patch_count() > 0;
+    };
+    const bool fused_list = !two_pass && !params.object_pass && fusable();
     // The object pass (PipelineParams::object_pass): the objects it leaves out become object-culled
     // spans.
     auto run_object_pass = [&](bool chain_per_object) {
@@ -150,7 +157,9 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         m.ensure_hiz();
         m.hiz_build.run(r.depth_texture(), m.hiz, rp.depth);
         clock.mark();
-        // 3. test every patch (of the objects drawn), update statuses.
+        // 3. test every patch (of the objects drawn), update statuses (and list pass 2's patches
+        // when fused).
+        if (!frame.aggressive && fusable()) chain.append_to(1, sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass);
         chain.run(&m.hiz);
         // 4. newly visible patches (Niessner & Loop §3.1: skipped when aggressive).
         if (!frame.aggressive) m.draw(1, sh::kDrawMaskSecondPass, sh::kDrawValueSecondPass, plan.drawn, params, plan);
@@ -169,6 +178,14 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         chain.begin_gaps();
         chain.end_gaps();
         m.draw(0, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.gaps_drawn, params, plan);
+        clock.mark();
+    } else if (fused_list) {
+        // The chain lists the draw's patches: the commands' K needs begin_frame's tessellation
+        // level, so the occluders are drawn before the chain (their time counts in cull_ms).
+        r.begin_frame(rp);
+        chain.append_to(0, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass);
+        chain.run(nullptr);
+        m.draw(0, sh::kDrawMaskFirstPass, sh::kDrawValueFirstPass, plan.drawn, params, plan);
         clock.mark();
     } else {
         chain.run(nullptr);
@@ -192,43 +209,34 @@ void CullPipeline::Impl::draw(int pass, std::uint32_t mask, std::uint32_t value,
         return;
     }
     if (spans.empty() || renderer.patch_count() == 0) return;
-    // At most patches_per_draw() patches a command (llvmpipe's limit); on a software rasterizer a
-    // sixteenth of that (about 4096 tessellated vertices a command): llvmpipe's tessellation
-    // costs more per patch in larger draws (default scene, 640x360, tess 16: pass 2 took 216 ms
-    // with 226 patches a command, 34 ms with 16).
-    const std::size_t k =
-        passes.is_software() ? std::max<std::size_t>(1, renderer.patches_per_draw() / 16) : renderer.patches_per_draw();
-    if (!l.started) {
-        // Every span a pass draws lies in one span of the plan at its first draw (an object's
-        // active spans, the gaps), so the plan's commands bound the pass's.
-        std::size_t commands = 0;
-        for (const PatchSpan& s : plan.drawn) commands += compact_command_count(s.count, k);
-        const std::size_t counts = plan.drawn.size();
-        auto grow = [](GLuint& buffer, std::size_t& capacity, std::size_t need, std::size_t bytes_each) {
-            if (buffer && need <= capacity) return;
-            capacity = std::max(need, 2 * capacity);
-            if (!buffer) glCreateBuffers(1, &buffer);
-            glNamedBufferData(buffer, static_cast<GLsizeiptr>(capacity * bytes_each), nullptr, GL_DYNAMIC_DRAW);
-        };
-        grow(l.list, l.list_capacity, std::max<std::size_t>(renderer.patch_count(), 1), 4);
-        grow(l.commands, l.command_capacity, std::max<std::size_t>(commands, 1), sizeof(DrawArraysIndirectCommand));
-        grow(l.counts, l.count_capacity, std::max<std::size_t>(counts, 1), 4);
-        l.started = true;
-    }
-    const std::size_t first_command = l.used_commands;
-    for (const PatchSpan& s : spans) {
-        const std::size_t commands = compact_command_count(s.count, k);
-        if (l.used_commands + commands > l.command_capacity || l.used_counts + 1 > l.count_capacity)
-            throw Error("render_frame: a draw pass's spans outgrew its command buffer (internal)");
-        PatchBuffers range = renderer.patch_buffers();
-        range.first = s.first;
-        range.count = s.count;
-        compact.run(range, mask, value,
-                    {l.list, s.first, l.commands, l.used_commands * sizeof(DrawArraysIndirectCommand), l.counts,
-                     l.used_counts * 4, k},
-                    params.compact);
-        l.used_commands += commands;
-        ++l.used_counts;
+    const std::size_t k = patches_per_command();
+    start_draw_list(pass, plan);
+    std::size_t first_command = l.used_commands;
+    if (!l.appended.empty()) {
+        // CompactMethod::fused_append: the chain's end listed these spans already.
+        const bool same =
+            l.appended.size() == spans.size() &&
+            std::equal(spans.begin(), spans.end(), l.appended.begin(),
+                       [](const PatchSpan& a, const PatchSpan& b) { return a.first == b.first && a.count == b.count; });
+        if (!same || l.used_counts != l.appended.size())
+            throw Error("render_frame: a draw pass's spans differ from those its chain listed (internal)");
+        first_command = l.appended_first_command;
+        l.appended.clear();
+    } else {
+        for (const PatchSpan& s : spans) {
+            const std::size_t commands = compact_command_count(s.count, k);
+            if (l.used_commands + commands > l.command_capacity || l.used_counts + 1 > l.count_capacity)
+                throw Error("render_frame: a draw pass's spans outgrew its command buffer (internal)");
+            PatchBuffers range = renderer.patch_buffers();
+            range.first = s.first;
+            range.count = s.count;
+            compact.run(range, mask, value,
+                        {l.list, s.first, l.commands, l.used_commands * sizeof(DrawArraysIndirectCommand), l.counts,
+                         l.used_counts * 4, k},
+                        params.compact);
+            l.used_commands += commands;
+            ++l.used_counts;
+        }
     }
     // With glMultiDrawArraysIndirectCount: one per span, each with its own range's draw count
     // (a span's commands past its survivors are never read). Without it: one
@@ -250,6 +258,53 @@ void CullPipeline::Impl::draw(int pass, std::uint32_t mask, std::uint32_t value,
         d.first_command += d.command_count;
         d.draw_count_offset += 4;
     }
+}
+
+std::size_t CullPipeline::Impl::patches_per_command() const {
+    // At most patches_per_draw() patches a command (llvmpipe's limit); on a software rasterizer a
+    // sixteenth of that (about 4096 tessellated vertices a command): llvmpipe's tessellation
+    // costs more per patch in larger draws (default scene, 640x360, tess 16: pass 2 took 216 ms
+    // with 226 patches a command, 34 ms with 16).
+    return passes.is_software() ? std::max<std::size_t>(1, renderer.patches_per_draw() / 16)
+                                : renderer.patches_per_draw();
+}
+
+void CullPipeline::Impl::start_draw_list(int pass, const SpanPlan& plan) {
+    PassDrawList& l = draw_lists[pass];
+    if (l.started) return;
+    // Every span a pass draws lies in one span of the plan at its first draw (an object's
+    // active spans, the gaps), so the plan's commands bound the pass's.
+    const std::size_t k = patches_per_command();
+    std::size_t commands = 0;
+    for (const PatchSpan& s : plan.drawn) commands += compact_command_count(s.count, k);
+    const std::size_t counts = plan.drawn.size();
+    auto grow = [](GLuint& buffer, std::size_t& capacity, std::size_t need, std::size_t bytes_each) {
+        if (buffer && need <= capacity) return;
+        capacity = std::max(need, 2 * capacity);
+        if (!buffer) glCreateBuffers(1, &buffer);
+        glNamedBufferData(buffer, static_cast<GLsizeiptr>(capacity * bytes_each), nullptr, GL_DYNAMIC_DRAW);
+    };
+    grow(l.list, l.list_capacity, std::max<std::size_t>(renderer.patch_count(), 1), 4);
+    grow(l.commands, l.command_capacity, std::max<std::size_t>(commands, 1), sizeof(DrawArraysIndirectCommand));
+    grow(l.counts, l.count_capacity, std::max<std::size_t>(counts, 1), 4);
+    l.started = true;
+}
+
+DrawListBuffers CullPipeline::Impl::reserve_draw_list(int pass, const PatchSpan& s, const SpanPlan& plan) {
+    start_draw_list(pass, plan);
+    PassDrawList& l = draw_lists[pass];
+    const std::size_t k = patches_per_command();
+    const std::size_t commands = compact_command_count(s.count, k);
+    if (l.used_commands + commands > l.command_capacity || l.used_counts + 1 > l.count_capacity)
+        throw Error("render_frame: a draw pass's spans outgrew its command buffer (internal)");
+    if (l.appended.empty()) l.appended_first_command = l.used_commands;
+    l.appended.push_back(s);
+    const DrawListBuffers out{
+        l.list,   s.first,           l.commands, l.used_commands * sizeof(DrawArraysIndirectCommand),
+        l.counts, l.used_counts * 4, k};
+    l.used_commands += commands;
+    ++l.used_counts;
+    return out;
 }
 
 std::size_t CullPipeline::Impl::submitted(int pass, DrawMode mode) const {

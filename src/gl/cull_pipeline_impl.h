@@ -107,6 +107,10 @@ struct CullPipeline::Impl {
         std::size_t used_commands = 0, used_counts = 0;
         bool started = false;    // sized for this frame
         std::size_t issued = 0;  // DrawMode::flags: the patches of the spans drawn
+        // CompactMethod::fused_append: the chain's end appended the lists of `appended` spans
+        // (reserve_draw_list), commands from appended_first_command on, for the pass's next draw.
+        std::vector<PatchSpan> appended;
+        std::size_t appended_first_command = 0;
     };
     PassDrawList draw_lists[2];
     std::map<BackpatchMethod, std::unique_ptr<BackpatchPass>> backpatch_passes;  // made on first use
@@ -155,9 +159,19 @@ struct CullPipeline::Impl {
     void begin_draws() {
         for (PassDrawList& l : draw_lists) {
             l.used_commands = l.used_counts = l.issued = 0;
+            l.appended.clear();
             l.started = false;
         }
     }
+    /// DrawMode::indirect's K: at most patches_per_draw() patches a command, a sixteenth of that
+    /// on a software rasterizer.
+    std::size_t patches_per_command() const;
+    /// Sizes pass's buffers for the frame on its first use (plan's spans bound its commands).
+    void start_draw_list(int pass, const SpanPlan& plan);
+    /// CompactMethod::fused_append: the range of pass's buffers for span s (its list entries at its
+    /// patches, its commands and draw count next), for CullStatusPass::end to append into; the
+    /// pass's next draw draws the spans reserved so far instead of compacting them, in this order.
+    DrawListBuffers reserve_draw_list(int pass, const PatchSpan& s, const SpanPlan& plan);
     /// The patches each pass issued (FrameStats::pass*_submitted; reads the commands back).
     std::size_t submitted(int pass, DrawMode mode) const;
 

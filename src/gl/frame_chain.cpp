@@ -10,6 +10,15 @@ PatchBuffers FrameChain::buffers_of(const PatchSpan& s) const {
     return b;
 }
 
+void FrameChain::end_span(const PatchSpan& s, std::size_t slot) {
+    if (append_pass_ < 0) {
+        m_.status.end(buffers_of(s), m_.counters, slot * m_.counter_stride);
+        return;
+    }
+    const DrawListBuffers out = m_.reserve_draw_list(append_pass_, s, plan_);
+    m_.status.end(buffers_of(s), m_.counters, slot * m_.counter_stride, out, append_mask_, append_value_);
+}
+
 void FrameChain::mark_culled(std::size_t first, std::size_t end) {
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     const std::uint32_t object_word = sh::kCullObject;
@@ -30,8 +39,7 @@ void FrameChain::begin_gaps() {
 
 void FrameChain::end_gaps() {
     for (const std::vector<PatchSpan>& spans : plan_.gap_spans)
-        for (const PatchSpan& s : spans)
-            m_.status.end(buffers_of(s), m_.counters, plan_.objects.size() * m_.counter_stride);
+        for (const PatchSpan& s : spans) end_span(s, plan_.objects.size());
 }
 
 void FrameChain::run(const HiZTexture* hiz, const std::vector<std::size_t>* only, bool timed) {
@@ -52,8 +60,7 @@ void FrameChain::run(const HiZTexture* hiz, const std::vector<std::size_t>* only
     }
     run_tests(hiz, *only, timed);
     for (std::size_t i : *only)
-        for (const PatchSpan& s : plan_.object_spans[i])
-            m_.status.end(buffers_of(s), m_.counters, i * m_.counter_stride);
+        for (const PatchSpan& s : plan_.object_spans[i]) end_span(s, i);
     if (with_gaps) end_gaps();
     if (timed) clock_.mark();
 }

@@ -43,9 +43,20 @@ public:
     /// begin / end on the gaps alone (counted in the last counter slot).
     void begin_gaps();
     void end_gaps();
+    /// CompactMethod::fused_append: the ends after this append each dispatch span's patches that
+    /// (flag & mask) == value keeps to draw pass `pass`'s list (CullPipeline::Impl::
+    /// reserve_draw_list), in the order of the plan's drawn spans when the plan has no culled
+    /// spans (every dispatch span is then a drawn span); -1 (the default) appends nothing.
+    void append_to(int pass, std::uint32_t mask, std::uint32_t value) {
+        append_pass_ = pass;
+        append_mask_ = mask;
+        append_value_ = value;
+    }
 
 private:
     PatchBuffers buffers_of(const PatchSpan& s) const;
+    /// CullStatusPass::end on span s, counted in slot `slot`, with the append when asked for.
+    void end_span(const PatchSpan& s, std::size_t slot);
     void run_tests(const HiZTexture* hiz, const std::vector<std::size_t>& only, bool timed);
 
     CullPipeline::Impl& m_;
@@ -53,6 +64,8 @@ private:
     const FrameTests& f_;
     const SpanPlan& plan_;
     PassClock& clock_;
+    int append_pass_ = -1;
+    std::uint32_t append_mask_ = 0, append_value_ = 0;
 };
 
 }  // namespace patchcull::gl

@@ -34,7 +34,10 @@
 // kBindingCullFlags, the list, command and count buffers at their bindings, and a buffer of its own
 // at kBindingCompactSums (the survivor count between its steps, and for the prefix scan one uint
 // per 2048 patches of the largest range seen before it; allocated on the first run and grown when
-// a larger range comes: the only GL objects made after the first run). Ranges of any size up to 2^28 patches
+// a larger range comes: the only GL objects made after the first run). Fused: CullStatusPass::end
+// with a DrawListBuffers (gl_passes.h) writes the same set, commands and count for the set the end
+// decides, in the end's own dispatch (cull_status.comp.glsl's PC_STATUS_APPEND: one atomicAdd per
+// work group, as the append) and a dispatch of this pass's commands step. Ranges of any size up to 2^28 patches
 // (list_first + count < 2^28, so that 16 (list_first + count) fits in 32 bits) are covered by dispatches of at most
 // 65535 work groups; the flags up to first + count and the list up to list_first + count must fit
 // GL_MAX_SHADER_STORAGE_BLOCK_SIZE (read once per PassContext; 128 MiB on llvmpipe: 2^25 patches).
@@ -62,13 +65,18 @@ struct DrawArraysIndirectCommand {
 };
 static_assert(sizeof(DrawArraysIndirectCommand) == 16);
 
-/// How the list is built. Both give the same set of patches.
+/// How the list is built. All give the same set of patches and the same commands.
 enum class CompactMethod {
     atomic_append,  ///< one atomicAdd per work group: the list's order may change from run to run
     prefix_scan,    ///< a prefix scan over work-group sums: ascending patch index, every run
+    /// The atomic append fused into the chain's last stage (CullStatusPass::end with a
+    /// DrawListBuffers, gl_passes.h) for the lists that stage decides: CullPipeline's pass 2 of a
+    /// two-pass frame and the one-pass frame's draw (gl_pipeline.h); CompactPass::run itself
+    /// treats it as atomic_append.
+    fused_append,
 };
 
-/// "atomic" or "scan".
+/// "atomic", "scan" or "fused".
 std::string_view compact_method_name(CompactMethod method);
 
 /// The commands CompactPass writes for a range of count patches with at most patches_per_command

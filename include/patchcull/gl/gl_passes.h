@@ -14,6 +14,7 @@
 //   frustum + cone + Hi-Z  (the three above, in one)      FusedCullPass      fused_cull.comp.glsl
 //   (ends of the chain)    -                              CullStatusPass     cull_status.comp.glsl
 //   (after the chain)      -                              CompactPass        compact.comp.glsl (gl_compaction.h)
+//   (or fused into the end: CullStatusPass::end with a DrawListBuffers, cull_status.comp.glsl's PC_STATUS_APPEND)
 // Each makes the same decisions as its CPU kernel on the same inputs (the arithmetic notes are
 // in gl_backpatch.h, gl_displaced.h and the shaders; tests/gl/*_gpu_test.cpp check it).
 //
@@ -457,6 +458,8 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+struct DrawListBuffers;  // gl_compaction.h
+
 /// The two ends of the flag chain (see the header).
 class CullStatusPass {
 public:
@@ -473,6 +476,19 @@ public:
     /// from byte counters_offset, a multiple of GL_SHADER_STORAGE_BUFFER_OFFSET_ALIGNMENT; 0 = not
     /// counted).
     void end(const PatchBuffers& patches, std::uint32_t counters, std::size_t counters_offset = 0);
+    /// end(patches, counters, counters_offset), fused with the compaction of the set it decides:
+    /// the patches whose new word satisfies (word & mask) == value (shared.h's kDrawMask* /
+    /// kDrawValue* pairs, e.g. kDrawMaskSecondPass for the newly visible) go to out.list, and the
+    /// commands and draw count to out, exactly as CompactPass::run(patches, mask, value, out,
+    /// CompactMethod::atomic_append) would write them after end (gl_compaction.h: same set, same
+    /// commands and count; the list's order changes from run to run). One atomicAdd per work group
+    /// in the end's own dispatch (no second pass over the flags), then a small dispatch of
+    /// compact.comp.glsl's commands step. Also checks out as CompactPass does (same errors, named
+    /// "CullStatusPass"), binds kBindingDrawList, kBindingDrawCommands, kBindingDrawCount and a
+    /// buffer of its own at kBindingCompactSums (made on the first such call), and ends with
+    /// GL_COMMAND_BARRIER_BIT too. A range of 0 patches writes CompactPass's empty command.
+    void end(const PatchBuffers& patches, std::uint32_t counters, std::size_t counters_offset,
+             const DrawListBuffers& out, std::uint32_t mask, std::uint32_t value);
 
 private:
     struct Impl;

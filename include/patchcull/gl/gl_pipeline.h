@@ -186,7 +186,13 @@ struct PipelineParams {
     /// (CHC++'s included) compact and draw each object when it draws it. Nothing is read back
     /// for the draws; only FrameStats's read-back (after the frame) sums the commands.
     DrawMode draw = DrawMode::flags;
-    /// The compaction of DrawMode::indirect (both give the same set; gl_compaction.h).
+    /// The compaction of DrawMode::indirect (all give the same set; gl_compaction.h).
+    /// fused_append: the lists the chain's end decides (pass 2 of a two-pass frame, the one-pass
+    /// frame's draw without an object pass) are appended by CullStatusPass::end itself, each
+    /// dispatch span into its range, as an atomic append would after it (no CompactPass for
+    /// them); pass 1, the object pass's draws, and every list of a frame with object-culled
+    /// spans (PipelineParams::object_culled, or objects the object pass left out: its dispatch
+    /// spans then differ from its draw spans) use CompactPass's atomic_append.
     CompactMethod compact = CompactMethod::prefix_scan;
 };
 
@@ -216,7 +222,9 @@ struct FrameStats {
     std::size_t pass1_submitted = 0, pass2_submitted = 0;
     /// Per-pass times in milliseconds. Two-pass: pass1 (clear, occluders, patches tagged visible),
     /// hiz (build), cull (the whole flag chain), pass2 (newly visible); a draw pass's time includes
-    /// its compaction (DrawMode::indirect). One pass (no occlusion):
+    /// its compaction (DrawMode::indirect; CompactMethod::fused_append's appends count in cull,
+    /// and in its one-pass frames the occluders' draw too: they are drawn before the chain).
+    /// One pass (no occlusion):
     /// cull first, then pass1 draws the patches that passed; hiz = pass2 = 0.
     double pass1_ms = 0, hiz_ms = 0, cull_ms = 0, pass2_ms = 0, total_ms = 0;
     /// Of cull_ms: the back-patch pass alone (0 when the mode has no back-patch test, or when the
