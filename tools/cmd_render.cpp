@@ -220,6 +220,10 @@ Runner add_render_command(CLI::App& app) {
             const bool indirect = state->draw == "indirect" && command->get_option("--draw")->count() > 0;
             if (!indirect && command->get_option("--compact")->count() > 0)
                 throw Error("--patch-source osd-table: --compact needs --draw indirect");
+            if (state->compact == "fused")
+                throw Error(
+                    "--patch-source osd-table: not with --compact fused (scan or append; the fused list is "
+                    "the Bezier pipeline's)");
             OsdTableRender o;
             o.model = state->model;
             o.frames = state->frames;
@@ -291,6 +295,8 @@ Runner add_render_command(CLI::App& app) {
                     throw Error("--api vulkan: not with " + option->get_name() +
                                 " (the Vulkan renderer draws the scene as one object, posed on the CPU)");
             if (automatic) throw Error("--api vulkan: not with --cull auto");
+            if (state->compact == "fused")
+                throw Error("--api vulkan: not with --compact fused (scan or append; the fused list is OpenGL's)");
             const ClipDepth depth = parse_clip_depth_option(state->clip_depth);
             if (depth == ClipDepth::minus_one_to_one)
                 throw Error(

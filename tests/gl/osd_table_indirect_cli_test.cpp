@@ -128,4 +128,5 @@ TEST(OsdTableIndirectCli, CompactWithoutIndirectIsAOneLineError) {
     expect_one_line_error(run(args + "--compact append"), "--compact needs --draw indirect");
     expect_one_line_error(run(args + "--draw flags --compact scan"), "--compact needs --draw indirect");
     expect_one_line_error(run(args + "--draw indirect --compact atomic"), "--compact");
+    expect_one_line_error(run(args + "--draw indirect --compact fused"), "--compact fused");
 }
