@@ -171,12 +171,14 @@ TEST(ViewerSettings, DrawModeAndCompactionSwitch) {
     EXPECT_EQ(s.draw, gl::DrawMode::flags);
     EXPECT_EQ(apply_setting(s, "compact", "append"), "");
     EXPECT_EQ(s.compact, gl::CompactMethod::atomic_append);
+    EXPECT_EQ(apply_setting(s, "compact", "fused"), "");
+    EXPECT_EQ(s.compact, gl::CompactMethod::fused_append);
     EXPECT_EQ(apply_setting(s, "draw", "indirect"), "");
     EXPECT_EQ(apply_setting(s, "compact", "scan"), "");
     EXPECT_EQ(s.draw, gl::DrawMode::indirect);
     EXPECT_EQ(s.compact, gl::CompactMethod::prefix_scan);
     EXPECT_EQ(apply_setting(s, "draw", "list"), "set draw: expected one of flags, indirect, got 'list'");
-    EXPECT_EQ(apply_setting(s, "compact", "atomic"), "set compact: expected one of scan, append, got 'atomic'");
+    EXPECT_EQ(apply_setting(s, "compact", "atomic"), "set compact: expected one of scan, append, fused, got 'atomic'");
     EXPECT_EQ(s.draw, gl::DrawMode::indirect);  // unchanged on error
     EXPECT_EQ(s.compact, gl::CompactMethod::prefix_scan);
     EXPECT_EQ(parse_error("3 set draw sometimes\n").rfind("s.txt:1: set draw: expected one of flags, indirect", 0), 0u);

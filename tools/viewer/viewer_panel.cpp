@@ -96,10 +96,14 @@ void culling_section(ViewerSettings& s, const PanelInfo& info) {
     int draw = s.draw == gl::DrawMode::indirect ? 1 : 0;
     if (combo("draw", draw, draws, 2)) s.draw = draw == 1 ? gl::DrawMode::indirect : gl::DrawMode::flags;
     if (s.draw == gl::DrawMode::indirect) {
-        static const char* const compactions[] = {"scan (same order)", "append (any order)"};
-        int compact = s.compact == gl::CompactMethod::atomic_append ? 1 : 0;
-        if (combo("compaction", compact, compactions, 2))
-            s.compact = compact == 1 ? gl::CompactMethod::atomic_append : gl::CompactMethod::prefix_scan;
+        static const char* const compactions[] = {"scan (same order)", "append (any order)",
+                                                  "fused (append in the chain's end)"};
+        static const gl::CompactMethod methods[] = {gl::CompactMethod::prefix_scan, gl::CompactMethod::atomic_append,
+                                                    gl::CompactMethod::fused_append};
+        int compact = 0;
+        for (int i = 0; i < 3; ++i)
+            if (s.compact == methods[i]) compact = i;
+        if (combo("compaction", compact, compactions, 3)) s.compact = methods[compact];
     }
 }
 

@@ -103,7 +103,9 @@ std::string apply_setting(ViewerSettings& settings, const std::string& name, con
                           {{"flags", gl::DrawMode::flags}, {"indirect", gl::DrawMode::indirect}});
     if (name == "compact")
         return set_choice(settings.compact, name, value,
-                          {{"scan", gl::CompactMethod::prefix_scan}, {"append", gl::CompactMethod::atomic_append}});
+                          {{"scan", gl::CompactMethod::prefix_scan},
+                           {"append", gl::CompactMethod::atomic_append},
+                           {"fused", gl::CompactMethod::fused_append}});
     if (name == "view")
         return set_choice(settings.view, name, value,
                           {{"colour", ViewerView::colour},
