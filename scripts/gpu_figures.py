@@ -14,6 +14,9 @@ Usage: python3 scripts/gpu_figures.py [BUILD_DIR]   (default: build)
 4. The same frames on Vulkan (`render --api vulkan --vk-device gpu`: the Vulkan passes and
    renderer on the first GPU, else lavapipe), timed by timestamp queries, beside OpenGL's:
    frame, Hi-Z and cull-chain times per tessellation level, and the cull chain against patch count.
+   The Vulkan renderer keeps its buffers in host-visible memory (vk_renderer.h: a test and tool
+   renderer), so on a discrete GPU its times include reads from system memory: compare its passes'
+   trends with GL's rather than the absolute ratio.
 Every figure is the mean over frames 1..N-1 (frame 0 compiles and primes the statuses). On
 llvmpipe the GL times are wall clock around glFinish (gl_renderer.h); on a GPU, timer queries.
 A build without Vulkan (PATCHCULL_WITH_VULKAN=OFF) skips figure 4.
@@ -92,7 +95,8 @@ def main():
         print(f"\n4. Vulkan: skipped ({e.stderr.strip()})")
         return
     print(f"\n4. Vulkan ({probe['renderer']}, timestamp queries) beside OpenGL: default scene, 640x360, 5 frames,")
-    print("   cull all (tcone), indirect draws; ms per frame (total, hiz, cull chain)")
+    print("   cull all (tcone), indirect draws; ms per frame (total, hiz, cull chain); the Vulkan renderer's")
+    print("   buffers are host-visible (a test renderer): on a discrete GPU it reads them from system memory")
     print(f"{'tess':>5} {'gl total':>9} {'vk total':>9} {'vk/gl':>6} {'gl hiz':>7} {'vk hiz':>7} "
           f"{'gl cull':>8} {'vk cull':>8}")
     for tess in (1, 4, 8, 16):

@@ -8,14 +8,6 @@
 
 namespace patchcull::gl {
 
-namespace detail {
-// compact_pass.cpp: CompactPass's checks of a DrawListBuffers and its commands' step.
-pp::CompactParams check_draw_list(const char* who, PassContext::Impl& context, const PatchBuffers& patches,
-                                  const DrawListBuffers& out);
-void dispatch_finish(ParamBlock& block, pp::CompactParams& params, std::size_t count, std::size_t commands,
-                     std::size_t total_word);
-}  // namespace detail
-
 namespace {
 // The end's draw-list append: the selection and where it goes (none when out is null).
 struct StatusAppend {

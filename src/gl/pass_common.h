@@ -17,6 +17,7 @@
 namespace patchcull::gl {
 
 namespace pp = pass_params;
+struct DrawListBuffers;  // gl_compaction.h
 
 struct PassContext::Impl {
     bool fma_via_double = false;
@@ -110,6 +111,16 @@ void finish_pass(const char* who);
 
 /// Copies a FrustumPlanes into a parameter block's clip_rows / plane_normal_length.
 void store_planes(const FrustumPlanes& planes, pp::vec4 clip_rows[4], pp::vec4 normal_length[2], pp::vec4& depth);
+
+// compact_pass.cpp, shared with CullStatusPass::end's draw-list append (cull_status_pass.cpp):
+/// CompactPass's checks of a DrawListBuffers for patches (one-line Error naming who), and the
+/// parameter block they start.
+pp::CompactParams check_draw_list(const char* who, PassContext::Impl& context, const PatchBuffers& patches,
+                                  const DrawListBuffers& out);
+/// compact.comp.glsl's kCompactFinish step: the commands and draw count from the total at
+/// total_word of the sums.
+void dispatch_finish(ParamBlock& block, pp::CompactParams& params, std::size_t count, std::size_t commands,
+                     std::size_t total_word);
 
 }  // namespace detail
 }  // namespace patchcull::gl

@@ -47,6 +47,50 @@ std::uint32_t graphics_family(VkPhysicalDevice device) {
     return count;
 }
 
+// What the renderer needs that device lacks (its first missing item), or "" when it has everything:
+// Vulkan 1.3, a graphics and compute queue, VK_KHR_push_descriptor, the features of the header and
+// linear filtering of R32_SFLOAT (the displacement map).
+std::string missing_requirement(VkPhysicalDevice device) {
+    VkPhysicalDeviceProperties p{};
+    vkGetPhysicalDeviceProperties(device, &p);
+    if (p.apiVersion < VK_API_VERSION_1_3) return "Vulkan 1.3";
+    std::uint32_t families = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(device, &families, nullptr);
+    if (graphics_family(device) == families) return "a queue for graphics and compute";
+    std::uint32_t count = 0;
+    vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr);
+    std::vector<VkExtensionProperties> extensions(count);
+    vkEnumerateDeviceExtensionProperties(device, nullptr, &count, extensions.data());
+    bool push_descriptor = false;
+    for (const VkExtensionProperties& e : extensions)
+        push_descriptor = push_descriptor || std::strcmp(e.extensionName, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) == 0;
+    if (!push_descriptor) return VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME;
+    VkPhysicalDeviceVulkan13Features have13{};
+    have13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+    VkPhysicalDeviceVulkan12Features have12{};
+    have12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+    have12.pNext = &have13;
+    VkPhysicalDeviceFeatures2 have{};
+    have.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    have.pNext = &have12;
+    vkGetPhysicalDeviceFeatures2(device, &have);
+    const std::pair<VkBool32, const char*> needed[] = {
+        {have.features.shaderFloat64, "the feature shaderFloat64"},
+        {have.features.tessellationShader, "the feature tessellationShader"},
+        {have.features.multiDrawIndirect, "the feature multiDrawIndirect"},
+        {have.features.vertexPipelineStoresAndAtomics, "the feature vertexPipelineStoresAndAtomics"},
+        {have.features.fragmentStoresAndAtomics, "the feature fragmentStoresAndAtomics"},
+        {have12.drawIndirectCount, "the feature drawIndirectCount"},
+        {have13.dynamicRendering, "the feature dynamicRendering"}};
+    for (const auto& [supported, what] : needed)
+        if (!supported) return what;
+    VkFormatProperties format{};
+    vkGetPhysicalDeviceFormatProperties(device, VK_FORMAT_R32_SFLOAT, &format);
+    if (!(format.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+        return "linear filtering of R32_SFLOAT images";
+    return "";
+}
+
 }  // namespace
 
 HeadlessDevice::HeadlessDevice(const HeadlessDeviceOptions& options) {
@@ -103,18 +147,20 @@ HeadlessDevice::HeadlessDevice(const HeadlessDeviceOptions& options) {
                 const bool gpu = p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU ||
                                  p.deviceType == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU;
                 const bool preferred = options.prefer == HeadlessDeviceOptions::Prefer::cpu ? cpu : gpu;
-                std::uint32_t families = 0;
-                vkGetPhysicalDeviceQueueFamilyProperties(d, &families, nullptr);
-                if (p.apiVersion < VK_API_VERSION_1_3 || graphics_family(d) == families || (pass == 0 && !preferred))
-                    continue;
+                if ((pass == 0 && !preferred) || !missing_requirement(d).empty()) continue;
                 physical_device_ = d;
                 name_ = p.deviceName;
                 software_ = cpu;
                 timestamp_period_ns_ = p.limits.timestampPeriod;
                 break;
             }
-        if (!physical_device_)
-            throw Error("Vulkan: no device with Vulkan 1.3 and a graphics queue (Debian: mesa-vulkan-drivers)");
+        if (!physical_device_) {
+            if (devices.empty()) throw Error("Vulkan: no device (Debian: mesa-vulkan-drivers)");
+            VkPhysicalDeviceProperties p{};
+            vkGetPhysicalDeviceProperties(devices[0], &p);
+            throw Error(std::string("Vulkan: no device has what the renderer needs (") + p.deviceName + " lacks " +
+                        missing_requirement(devices[0]) + ")");
+        }
         queue_family_ = graphics_family(physical_device_);
         {
             std::uint32_t families = 0;
@@ -123,26 +169,6 @@ HeadlessDevice::HeadlessDevice(const HeadlessDeviceOptions& options) {
             vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &families, props.data());
             if (props[queue_family_].timestampValidBits == 0) timestamp_period_ns_ = 0;
         }
-
-        VkPhysicalDeviceVulkan13Features have13{};
-        have13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
-        VkPhysicalDeviceVulkan12Features have12{};
-        have12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
-        have12.pNext = &have13;
-        VkPhysicalDeviceFeatures2 have{};
-        have.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
-        have.pNext = &have12;
-        vkGetPhysicalDeviceFeatures2(physical_device_, &have);
-        const std::pair<VkBool32, const char*> needed[] = {
-            {have.features.shaderFloat64, "shaderFloat64"},
-            {have.features.tessellationShader, "tessellationShader"},
-            {have.features.multiDrawIndirect, "multiDrawIndirect"},
-            {have.features.vertexPipelineStoresAndAtomics, "vertexPipelineStoresAndAtomics"},
-            {have.features.fragmentStoresAndAtomics, "fragmentStoresAndAtomics"},
-            {have12.drawIndirectCount, "drawIndirectCount"},
-            {have13.dynamicRendering, "dynamicRendering"}};
-        for (const auto& [supported, feature] : needed)
-            if (!supported) throw Error(std::string("Vulkan: the device ") + name_ + " lacks the feature " + feature);
 
         VkPhysicalDeviceVulkan13Features enable13{};
         enable13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;

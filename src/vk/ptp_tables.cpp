@@ -42,39 +42,49 @@ std::vector<std::uint32_t> table_words() {
 }  // namespace
 
 BufferRange PassContext::Impl::ptp_tables() {
-    const std::vector<std::uint32_t> words = table_words();
+    static const std::vector<std::uint32_t> words = table_words();
     const VkDeviceSize bytes = words.size() * sizeof(std::uint32_t);
     if (ptp_table_buffer) return {ptp_table_buffer, 0, bytes};
-    VkBufferCreateInfo info{};
-    info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
-    info.size = bytes;
-    info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    detail::check_vk(vk.CreateBuffer(device, &info, nullptr, &ptp_table_buffer), "BackpatchPtpPass", "vkCreateBuffer");
-    VkMemoryRequirements requirements{};
-    vk.GetBufferMemoryRequirements(device, ptp_table_buffer, &requirements);
-    VkPhysicalDeviceMemoryProperties properties{};
-    vkGetPhysicalDeviceMemoryProperties(physical_device, &properties);
-    const VkMemoryPropertyFlags wanted = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-    std::uint32_t type = properties.memoryTypeCount;
-    for (std::uint32_t i = 0; i < properties.memoryTypeCount && type == properties.memoryTypeCount; ++i)
-        if ((requirements.memoryTypeBits & (1u << i)) && (properties.memoryTypes[i].propertyFlags & wanted) == wanted)
-            type = i;
-    if (type == properties.memoryTypeCount)
-        throw Error("Vulkan: BackpatchPtpPass: no host-visible coherent memory for the ptp tables");
-    VkMemoryAllocateInfo allocate{};
-    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-    allocate.allocationSize = requirements.size;
-    allocate.memoryTypeIndex = type;
-    detail::check_vk(vk.AllocateMemory(device, &allocate, nullptr, &ptp_table_memory), "BackpatchPtpPass",
-                     "vkAllocateMemory");
-    detail::check_vk(vk.BindBufferMemory(device, ptp_table_buffer, ptp_table_memory, 0), "BackpatchPtpPass",
-                     "vkBindBufferMemory");
-    void* mapped = nullptr;
-    detail::check_vk(vk.MapMemory(device, ptp_table_memory, 0, VK_WHOLE_SIZE, 0, &mapped), "BackpatchPtpPass",
-                     "vkMapMemory");
-    std::memcpy(mapped, words.data(), bytes);
-    vk.UnmapMemory(device, ptp_table_memory);
+    // Made in locals and kept only when it is filled: a failure leaves nothing half-built.
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    try {
+        VkBufferCreateInfo info{};
+        info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+        info.size = bytes;
+        info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+        info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+        detail::check_vk(vk.CreateBuffer(device, &info, nullptr, &buffer), "BackpatchPtpPass", "vkCreateBuffer");
+        VkMemoryRequirements requirements{};
+        vk.GetBufferMemoryRequirements(device, buffer, &requirements);
+        VkPhysicalDeviceMemoryProperties properties{};
+        vkGetPhysicalDeviceMemoryProperties(physical_device, &properties);
+        const VkMemoryPropertyFlags wanted = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+        std::uint32_t type = properties.memoryTypeCount;
+        for (std::uint32_t i = 0; i < properties.memoryTypeCount && type == properties.memoryTypeCount; ++i)
+            if ((requirements.memoryTypeBits & (1u << i)) &&
+                (properties.memoryTypes[i].propertyFlags & wanted) == wanted)
+                type = i;
+        if (type == properties.memoryTypeCount)
+            throw Error("Vulkan: BackpatchPtpPass: no host-visible coherent memory for the ptp tables");
+        VkMemoryAllocateInfo allocate{};
+        allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+        allocate.allocationSize = requirements.size;
+        allocate.memoryTypeIndex = type;
+        detail::check_vk(vk.AllocateMemory(device, &allocate, nullptr, &memory), "BackpatchPtpPass",
+                         "vkAllocateMemory");
+        detail::check_vk(vk.BindBufferMemory(device, buffer, memory, 0), "BackpatchPtpPass", "vkBindBufferMemory");
+        void* mapped = nullptr;
+        detail::check_vk(vk.MapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &mapped), "BackpatchPtpPass", "vkMapMemory");
+        std::memcpy(mapped, words.data(), bytes);
+        vk.UnmapMemory(device, memory);
+    } catch (...) {
+        if (buffer) vk.DestroyBuffer(device, buffer, nullptr);
+        if (memory) vk.FreeMemory(device, memory, nullptr);
+        throw;
+    }
+    ptp_table_buffer = buffer;
+    ptp_table_memory = memory;
     return {ptp_table_buffer, 0, bytes};
 }
 

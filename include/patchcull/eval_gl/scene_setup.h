@@ -16,7 +16,9 @@ namespace patchcull::eval_gl {
 bool scene_is_one_sided(const Scene& scene);
 
 /// The renderer's attributes of the poser's last pose: its ACC tangent patches (shading normals),
-/// refinement depths, and for a displaced scene the texcoords and displacement ranges.
+/// refinement depths, and for a displaced scene the texcoords and displacement ranges. Pose first,
+/// in a statement of its own: in `set_patches(poser.pose(t), pose_attributes(poser))` C++ may
+/// evaluate the attributes first (GCC does), which gives the previous pose's.
 gl::PatchAttributes pose_attributes(const ScenePoser& poser);
 
 /// PatchRenderer::set_occluders with the scene's occluders, the one-sided environment objects

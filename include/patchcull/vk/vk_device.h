@@ -7,7 +7,9 @@
 // lavapipe, Mesa's CPU driver, so that runs are alike everywhere; a GPU for measurements), created with what the passes
 // and the renderer need: VK_KHR_push_descriptor, shaderFloat64 (the passes' exact fma), tessellationShader,
 // multiDrawIndirect, vertexPipelineStoresAndAtomics and fragmentStoresAndAtomics (the drawn and front marks),
-// drawIndirectCount and dynamicRendering. A device without one of them: Error naming it.
+// drawIndirectCount and dynamicRendering, and linear filtering of R32_SFLOAT images (the
+// displacement map). A device that lacks one is passed over; when none has everything: Error
+// naming what the first device lacks.
 //
 // Validation (HeadlessDeviceOptions::validation): VK_LAYER_KHRONOS_validation with synchronization
 // validation, and a messenger that keeps every warning and error of the validation and general
