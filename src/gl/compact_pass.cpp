@@ -13,7 +13,7 @@ static_assert(sizeof(pp::CompactParams) == 48);
 
 std::string_view compact_method_name(CompactMethod method) {
     if (method == CompactMethod::fused_append) return "fused";
-    return method == CompactMethod::atomic_append ? "atomic" : "scan";
+    return method == CompactMethod::atomic_append ? "append" : "scan";
 }
 
 std::size_t compact_command_count(std::size_t count, std::size_t patches_per_command) {

@@ -71,6 +71,19 @@ struct CullRenderer::Impl {
           depth(d),
           hiz_image(d),
           displacement(d) {
+        try {
+            create_objects();
+        } catch (...) {
+            destroy_objects();
+            throw;
+        }
+    }
+    ~Impl() {
+        vkDeviceWaitIdle(dev.device());
+        destroy_objects();
+    }
+    // The sampler, the timestamp pool and the first (empty) inputs; destroy_objects undoes them.
+    void create_objects() {
         VkSamplerCreateInfo sampler{};
         sampler.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
         sampler.magFilter = VK_FILTER_LINEAR;
@@ -90,10 +103,11 @@ struct CullRenderer::Impl {
         flags.assign(nullptr, 4);
         upload_patches(nullptr, 0, {}, false);
     }
-    ~Impl() {
-        vkDeviceWaitIdle(dev.device());
-        vkDestroySampler(dev.device(), linear, nullptr);
-        vkDestroyQueryPool(dev.device(), timestamps, nullptr);
+    void destroy_objects() {
+        if (linear) vkDestroySampler(dev.device(), linear, nullptr);
+        if (timestamps) vkDestroyQueryPool(dev.device(), timestamps, nullptr);
+        linear = VK_NULL_HANDLE;
+        timestamps = VK_NULL_HANDLE;
     }
     Impl(const Impl&) = delete;
     Impl& operator=(const Impl&) = delete;

@@ -49,7 +49,16 @@ VkPipelineLayout make_layout(VkDevice d, VkDescriptorSetLayout set) {
 }  // namespace
 
 DrawPipelines::DrawPipelines(HeadlessDevice& device) : device_(&device) {
-    const VkDevice d = device.device();
+    try {
+        create_layouts();
+    } catch (...) {
+        release();
+        throw;
+    }
+}
+
+void DrawPipelines::create_layouts() {
+    const VkDevice d = device_->device();
     std::vector<VkDescriptorSetLayoutBinding> patch_bindings;
     for (std::uint32_t b : kPatchStorageBindings)
         patch_bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_ALL_GRAPHICS, nullptr});
@@ -65,14 +74,22 @@ DrawPipelines::DrawPipelines(HeadlessDevice& device) : device_(&device) {
     if (!push_descriptors_) throw Error("Vulkan: CullRenderer: the device has no vkCmdPushDescriptorSetKHR");
 }
 
-DrawPipelines::~DrawPipelines() {
+DrawPipelines::~DrawPipelines() { release(); }
+
+void DrawPipelines::release() {
     const VkDevice d = device_->device();
-    for (const auto& [key, p] : pipelines_) vkDestroyPipeline(d, p, nullptr);
-    for (const auto& [name, m] : modules_) vkDestroyShaderModule(d, m, nullptr);
-    vkDestroyPipelineLayout(d, patch_layout_, nullptr);
-    vkDestroyPipelineLayout(d, occluder_layout_, nullptr);
-    vkDestroyDescriptorSetLayout(d, patch_set_, nullptr);
-    vkDestroyDescriptorSetLayout(d, occluder_set_, nullptr);
+    for (const auto& [key, p] : pipelines_)
+        if (p) vkDestroyPipeline(d, p, nullptr);
+    for (const auto& [name, m] : modules_)
+        if (m) vkDestroyShaderModule(d, m, nullptr);
+    pipelines_.clear();
+    modules_.clear();
+    if (patch_layout_) vkDestroyPipelineLayout(d, patch_layout_, nullptr);
+    if (occluder_layout_) vkDestroyPipelineLayout(d, occluder_layout_, nullptr);
+    if (patch_set_) vkDestroyDescriptorSetLayout(d, patch_set_, nullptr);
+    if (occluder_set_) vkDestroyDescriptorSetLayout(d, occluder_set_, nullptr);
+    patch_layout_ = occluder_layout_ = VK_NULL_HANDLE;
+    patch_set_ = occluder_set_ = VK_NULL_HANDLE;
 }
 
 VkShaderModule DrawPipelines::module(const char* shader, const char* variant) {

@@ -51,6 +51,8 @@ public:
     PFN_vkCmdPushDescriptorSetKHR push_descriptors() const { return push_descriptors_; }
 
 private:
+    void create_layouts();  ///< the set and pipeline layouts, the push-descriptor command
+    void release();         ///< destroys what exists
     VkShaderModule module(const char* shader, const char* variant);
     HeadlessDevice* device_;
     VkDescriptorSetLayout patch_set_ = VK_NULL_HANDLE, occluder_set_ = VK_NULL_HANDLE;

@@ -76,7 +76,7 @@ enum class CompactMethod {
     fused_append,
 };
 
-/// "atomic", "scan" or "fused".
+/// "append", "scan" or "fused": the CLI's --compact values.
 std::string_view compact_method_name(CompactMethod method);
 
 /// The commands CompactPass writes for a range of count patches with at most patches_per_command
