@@ -261,12 +261,9 @@ void CullPipeline::Impl::draw(int pass, std::uint32_t mask, std::uint32_t value,
 }
 
 std::size_t CullPipeline::Impl::patches_per_command() const {
-    // At most patches_per_draw() patches a command (llvmpipe's limit); on a software rasterizer a
-    // sixteenth of that (about 4096 tessellated vertices a command): llvmpipe's tessellation
-    // costs more per patch in larger draws (default scene, 640x360, tess 16: pass 2 took 216 ms
-    // with 226 patches a command, 34 ms with 16).
-    return passes.is_software() ? std::max<std::size_t>(1, renderer.patches_per_draw() / 16)
-                                : renderer.patches_per_draw();
+    // At most patches_per_draw() patches a command (llvmpipe's limit), a sixteenth of that on a
+    // software rasterizer (core/render_params.h).
+    return patches_per_indirect_command(renderer.patches_per_draw(), passes.is_software());
 }
 
 void CullPipeline::Impl::start_draw_list(int pass, const SpanPlan& plan) {

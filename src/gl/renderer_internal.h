@@ -322,8 +322,7 @@ struct PatchRenderer::Impl {
     // llvmpipe workaround 2 (header): at most 65536 / (L+1)^2 patches per sub-draw, L the largest
     // level of the set at `level` (depth scales included).
     std::size_t patches_per_draw(int level) const {
-        const int top = std::min(64, static_cast<int>(static_cast<float>(level) * max_tess_scale));
-        return std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((top + 1) * (top + 1)));
+        return max_patches_per_draw(std::min(64, static_cast<int>(static_cast<float>(level) * max_tess_scale)));
     }
 
     // Binds program dp (its selection mask and value set) with the buffers, marks, texture and

@@ -30,6 +30,7 @@
 #include <utility>
 
 #include "patchcull/core/error.h"
+#include "patchcull/core/render_params.h"
 #include "patchcull/import/osd_patch_table.h"
 #include "shared.h"
 
@@ -424,11 +425,10 @@ std::size_t OsdPatchTableDraw::tessellated_count() const {
 
 namespace {
 
-// llvmpipe's limit: at most 65536 / (L + 1)^2 patches a draw at level L, L = 2 OsdTessLevel()
+// llvmpipe's limit (core/render_params.h) at OpenSubdiv's largest level L = 2 OsdTessLevel()
 // (OpenSubdiv's uniform level doubles on patches of refinement level 0), at most 64.
-std::size_t max_patches_per_draw(float tess_level) {
-    const int top = std::min(64, static_cast<int>(std::ceil(2.0f * tess_level)));
-    return std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((top + 1) * (top + 1)));
+std::size_t osd_patches_per_draw(float tess_level) {
+    return max_patches_per_draw(std::min(64, static_cast<int>(std::ceil(2.0f * tess_level))));
 }
 
 void check_view(const OsdView& view) {
@@ -504,7 +504,7 @@ void OsdPatchTableDraw::draw(const OsdVertexBuffer& vertices, std::uint32_t flag
         // draw of more than 65536 / (L + 1)^2 patches at level L wrong (docs/ENGINE.md): L is
         // OpenSubdiv's largest level, 2 OsdTessLevel() (refinement level 0).
         const std::size_t n = static_cast<std::size_t>(a.control_vertices);
-        const std::size_t step = m.software ? std::min(1024 / n, max_patches_per_draw(view.tess_level)) : a.patches;
+        const std::size_t step = m.software ? std::min(1024 / n, osd_patches_per_draw(view.tess_level)) : a.patches;
         for (std::size_t at = 0; at < a.patches; at += step) {
             const std::size_t count = std::min(step, a.patches - at);
             glUniform1i(p.primitive_id_base, static_cast<GLint>(a.first_patch + at));
@@ -688,7 +688,7 @@ struct OsdCullFrame::Impl {
     // CullPipeline's indirect draw): 65536 / (L + 1)^2 / 16 patches at OpenSubdiv's largest level
     // L = 2 OsdTessLevel() (a patch of refinement level 0 gets twice the uniform level).
     std::size_t patches_per_command(float tess_level) const {
-        return software ? std::max<std::size_t>(1, max_patches_per_draw(tess_level) / 16) : 0;
+        return software ? patches_per_indirect_command(osd_patches_per_draw(tess_level), true) : 0;
     }
 
     gl_osd::OsdDrawList draw_list(int pass, std::size_t k) {

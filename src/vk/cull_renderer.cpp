@@ -158,9 +158,8 @@ struct CullRenderer::Impl {
     void ensure_targets(int w, int h);
     DrawPushConstants push_constants(const RenderParams& rp, bool mark_drawn) const;
     int level(const RenderParams& rp) const { return std::clamp(rp.tess_level, 1, 64); }
-    std::size_t patches_per_draw(int lvl) const {
-        const int top = std::min(64, static_cast<int>(static_cast<float>(lvl) * max_tess_scale));
-        return std::max<std::size_t>(1, 65536 / static_cast<std::size_t>((top + 1) * (top + 1)));
+    std::size_t patches_per_draw(int lvl) const {  // core/render_params.h's llvmpipe split
+        return max_patches_per_draw(std::min(64, static_cast<int>(static_cast<float>(lvl) * max_tess_scale)));
     }
     PatchBuffers chain_buffers(bool displacing) const {
         PatchBuffers b;
@@ -288,8 +287,7 @@ struct CullRenderer::Impl {
     // Lists the patches of pass `pass` that (w & mask) == value keeps (before the rendering).
     void compact_pass(VkCommandBuffer cmd, int pass, std::uint32_t mask, std::uint32_t value, int lvl,
                       CompactMethod method) {
-        const std::size_t k =
-            dev.is_software() ? std::max<std::size_t>(1, patches_per_draw(lvl) / 16) : patches_per_draw(lvl);
+        const std::size_t k = patches_per_indirect_command(patches_per_draw(lvl), dev.is_software());
         const std::size_t command_count = compact_command_count(count, k);
         lists[pass].reserve(std::max<std::size_t>(count, 1) * 4);
         commands[pass].reserve(command_count * 16);
