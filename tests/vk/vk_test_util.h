@@ -1,8 +1,7 @@
-// The Vulkan tests' context: one headless instance and device per test process on Mesa's
-// lavapipe (the physical device of type CPU), with VK_LAYER_KHRONOS_validation and its
-// synchronization validation on, and a debug messenger that keeps every message the layers and
-// the loader report at warning or error severity (and every validation message). VkTest, the
-// fixture of the Vulkan tests, fails a test that leaves any message.
+// The Vulkan tests' context: one vk::HeadlessDevice per test process (vk_device.h: Mesa's
+// lavapipe, the CPU device, with VK_LAYER_KHRONOS_validation and its synchronization validation
+// on, keeping every warning and error the layers and the loader report). VkTest, the fixture of
+// the Vulkan tests, fails a test that leaves any message.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -16,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "patchcull/vk/vk_device.h"
 #include "patchcull/vk/vk_passes.h"
 
 namespace patchcull::vk::test {
@@ -29,9 +29,9 @@ public:
     Context(const Context&) = delete;
     Context& operator=(const Context&) = delete;
 
-    VkInstance instance() const { return instance_; }
-    VkPhysicalDevice physical_device() const { return physical_device_; }
-    VkDevice device() const { return device_; }
+    VkInstance instance() const { return device_.instance(); }
+    VkPhysicalDevice physical_device() const { return device_.physical_device(); }
+    VkDevice device() const { return device_.device(); }
     /// The process's PassContext on device() (exact fma).
     PassContext& passes();
 
@@ -39,22 +39,14 @@ public:
     /// submits it and waits for it.
     void submit(const std::function<void(VkCommandBuffer)>& record);
 
-    /// The messages reported since the last call (and forgets them).
+    /// The messages reported since the last call (and forgets them); with
+    /// PATCHCULL_VK_TEST_PRINT set, each is also printed on stderr.
     std::vector<std::string> take_messages();
-    /// Adds a message (the messenger's callback).
-    void report(std::string message) { messages_.push_back(std::move(message)); }
 
 private:
     Context();
-    VkInstance instance_ = VK_NULL_HANDLE;
-    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
-    VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
-    VkDevice device_ = VK_NULL_HANDLE;
-    VkQueue queue_ = VK_NULL_HANDLE;
-    std::uint32_t queue_family_ = 0;
-    VkCommandPool pool_ = VK_NULL_HANDLE;
+    HeadlessDevice device_;  // vk_device.h: lavapipe, validation and synchronization validation on
     std::unique_ptr<PassContext> passes_;
-    std::vector<std::string> messages_;
 };
 
 /// A storage buffer in host-visible, coherent memory, mapped for its lifetime.
