@@ -62,6 +62,7 @@ void FrameChain::run(const HiZTexture* hiz, const std::vector<std::size_t>* only
     for (std::size_t i : *only)
         for (const PatchSpan& s : plan_.object_spans[i]) end_span(s, i);
     if (with_gaps) end_gaps();
+    append_pass_ = -1;  // append_to holds for one run
     if (timed) clock_.mark();
 }
 

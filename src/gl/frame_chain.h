@@ -43,10 +43,11 @@ public:
     /// begin / end on the gaps alone (counted in the last counter slot).
     void begin_gaps();
     void end_gaps();
-    /// CompactMethod::fused_append: the ends after this append each dispatch span's patches that
-    /// (flag & mask) == value keeps to draw pass `pass`'s list (CullPipeline::Impl::
+    /// CompactMethod::fused_append: the ends of the next run() append each dispatch span's patches
+    /// that (flag & mask) == value keeps to draw pass `pass`'s list (CullPipeline::Impl::
     /// reserve_draw_list), in the order of the plan's drawn spans when the plan has no culled
-    /// spans (every dispatch span is then a drawn span); -1 (the default) appends nothing.
+    /// spans (every dispatch span is then a drawn span). For that one run: run() clears it, and
+    /// without it (the default) nothing is appended.
     void append_to(int pass, std::uint32_t mask, std::uint32_t value) {
         append_pass_ = pass;
         append_mask_ = mask;

@@ -269,7 +269,11 @@ void HeadlessDevice::submit(const std::function<void(VkCommandBuffer)>& record) 
     submit_info.commandBufferCount = 1;
     submit_info.pCommandBuffers = &cmd;
     VkResult r = vkQueueSubmit(queue_, 1, &submit_info, fence);
-    if (r == VK_SUCCESS) r = vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX);
+    if (r == VK_SUCCESS) {
+        r = vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX);
+        // The command buffer must not be pending when the guard frees it.
+        if (r != VK_SUCCESS) vkDeviceWaitIdle(device_);
+    }
     vkDestroyFence(device_, fence, nullptr);
     check(r, "vkQueueSubmit");
 }
