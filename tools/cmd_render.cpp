@@ -86,6 +86,7 @@
 #include "commands.h"
 #include "cull_mode_names.h"
 #include "frame_poser.h"
+#include "frame_report.h"
 #include "object_level_options.h"
 #include "patchcull/core/error.h"
 #include "patchcull/eval_gl/reference_frame.h"
@@ -431,11 +432,7 @@ Runner add_render_command(CLI::App& app) {
                 }
                 write_bounds_png(state->out, pipeline.renderer().read_color(), ids, width, height, bounds);
             }
-            nlohmann::json ms = {{"pass1", stats.pass1_ms},
-                                 {"hiz", stats.hiz_ms},
-                                 {"cull", stats.cull_ms},
-                                 {"pass2", stats.pass2_ms},
-                                 {"total", stats.total_ms}};
+            nlohmann::json ms = frame_ms_json(stats);
             if (object_level->enabled()) {
                 ms["object_level"] = object_level->object_level_ms();  // CPU, before the GPU frame
                 ms["cpu_frustum_after_objects"] = object_level->cpu_frustum_ms();
@@ -458,27 +455,16 @@ Runner add_render_command(CLI::App& app) {
                 ms["reference"] = reference.ms;
             }
             total_false += false_culls;
-            frames.push_back({{"frame", f},
-                              {"pass1_drawn", stats.pass1_drawn},
-                              {"pass2_drawn", stats.pass2_drawn},
-                              {"frustum_culled", stats.frustum_culled},
-                              {"backpatch_culled", stats.backpatch_culled},
-                              {"occlusion_culled", stats.occlusion_culled},
-                              {"displaced_occlusion_culled", stats.displaced_occlusion_culled},
-                              {"visible", stats.visible},
-                              {"newly_visible", stats.newly_visible},
-                              {"ms", ms},
-                              {"pose",
-                               {{"where", pose_where_name(pose_cost.where)},
-                                {"cpu_patches", pose_cost.cpu_patches},
-                                {"cpu_ms", pose_cost.cpu_ms},
-                                {"done_ms", pose_cost.done_ms},
-                                {"meshes_ms", pose_cost.meshes_ms},
-                                {"bytes_uploaded", pose_cost.bytes_uploaded}}},
-                              {"false_culls", false_culls},
-                              {"depth_ties", depth_ties},
-                              {"fused_pass", stats.fused_pass},
-                              {"submitted", {{"pass1", stats.pass1_submitted}, {"pass2", stats.pass2_submitted}}}});
+            frames.push_back(frame_counts_json(f, stats));
+            frames.back()["ms"] = ms;
+            frames.back()["pose"] = {{"where", pose_where_name(pose_cost.where)},
+                                     {"cpu_patches", pose_cost.cpu_patches},
+                                     {"cpu_ms", pose_cost.cpu_ms},
+                                     {"done_ms", pose_cost.done_ms},
+                                     {"meshes_ms", pose_cost.meshes_ms},
+                                     {"bytes_uploaded", pose_cost.bytes_uploaded}};
+            frames.back()["false_culls"] = false_culls;
+            frames.back()["depth_ties"] = depth_ties;
             if (!false_culled.empty()) frames.back()["false_culled_patches"] = false_culled;
             if (state->verify) frames.back()["differing_pixels"] = differing_pixels;
             if (automatic) frames.back()["auto_objects"] = auto_objects_json(objects, policy.decisions());
@@ -492,12 +478,7 @@ Runner add_render_command(CLI::App& app) {
                 }
             }
             if (!state->json) {
-                std::printf(
-                    "frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu "
-                    "(displaced %zu); ms pass1 %.1f hiz %.1f cull %.1f pass2 %.1f",
-                    f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled,
-                    stats.backpatch_culled, stats.occlusion_culled, stats.displaced_occlusion_culled, stats.pass1_ms,
-                    stats.hiz_ms, stats.cull_ms, stats.pass2_ms);
+                print_frame_line(f, stats);
                 if (state->verify) std::printf("; false culls %zu", false_culls);
                 std::printf("\n");
                 if (object_level->enabled()) {

@@ -11,6 +11,7 @@
 
 #ifdef PATCHCULL_CLI_VULKAN
 #include "frame_poser.h"
+#include "frame_report.h"
 #include "patchcull/eval_gl/reference_frame.h"
 #include "patchcull/eval_gl/scene_setup.h"
 #include "patchcull/gl/gl_verification.h"
@@ -108,36 +109,16 @@ int run_vulkan_render(const VulkanRenderJob& job) {
         const std::vector<std::string> frame_messages = device.take_messages();
         for (const std::string& m : frame_messages) std::fprintf(stderr, "Vulkan validation: %s\n", m.c_str());
         messages += frame_messages.size();
-        nlohmann::json frame = {{"frame", f},
-                                {"pass1_drawn", stats.pass1_drawn},
-                                {"pass2_drawn", stats.pass2_drawn},
-                                {"frustum_culled", stats.frustum_culled},
-                                {"backpatch_culled", stats.backpatch_culled},
-                                {"occlusion_culled", stats.occlusion_culled},
-                                {"displaced_occlusion_culled", stats.displaced_occlusion_culled},
-                                {"visible", stats.visible},
-                                {"newly_visible", stats.newly_visible},
-                                {"ms",
-                                 {{"pass1", stats.pass1_ms},
-                                  {"hiz", stats.hiz_ms},
-                                  {"cull", stats.cull_ms},
-                                  {"pass2", stats.pass2_ms},
-                                  {"total", stats.total_ms}}},
-                                {"false_culls", false_culls},
-                                {"depth_ties", depth_ties},
-                                {"fused_pass", stats.fused_pass},
-                                {"submitted", {{"pass1", stats.pass1_submitted}, {"pass2", stats.pass2_submitted}}},
-                                {"validation_messages", frame_messages.size()}};
+        nlohmann::json frame = frame_counts_json(f, stats);  // the GL run's keys (frame_report.h)
+        frame["ms"] = frame_ms_json(stats);
+        frame["false_culls"] = false_culls;
+        frame["depth_ties"] = depth_ties;
+        frame["validation_messages"] = frame_messages.size();
         if (!false_culled.empty()) frame["false_culled_patches"] = false_culled;
         if (job.verify) frame["differing_pixels"] = differing_pixels;
         frames.push_back(frame);
         if (!job.json) {
-            std::printf(
-                "frame %d: drawn %zu + %zu of %zu; culled frustum %zu, back-patch %zu, occlusion %zu (displaced %zu); "
-                "ms pass1 %.1f hiz %.1f cull %.1f pass2 %.1f",
-                f, stats.pass1_drawn, stats.pass2_drawn, stats.patches, stats.frustum_culled, stats.backpatch_culled,
-                stats.occlusion_culled, stats.displaced_occlusion_culled, stats.pass1_ms, stats.hiz_ms, stats.cull_ms,
-                stats.pass2_ms);
+            print_frame_line(f, stats);
             if (job.verify) std::printf("; false culls %zu", false_culls);
             std::printf("\n");
         }
