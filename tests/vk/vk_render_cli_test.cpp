@@ -165,6 +165,8 @@ TEST(VulkanRenderCli, RefusesWhatItCannotDraw) {
     expect_one_line_error(run("render --api vulkan --pose gpu --frames 1"), "--pose");
     expect_one_line_error(run("render --api vulkan --compact fused --frames 1"), "--compact fused");
     expect_one_line_error(run("render --vk-validation --frames 1"), "--vk-validation");
+    expect_one_line_error(run("render --vk-device gpu --frames 1"), "--vk-device");
+    expect_one_line_error(run("render --api vulkan --vk-device tpu --frames 1"), "--vk-device");
     expect_one_line_error(run("render --api metal --frames 1"), "--api");
     expect_one_line_error(run("render bigguy --scheme osd --patch-source osd-table --api vulkan --frames 1"), "--api");
 }
