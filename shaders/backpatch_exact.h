@@ -10,9 +10,13 @@
 //   with (m- + m) / 2 < A / B < (m + m+) / 2, m-/m+ its neighbours (A / B is never exactly a
 //   midpoint of two floats). The midpoints have 25 significant bits, so mid * B (25 x 24 bits)
 //   is exact in double and A < mid * B is an exact comparison. Three steps of one ulp each cover
-//   the 2.5 ULP GLSL allows. (On llvmpipe a / b and sqrt are already correctly rounded, so the
-//   correction never moves there; the probe's *_from modes test it from perturbed guesses.)
+//   the 2.5 ULP GLSL allows.
 //   sqrt: likewise with x < mid * mid (mid^2 has 50 bits: exact in double).
+// On llvmpipe a / b and sqrt are already correctly rounded (LLVM's fdiv and sqrt), so the
+// correction never moves there, yet costs its full length: llvmpipe runs both sides of every
+// branch. With PATCHCULL_NATIVE_DIV_SQRT defined (the GL passes define it on a software rasterizer
+// whose / and sqrt pass the start-up check, gl_passes.h) pc_div and pc_sqrt are the driver's own.
+// The probe's *_from modes test the correction from perturbed guesses either way.
 // Exact as long as double +, * are correctly rounded (IEEE; llvmpipe and the GPUs we know). Not
 // handled (values returned as the driver computes them): zero, negative, infinite or NaN
 // operands and results, and subnormal results (llvmpipe flushes float subnormals to zero, the
@@ -45,11 +49,6 @@ float pc_div_from(float a, float b, float q) {
     return ((a < 0.0) != (b < 0.0)) ? -m : m;
 }
 
-/// a / b correctly rounded (std's a / b for normal operands and results).
-float pc_div(float a, float b) {
-    precise float q = a / b;
-    return pc_div_from(a, b, q);
-}
 
 /// sqrt(x) correctly rounded from a guess s within 3 ulps of it (used as is when x or s is zero,
 /// negative, infinite or NaN).
@@ -68,11 +67,28 @@ float pc_sqrt_from(float x, float s) {
     return s;
 }
 
-/// sqrt(x) correctly rounded (std::sqrt for normal x > 0).
+/// a / b and sqrt(x) correctly rounded (std's a / b and std::sqrt for normal operands and
+/// results): the driver's own where PATCHCULL_NATIVE_DIV_SQRT says it rounds them correctly,
+/// else corrected from its value.
+#ifdef PATCHCULL_NATIVE_DIV_SQRT
+float pc_div(float a, float b) {
+    precise float q = a / b;
+    return q;
+}
+float pc_sqrt(float x) {
+    precise float s = sqrt(x);
+    return s;
+}
+#else
+float pc_div(float a, float b) {
+    precise float q = a / b;
+    return pc_div_from(a, b, q);
+}
 float pc_sqrt(float x) {
     precise float s = sqrt(x);
     return pc_sqrt_from(x, s);
 }
+#endif
 
 float pc_min_like(float a, float b) {
     precise float r = a < b ? a : b;

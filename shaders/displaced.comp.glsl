@@ -102,7 +102,12 @@ void main() {
         bound = pc_displaced_bound_with_cone(P, range, cone, u_bound_kind);
     }
     uint reason = 0u;
-    if (displaced.occlusion != 0u) {
+#ifdef PC_DISPLACED_OCCLUSION
+    const bool occlusion = PC_DISPLACED_OCCLUSION != 0;  // one program each (flag_chain.h's PC_MARGINS)
+#else
+    const bool occlusion = displaced.occlusion != 0u;
+#endif
+    if (occlusion) {
         const uint decision = pc_hiz_decision(bound);
         reason = decision == kPcHiZFrustumCulled ? kCullFrustum : decision == kPcHiZOccluded ? kCullOcclusion : 0u;
     } else if (pc_bound_outside_frustum(bound)) {

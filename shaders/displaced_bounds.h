@@ -315,8 +315,14 @@ PcDisplacedBound pc_displaced_bound_with_cone(vec4 P[16], vec2 range, PcCone con
     const float radius = pc_max_like(d_max, -d_min);
     PcCone used = cone;
     if (!(cone.valid && pc_finite(cone.axis.x) && pc_finite(cone.axis.y) && pc_finite(cone.axis.z))) used.valid = false;
+#ifdef PC_DISPLACED_BOUND
+    // One program per bound kind (llvmpipe would compute both bounds for a uniform choice).
+    return PC_DISPLACED_BOUND == kDisplacedBoundCaf ? pc_caf_bound(p, used, d_min, d_max, radius)
+                                                    : pc_oobb_bound(p, used, d_min, d_max, radius);
+#else
     return bound_kind == kDisplacedBoundCaf ? pc_caf_bound(p, used, d_min, d_max, radius)
                                             : pc_oobb_bound(p, used, d_min, d_max, radius);
+#endif
 }
 
 /// outside_frustum of a bound.

@@ -19,5 +19,14 @@ bool pc_chain_culled(uint p) { return (cull_flags[p] & kCullReasonMask) != 0u; }
 // Culls patch p with `reason` (its status bits kept).
 void pc_chain_cull(uint p, uint reason) { cull_flags[p] = (cull_flags[p] & ~kCullReasonMask) | reason; }
 
+// Whether the pass has a margin buffer: its has_margins flag, or the constant PC_MARGINS (0 or 1)
+// where the pass compiles one program for each (llvmpipe runs both sides of a branch even on a
+// uniform, so a constant drops the unused side's cost).
+#ifdef PC_MARGINS
+#define PC_HAS_MARGINS(has_margins) (PC_MARGINS != 0)
+#else
+#define PC_HAS_MARGINS(has_margins) ((has_margins) != 0u)
+#endif
+
 // Patch p's displacement margin, 0 without a margin buffer.
-float pc_margin(uint p, uint has_margins) { return has_margins != 0u ? max_displacement[p] : 0.0; }
+float pc_margin(uint p, uint has_margins) { return PC_HAS_MARGINS(has_margins) ? max_displacement[p] : 0.0; }

@@ -39,7 +39,7 @@ void main() {
 #endif
     const float d = pc_margin(p, frustum.has_margins);
     float mx[6];
-    if (pc_frustum_culled(p, frustum.has_margins != 0u, d, mx)) pc_chain_cull(p, kCullFrustum);
+    if (pc_frustum_culled(p, PC_HAS_MARGINS(frustum.has_margins), d, mx)) pc_chain_cull(p, kCullFrustum);
     if (frustum.write_plane_values != 0u)
         for (int q = 0; q < 6; ++q) plane_values[6u * p + uint(q)] = mx[q];
 }

@@ -133,7 +133,7 @@ void main() {
     PcFusedPoints points;
     points.frustum_culled = false;
     points.projectable = false;
-    if (frustum_tested || hiz_tested) points = pc_fused_points(p, frustum_tested, hiz_tested, fused.has_margins != 0u, d);
+    if (frustum_tested || hiz_tested) points = pc_fused_points(p, frustum_tested, hiz_tested, PC_HAS_MARGINS(fused.has_margins), d);
     if (points.frustum_culled) {
         pc_chain_cull(p, kCullFrustum);
         return;

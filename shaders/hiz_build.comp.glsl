@@ -36,8 +36,14 @@ float depth_key(float d) {
 }
 
 float source(int x, int y) {
-    return hiz_build.from_depth != 0u ? depth_key(texelFetch(u_depth, ivec2(x, y), 0).r)
-                                      : texelFetch(u_hiz, ivec2(x, y), hiz_build.source_level).r;
+#ifdef PC_HIZ_FROM_DEPTH
+    // One program for level 0 and one for the others (llvmpipe runs both sides of a branch).
+    const bool from_depth = PC_HIZ_FROM_DEPTH != 0;
+#else
+    const bool from_depth = hiz_build.from_depth != 0u;
+#endif
+    return from_depth ? depth_key(texelFetch(u_depth, ivec2(x, y), 0).r)
+                      : texelFetch(u_hiz, ivec2(x, y), hiz_build.source_level).r;
 }
 
 void main() {

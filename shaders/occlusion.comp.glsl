@@ -68,9 +68,14 @@ void main() {
     if (!pc_gather_source(p)) return;
 #endif
     const float d = pc_margin(p, occlusion.has_margins);
-    if (occlusion.with_frustum != 0u) {
+#ifdef PC_WITH_FRUSTUM
+    const bool with_frustum = PC_WITH_FRUSTUM != 0;  // one program each (see PC_MARGINS)
+#else
+    const bool with_frustum = occlusion.with_frustum != 0u;
+#endif
+    if (with_frustum) {
         float mx[6];
-        if (pc_frustum_culled(p, occlusion.has_margins != 0u, d, mx)) {
+        if (pc_frustum_culled(p, PC_HAS_MARGINS(occlusion.has_margins), d, mx)) {
             pc_chain_cull(p, kCullFrustum);
             return;
         }

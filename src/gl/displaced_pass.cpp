@@ -76,7 +76,10 @@ void DisplacedPass::run(const PatchBuffers& patches, std::uint32_t ranges, Displ
         glTextureParameteri(m.placeholder_hiz, GL_TEXTURE_MIN_FILTER, GL_NEAREST_MIPMAP_NEAREST);
         glTextureParameteri(m.placeholder_hiz, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     }
-    const std::string defines = "#define PC_DISPLACED_CONE " + std::to_string(static_cast<int>(cone)) + "\n";
+    // One program per cone, bound and test (llvmpipe would run every side of a uniform branch).
+    const std::string defines = "#define PC_DISPLACED_CONE " + std::to_string(static_cast<int>(cone)) +
+                                "\n#define PC_DISPLACED_BOUND " + std::to_string(params.bound_kind) +
+                                "u\n#define PC_DISPLACED_OCCLUSION " + (hiz ? "1" : "0") + "\n";
     glUseProgram(m.context.program("displaced.comp.glsl", defines));
     detail::bind_patch_buffers(patches);
     if (ranges) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingDisplacementRanges, ranges);

@@ -23,7 +23,7 @@ void FrustumPass::run(const PatchBuffers& patches, const FrustumPlanes& planes, 
     detail::store_planes(planes, params.clip_rows, params.plane_normal_length, params.plane_depth);
     params.has_margins = patches.margins ? 1u : 0u;
     params.write_plane_values = plane_values ? 1u : 0u;
-    glUseProgram(impl_->context.program("frustum.comp.glsl"));
+    glUseProgram(impl_->context.program("frustum.comp.glsl", detail::margins_define(patches.margins != 0)));
     detail::bind_patch_buffers(patches);
     if (plane_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingPlaneValues, plane_values);
     detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kCullGroupSize);
@@ -45,7 +45,8 @@ void FrustumPass::run(const GpuPatchSource& source, const FrustumPlanes& planes,
     detail::store_planes(planes, params.clip_rows, params.plane_normal_length, params.plane_depth);
     params.has_margins = source.margins ? 1u : 0u;
     params.write_plane_values = plane_values ? 1u : 0u;
-    glUseProgram(impl_->context.program("frustum.comp.glsl", detail::patch_source_defines(source)));
+    glUseProgram(impl_->context.program("frustum.comp.glsl", std::string(detail::patch_source_defines(source)) +
+                                                                 detail::margins_define(source.margins != 0)));
     detail::bind_patch_source(*impl_, source, source_params);
     if (plane_values) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingPlaneValues, plane_values);
     detail::dispatch_patches(impl_->block, params, source.first, source.count, shared::kCullGroupSize);

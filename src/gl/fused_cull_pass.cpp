@@ -56,7 +56,9 @@ void FusedCullPass::run(const PatchBuffers& patches, std::uint32_t tests, const 
     pp::FusedCullParams params = fused_params(tests, any_object_to_clip, depth, method, eye, hiz, patches.margins != 0);
     if (patches.count == 0 || tests == 0) return;
     const bool ncone = (tests & shared::kCullBackPatch) != 0 && method == BackpatchMethod::ncone;
-    glUseProgram(impl_->context.program("fused_cull.comp.glsl", ncone ? "#define PATCHCULL_NCONE 1\n" : ""));
+    glUseProgram(impl_->context.program(
+        "fused_cull.comp.glsl",
+        std::string(ncone ? "#define PATCHCULL_NCONE 1\n" : "") + detail::margins_define(patches.margins != 0)));
     detail::bind_patch_buffers(patches);
     if (tests & shared::kCullOcclusion) glBindTextureUnit(shared::kTextureUnitHiZ, hiz->texture);
     detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kCullGroupSize);
@@ -72,8 +74,8 @@ void FusedCullPass::run(const GpuPatchSource& source, std::uint32_t tests, const
     // A Gregory program has one cone for both methods (its Gregory tangent cone).
     const bool ncone = (tests & shared::kCullBackPatch) != 0 && method == BackpatchMethod::ncone &&
                        source.basis != PatchBasis::gregory;
-    const std::string defines =
-        std::string(ncone ? "#define PATCHCULL_NCONE 1\n" : "") + detail::patch_source_defines(source);
+    const std::string defines = std::string(ncone ? "#define PATCHCULL_NCONE 1\n" : "") +
+                                detail::patch_source_defines(source) + detail::margins_define(source.margins != 0);
     glUseProgram(impl_->context.program("fused_cull.comp.glsl", defines));
     detail::bind_patch_source(*impl_, source, source_params);
     if (tests & shared::kCullOcclusion) glBindTextureUnit(shared::kTextureUnitHiZ, hiz->texture);

@@ -48,7 +48,6 @@ void HiZBuildPass::run(std::uint32_t depth_texture, HiZTexture& hiz, ClipDepth c
         }
     }
     hiz.reversed = is_reversed(convention);
-    glUseProgram(impl_->context.program("hiz_build.comp.glsl"));
     glBindTextureUnit(shared::kTextureUnitDepth, depth_texture);
     glBindTextureUnit(shared::kTextureUnitHiZ, hiz.texture);
     const int levels = HiZPyramid::level_count(hiz.width, hiz.height);
@@ -64,6 +63,9 @@ void HiZBuildPass::run(std::uint32_t depth_texture, HiZTexture& hiz, ClipDepth c
         params.out_height = out_h;
         params.reversed = hiz.reversed ? 1u : 0u;
         params.unorm24 = unorm24 ? 1u : 0u;
+        if (l < 2)  // level 0 reads the depth texture, the others the pyramid: a program each
+            glUseProgram(impl_->context.program(
+                "hiz_build.comp.glsl", l == 0 ? "#define PC_HIZ_FROM_DEPTH 1\n" : "#define PC_HIZ_FROM_DEPTH 0\n"));
         impl_->block.upload(params);
         glBindImageTexture(shared::kImageUnitHiZOut, hiz.texture, l, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
         glDispatchCompute((static_cast<GLuint>(out_w) + shared::kHiZGroupSize - 1) / shared::kHiZGroupSize,

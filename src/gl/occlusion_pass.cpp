@@ -31,6 +31,12 @@ pp::OcclusionParams make_params(const FrustumPlanes& planes, const HiZTexture& h
     return params;
 }
 
+/// The program's constants (flag_chain.h's PC_MARGINS, PC_WITH_FRUSTUM): one program each.
+std::string defines(bool has_margins, bool with_frustum) {
+    return std::string(detail::margins_define(has_margins)) + "#define PC_WITH_FRUSTUM " + (with_frustum ? "1" : "0") +
+           "\n";
+}
+
 }  // namespace
 
 OcclusionPass::OcclusionPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
@@ -46,7 +52,7 @@ void OcclusionPass::run(const PatchBuffers& patches, const Mat4& any_object_to_c
     const FrustumPlanes planes = make_frustum_planes(any_object_to_clip, depth);  // refuses a contradiction
     if (patches.count == 0) return;
     pp::OcclusionParams params = make_params(planes, hiz, patches.margins != 0, with_frustum);
-    glUseProgram(impl_->context.program("occlusion.comp.glsl"));
+    glUseProgram(impl_->context.program("occlusion.comp.glsl", defines(patches.margins != 0, with_frustum)));
     detail::bind_patch_buffers(patches);
     glBindTextureUnit(shared::kTextureUnitHiZ, hiz.texture);
     detail::dispatch_patches(impl_->block, params, patches.first, patches.count, shared::kCullGroupSize);
@@ -65,7 +71,8 @@ void OcclusionPass::run(const GpuPatchSource& source, const Mat4& any_object_to_
     const FrustumPlanes planes = make_frustum_planes(any_object_to_clip, depth);  // refuses a contradiction
     if (source.count == 0) return;
     pp::OcclusionParams params = make_params(planes, hiz, source.margins != 0, with_frustum);
-    glUseProgram(impl_->context.program("occlusion.comp.glsl", detail::patch_source_defines(source)));
+    glUseProgram(impl_->context.program(
+        "occlusion.comp.glsl", detail::patch_source_defines(source) + defines(source.margins != 0, with_frustum)));
     detail::bind_patch_source(*impl_, source, source_params);
     glBindTextureUnit(shared::kTextureUnitHiZ, hiz.texture);
     detail::dispatch_patches(impl_->block, params, source.first, source.count, shared::kCullGroupSize);

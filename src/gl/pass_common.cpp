@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <random>
 
 namespace patchcull::gl {
 
@@ -52,13 +53,19 @@ PassContext::Impl::~Impl() {
 }
 
 GLuint PassContext::Impl::program(const char* shader, const std::string& defines) {
-    const std::string all = (fma_via_double ? "#define PATCHCULL_FMA_VIA_DOUBLE 1\n" : "") + defines;
+    const std::string all = std::string(fma_via_double ? "#define PATCHCULL_FMA_VIA_DOUBLE 1\n" : "") +
+                            (native_div_sqrt ? "#define PATCHCULL_NATIVE_DIV_SQRT 1\n" : "") + defines;
     const std::string key = std::string(shader) + "\n" + all;
     auto it = programs.find(key);
     if (it != programs.end()) return it->second;
     const GLuint p = link_program({{shader, GL_COMPUTE_SHADER}}, shader, all);
     programs.emplace(key, p);
     return p;
+}
+
+void PassContext::Impl::drop_programs() {
+    for (const auto& [key, program] : programs) glDeleteProgram(program);
+    programs.clear();
 }
 
 namespace {
@@ -98,10 +105,36 @@ PassContext::PassContext() : impl_(std::make_unique<Impl>()) {
         for (std::size_t i = 0; i < cases.size(); ++i)
             once = once && got[i] == std::fma(cases[i].x, cases[i].y, cases[i].z);
         if (!once) {
-            for (const auto& [key, program] : m.programs) glDeleteProgram(program);
-            m.programs.clear();
+            m.drop_programs();
             m.fma_via_double = true;
         }
+    }
+    if (m.software) {
+        // The driver's a / b and sqrt, used as they are when they round correctly here: quotients
+        // and roots within half an ulp of a midpoint between two floats (where a 1-ulp
+        // approximation or a second rounding often gives the other neighbour), and random ones
+        // over wide ranges.
+        m.native_div_sqrt = true;
+        std::vector<Vec3> div_cases, sqrt_cases;
+        std::mt19937 rng(2024);
+        std::uniform_int_distribution<std::uint32_t> mantissa(0, (1u << 23) - 1);
+        std::uniform_int_distribution<int> exponent(-60, 60);
+        auto random_float = [&](int e) { return std::ldexp(1.0f + std::ldexp(float(mantissa(rng)), -23), e); };
+        for (int i = 0; i < 2048; ++i) {
+            // mid: halfway between m and its upper neighbour (25 bits, exact in double).
+            const float m_value = random_float(0), b = random_float(exponent(rng));
+            const double mid = static_cast<double>(m_value) + std::ldexp(1.0, -24);
+            div_cases.push_back({static_cast<float>(mid * b), b, 0.0f});
+            sqrt_cases.push_back({static_cast<float>(mid * mid), 0.0f, 0.0f});
+            div_cases.push_back({random_float(exponent(rng)), random_float(exponent(rng)), 0.0f});
+            sqrt_cases.push_back({random_float(exponent(rng)), 0.0f, 0.0f});
+        }
+        const std::vector<float> q = probe(BackpatchProbe::div, div_cases);
+        const std::vector<float> r = probe(BackpatchProbe::sqrt, sqrt_cases);
+        for (std::size_t i = 0; i < div_cases.size(); ++i)
+            m.native_div_sqrt =
+                m.native_div_sqrt && q[i] == div_cases[i].x / div_cases[i].y && r[i] == std::sqrt(sqrt_cases[i].x);
+        if (!m.native_div_sqrt) m.drop_programs();
     }
 }
 
@@ -109,6 +142,7 @@ PassContext::PassContext(PassContext&&) noexcept = default;
 PassContext& PassContext::operator=(PassContext&&) noexcept = default;
 PassContext::~PassContext() = default;
 bool PassContext::fma_via_double() const { return impl_->fma_via_double; }
+bool PassContext::native_div_sqrt() const { return impl_->native_div_sqrt; }
 bool PassContext::is_software() const { return impl_->software; }
 PassContext::Impl& PassContext::impl() { return *impl_; }
 

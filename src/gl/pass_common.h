@@ -21,14 +21,18 @@ struct DrawListBuffers;  // gl_compaction.h
 
 struct PassContext::Impl {
     bool fma_via_double = false;
+    bool native_div_sqrt = false;  // PATCHCULL_NATIVE_DIV_SQRT (shaders/backpatch_exact.h)
     bool software = false;
     std::map<std::string, GLuint> programs;  // key: shader name + "\n" + defines
     GLint64 max_storage_block = -1;          // GL_MAX_SHADER_STORAGE_BLOCK_SIZE, read on the first source run
     GLuint probe_in = 0, probe_out = 0;
     ~Impl();
     /// The program of compute shader `shader` with `defines` (lines "#define X 1\n"), plus
-    /// PATCHCULL_FMA_VIA_DOUBLE when fma_via_double; compiled on first use.
+    /// PATCHCULL_FMA_VIA_DOUBLE when fma_via_double and PATCHCULL_NATIVE_DIV_SQRT when
+    /// native_div_sqrt; compiled on first use.
     GLuint program(const char* shader, const std::string& defines = {});
+    /// Deletes every program (they are compiled again with the modes as they are then).
+    void drop_programs();
 };
 
 namespace detail {
@@ -76,6 +80,11 @@ pp::PatchSourceParams check_patch_source(const char* who, PassContext::Impl& con
 /// The defines of a pass's program over source: PC_PATCH_SOURCE, and PC_PATCH_SOURCE_GREGORY for
 /// a Gregory source.
 const char* patch_source_defines(const GpuPatchSource& source);
+/// "#define PC_MARGINS 1" or 0 (shaders/flag_chain.h): a program for passes with margins and one
+/// for those without.
+inline const char* margins_define(bool has_margins) {
+    return has_margins ? "#define PC_MARGINS 1\n" : "#define PC_MARGINS 0\n";
+}
 
 /// Binds the chain's buffers of source (flags, margins when given) and its own (vertices,
 /// indices, masks), uploads params into state.source_block at kUniformPatchSource, and issues a

@@ -217,8 +217,17 @@ TEST(BackpatchGpu, FmaDivisionAndSqrtAreCorrectlyRounded) {
     EXPECT_EQ(bad_div_from, 0) << "of " << div_guess.size();
     EXPECT_EQ(bad_sqrt_from, 0) << "of " << sqrt_guess.size();
     EXPECT_EQ(bad_fma, 0) << "of " << in.size() << " (fma_via_double = " << c.fma_via_double() << ")";
-    EXPECT_EQ(bad_div, 0) << "of " << in.size();
+    EXPECT_EQ(bad_div, 0) << "of " << in.size() << " (native_div_sqrt = " << test::passes().native_div_sqrt() << ")";
     EXPECT_EQ(bad_sqrt, 0) << "of " << in.size();
+}
+
+TEST(BackpatchGpu, SoftwareRasterizerDividesNatively) {
+    // On llvmpipe the start-up check finds / and sqrt correctly rounded (LLVM's fdiv and sqrt), so
+    // the shaders use them as they are; FmaDivisionAndSqrtAreCorrectlyRounded above then checks
+    // those against the CPU, and the correction steps alone through the *_from modes.
+    PassContext& passes = test::passes();
+    if (!passes.is_software()) GTEST_SKIP() << "a GPU: the shaders correct its division";
+    EXPECT_TRUE(passes.native_div_sqrt());
 }
 
 // ---- inputs ---------------------------------------------------------------------------------------

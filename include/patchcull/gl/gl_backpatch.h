@@ -33,7 +33,8 @@
 //   native fma() on GPUs that round it once.
 // - sqrt and division (cones only) are pc_sqrt / pc_div (shaders/backpatch_exact.h): the driver's
 //   value corrected to the correctly rounded one by exact double-precision midpoint tests, so a
-//   GPU's 2.5-ULP division or rsqrt-based sqrt gives the CPU's values too.
+//   GPU's 2.5-ULP division or rsqrt-based sqrt gives the CPU's values too; the driver's own on a
+//   software rasterizer whose / and sqrt pass the start-up check (PassContext::native_div_sqrt).
 // - Other float operations (+, -, *) are correctly rounded in GLSL and written `precise`, in the
 //   CPU's order; comparisons are written so that NaN fails them as on the CPU. Sums start from a
 //   uniform u_zero = 0 rather than a literal: Mesa folds `x + 0.0` to x even in precise code,

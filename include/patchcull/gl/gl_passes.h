@@ -72,9 +72,10 @@
 // as "GL: error 0x.... pending before <pass> (left by an earlier GL call)", not blamed on the
 // pass) and checks again after its work ("GL: error 0x.... after <pass>"); glGetError is the
 // only query it makes besides buffer sizes (glGetNamedBufferParameteri64v) and names (glIs*).
-// The PassContext constructor, on a GPU (not on software rasterizers), runs the fma probe once:
-// it binds shader storage bindings 15 and 16 (shared.h's kBindingProbeIn/Out) and a
-// program, reads one small buffer back (a wait), and leaves glUseProgram(0).
+// The PassContext constructor runs the probe once, of fma on a GPU and of division and square
+// root on a software rasterizer: it binds shader storage bindings 15 and 16 (shared.h's
+// kBindingProbeIn/Out) and a program, reads small buffers back (a wait), and leaves
+// glUseProgram(0).
 // Depth conventions: any of clip_space.h's four (zero-to-one, -1..1, reversed, reversed with an
 // infinite far plane), named wherever a decision depends on depth: FrustumPlanes and
 // DisplacedCullView are built with one; HiZBuildPass, OcclusionPass, FrustumDispPass and
@@ -134,7 +135,8 @@ public:
     /// SDL or an engine: any OpenGL 4.5 core context; functions are loaded through libepoxy).
     /// On a GPU it checks once that GLSL fma() rounds once (the probe shader); on software
     /// rasterizers, and on a GPU whose fma() fails, the passes compute it exactly in double
-    /// (shaders/exact_fma.h). Throws patchcull::Error when no 4.5 context is current.
+    /// (shaders/exact_fma.h). On software rasterizers it checks / and sqrt the same way
+    /// (native_div_sqrt()). Throws patchcull::Error when no 4.5 context is current.
     PassContext();
     PassContext(PassContext&&) noexcept;
     PassContext& operator=(PassContext&&) noexcept;
@@ -144,6 +146,10 @@ public:
 
     /// True when pc_fma is computed in double (software rasterizer, or GLSL fma() rounds twice).
     bool fma_via_double() const;
+    /// True when pc_div and pc_sqrt are the driver's own / and sqrt: on a software rasterizer whose
+    /// division and square root round correctly on the start-up check's cases (llvmpipe: LLVM's
+    /// fdiv and sqrt); else the shaders correct the driver's values (shaders/backpatch_exact.h).
+    bool native_div_sqrt() const;
     /// True for a software rasterizer (llvmpipe, softpipe, swrast).
     bool is_software() const;
     /// Evaluates the probe's operation on the GPU for each input (a, b, c) (tests: compare with
