@@ -43,6 +43,7 @@ CullAutoPolicy::CullAutoPolicy(const std::vector<ObjectRange>& objects, std::siz
         throw Error("cull auto: the average weights must be in (0, 1]");
     if (!(config.tess_cost_offset >= 0)) throw Error("cull auto: tess_cost_offset must be >= 0");
     if (config.cost_frames < 1) throw Error("cull auto: cost_frames must be >= 1");
+    if (config.measure_frames < 1) throw Error("cull auto: measure_frames must be >= 1");
     for (const ObjectRange& o : objects) {
         if (o.first > patch_count || o.count > patch_count - o.first)
             throw Error("cull auto: an object leaves the set of " + std::to_string(patch_count) + " patches");
@@ -69,9 +70,10 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
     if (tess_factors.size() != objects_.size())
         throw std::logic_error("CullAutoPolicy::decide: one tessellation factor per object expected");
     const bool known = costs_ready();
-    // The bootstrap's last frame: the two-pass costs are measured, the draw cost per patch is not
-    // (it comes from a one-pass frame, docs/METHODS.md): nothing is culled.
-    const bool measure = !known && costs_.known() && cost_samples_ >= config_.cost_frames && !tess_one_pass_;
+    // The bootstrap's last frames: the two-pass costs are measured, the draw cost per patch is not
+    // (it comes from one-pass frames, docs/METHODS.md): nothing is culled.
+    const bool measure =
+        !known && costs_.known() && cost_samples_ >= config_.cost_frames && tess_samples_ < config_.measure_frames;
     decisions_.assign(objects_.size(), Decision{});
     bool any_probe = false;
     for (std::size_t i = 0; i < objects_.size(); ++i) {
@@ -234,7 +236,7 @@ void CullAutoPolicy::observe(const FrameStats& stats) {
         const double a1 = static_cast<double>(stats.pass1_drawn), a2 = static_cast<double>(stats.pass2_drawn);
         // Provisional, until a one-pass frame: pass 1 - pass 2 includes pass 1's clear and occluders
         // and the cost of visible patches, so it overstates what a culled patch would have cost.
-        if (!tess_one_pass_ && a1 - a2 >= 0.1 * n) {
+        if (tess_samples_ == 0 && a1 - a2 >= 0.1 * n) {
             const double tess = (stats.pass1_ms - stats.pass2_ms) / (a1 - a2);
             if (tess > 0) costs_.tess_unit_ms = average(costs_.tess_unit_ms, tess / wbar, cw);
         }
@@ -266,11 +268,19 @@ void CullAutoPolicy::observe(const FrameStats& stats) {
                                     ? (stats.pass1_ms - costs_.pass_ms) / static_cast<double>(stats.pass1_submitted)
                                     : (stats.pass1_ms - costs_.issue_ms * n) / static_cast<double>(stats.pass1_drawn);
             if (tess > 0 && std::isfinite(tess)) {
-                // The first one-pass value replaces the provisional two-pass one.
-                costs_.tess_unit_ms = average(tess_one_pass_ ? costs_.tess_unit_ms : kUnknown, tess / wbar, cw);
+                // The first one-pass value replaces the provisional two-pass one; the bootstrap's
+                // measuring frames keep their smallest (noise only adds time); later frames average.
+                const double unit = tess / wbar;
+                if (tess_samples_ == 0)
+                    costs_.tess_unit_ms = unit;
+                else if (tess_samples_ < config_.measure_frames)
+                    costs_.tess_unit_ms = std::min(costs_.tess_unit_ms, unit);
+                else
+                    costs_.tess_unit_ms = average(costs_.tess_unit_ms, unit, cw);
             }
         }
-        tess_one_pass_ = true;  // a failed measurement keeps the provisional value
+        // A failed measurement keeps the value it had (the provisional one at first).
+        if (tess_samples_ < config_.measure_frames) ++tess_samples_;
     }
 }
 

@@ -253,8 +253,9 @@ TEST(CullAutoPolicy, CostsComeFromThePassTimesAndTheFirstFrameIsIgnored) {
     }
     EXPECT_FALSE(policy.costs_ready());
     EXPECT_FALSE(policy.costs().indirect);
-    // Frame 3 measures the draw cost in one unculled pass (every patch issued and drawn).
-    {
+    // Frames 3 and 4 measure the draw cost in one unculled pass each (every patch issued and
+    // drawn); frame 3 runs slowed down by the machine (twice the time): the smaller value is kept.
+    for (int f = 3; f <= 4; ++f) {
         const auto& d = policy.decide(kLevel8);
         EXPECT_FALSE(d[0].cull || d[1].cull);
         EXPECT_EQ(d[0].reason, "measure: one unculled pass (the draw cost per patch)");
@@ -263,7 +264,8 @@ TEST(CullAutoPolicy, CostsComeFromThePassTimesAndTheFirstFrameIsIgnored) {
         s.two_pass = false;
         s.timing = gl::TimingMethod::wall_clock;
         s.pass1_drawn = s.pass1_submitted = 200;
-        s.pass1_ms = 200 * (issue + tess);
+        s.pass1_ms = 200 * (issue + tess) * (f == 3 ? 2 : 1);
+        EXPECT_FALSE(policy.costs_ready()) << "frame " << f;
         policy.observe(s);
     }
     ASSERT_TRUE(policy.costs_ready());
@@ -321,13 +323,15 @@ TEST(CullAutoPolicy, IndirectDrawsCostNothingPerCulledPatchAndTheDrawCostComesFr
         policy.observe(indirect_frame(true, f == 0 ? 1000.0 : 0.0));
     }
     // Pass 1 - pass 2 over the patches drawn overstates the draw cost: (4 + 9.2) / 4000 = 3.3 us,
-    // x = 2.7 / 3.3 = 0.82 would cull object 0. It is provisional: frame 3 draws everything once.
+    // x = 2.7 / 3.3 = 0.82 would cull object 0. It is provisional: frames 3 and 4 draw everything.
     EXPECT_FALSE(policy.costs_ready());
     EXPECT_NEAR(policy.tess_cost_ms(1), (kClear + 4000 * kRt) / 4000, 1e-12);
-    const auto& m = policy.decide(kLevel1);
-    EXPECT_FALSE(m[0].cull || m[1].cull) << m[0].reason;
-    EXPECT_EQ(policy.frame_cull_mode(gl::CullMode::all), gl::CullMode::none);
-    policy.observe(indirect_frame(false, 0));
+    for (int f = 3; f <= 4; ++f) {
+        const auto& m = policy.decide(kLevel1);
+        EXPECT_FALSE(m[0].cull || m[1].cull) << m[0].reason;
+        EXPECT_EQ(policy.frame_cull_mode(gl::CullMode::all), gl::CullMode::none);
+        policy.observe(indirect_frame(false, 0));
+    }
     ASSERT_TRUE(policy.costs_ready());
     const CullAutoPolicy::Costs& c = policy.costs();
     EXPECT_TRUE(c.indirect);
@@ -379,6 +383,9 @@ TEST(CullAutoPolicy, MisuseAndBadRangesThrow) {
     CullAutoPolicy::Config bad;
     bad.probe_interval = 0;
     EXPECT_THROW(CullAutoPolicy(two_objects(), 200, bad), Error);
+    CullAutoPolicy::Config no_measure;
+    no_measure.measure_frames = 0;
+    EXPECT_THROW(CullAutoPolicy(two_objects(), 200, no_measure), Error);
     CullAutoPolicy policy(two_objects(), 200);
     EXPECT_THROW(policy.observe(untimed_frame({0, 0})), std::logic_error);
     EXPECT_THROW(policy.decide({8}), std::logic_error);

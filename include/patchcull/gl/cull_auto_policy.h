@@ -14,10 +14,10 @@
 //   false), an object it turns on gets the ordinary conservative tests. It only decides where the
 //   cull passes run.
 // - Bootstrap: until Config::cost_frames two-pass frames after the first are measured, every
-//   object is culled ("probe"); then one frame culls nothing ("measure": one pass, from which the
-//   draw cost per patch, RT - RT0, is taken; the two-pass frames' estimate includes pass 1's fixed
-//   costs). Then an object is culled while its cull rate exceeds x at its tessellation factor,
-//   provided the frame's predicted saving exceeds the Hi-Z build plus pass 2's cost beyond the
+//   object is culled ("probe"); then Config::measure_frames frames cull nothing ("measure": one
+//   pass each, from which the draw cost per patch, RT - RT0, is taken, the smallest of them; the
+//   two-pass frames' estimate includes pass 1's fixed costs). Then an object is culled while its cull rate exceeds x at
+//   its tessellation factor, provided the frame's predicted saving exceeds the Hi-Z build plus pass 2's cost beyond the
 //   culled objects (flags: the other objects' issue; indirect: the pass's fixed cost); an object
 //   switched off is probed (culled for one frame) after its probe interval (Config). A frame with
 //   no object culled runs as CullMode::none (one pass, no Hi-Z). An object whose cull cost per
@@ -59,6 +59,10 @@ public:
         /// Two-pass frames whose times are averaged before the costs are used (>= 1; the first
         /// two-pass frame, compilation, is not one of them).
         int cost_frames = 2;
+        /// One-pass frames that cull nothing after them, to measure the draw cost per patch (>= 1).
+        /// The smallest of their values is kept: a frame the machine slowed down can only
+        /// overstate the cost, and an overstated draw cost lowers x (culls where it does not pay).
+        int measure_frames = 2;
     };
     static constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
 
@@ -114,11 +118,14 @@ public:
     void set_costs(const Costs& costs) {
         costs_ = costs;
         cost_samples_ = config_.cost_frames;
-        tess_one_pass_ = pass_measured_ = true;
+        tess_samples_ = config_.measure_frames;
+        pass_measured_ = true;
     }
     /// The costs are used: known(), averaged over Config::cost_frames two-pass frames, and the draw
-    /// cost taken from a one-pass frame (or set).
-    bool costs_ready() const { return costs_.known() && cost_samples_ >= config_.cost_frames && tess_one_pass_; }
+    /// cost taken from Config::measure_frames one-pass frames (or set).
+    bool costs_ready() const {
+        return costs_.known() && cost_samples_ >= config_.cost_frames && tess_samples_ >= config_.measure_frames;
+    }
     /// tess(t) of the current estimates (NaN while unknown).
     double tess_cost_ms(double tess_factor) const;
     /// The break-even rate x at tessellation factor t (NaN while the costs are not known()).
@@ -142,7 +149,7 @@ private:
     int cost_samples_ = 0;  ///< two-pass frames measured
     bool pending_ = false;
     bool seen_one_pass_ = false, seen_two_pass_ = false, status_measured_ = false;
-    bool tess_one_pass_ = false;  ///< tess_unit measured in a one-pass frame (the two-pass one is provisional)
+    int tess_samples_ = 0;        ///< one-pass frames that measured tess_unit (the two-pass value is provisional)
     bool pass_measured_ = false;  ///< Costs::pass_ms measured
 };
 
