@@ -19,6 +19,27 @@ bool pc_chain_culled(uint p) { return (cull_flags[p] & kCullReasonMask) != 0u; }
 // Culls patch p with `reason` (its status bits kept).
 void pc_chain_cull(uint p, uint reason) { cull_flags[p] = (cull_flags[p] & ~kCullReasonMask) | reason; }
 
+// Runs `call`, a pass's work on patch p (its flag word and its own outputs written), exactly. With
+// PATCHCULL_FMA_VIA_DOUBLE (exact_fma.h) it runs first with the fast pc_fma, and returns from
+// main when no call was suspect; otherwise it restores the flag word and runs again exactly.
+// Use it at the top level of main: llvmpipe skips the exact run when every invocation of the
+// group returned, where it would run both sides of an `if`.
+#ifdef PATCHCULL_FMA_VIA_DOUBLE
+#define PC_RUN_EXACT(p, call)              \
+    {                                      \
+        const uint pc_word = cull_flags[p]; \
+        pc_fma_exact = false;              \
+        pc_fma_suspect = false;            \
+        call;                              \
+        if (!pc_fma_suspect) return;       \
+        cull_flags[p] = pc_word;           \
+        pc_fma_exact = true;               \
+        call;                              \
+    }
+#else
+#define PC_RUN_EXACT(p, call) call
+#endif
+
 // Whether the pass has a margin buffer: its has_margins flag, or the constant PC_MARGINS (0 or 1)
 // where the pass compiles one program for each (llvmpipe runs both sides of a branch even on a
 // uniform, so a constant drops the unused side's cost).

@@ -31,15 +31,20 @@ layout(local_size_x = kCullGroupSize) in;
 #define u_plane_depth frustum.plane_depth
 #include "frustum_test.h"
 
+// The pass's work on patch p: its frustum decision, and its plane values when asked for.
+void pc_frustum_patch(uint p) {
+    const float d = pc_margin(p, frustum.has_margins);
+    float mx[6];
+    if (pc_frustum_culled(p, PC_HAS_MARGINS(frustum.has_margins), d, mx)) pc_chain_cull(p, kCullFrustum);
+    if (frustum.write_plane_values != 0u)
+        for (int q = 0; q < 6; ++q) plane_values[6u * p + uint(q)] = mx[q];
+}
+
 void main() {
     const uint p = frustum.first_patch + gl_GlobalInvocationID.x;
     if (gl_GlobalInvocationID.x >= frustum.patch_count || pc_chain_culled(p)) return;
 #ifdef PC_PATCH_SOURCE
     if (!pc_gather_source(p)) return;
 #endif
-    const float d = pc_margin(p, frustum.has_margins);
-    float mx[6];
-    if (pc_frustum_culled(p, PC_HAS_MARGINS(frustum.has_margins), d, mx)) pc_chain_cull(p, kCullFrustum);
-    if (frustum.write_plane_values != 0u)
-        for (int q = 0; q < 6; ++q) plane_values[6u * p + uint(q)] = mx[q];
+    PC_RUN_EXACT(p, pc_frustum_patch(p));
 }

@@ -61,12 +61,8 @@ bool hiz_occluded(uint p) {
     return hiz_box_occluded(box.nxmin, box.nxmax, box.nymin, box.nymax, box.zmin);  // steps 5-9
 }
 
-void main() {
-    const uint p = occlusion.first_patch + gl_GlobalInvocationID.x;
-    if (gl_GlobalInvocationID.x >= occlusion.patch_count || pc_chain_culled(p)) return;
-#ifdef PC_PATCH_SOURCE
-    if (!pc_gather_source(p)) return;
-#endif
+// The pass's work on patch p: the frustum test when asked for, then the Hi-Z test.
+void pc_occlusion_patch(uint p) {
     const float d = pc_margin(p, occlusion.has_margins);
 #ifdef PC_WITH_FRUSTUM
     const bool with_frustum = PC_WITH_FRUSTUM != 0;  // one program each (see PC_MARGINS)
@@ -81,4 +77,13 @@ void main() {
         }
     }
     if (d == 0.0 && hiz_occluded(p)) pc_chain_cull(p, kCullOcclusion);
+}
+
+void main() {
+    const uint p = occlusion.first_patch + gl_GlobalInvocationID.x;
+    if (gl_GlobalInvocationID.x >= occlusion.patch_count || pc_chain_culled(p)) return;
+#ifdef PC_PATCH_SOURCE
+    if (!pc_gather_source(p)) return;
+#endif
+    PC_RUN_EXACT(p, pc_occlusion_patch(p));
 }
