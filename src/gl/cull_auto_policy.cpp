@@ -72,8 +72,11 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
     const bool known = costs_ready();
     // The bootstrap's last frames: the two-pass costs are measured, the draw cost per patch is not
     // (it comes from one-pass frames, docs/METHODS.md): nothing is culled.
-    const bool measure =
-        !known && costs_.known() && cost_samples_ >= config_.cost_frames && tess_samples_ < config_.measure_frames;
+    // tess_unit may still be unknown there: when the two-pass frames drew too few patches to
+    // estimate it (a scene almost wholly culled), the measuring frames give it.
+    const bool measure = !known && !std::isnan(costs_.issue_ms) && !std::isnan(costs_.cull_ms) &&
+                         !std::isnan(costs_.hiz_ms) && cost_samples_ >= config_.cost_frames &&
+                         tess_samples_ < config_.measure_frames;
     decisions_.assign(objects_.size(), Decision{});
     bool any_probe = false;
     for (std::size_t i = 0; i < objects_.size(); ++i) {
@@ -240,16 +243,17 @@ void CullAutoPolicy::observe(const FrameStats& stats) {
             const double tess = (stats.pass1_ms - stats.pass2_ms) / (a1 - a2);
             if (tess > 0) costs_.tess_unit_ms = average(costs_.tess_unit_ms, tess / wbar, cw);
         }
+        // Without a draw cost yet (too few patches drawn to estimate it), pass 2's patches are
+        // counted as costing nothing: the pass's fixed cost and the issue are then overstated
+        // (the frame rule stricter) until the measuring frames give the draw cost.
+        const double drawn2_ms = std::isnan(costs_.tess_unit_ms) ? 0.0 : costs_.tess_unit_ms * wbar;
         if (costs_.indirect) {
             costs_.issue_ms = 0;
-            if (!std::isnan(costs_.tess_unit_ms)) {
-                const double pass = std::max(
-                    0.0, stats.pass2_ms - costs_.tess_unit_ms * wbar * static_cast<double>(stats.pass2_submitted));
-                costs_.pass_ms = pass_measured_ ? average(costs_.pass_ms, pass, cw) : pass;
-                pass_measured_ = true;
-            }
-        } else if (!std::isnan(costs_.tess_unit_ms)) {
-            const double issue = std::max(0.0, (stats.pass2_ms - costs_.tess_unit_ms * wbar * a2) / n);
+            const double pass = std::max(0.0, stats.pass2_ms - drawn2_ms * static_cast<double>(stats.pass2_submitted));
+            costs_.pass_ms = pass_measured_ ? average(costs_.pass_ms, pass, cw) : pass;
+            pass_measured_ = true;
+        } else {
+            const double issue = std::max(0.0, (stats.pass2_ms - drawn2_ms * a2) / n);
             costs_.issue_ms = average(costs_.issue_ms, issue, cw);
         }
         if (culled_patches > 0) {
