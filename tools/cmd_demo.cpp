@@ -181,6 +181,7 @@ int run_demo(const DemoOptions& options) {
                 policy.decide(gl::object_tess_factors(poses[static_cast<std::size_t>(f)], ranges, params.frame.render));
                 params.objects = policy.objects();
                 params.frame.cull = policy.frame_cull_mode(method.cull);
+                if (policy.resumes_culling()) pipeline.forget_visibility();
             }
             const gl::FrameStats s = pipeline.render_frame(params);
             if (method.automatic) policy.observe(s);

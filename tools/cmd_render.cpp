@@ -408,6 +408,7 @@ Runner add_render_command(CLI::App& app) {
                 policy.decide(object_tess_factors(*pose, ranges, params.frame.render));
                 params.objects = policy.objects();
                 params.frame.cull = policy.frame_cull_mode(applied);
+                if (policy.resumes_culling()) pipeline.forget_visibility();
             }
             const gl::FrameStats stats = pipeline.render_frame(params);
             if (automatic) policy.observe(stats);

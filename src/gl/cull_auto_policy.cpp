@@ -161,6 +161,9 @@ const std::vector<CullAutoPolicy::Decision>& CullAutoPolicy::decide(const std::v
     }
     factors_ = tess_factors;
     pending_ = true;
+    const bool culls = culled_objects() > 0;
+    resumes_culling_ = culls && !previous_culled_;
+    previous_culled_ = culls;
     return decisions_;
 }
 

@@ -30,6 +30,7 @@ void CullPipeline::update_patches(const std::vector<BezierPatch>& patches, const
 
 std::size_t CullPipeline::patch_count() const { return impl_->renderer.patch_count(); }
 void CullPipeline::reset_visibility() { impl_->primed_generation = ~std::uint64_t{0}; }
+void CullPipeline::forget_visibility() { impl_->forget_visibility = true; }
 
 const char* frustum_test_name(FrustumTest test) { return test == FrustumTest::aabb ? "aabb" : "hull"; }
 const char* draw_mode_name(DrawMode mode) { return mode == DrawMode::indirect ? "indirect" : "flags"; }
@@ -106,6 +107,12 @@ FrameStats CullPipeline::render_frame(const PipelineParams& params) {
         throw Error("render_frame: an object pass needs PipelineParams::objects");
 
     if (m.primed_generation != r.flag_generation()) m.prime_statuses();
+    if (m.forget_visibility && r.patch_count() > 0) {
+        // No status, no reason: as a patch no frame has drawn yet (after the last frame's writes).
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        glClearNamedBufferData(r.flag_buffer(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    }
+    m.forget_visibility = false;
     r.set_culled_occluders(params.culled_occluders);
     m.ensure_counter_slots(plan.objects.size() + 1);
     m.begin_draws();

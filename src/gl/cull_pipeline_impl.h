@@ -122,6 +122,7 @@ struct CullPipeline::Impl {
     // The renderer's flag_generation when the statuses were primed; another value (the flags were
     // replaced, or reset_visibility) makes the next frame a first frame.
     std::uint64_t primed_generation = ~std::uint64_t{0};
+    bool forget_visibility = false;  // CullPipeline::forget_visibility: clear the statuses first
 
     // Tags the even-indexed patches visible, the others not (Niessner & Loop §3's first frame).
     void prime_statuses() {

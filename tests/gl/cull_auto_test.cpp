@@ -269,6 +269,7 @@ TEST(CullAutoPolicy, CostsComeFromThePassTimesAndTheFirstFrameIsIgnored) {
         policy.observe(s);
     }
     ASSERT_TRUE(policy.costs_ready());
+    EXPECT_FALSE(policy.resumes_culling());  // the measuring frames cull nothing
     EXPECT_NEAR(policy.costs().issue_ms, issue, 1e-12);
     EXPECT_NEAR(policy.costs().cull_ms, cull, 1e-12);
     EXPECT_NEAR(policy.costs().hiz_ms, hiz, 1e-12);
@@ -277,6 +278,11 @@ TEST(CullAutoPolicy, CostsComeFromThePassTimesAndTheFirstFrameIsIgnored) {
     EXPECT_NEAR(d[0].break_even, (issue + cull) / tess, 1e-9);
     EXPECT_EQ(d[0].reason, "rate 0.40 > break-even 0.20");
     EXPECT_TRUE(d[0].cull);
+    // The first culled frame after the unculled ones: the caller forgets the visibility.
+    EXPECT_TRUE(policy.resumes_culling());
+    policy.observe(untimed_frame({40, 40}));
+    policy.decide(kLevel8);
+    EXPECT_FALSE(policy.resumes_culling());
 }
 
 namespace {

@@ -342,6 +342,36 @@ TEST(OcclusionPipeline, StrictIdBufferIdenticalAtFixedCameras) {
         total.frustum, total.occluded, total.pass2, total.ties);
 }
 
+TEST(OcclusionPipeline, ForgetVisibilityStartsPassOneEmptyAndStaysStrict) {
+    // After an unculled frame every patch is tagged visible, and pass 1 of the next culled frame
+    // would draw them all; forget_visibility starts that frame from none (occluders only in pass 1,
+    // every patch that passes in pass 2), and it still matches the unculled render.
+    const std::vector<BezierPatch> patches = teapot_y_up();
+    const Bounds b = test::control_point_bounds(patches);
+    const Occluders occ = ground_and_wall(b, 1, 2);
+    CullPipeline pipeline(test::context());
+    PatchRenderer& r = pipeline.renderer();
+    r.set_patches(patches);
+    r.set_occluders(occ.vertices, occ.indices);
+    const Camera cams[] = {camera_at(b, {0.3f, 0.35f, -1}, 2.4f), camera_at(b, {0.6f, 0.2f, -0.8f}, 0.8f)};
+    for (std::size_t c = 0; c < std::size(cams); ++c) {
+        const RenderParams params = params_for(cams[c]);
+        FrameParams unculled;
+        unculled.render = params;
+        unculled.cull = CullMode::none;
+        const FrameStats none = pipeline.render_frame(pipeline_params(unculled));
+        EXPECT_EQ(none.visible, patches.size());
+        pipeline.forget_visibility();
+        const std::string what = "camera " + std::to_string(c) + ", the frame after forget_visibility";
+        const Totals t = strict_frame(pipeline, patches, &occ, params, kFrustumOcclusion, false, what);
+        EXPECT_EQ(t.pass1, 0u) << what;
+        EXPECT_GT(t.pass2, 0u) << what;
+        // The frame after it is an ordinary one: pass 1 draws what was visible.
+        const Totals next = strict_frame(pipeline, patches, &occ, params, kFrustumOcclusion, false, what + " + 1");
+        EXPECT_EQ(next.pass1, t.pass2) << what;
+    }
+}
+
 TEST(OcclusionPipeline, StrictIdBufferIdenticalThroughAnimatedTeapotSequence) {
     const std::vector<BezierPatch> rest = teapot_y_up();
     const Bounds b = test::control_point_bounds(rest);

@@ -292,6 +292,7 @@ int run_viewer(ViewerConfig& config) {
             policy.decide(gl::object_tess_factors(world.current_pose(), world.ranges(), params.frame.render));
             params.objects = policy.objects();
             params.frame.cull = policy.frame_cull_mode(params.frame.cull);
+            if (policy.resumes_culling()) pipeline.forget_visibility();
         }
         stats = pipeline.render_frame(params);
         if (settings.cull_auto) policy.observe(stats);

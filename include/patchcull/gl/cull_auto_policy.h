@@ -103,6 +103,10 @@ public:
     /// The last decision as PipelineParams::objects.
     std::vector<ObjectRange> objects() const;
     std::size_t culled_objects() const;  ///< of the last decision
+    /// The last decision culls an object after a frame that culled none (drawn unculled, every patch
+    /// tagged visible): the caller lets the frame start from no visible patch
+    /// (CullPipeline::forget_visibility), or its pass 1 would draw every patch.
+    bool resumes_culling() const { return resumes_culling_; }
     /// The cull mode of the frame: `tests` (the mode of the culled objects, e.g. applicable_cull_mode
     /// of all) when an object is culled, none otherwise (one pass, no Hi-Z; see the header).
     CullMode frame_cull_mode(CullMode tests) const;
@@ -148,6 +152,8 @@ private:
     long frame_ = 0;
     int cost_samples_ = 0;  ///< two-pass frames measured
     bool pending_ = false;
+    bool previous_culled_ = true;  ///< the frame before the last decision culled an object
+    bool resumes_culling_ = false;
     bool seen_one_pass_ = false, seen_two_pass_ = false, status_measured_ = false;
     int tess_samples_ = 0;        ///< one-pass frames that measured tess_unit (the two-pass value is provisional)
     bool pass_measured_ = false;  ///< Costs::pass_ms measured

@@ -261,6 +261,11 @@ public:
 
     /// Makes the next frame a first frame (even-indexed patches tagged visible).
     void reset_visibility();
+    /// The next frame starts with no patch tagged visible: its pass 1 draws only the occluders, and
+    /// pass 2 every patch that passes the tests against their pyramid. For a switch from frames
+    /// drawn unculled (which tag every patch visible, so that pass 1 would draw them all) to
+    /// culled ones, as `--cull auto` switches (CullAutoPolicy::resumes_culling).
+    void forget_visibility();
 
     /// The pyramid of the last two-pass frame (HiZPyramid::data()'s layout, row 0 = bottom), and
     /// its level count (0 before any). Waits for the GPU.
