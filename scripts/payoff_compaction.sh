@@ -5,11 +5,13 @@
 #   render SCENE --cull none --draw flags                 (RT: every patch drawn)
 #   render SCENE --cull all  --draw flags|indirect        (RT0 from pass 2, CT = cull + Hi-Z)
 #   render SCENE --cull auto --draw flags|indirect        (auto's own measured break-even)
-# each --frames 6 at 640x360 (frame 0 compiles the programs; the tables and the plot average
-# frames 1..5), the whole sweep repeated ROUNDS times. One JSON file per run under
+# at 640x360, --frames 6 (frame 0 compiles the programs; the tables and the plot average frames
+# 1..5), the auto runs --frames 8 (their own decisions start at frame 5), the whole sweep repeated
+# ROUNDS times. Scenes: the built-in default (8226 patches, levels 1-16) and city (301,620
+# patches, levels 1-8: its unculled frame at level 16 takes ~27 s here). One JSON file per run under
 # DATA_DIR/roundR/SCENE/, `uptime` before each level and at the end in DATA_DIR/uptime.txt. Then
 # scripts/plot_payoff_compaction.py prints the tables (medians over the rounds) and draws
-# docs/figures/payoff_compaction.png. About 2 minutes a round on a loaded 2-core llvmpipe guest.
+# docs/figures/payoff_compaction.png. About 6 minutes a round on a quiet 2-core llvmpipe guest.
 #
 # Usage: bash scripts/payoff_compaction.sh [BUILD_DIR] [DATA_DIR] [ROUNDS]
 #        (defaults: build, docs/figures/data/payoff_compaction, 3)
@@ -34,22 +36,21 @@ fi
 note() { echo "$(date -u +%H:%M:%S) $1: $(uptime | sed 's/.*load/load/')" | tee -a "$DATA/uptime.txt"; }
 : > "$DATA/uptime.txt"
 
-# default: the built-in scene (8226 patches); city_small: data/scenes/city_small.json (27420).
 for round in $(seq 1 "$ROUNDS"); do
-for scene in default city_small; do
-  model=$scene
-  [ "$scene" = city_small ] && model=data/scenes/city_small.json
+for scene in default city; do
+  levels="1 2 4 8 16"
+  [ "$scene" = city ] && levels="1 2 4 8"
   mkdir -p "$DATA/round$round/$scene"
-  for level in 1 2 4 8 16; do
+  for level in $levels; do
     note "round $round $scene level $level"
-    common=(--tess "$level" --frames 6 --size 640x360 --json)
+    common=(--tess "$level" --size 640x360 --json)
     out="$DATA/round$round/$scene/level${level}"
-    "$CLI" render "$model" "${common[@]}" --cull none --draw flags > "${out}_none.json"
+    "$CLI" render "$scene" "${common[@]}" --frames 6 --cull none --draw flags > "${out}_none.json"
     for draw in flags indirect; do
-      "$CLI" render "$model" "${common[@]}" --cull all --draw "$draw" > "${out}_all_${draw}.json"
+      "$CLI" render "$scene" "${common[@]}" --frames 6 --cull all --draw "$draw" > "${out}_all_${draw}.json"
     done
     for draw in flags indirect; do
-      "$CLI" render "$model" "${common[@]}" --cull auto --draw "$draw" > "${out}_auto_${draw}.json"
+      "$CLI" render "$scene" "${common[@]}" --frames 8 --cull auto --draw "$draw" > "${out}_auto_${draw}.json"
     done
   done
 done

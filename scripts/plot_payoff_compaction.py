@@ -24,9 +24,9 @@ scene's patches, per patch in microseconds:
   RT0 pair = (ms.pass2 of all flags - ms.pass2 of all indirect) / (n - pass2_drawn): the same
         frames (the decisions do not depend on the draw mode) drawn both ways, a check of
         RT0 flags - RT0 indirect that does not use RT;
-  auto x: the median of `auto_objects[].break_even` over the `auto` run's frames 3..N-1 (after its
-        bootstrap: frames 0..2 cull every object) and objects; "objects culled by auto" and
-        "auto / none, frames 3..N-1" over the same frames.
+  auto x: the median of `auto_objects[].break_even` over the `auto` run's frames 5..N-1 (after its
+        bootstrap: frames 0..2 cull every object, 3..4 none) and objects; "objects culled by auto" and
+        "auto / none, frames 5..N-1" over the same frames.
 Bad input: one line naming the file, exit status 2 (as scripts/plot_figures.py).
 """
 import math
@@ -41,13 +41,12 @@ from plot_figures import InputError, ROOT, fail, field, load_json, log_axes, sav
 
 PROG = "plot_payoff_compaction.py"
 plot_figures.PROG = PROG  # fail()'s prefix
-SCENES = [("default", "default scene"), ("city_small", "city_small")]
+SCENES = [("default", "default scene"), ("city", "city")]
 DRAWS = ("flags", "indirect")
 # --cull auto culls every object in frames 0..2 (compilation, then CullAutoPolicy::Config::cost_frames
-# = 2 frames that measure the costs): its own decisions started at frame 3 in the archived runs
-# (docs/figures/data/payoff_compaction/). The re-derived policy adds one measuring frame that culls
-# nothing, so for runs of it set BOOTSTRAP = 4.
-BOOTSTRAP = 3
+# = 2 frames that measure the costs), then frames 3 and 4 cull nothing (Config::measure_frames: one
+# pass each, the draw cost per patch): its own decisions start at frame 5.
+BOOTSTRAP = 5
 
 
 def frame_mean(path, frames, get):
@@ -181,8 +180,8 @@ def print_table(scene, rows):
     print(f"\n{scene}: {first['n']} patches, {first['objects']} objects, medians over {first['rounds']} rounds"
           " (min..max); RT, RT0, CT in us per patch")
     print("| level | culled | none (ms) | all / none, flags | all / none, indirect | all indirect / all flags "
-          "| auto / none, flags | auto / none, indirect | the same, frames 3..5: flags / indirect "
-          "| objects culled by auto, frames 3..5: flags / indirect |")
+          "| auto / none, flags | auto / none, indirect | the same, frames 5..7: flags / indirect "
+          "| objects culled by auto, frames 5..7: flags / indirect |")
     print("|" + "---|" * 10)
     for level, r in sorted(rows.items()):
         print(f"| {level} | {100 * r['culled']:.1f}% | {r['none_ms']:.1f} | {r['all_flags_ratio']:.2f} | "
@@ -209,7 +208,11 @@ def plot(plt, data, out):
         for i, (key, name) in enumerate((("none_ms", "no culling"), ("all_flags_ms", "all, --draw flags"),
                                          ("all_indirect_ms", "all, --draw indirect"))):
             top.plot(levels, [rows[L][key] for L in levels], marker="o", color=f"C{i}", label=name)
-        for i, (key, name) in enumerate((("auto_flags_ms", "auto, flags"), ("auto_indirect_ms", "auto, indirect"))):
+        # auto after its bootstrap (its own decisions): the bootstrap's unculled frames would
+        # dominate a whole-run mean at high levels.
+        post = f"frames {BOOTSTRAP} on"
+        for i, (key, name) in enumerate((("auto_post_flags_ms", f"auto, flags, {post}"),
+                                         ("auto_post_indirect_ms", f"auto, indirect, {post}"))):
             top.plot(levels, [rows[L][key] for L in levels], marker=".", color=f"C{i + 1}", linestyle=":", label=name)
         log_axes(top, "both")
         top.set_xlabel("tessellation level")
