@@ -22,8 +22,11 @@ void pc_chain_cull(uint p, uint reason) { cull_flags[p] = (cull_flags[p] & ~kCul
 // Runs `call`, a pass's work on patch p (its flag word and its own outputs written), exactly. With
 // PATCHCULL_FMA_VIA_DOUBLE (exact_fma.h) it runs first with the fast pc_fma, and returns from
 // main when no call was suspect; otherwise it restores the flag word and runs again exactly.
-// Use it at the top level of main: llvmpipe skips the exact run when every invocation of the
-// group returned, where it would run both sides of an `if`.
+// Use it at the top level of main. llvmpipe (Mesa 22.3) branches neither on `if` nor on `return`
+// (it runs the code with the invocations masked off); it only leaves a loop early once no
+// invocation is left in it. So the rerun pays where a pass's work is mostly loops: measured
+// cheaper for the frustum and occlusion passes, dearer for the cones and the displaced bounds,
+// which run once, exactly (docs/PERFORMANCE.md).
 #ifdef PATCHCULL_FMA_VIA_DOUBLE
 #define PC_RUN_EXACT(p, call)              \
     {                                      \
