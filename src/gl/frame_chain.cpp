@@ -87,10 +87,24 @@ void FrameChain::run_tests(const HiZTexture* hiz, const std::vector<std::size_t>
                     m_.frustum.run(buffers_of(s), f_.view);
             }
     if (timed) clock_.mark();
+    // The back-patch, Hi-Z and displaced-bound passes skip some patches (displaced or not): they
+    // run on the parts of a span that hold the others (PatchRenderer::undisplaced_runs), since
+    // llvmpipe spends as long on a patch a pass returns from at once as on one it tests.
+    std::vector<PatchSpan> pieces;
+    auto for_each_piece = [&](const PatchSpan& s, const std::vector<PatchSpan>* runs, auto&& run) {
+        if (!runs) return run(s);
+        pieces.clear();
+        clip_to_runs(s, *runs, pieces);
+        for (const PatchSpan& piece : pieces) run(piece);
+    };
+    // Without margins (drawn undisplaced) every patch is tested as undisplaced.
+    const std::vector<PatchSpan>* undisplaced = f_.chain.margins ? &m_.renderer.undisplaced_runs() : nullptr;
     for (std::size_t i : only) {
         if (f_.fused || !tested(i) || !(tests & sh::kCullBackPatch)) continue;
         for (const PatchSpan& s : plan_.object_spans[i])
-            m_.backpatch_pass(params_.backpatch).run(buffers_of(s), f_.view, f_.backpatch_options);
+            for_each_piece(s, undisplaced, [&](const PatchSpan& piece) {
+                m_.backpatch_pass(params_.backpatch).run(buffers_of(piece), f_.view, f_.backpatch_options);
+            });
     }
     if (timed) clock_.mark();
     // The frustum pass ran first when the mode has it: the occlusion pass only tests Hi-Z.
@@ -105,10 +119,15 @@ void FrameChain::run_tests(const HiZTexture* hiz, const std::vector<std::size_t>
     for (std::size_t i : only) {
         if (!tested(i)) continue;
         for (const PatchSpan& s : plan_.object_spans[i]) {
-            if (occluding && !f_.fused) m_.occlusion.run(buffers_of(s), f_.view, *occluding, false);
+            if (occluding && !f_.fused)
+                for_each_piece(s, undisplaced, [&](const PatchSpan& piece) {
+                    m_.occlusion.run(buffers_of(piece), f_.view, *occluding, false);
+                });
             if (bounds)
-                m_.displaced.run(buffers_of(s), f_.ranges, params_.bound, params_.cone, displaced_view, occluding,
-                                 true);
+                for_each_piece(s, &m_.renderer.displaced_runs(), [&](const PatchSpan& piece) {
+                    m_.displaced.run(buffers_of(piece), f_.ranges, params_.bound, params_.cone, displaced_view,
+                                     occluding, true);
+                });
         }
     }
 }

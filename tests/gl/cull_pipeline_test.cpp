@@ -12,6 +12,7 @@
 #include "gl_test_util.h"
 #include "patchcull/core/backpatch.h"
 #include "patchcull/core/camera.h"
+#include "patchcull/core/displacement.h"
 #include "patchcull/gl/gl_pipeline.h"
 #include "patchcull/gl/gl_verification.h"
 #include "patchcull/import/model_loader.h"
@@ -37,7 +38,9 @@ RenderParams params_for(const Camera& camera) {
     return rp;
 }
 
-std::size_t cpu_culled(BackpatchMethod method, const std::vector<BezierPatch>& patches, const RenderParams& rp) {
+// The CPU scalar kernel's decision per patch.
+std::vector<std::uint8_t> cpu_culled_set(BackpatchMethod method, const std::vector<BezierPatch>& patches,
+                                         const RenderParams& rp) {
     const PatchBatch batch = make_batch(patches);
     std::vector<std::uint8_t> culled(patches.size());
     const Mat4 object_to_clip = rp.projection * rp.view;
@@ -53,8 +56,12 @@ std::size_t cpu_culled(BackpatchMethod method, const std::vector<BezierPatch>& p
                             culled.data());
             break;
     }
+    return culled;
+}
+
+std::size_t cpu_culled(BackpatchMethod method, const std::vector<BezierPatch>& patches, const RenderParams& rp) {
     std::size_t n = 0;
-    for (std::uint8_t c : culled) n += c ? 1 : 0;
+    for (std::uint8_t c : cpu_culled_set(method, patches, rp)) n += c ? 1 : 0;
     return n;
 }
 
@@ -128,6 +135,56 @@ TEST(CullPipeline, BackPatchPassFeedsTheFrameForEveryMethod) {
             EXPECT_TRUE(cmp.conservative()) << name;
         }
     }
+}
+
+TEST(CullPipeline, BackPatchPassRunsOnTheUndisplacedRunsWithTheSameDecisions) {
+    // Displaced patches (margin > 0) before c, in [c + 100, c + 110) and after c2, where c and c2
+    // are patches every method culls: the undisplaced run [c, c2] holds the run of 10 (too short
+    // to dispatch around), the others are left out of the back-patch pass. The frame still culls
+    // exactly the undisplaced patches the CPU kernel culls, patch by patch, for every method (c
+    // and c2 among them: a run dispatched one patch short fails).
+    const std::vector<BezierPatch>& rest = bigguy();
+    const RenderParams rp = params_for(orbit_sequence(test::control_point_bounds(rest), 1, 0.0f)[0]);
+    const std::vector<BackpatchMethod> methods = {BackpatchMethod::tcone, BackpatchMethod::ncone, BackpatchMethod::ptp};
+    std::vector<std::vector<std::uint8_t>> cpu;
+    for (const BackpatchMethod method : methods) cpu.push_back(cpu_culled_set(method, rest, rp));
+    auto culled_by_all = [&](std::size_t i) { return cpu[0][i] && cpu[1][i] && cpu[2][i]; };
+    std::size_t c = 300, c2 = rest.size() - 300;
+    while (c < c2 && !culled_by_all(c)) ++c;
+    while (c2 > c && !culled_by_all(c2)) --c2;
+    ASSERT_GT(c2, c + 300);
+    PatchAttributes attributes;
+    attributes.max_displacement.assign(rest.size(), 0.0f);
+    for (const PatchSpan run : {PatchSpan{0, c}, PatchSpan{c + 100, 10}, PatchSpan{c2 + 1, rest.size() - c2 - 1}})
+        for (std::size_t i = run.first; i < run.first + run.count; ++i) attributes.max_displacement[i] = 0.01f;
+    CullPipeline& p = pipeline();
+    p.set_patches(rest, attributes);
+    p.renderer().set_displacement_map(make_procedural_displacement(16, 0.001f));
+    const std::vector<PatchSpan>& runs = p.renderer().undisplaced_runs();
+    ASSERT_EQ(runs.size(), 1u);
+    EXPECT_EQ(runs[0].first, c);
+    EXPECT_EQ(runs[0].count, c2 + 1 - c);
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+        PipelineParams params;
+        params.frame.render = rp;
+        params.frame.cull = CullMode::backpatch;
+        params.frame.timing = TimingMethod::wall_clock;
+        params.backpatch = methods[m];
+        const FrameStats s = p.render_frame(params);
+        const char* name = backpatch_method_name(methods[m]);
+        EXPECT_EQ(s.frustum_culled, 0u) << name;
+        const std::vector<std::uint32_t> flags = p.renderer().read_cull_flags();
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < rest.size(); ++i) {
+            const bool expected = cpu[m][i] && attributes.max_displacement[i] == 0.0f;
+            differ += ((flags[i] & kCullReasonMask) == kCullBackPatch) != expected ? 1 : 0;
+        }
+        EXPECT_EQ(differ, 0u) << name;
+        EXPECT_EQ(flags[c] & kCullReasonMask, kCullBackPatch) << name;
+        EXPECT_EQ(flags[c2] & kCullReasonMask, kCullBackPatch) << name;
+    }
+    p.renderer().set_displacement_map(DisplacementMap{});
+    p.set_patches(rest);
 }
 
 TEST(CullPipeline, ModesWithoutBackPatchRunNoPass) {
