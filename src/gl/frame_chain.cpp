@@ -1,6 +1,8 @@
 // FrameChain (frame_chain.h): one frame's flag chain over its dispatch spans.
 #include "frame_chain.h"
 
+#include <algorithm>
+
 namespace patchcull::gl {
 
 PatchBuffers FrameChain::buffers_of(const PatchSpan& s) const {
@@ -68,24 +70,34 @@ void FrameChain::run(const HiZTexture* hiz, const std::vector<std::size_t>* only
 
 void FrameChain::run_tests(const HiZTexture* hiz, const std::vector<std::size_t>& only, bool timed) {
     const std::uint32_t tests = f_.tests;
-    auto tested = [this](std::size_t i) { return plan_.objects[i].cull; };  // ObjectRange::cull
+    // The tested objects' spans, ascending, adjacent ones joined: the tests are per patch, so a
+    // dispatch may cross objects (CullStatusPass::end still counts each object apart).
+    std::vector<PatchSpan> spans;
+    for (std::size_t i : only)
+        if (plan_.objects[i].cull)  // ObjectRange::cull
+            spans.insert(spans.end(), plan_.object_spans[i].begin(), plan_.object_spans[i].end());
+    std::sort(spans.begin(), spans.end(), [](const PatchSpan& a, const PatchSpan& b) { return a.first < b.first; });
+    std::size_t joined = 0;
+    for (std::size_t k = 0; k < spans.size(); ++k) {
+        if (joined > 0 && spans[joined - 1].first + spans[joined - 1].count == spans[k].first)
+            spans[joined - 1].count += spans[k].count;
+        else
+            spans[joined++] = spans[k];
+    }
+    spans.resize(joined);
     if (f_.fused) {
         // One dispatch per span for all three tests; its time counts as the first part.
         const std::uint32_t fused_tests =
             (tests & (sh::kCullFrustum | sh::kCullBackPatch)) | (hiz ? (tests & sh::kCullOcclusion) : 0u);
-        for (std::size_t i : only)
-            if (tested(i))
-                for (const PatchSpan& s : plan_.object_spans[i])
-                    m_.fused.run(buffers_of(s), fused_tests, f_.view, params_.backpatch, hiz);
+        for (const PatchSpan& s : spans) m_.fused.run(buffers_of(s), fused_tests, f_.view, params_.backpatch, hiz);
     }
-    for (std::size_t i : only)
-        if (!f_.fused && tested(i) && (tests & sh::kCullFrustum))
-            for (const PatchSpan& s : plan_.object_spans[i]) {
-                if (f_.aabb)
-                    m_.frustum_disp.run(buffers_of(s), f_.view);
-                else
-                    m_.frustum.run(buffers_of(s), f_.view);
-            }
+    if (!f_.fused && (tests & sh::kCullFrustum))
+        for (const PatchSpan& s : spans) {
+            if (f_.aabb)
+                m_.frustum_disp.run(buffers_of(s), f_.view);
+            else
+                m_.frustum.run(buffers_of(s), f_.view);
+        }
     if (timed) clock_.mark();
     // The back-patch, Hi-Z and displaced-bound passes skip some patches (displaced or not): they
     // run on the parts of a span that hold the others (PatchRenderer::undisplaced_runs), since
@@ -99,13 +111,11 @@ void FrameChain::run_tests(const HiZTexture* hiz, const std::vector<std::size_t>
     };
     // Without margins (drawn undisplaced) every patch is tested as undisplaced.
     const std::vector<PatchSpan>* undisplaced = f_.chain.margins ? &m_.renderer.undisplaced_runs() : nullptr;
-    for (std::size_t i : only) {
-        if (f_.fused || !tested(i) || !(tests & sh::kCullBackPatch)) continue;
-        for (const PatchSpan& s : plan_.object_spans[i])
+    if (!f_.fused && (tests & sh::kCullBackPatch))
+        for (const PatchSpan& s : spans)
             for_each_piece(s, undisplaced, [&](const PatchSpan& piece) {
                 m_.backpatch_pass(params_.backpatch).run(buffers_of(piece), f_.view, f_.backpatch_options);
             });
-    }
     if (timed) clock_.mark();
     // The frustum pass ran first when the mode has it: the occlusion pass only tests Hi-Z.
     const HiZTexture* occluding = (tests & sh::kCullOcclusion) ? hiz : nullptr;
@@ -116,19 +126,16 @@ void FrameChain::run_tests(const HiZTexture* hiz, const std::vector<std::size_t>
     const bool bounds =
         f_.ranges && (f_.aabb ? occluding != nullptr : (tests & (sh::kCullFrustum | sh::kCullOcclusion)) != 0);
     const DisplacedCullView displaced_view = bounds ? make_displaced_cull_view(f_.view) : DisplacedCullView{};
-    for (std::size_t i : only) {
-        if (!tested(i)) continue;
-        for (const PatchSpan& s : plan_.object_spans[i]) {
-            if (occluding && !f_.fused)
-                for_each_piece(s, undisplaced, [&](const PatchSpan& piece) {
-                    m_.occlusion.run(buffers_of(piece), f_.view, *occluding, false);
-                });
-            if (bounds)
-                for_each_piece(s, &m_.renderer.displaced_runs(), [&](const PatchSpan& piece) {
-                    m_.displaced.run(buffers_of(piece), f_.ranges, params_.bound, params_.cone, displaced_view,
-                                     occluding, true);
-                });
-        }
+    for (const PatchSpan& s : spans) {
+        if (occluding && !f_.fused)
+            for_each_piece(s, undisplaced, [&](const PatchSpan& piece) {
+                m_.occlusion.run(buffers_of(piece), f_.view, *occluding, false);
+            });
+        if (bounds)
+            for_each_piece(s, &m_.renderer.displaced_runs(), [&](const PatchSpan& piece) {
+                m_.displaced.run(buffers_of(piece), f_.ranges, params_.bound, params_.cone, displaced_view, occluding,
+                                 true);
+            });
     }
 }
 
