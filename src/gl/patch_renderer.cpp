@@ -105,8 +105,8 @@ std::uint32_t PatchRenderer::patch_buffer() const { return impl_->control_points
 std::uint32_t PatchRenderer::flag_buffer() const { return impl_->cull_flags; }
 std::uint32_t PatchRenderer::margin_buffer() const { return impl_->has_max_displacement ? impl_->max_displacement : 0; }
 std::uint32_t PatchRenderer::range_buffer() const { return impl_->has_ranges ? impl_->ranges : 0; }
-const std::vector<PatchSpan>& PatchRenderer::undisplaced_runs() const { return impl_->undisplaced_runs; }
-const std::vector<PatchSpan>& PatchRenderer::displaced_runs() const { return impl_->displaced_runs; }
+const std::vector<PatchSpan>& PatchRenderer::undisplaced_runs() const { return impl_->runs.undisplaced; }
+const std::vector<PatchSpan>& PatchRenderer::displaced_runs() const { return impl_->runs.displaced; }
 std::uint32_t PatchRenderer::depth_texture() const { return impl_->depth; }
 std::uint32_t PatchRenderer::tangent_buffer() const { return impl_->tangents; }
 std::size_t PatchRenderer::last_upload_bytes() const { return last_upload_bytes_; }

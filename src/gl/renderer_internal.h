@@ -18,8 +18,8 @@
 #include "gl_util.h"
 #include "patchcull/core/error.h"
 #include "patchcull/core/hiz.h"
+#include "patchcull/core/patch_runs.h"
 #include "patchcull/gl/gl_renderer.h"
-#include "patchcull/gl/gl_span_plan.h"
 #include "png_file.h"
 #include "shader_sources.h"
 #include "shared.h"
@@ -29,11 +29,6 @@ namespace patchcull::gl {
 namespace sh = shared;
 
 using namespace detail;
-
-// The shortest gap between two runs of undisplaced_runs / displaced_runs: a shorter one stays in
-// the run, since dispatching around it would cost more than testing it (on llvmpipe a dispatch
-// costs tens of microseconds, a patch in the cone pass about 0.2).
-constexpr std::size_t kMinSkippedRun = 256;
 
 struct PatchRenderer::Impl {
     GLuint vao = 0;
@@ -52,8 +47,7 @@ struct PatchRenderer::Impl {
     bool has_displacement_map = false;
     bool has_max_displacement = false;
     bool has_ranges = false;
-    // PatchRenderer::undisplaced_runs / displaced_runs, from set_patches' margins and ranges.
-    std::vector<PatchSpan> undisplaced_runs, displaced_runs;
+    DisplacementRuns runs;                          // PatchRenderer::undisplaced_runs / displaced_runs (set_patches)
     bool has_tangents = false;                      // the tangent buffer holds kTangentVec4s vec4 per patch
     int frame_level = 1;                            // begin_frame's effective tessellation level
     ClipDepth clip_depth = ClipDepth::zero_to_one;  // the last set_draw_uniforms' RenderParams::depth
@@ -190,13 +184,7 @@ struct PatchRenderer::Impl {
         upload(max_displacement, has_max_displacement ? n * sizeof(float) : 0, margins.data());
         has_ranges = !a.displacement_ranges.empty();
         upload(ranges, has_ranges ? n * sizeof(DisplacementRange) : 0, a.displacement_ranges.data());
-        std::vector<std::uint8_t> keep(n, 1);
-        for (std::size_t p = 0; p < margins.size(); ++p) keep[p] = !(margins[p] > 0.0f);
-        undisplaced_runs = kept_runs(keep, kMinSkippedRun);
-        keep.assign(a.displacement_ranges.size(), 0);
-        for (std::size_t p = 0; p < keep.size(); ++p)
-            keep[p] = a.displacement_ranges[p].d_min != 0.0f || a.displacement_ranges[p].d_max != 0.0f;
-        displaced_runs = kept_runs(keep, kMinSkippedRun);
+        runs = displacement_runs(n, margins, a.displacement_ranges);
         std::vector<Vec2> uv(4 * n);
         for (std::size_t p = 0; p < n; ++p)
             for (int c = 0; c < 4; ++c)

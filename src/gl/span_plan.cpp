@@ -1,5 +1,4 @@
-// plan_spans (patchcull/gl/gl_span_plan.h): a frame's dispatch and draw spans; kept_runs and
-// clip_to_runs, the runs a pass that skips some patches is dispatched on.
+// plan_spans (patchcull/gl/gl_span_plan.h): a frame's dispatch and draw spans.
 #include <algorithm>
 #include <string>
 
@@ -81,35 +80,6 @@ SpanPlan plan_spans(std::size_t count, const std::vector<ObjectRange>& objects,
     }
     plan_dispatch_and_draws(plan);
     return plan;
-}
-
-std::vector<PatchSpan> kept_runs(const std::vector<std::uint8_t>& keep, std::size_t min_gap) {
-    std::vector<PatchSpan> runs;
-    for (std::size_t p = 0; p < keep.size();) {
-        if (!keep[p]) {
-            ++p;
-            continue;
-        }
-        std::size_t end = p + 1;
-        while (end < keep.size() && keep[end]) ++end;
-        if (!runs.empty() && p - (runs.back().first + runs.back().count) < min_gap)
-            runs.back().count = end - runs.back().first;
-        else
-            runs.push_back({p, end - p});
-        p = end;
-    }
-    return runs;
-}
-
-void clip_to_runs(const PatchSpan& span, const std::vector<PatchSpan>& runs, std::vector<PatchSpan>& out) {
-    const std::size_t span_end = span.first + span.count;
-    // The first run that ends after the span starts.
-    auto it = std::upper_bound(runs.begin(), runs.end(), span.first,
-                               [](std::size_t first, const PatchSpan& r) { return first < r.first + r.count; });
-    for (; it != runs.end() && it->first < span_end; ++it) {
-        const std::size_t a = std::max(span.first, it->first), b = std::min(span_end, it->first + it->count);
-        if (a < b) out.push_back({a, b - a});
-    }
 }
 
 }  // namespace patchcull::gl

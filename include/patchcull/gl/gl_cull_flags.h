@@ -17,6 +17,7 @@
 #include <cstdint>
 
 #include "patchcull/core/cull_flags.h"
+#include "patchcull/core/patch_runs.h"
 
 namespace patchcull::gl {
 
@@ -32,11 +33,9 @@ using patchcull::kStatusVisible;
 /// Id of occluder triangle t in the id buffer: kIdOccluderBit | t (shaders/shared.h's value).
 inline constexpr std::uint32_t kIdOccluderBit = 0x80000000u;
 
-/// Patches [first, first + count) of the set (object-level culling and draws restricted to spans).
-struct PatchSpan {
-    std::size_t first = 0;
-    std::size_t count = 0;
-};
+/// Patches [first, first + count) of the set (object-level culling and draws restricted to spans):
+/// core/patch_runs.h's.
+using patchcull::PatchSpan;
 /// Occluder triangles [first, first + count) (set_occluders' triangle order).
 struct TriangleSpan {
     std::size_t first = 0;

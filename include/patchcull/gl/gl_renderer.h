@@ -143,10 +143,10 @@ public:
     /// The ascending runs of patches a pass that skips displaced patches needs: undisplaced_runs
     /// holds every patch whose margin is not > 0 (the back-patch tests and the Hi-Z test of
     /// OcclusionPass skip the others), displaced_runs every patch with a displacement range other
-    /// than (0, 0) (what DisplacedPass tests with only_displaced). Gaps of fewer than 256 patches
-    /// stay inside a run. From the last set_patches / update_patches: without margins one run of
-    /// the whole set, without ranges none. CullPipeline dispatches those passes on them alone
-    /// (on llvmpipe a patch a pass returns from at once costs as much as one it tests).
+    /// than (0, 0) (what DisplacedPass tests with only_displaced): core/patch_runs.h's
+    /// displacement_runs of the last set_patches / update_patches. CullPipeline dispatches those
+    /// passes on them alone (on llvmpipe a patch a pass returns from at once costs as much as one
+    /// it tests).
     const std::vector<PatchSpan>& undisplaced_runs() const;
     const std::vector<PatchSpan>& displaced_runs() const;
     /// {patch_buffer, flag_buffer, margin_buffer, 0, patch_count()}: the whole set for a pass.

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cstddef>
-#include <cstdint>
 #include <vector>
 
 #include "patchcull/gl/gl_cull_flags.h"
@@ -39,14 +38,5 @@ struct SpanPlan {
 /// set, or objects (culled spans) overlap.
 SpanPlan plan_spans(std::size_t patch_count, const std::vector<ObjectRange>& objects,
                     const std::vector<PatchSpan>& object_culled);
-
-/// The ascending runs of the patches p with keep[p] != 0, a gap shorter than min_gap between two
-/// runs joined into one (the result covers every kept patch and some others; min_gap 0 or 1:
-/// exactly the kept ones).
-std::vector<PatchSpan> kept_runs(const std::vector<std::uint8_t>& keep, std::size_t min_gap);
-
-/// Appends to out the nonempty parts of span inside runs (ascending and disjoint, as kept_runs
-/// returns them), ascending.
-void clip_to_runs(const PatchSpan& span, const std::vector<PatchSpan>& runs, std::vector<PatchSpan>& out);
 
 }  // namespace patchcull::gl
