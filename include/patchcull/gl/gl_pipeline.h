@@ -13,7 +13,9 @@
 //      displaced patches skipped); OcclusionPass (control-point boxes; displaced patches
 //      skipped) - or those three as one FusedCullPass (PipelineParams::fused_pass);
 //      DisplacedPass (Niessner & Loop §4.2's bound of each displaced patch, against the frustum
-//      and the same pyramid); CullStatusPass::end (statuses, counters);
+//      and the same pyramid); CullStatusPass::end (statuses, counters). The passes that skip
+//      displaced (undisplaced) patches are dispatched on PatchRenderer::undisplaced_runs()
+//      (displaced_runs()) alone, one dispatch per run of adjacent tested objects;
 //   4. the newly visible patches (draw pass 2; skipped when aggressive).
 // Without occlusion: the chain (without the Hi-Z passes; the displaced pass then tests the
 // frustum only), then clear, occluders and the patches that passed (one draw).
