@@ -1,4 +1,4 @@
-// kept_runs, clip_to_runs and displacement_runs (patchcull/core/patch_runs.h).
+// kept_runs, clip_to_runs, join_adjacent and displacement_runs (patchcull/core/patch_runs.h).
 #include "patchcull/core/patch_runs.h"
 
 #include <algorithm>
@@ -32,6 +32,18 @@ void clip_to_runs(const PatchSpan& span, const std::vector<PatchSpan>& runs, std
         const std::size_t a = std::max(span.first, it->first), b = std::min(span_end, it->first + it->count);
         if (a < b) out.push_back({a, b - a});
     }
+}
+
+void join_adjacent(std::vector<PatchSpan>& spans) {
+    std::sort(spans.begin(), spans.end(), [](const PatchSpan& a, const PatchSpan& b) { return a.first < b.first; });
+    std::size_t joined = 0;
+    for (const PatchSpan& s : spans) {
+        if (joined > 0 && spans[joined - 1].first + spans[joined - 1].count == s.first)
+            spans[joined - 1].count += s.count;
+        else
+            spans[joined++] = s;
+    }
+    spans.resize(joined);
 }
 
 DisplacementRuns displacement_runs(std::size_t n, const std::vector<float>& margins,

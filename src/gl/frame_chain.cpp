@@ -1,8 +1,6 @@
 // FrameChain (frame_chain.h): one frame's flag chain over its dispatch spans.
 #include "frame_chain.h"
 
-#include <algorithm>
-
 namespace patchcull::gl {
 
 PatchBuffers FrameChain::buffers_of(const PatchSpan& s) const {
@@ -76,15 +74,7 @@ void FrameChain::run_tests(const HiZTexture* hiz, const std::vector<std::size_t>
     for (std::size_t i : only)
         if (plan_.objects[i].cull)  // ObjectRange::cull
             spans.insert(spans.end(), plan_.object_spans[i].begin(), plan_.object_spans[i].end());
-    std::sort(spans.begin(), spans.end(), [](const PatchSpan& a, const PatchSpan& b) { return a.first < b.first; });
-    std::size_t joined = 0;
-    for (std::size_t k = 0; k < spans.size(); ++k) {
-        if (joined > 0 && spans[joined - 1].first + spans[joined - 1].count == spans[k].first)
-            spans[joined - 1].count += spans[k].count;
-        else
-            spans[joined++] = spans[k];
-    }
-    spans.resize(joined);
+    join_adjacent(spans);
     if (f_.fused) {
         // One dispatch per span for all three tests; its time counts as the first part.
         const std::uint32_t fused_tests =

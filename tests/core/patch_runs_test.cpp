@@ -1,5 +1,5 @@
-// kept_runs, clip_to_runs and displacement_runs (patchcull/core/patch_runs.h): the runs a pass
-// that skips displaced or undisplaced patches is dispatched on.
+// kept_runs, clip_to_runs, join_adjacent and displacement_runs (patchcull/core/patch_runs.h): the
+// runs a pass that skips displaced or undisplaced patches is dispatched on.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -68,6 +68,15 @@ TEST(KeptRuns, ClipToRunsKeepsTheSpansPartsInsideTheRuns) {
     EXPECT_TRUE(same(clipped({4, 0}), {}));
     std::vector<PatchSpan> none;
     clip_to_runs({0, 10}, {}, none);
+    EXPECT_TRUE(none.empty());
+}
+
+TEST(KeptRuns, JoinAdjacentSortsAndJoinsTouchingSpans) {
+    std::vector<PatchSpan> spans = {{10, 5}, {0, 4}, {4, 2}, {20, 1}, {15, 3}};
+    join_adjacent(spans);
+    EXPECT_TRUE(same(spans, {{0, 6}, {10, 8}, {20, 1}}));
+    std::vector<PatchSpan> none;
+    join_adjacent(none);
     EXPECT_TRUE(none.empty());
 }
 

@@ -28,6 +28,10 @@ std::vector<PatchSpan> kept_runs(const std::vector<std::uint8_t>& keep, std::siz
 /// returns them), ascending.
 void clip_to_runs(const PatchSpan& span, const std::vector<PatchSpan>& runs, std::vector<PatchSpan>& out);
 
+/// Sorts disjoint spans by first and joins those that touch (a.first + a.count == b.first), in
+/// place: the fewest dispatches that cover the same patches.
+void join_adjacent(std::vector<PatchSpan>& spans);
+
 /// The shortest gap displacement_runs leaves out between two runs: a shorter one costs less to
 /// test than a dispatch around it (on llvmpipe a dispatch costs tens of microseconds, a patch in
 /// the cone pass about 0.2).
