@@ -28,10 +28,19 @@ float pc_next_up(float x) {
     return uintBitsToFloat(x > 0.0 ? b + 1u : b - 1u);
 }
 
-// The depth key of depth-buffer value d.
+// The depth key of depth-buffer value d. Level 0's program is compiled for the texture's format
+// and convention (PC_HIZ_UNORM24, PC_HIZ_REVERSED: 0 or 1; llvmpipe computes every side of a
+// branch, even on a uniform).
+#ifdef PC_HIZ_UNORM24
+#define PC_HIZ_IS_UNORM24 (PC_HIZ_UNORM24 != 0)
+#define PC_HIZ_IS_REVERSED (PC_HIZ_REVERSED != 0)
+#else
+#define PC_HIZ_IS_UNORM24 (hiz_build.unorm24 != 0u)
+#define PC_HIZ_IS_REVERSED (hiz_build.reversed != 0u)
+#endif
 float depth_key(float d) {
-    if (hiz_build.unorm24 == 0u) return hiz_build.reversed != 0u ? -d : d;
-    precise float widened = hiz_build.reversed != 0u ? kHiZUnorm24Slack - d : d + kHiZUnorm24Slack;
+    if (!PC_HIZ_IS_UNORM24) return PC_HIZ_IS_REVERSED ? -d : d;
+    precise float widened = PC_HIZ_IS_REVERSED ? kHiZUnorm24Slack - d : d + kHiZUnorm24Slack;
     return pc_next_up(widened);
 }
 
@@ -49,9 +58,19 @@ float source(int x, int y) {
 void main() {
     const ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (t.x >= hiz_build.out_width || t.y >= hiz_build.out_height) return;
+#if defined(PC_HIZ_FROM_DEPTH) && PC_HIZ_FROM_DEPTH != 0
+    // Level 0 (GL): one textureGather of the 2x2 children around their shared corner. The pass
+    // binds a nearest, clamp-to-edge sampler, so a child past the last row or column is the last
+    // one, as below; gather's x, y, z, w are children (x0, y1), (x1, y1), (x1, y0), (x0, y0).
+    const vec2 corner = vec2(2 * t + 1) / vec2(hiz_build.source_width, hiz_build.source_height);
+    const vec4 d = textureGather(u_depth, corner, 0);
+    const float m0 = pc_max(depth_key(d.w), depth_key(d.z));
+    const float m1 = pc_max(depth_key(d.x), depth_key(d.y));
+#else
     const int x0 = 2 * t.x, x1 = min(2 * t.x + 1, hiz_build.source_width - 1);
     const int y0 = 2 * t.y, y1 = min(2 * t.y + 1, hiz_build.source_height - 1);
     const float m0 = pc_max(source(x0, y0), source(x1, y0));
     const float m1 = pc_max(source(x0, y1), source(x1, y1));
+#endif
     imageStore(u_out, t, vec4(pc_max(m0, m1), 0.0, 0.0, 0.0));
 }

@@ -1,5 +1,5 @@
 // HiZBuildPass (patchcull/gl/gl_passes.h): Niessner & Loop §4.1's pyramid, shaders/hiz_build.comp.glsl,
-// one dispatch per level.
+// one dispatch per level, level 0 gathering from the depth texture.
 #include "pass_common.h"
 
 #include <cstdio>
@@ -9,6 +9,13 @@ namespace patchcull::gl {
 
 struct HiZBuildPass::Impl : detail::PassState {
     using PassState::PassState;
+    Impl(const Impl&) = delete;
+    Impl& operator=(const Impl&) = delete;
+    ~Impl() {
+        if (clamp_sampler) glDeleteSamplers(1, &clamp_sampler);
+    }
+    // Level 0's sampler of the depth texture: nearest, clamp to edge (its textureGather).
+    GLuint clamp_sampler = 0;
 };
 
 HiZBuildPass::HiZBuildPass(PassContext& context) : impl_(std::make_unique<Impl>(context.impl())) {}
@@ -49,6 +56,14 @@ void HiZBuildPass::run(std::uint32_t depth_texture, HiZTexture& hiz, ClipDepth c
     }
     hiz.reversed = is_reversed(convention);
     glBindTextureUnit(shared::kTextureUnitDepth, depth_texture);
+    if (!impl_->clamp_sampler) {
+        glCreateSamplers(1, &impl_->clamp_sampler);
+        glSamplerParameteri(impl_->clamp_sampler, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glSamplerParameteri(impl_->clamp_sampler, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glSamplerParameteri(impl_->clamp_sampler, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glSamplerParameteri(impl_->clamp_sampler, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    glBindSampler(shared::kTextureUnitDepth, impl_->clamp_sampler);
     glBindTextureUnit(shared::kTextureUnitHiZ, hiz.texture);
     const int levels = HiZPyramid::level_count(hiz.width, hiz.height);
     pp::HiZBuildParams params;
@@ -63,9 +78,14 @@ void HiZBuildPass::run(std::uint32_t depth_texture, HiZTexture& hiz, ClipDepth c
         params.out_height = out_h;
         params.reversed = hiz.reversed ? 1u : 0u;
         params.unorm24 = unorm24 ? 1u : 0u;
-        if (l < 2)  // level 0 reads the depth texture, the others the pyramid: a program each
-            glUseProgram(impl_->context.program(
-                "hiz_build.comp.glsl", l == 0 ? "#define PC_HIZ_FROM_DEPTH 1\n" : "#define PC_HIZ_FROM_DEPTH 0\n"));
+        // Level 0 gathers from the depth texture (a program per depth format and convention), the
+        // others read the pyramid: llvmpipe computes every side of a branch, even on a uniform.
+        if (l == 0)
+            glUseProgram(impl_->context.program("hiz_build.comp.glsl",
+                                                std::string("#define PC_HIZ_FROM_DEPTH 1\n#define PC_HIZ_UNORM24 ") +
+                                                    (unorm24 ? "1" : "0") + "\n#define PC_HIZ_REVERSED " +
+                                                    (hiz.reversed ? "1" : "0") + "\n"));
+        if (l == 1) glUseProgram(impl_->context.program("hiz_build.comp.glsl", "#define PC_HIZ_FROM_DEPTH 0\n"));
         impl_->block.upload(params);
         glBindImageTexture(shared::kImageUnitHiZOut, hiz.texture, l, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
         glDispatchCompute((static_cast<GLuint>(out_w) + shared::kHiZGroupSize - 1) / shared::kHiZGroupSize,
@@ -75,6 +95,7 @@ void HiZBuildPass::run(std::uint32_t depth_texture, HiZTexture& hiz, ClipDepth c
         source_w = out_w;
         source_h = out_h;
     }
+    glBindSampler(shared::kTextureUnitDepth, 0);  // the caller's unit samples with its texture's state again
     detail::finish_pass("HiZBuildPass");
 }
 

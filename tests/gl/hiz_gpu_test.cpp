@@ -16,6 +16,7 @@
 #include "gl_test_util.h"
 #include "patchcull/core/camera.h"
 #include "patchcull/core/hiz.h"
+#include "shared.h"
 
 using namespace patchcull;
 using namespace patchcull::gl;
@@ -162,6 +163,13 @@ TEST(GpuHiZ, PyramidBitIdenticalToCpuAtPotAndNpotSizes) {
         const std::string what = std::to_string(s[0]) + "x" + std::to_string(s[1]);
         check_pyramid(r, what.c_str());
     }
+    // The pass samples the depth texture through its own sampler and leaves sampler 0 bound there.
+    GLint active = 0, sampler = -1;
+    glGetIntegerv(GL_ACTIVE_TEXTURE, &active);
+    glActiveTexture(GL_TEXTURE0 + shared::kTextureUnitDepth);
+    glGetIntegerv(GL_SAMPLER_BINDING, &sampler);
+    glActiveTexture(static_cast<GLenum>(active));
+    EXPECT_EQ(sampler, 0);
 }
 
 TEST(GpuHiZ, DecisionsEqualCpuOnTeapotWithOccluders) {

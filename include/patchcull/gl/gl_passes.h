@@ -61,8 +61,10 @@
 // glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
 // GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT) after its dispatches, so a
 // following pass, draw (TCS reads) or read-back sees its writes. It changes no other state (no
-// framebuffer, viewport, depth or VAO state), does not wait for the GPU and allocates no GL
-// objects after its first run (programs are compiled on first use and cached in the PassContext).
+// framebuffer, viewport, depth or VAO state; HiZBuildPass binds its own sampler at
+// kTextureUnitDepth while it reads the depth texture and leaves sampler 0 bound there), does not
+// wait for the GPU and allocates no GL objects after its first run (programs are compiled on first
+// use and cached in the PassContext).
 // Large ranges are split into dispatches of at most 65535 work groups (dispatch_patches).
 // A run over a GpuPatchSource also binds the source's buffers and a second parameter block at
 // kUniformPatchSource, issues glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT) before its dispatches
