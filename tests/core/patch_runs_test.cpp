@@ -12,23 +12,16 @@
 namespace patchcull {
 namespace {
 
-bool same(const std::vector<PatchSpan>& a, const std::vector<PatchSpan>& b) {
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (a[i].first != b[i].first || a[i].count != b[i].count) return false;
-    return true;
-}
-
 TEST(KeptRuns, RunsOfKeptPatchesJoinedAcrossShortGaps) {
     //                                     0  1  2  3  4  5  6  7  8  9
     const std::vector<std::uint8_t> keep = {1, 1, 0, 1, 0, 0, 0, 1, 1, 0};
-    EXPECT_TRUE(same(kept_runs(keep, 0), {{0, 2}, {3, 1}, {7, 2}}));
-    EXPECT_TRUE(same(kept_runs(keep, 1), {{0, 2}, {3, 1}, {7, 2}}));
-    EXPECT_TRUE(same(kept_runs(keep, 2), {{0, 4}, {7, 2}}));  // the gap of 1 joined, of 3 not
-    EXPECT_TRUE(same(kept_runs(keep, 4), {{0, 9}}));
-    EXPECT_TRUE(same(kept_runs({0, 0, 0}, 8), {}));
-    EXPECT_TRUE(same(kept_runs({}, 8), {}));
-    EXPECT_TRUE(same(kept_runs({1, 1, 1}, 8), {{0, 3}}));
+    EXPECT_EQ(kept_runs(keep, 0), (std::vector<PatchSpan>{{0, 2}, {3, 1}, {7, 2}}));
+    EXPECT_EQ(kept_runs(keep, 1), (std::vector<PatchSpan>{{0, 2}, {3, 1}, {7, 2}}));
+    EXPECT_EQ(kept_runs(keep, 2), (std::vector<PatchSpan>{{0, 4}, {7, 2}}));  // the gap of 1 joined, of 3 not
+    EXPECT_EQ(kept_runs(keep, 4), (std::vector<PatchSpan>{{0, 9}}));
+    EXPECT_EQ(kept_runs({0, 0, 0}, 8), (std::vector<PatchSpan>{}));
+    EXPECT_EQ(kept_runs({}, 8), (std::vector<PatchSpan>{}));
+    EXPECT_EQ(kept_runs({1, 1, 1}, 8), (std::vector<PatchSpan>{{0, 3}}));
     // Every kept patch is covered, whatever the pattern and gap.
     std::vector<std::uint8_t> pattern(1000);
     for (std::size_t p = 0; p < pattern.size(); ++p) pattern[p] = (p * 7919 % 13) < 4 || (p / 100) % 3 == 0;
@@ -60,12 +53,12 @@ TEST(KeptRuns, ClipToRunsKeepsTheSpansPartsInsideTheRuns) {
         out.erase(out.begin());
         return out;
     };
-    EXPECT_TRUE(same(clipped({0, 20}), {{2, 3}, {8, 2}, {12, 4}}));
-    EXPECT_TRUE(same(clipped({3, 10}), {{3, 2}, {8, 2}, {12, 1}}));
-    EXPECT_TRUE(same(clipped({5, 3}), {}));  // between two runs
-    EXPECT_TRUE(same(clipped({9, 1}), {{9, 1}}));
-    EXPECT_TRUE(same(clipped({16, 4}), {}));
-    EXPECT_TRUE(same(clipped({4, 0}), {}));
+    EXPECT_EQ(clipped({0, 20}), (std::vector<PatchSpan>{{2, 3}, {8, 2}, {12, 4}}));
+    EXPECT_EQ(clipped({3, 10}), (std::vector<PatchSpan>{{3, 2}, {8, 2}, {12, 1}}));
+    EXPECT_EQ(clipped({5, 3}), (std::vector<PatchSpan>{}));  // between two runs
+    EXPECT_EQ(clipped({9, 1}), (std::vector<PatchSpan>{{9, 1}}));
+    EXPECT_EQ(clipped({16, 4}), (std::vector<PatchSpan>{}));
+    EXPECT_EQ(clipped({4, 0}), (std::vector<PatchSpan>{}));
     std::vector<PatchSpan> none;
     clip_to_runs({0, 10}, {}, none);
     EXPECT_TRUE(none.empty());
@@ -74,7 +67,7 @@ TEST(KeptRuns, ClipToRunsKeepsTheSpansPartsInsideTheRuns) {
 TEST(KeptRuns, JoinAdjacentSortsAndJoinsTouchingSpans) {
     std::vector<PatchSpan> spans = {{10, 5}, {0, 4}, {4, 2}, {20, 1}, {15, 3}};
     join_adjacent(spans);
-    EXPECT_TRUE(same(spans, {{0, 6}, {10, 8}, {20, 1}}));
+    EXPECT_EQ(spans, (std::vector<PatchSpan>{{0, 6}, {10, 8}, {20, 1}}));
     std::vector<PatchSpan> none;
     join_adjacent(none);
     EXPECT_TRUE(none.empty());
@@ -84,7 +77,7 @@ TEST(KeptRuns, DisplacementRunsFromMarginsAndRanges) {
     const std::size_t n = 1000;
     // No margins, no ranges: every patch undisplaced, none displaced.
     DisplacementRuns none = displacement_runs(n, {}, {});
-    EXPECT_TRUE(same(none.undisplaced, {{0, n}}));
+    EXPECT_EQ(none.undisplaced, (std::vector<PatchSpan>{{0, n}}));
     EXPECT_TRUE(none.displaced.empty());
     EXPECT_TRUE(displacement_runs(0, {}, {}).undisplaced.empty());
     // Displaced (margin > 0, range not (0, 0)) in [300, 600) and at 800: the gaps of 1 and 200
@@ -98,15 +91,15 @@ TEST(KeptRuns, DisplacementRunsFromMarginsAndRanges) {
     margins[800] = 0.1f;
     ranges[800] = {0.0f, 0.1f};
     const DisplacementRuns runs = displacement_runs(n, margins, ranges);
-    EXPECT_TRUE(same(runs.undisplaced, {{0, 300}, {600, n - 600}}));
-    EXPECT_TRUE(same(runs.displaced, {{300, 501}}));
+    EXPECT_EQ(runs.undisplaced, (std::vector<PatchSpan>{{0, 300}, {600, n - 600}}));
+    EXPECT_EQ(runs.displaced, (std::vector<PatchSpan>{{300, 501}}));
     // A NaN margin is not > 0: the pass tests it (and decides for itself).
     margins[100] = std::numeric_limits<float>::quiet_NaN();
-    EXPECT_TRUE(same(displacement_runs(n, margins, {}).undisplaced, {{0, 300}, {600, n - 600}}));
+    EXPECT_EQ(displacement_runs(n, margins, {}).undisplaced, (std::vector<PatchSpan>{{0, 300}, {600, n - 600}}));
     // A range with only d_min is displaced.
     std::vector<DisplacementRange> low(n);
     low[5] = {-0.1f, 0.0f};
-    EXPECT_TRUE(same(displacement_runs(n, {}, low).displaced, {{5, 1}}));
+    EXPECT_EQ(displacement_runs(n, {}, low).displaced, (std::vector<PatchSpan>{{5, 1}}));
 }
 
 }  // namespace

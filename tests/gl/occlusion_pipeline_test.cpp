@@ -298,16 +298,26 @@ std::vector<Camera> moving_cameras(const Bounds& b, int frames, float degrees) {
     return cams;
 }
 
+// The teapot on the ground behind a wall (ground_and_wall), in a pipeline of its own with both set.
+struct TeapotBehindAWall {
+    std::vector<BezierPatch> patches = teapot_y_up();
+    Bounds bounds = test::control_point_bounds(patches);
+    Occluders occluders = ground_and_wall(bounds, 1, 2);
+    CullPipeline pipeline{test::context()};
+    TeapotBehindAWall() {
+        pipeline.renderer().set_patches(patches);
+        pipeline.renderer().set_occluders(occluders.vertices, occluders.indices);
+    }
+};
+
 }  // namespace
 
 TEST(OcclusionPipeline, StrictIdBufferIdenticalAtFixedCameras) {
-    const std::vector<BezierPatch> patches = teapot_y_up();
-    const Bounds b = test::control_point_bounds(patches);
-    const Occluders occ = ground_and_wall(b, 1, 2);
-    CullPipeline pipeline(test::context());
-    PatchRenderer& r = pipeline.renderer();
-    r.set_patches(patches);
-    r.set_occluders(occ.vertices, occ.indices);
+    TeapotBehindAWall scene;
+    const std::vector<BezierPatch>& patches = scene.patches;
+    const Bounds& b = scene.bounds;
+    const Occluders& occ = scene.occluders;
+    CullPipeline& pipeline = scene.pipeline;
     const Camera cams[] = {
         camera_at(b, {0.3f, 0.35f, -1}, 2.4f),            // front, through the wall
         camera_at(b, {1, 0.25f, 0.3f}, 2.0f),             // side
@@ -346,13 +356,11 @@ TEST(OcclusionPipeline, ForgetVisibilityStartsPassOneEmptyAndStaysStrict) {
     // After an unculled frame every patch is tagged visible, and pass 1 of the next culled frame
     // would draw them all; forget_visibility starts that frame from none (occluders only in pass 1,
     // every patch that passes in pass 2), and it still matches the unculled render.
-    const std::vector<BezierPatch> patches = teapot_y_up();
-    const Bounds b = test::control_point_bounds(patches);
-    const Occluders occ = ground_and_wall(b, 1, 2);
-    CullPipeline pipeline(test::context());
-    PatchRenderer& r = pipeline.renderer();
-    r.set_patches(patches);
-    r.set_occluders(occ.vertices, occ.indices);
+    TeapotBehindAWall scene;
+    const std::vector<BezierPatch>& patches = scene.patches;
+    const Bounds& b = scene.bounds;
+    const Occluders& occ = scene.occluders;
+    CullPipeline& pipeline = scene.pipeline;
     const Camera cams[] = {camera_at(b, {0.3f, 0.35f, -1}, 2.4f), camera_at(b, {0.6f, 0.2f, -0.8f}, 0.8f)};
     for (std::size_t c = 0; c < std::size(cams); ++c) {
         const RenderParams params = params_for(cams[c]);
@@ -648,13 +656,10 @@ TEST(OcclusionPipeline, OccludersWriteTaggedIdsAndHidePatches) {
 }
 
 TEST(OcclusionPipeline, TimingMethodsAndStatusImage) {
-    const std::vector<BezierPatch> patches = teapot_y_up();
-    const Bounds b = test::control_point_bounds(patches);
-    const Occluders occ = ground_and_wall(b, 1, 2);
-    CullPipeline pipeline(test::context());
+    TeapotBehindAWall scene;
+    const Bounds& b = scene.bounds;
+    CullPipeline& pipeline = scene.pipeline;
     PatchRenderer& r = pipeline.renderer();
-    r.set_patches(patches);
-    r.set_occluders(occ.vertices, occ.indices);
     FrameParams fp;
     fp.render = params_for(camera_at(b, {0.3f, 0.35f, -1}, 2.4f));
     fp.cull = kFrustumOcclusion;

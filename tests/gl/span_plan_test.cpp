@@ -10,20 +10,13 @@
 namespace patchcull::gl {
 namespace {
 
-bool same(const std::vector<PatchSpan>& a, const std::vector<PatchSpan>& b) {
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (a[i].first != b[i].first || a[i].count != b[i].count) return false;
-    return true;
-}
-
 TEST(SpanPlan, NoObjectsIsOneObjectOfEveryPatch) {
     const SpanPlan plan = plan_spans(10, {}, {});
     ASSERT_EQ(plan.objects.size(), 1u);
     EXPECT_EQ(plan.objects[0].count, 10u);
     EXPECT_TRUE(plan.gaps.empty());
-    EXPECT_TRUE(same(plan.object_spans[0], {{0, 10}}));
-    EXPECT_TRUE(same(plan.drawn, {{0, 10}}));
+    EXPECT_EQ(plan.object_spans[0], (std::vector<PatchSpan>{{0, 10}}));
+    EXPECT_EQ(plan.drawn, (std::vector<PatchSpan>{{0, 10}}));
 }
 
 TEST(SpanPlan, GapsAreDrawnAndObjectCulledSpansAreNot) {
@@ -32,18 +25,18 @@ TEST(SpanPlan, GapsAreDrawnAndObjectCulledSpansAreNot) {
     const SpanPlan plan = plan_spans(12, {{8, 2, true}, {2, 4, true}}, {{8, 2}, {3, 2}});
     ASSERT_EQ(plan.gaps.size(), 3u);  // [0, 2), [6, 8), [10, 12)
     EXPECT_EQ(plan.gaps[1].first, 6u);
-    EXPECT_TRUE(same(plan.object_spans[0], {}));        // culled whole: no dispatch
-    EXPECT_TRUE(same(plan.object_spans[1], {{2, 4}}));  // dispatched whole, 3-4 pre-marked
-    EXPECT_TRUE(same(plan.active_spans(plan.objects[1]), {{2, 1}, {5, 1}}));
-    EXPECT_TRUE(same(plan.gaps_drawn, {{0, 2}, {6, 2}, {10, 2}}));
-    EXPECT_TRUE(same(plan.drawn, {{2, 1}, {5, 1}, {0, 2}, {6, 2}, {10, 2}}));
+    EXPECT_EQ(plan.object_spans[0], (std::vector<PatchSpan>{}));        // culled whole: no dispatch
+    EXPECT_EQ(plan.object_spans[1], (std::vector<PatchSpan>{{2, 4}}));  // dispatched whole, 3-4 pre-marked
+    EXPECT_EQ(plan.active_spans(plan.objects[1]), (std::vector<PatchSpan>{{2, 1}, {5, 1}}));
+    EXPECT_EQ(plan.gaps_drawn, (std::vector<PatchSpan>{{0, 2}, {6, 2}, {10, 2}}));
+    EXPECT_EQ(plan.drawn, (std::vector<PatchSpan>{{2, 1}, {5, 1}, {0, 2}, {6, 2}, {10, 2}}));
 }
 
 TEST(SpanPlan, AddCulledPlansAgain) {
     SpanPlan plan = plan_spans(8, {{0, 4, true}, {4, 4, true}}, {});
     plan.add_culled({{4, 4}});
-    EXPECT_TRUE(same(plan.object_spans[1], {}));
-    EXPECT_TRUE(same(plan.drawn, {{0, 4}}));
+    EXPECT_EQ(plan.object_spans[1], (std::vector<PatchSpan>{}));
+    EXPECT_EQ(plan.drawn, (std::vector<PatchSpan>{{0, 4}}));
 }
 
 TEST(SpanPlan, RefusesRangesOutsideTheSetAndOverlaps) {

@@ -17,6 +17,7 @@ namespace patchcull {
 struct PatchSpan {
     std::size_t first = 0;
     std::size_t count = 0;
+    bool operator==(const PatchSpan&) const = default;
 };
 
 /// The ascending runs of the patches p with keep[p] != 0, a gap shorter than min_gap between two
