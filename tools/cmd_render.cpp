@@ -64,6 +64,9 @@
 // pass and when aggressive). --patch-source osd-table draws with the flags unless --draw indirect
 // is given (render_osd_table.h).
 // --compact scan|append ("compact"): how --draw indirect lists the survivors (render_options.h).
+// --driver-threads spread|os ("driver_threads", and "pinned_driver_threads": how many were pinned):
+// on a software rasterizer, each thread the driver starts pinned to a CPU of its own (the default),
+// or left to the operating system (core/thread_placement.h).
 // --api gl|vulkan ("api"): the OpenGL pipeline above, or the same frames on patchcull's headless
 // Vulkan renderer (render_vulkan.h: one object, posed on the CPU; --vk-validation, --vk-device).
 // --patch-source bezier|osd-table ("patch_source" in the JSON): bezier (the default) draws the
@@ -135,6 +138,7 @@ Runner add_render_command(CLI::App& app) {
         std::string pose = "cpu";
         bool fused_pass = false;
         std::string draw = "indirect";
+        std::string driver_threads = "spread";
         std::string compact = "scan";
         std::string api = "gl";
         bool vk_validation = false;
@@ -175,6 +179,7 @@ Runner add_render_command(CLI::App& app) {
                       "how the draw passes issue patches: indirect (the default: the survivors compacted into indirect "
                       "draws, a culled patch is never issued) or flags (every patch, the TCS drops the culled)");
     add_compact_option(*command, state->compact);
+    add_driver_threads_option(*command, state->driver_threads);
     add_choice_option(*command, "--api", state->api, {"gl", "vulkan"},
                       "graphics API of the renderer and the cull passes: gl (OpenGL 4.5 through EGL) or vulkan "
                       "(Vulkan 1.3 on a headless device; one object per frame: no --cull auto, --objects, "
@@ -210,9 +215,10 @@ Runner add_render_command(CLI::App& app) {
         parse_size("--size", state->size, width, height);
         if (state->patch_source == "osd-table") {
             if (state->scheme != "osd") throw Error("--patch-source osd-table: needs --scheme osd");
-            const std::set<std::string> applies = {
-                "MODEL",  "--scheme", "--patch-source", "--frames", "--cull", "--backpatch", "--clip-depth",
-                "--tess", "--size",   "--verify",       "--json",   "--help", "--draw",      "--compact"};
+            const std::set<std::string> applies = {"MODEL",  "--scheme",    "--patch-source",  "--frames",
+                                                   "--cull", "--backpatch", "--clip-depth",    "--tess",
+                                                   "--size", "--verify",    "--json",          "--help",
+                                                   "--draw", "--compact",   "--driver-threads"};
             for (const CLI::Option* option : command->get_options())
                 if (option->count() > 0 && !applies.count(option->get_name()))
                     throw Error("--patch-source osd-table: not with " + option->get_name());
@@ -236,6 +242,7 @@ Runner add_render_command(CLI::App& app) {
             o.tess = state->tess;
             o.indirect = indirect;
             o.compact = parse_compact_option(state->compact);
+            o.driver_threads = driver_threads_option(state->driver_threads);
             o.verify = state->verify;
             o.json = state->json;
             return run_osd_table_render(o);
@@ -290,7 +297,7 @@ Runner add_render_command(CLI::App& app) {
                 "--tess-mode",     "--tess-distance", "--displace", "--displace-scale",
                 "--bound",         "--cone",          "--size",     "--aggressive",
                 "--verify",        "--out",           "--json",     "--api",
-                "--vk-validation", "--vk-device",     "--help"};
+                "--vk-validation", "--vk-device",     "--help",     "--driver-threads"};
             for (const CLI::Option* option : command->get_options())
                 if (option->count() > 0 && !applies.count(option->get_name()))
                     throw Error("--api vulkan: not with " + option->get_name() +
@@ -336,6 +343,7 @@ Runner add_render_command(CLI::App& app) {
             job.json = state->json;
             job.validation = state->vk_validation;
             job.prefer_gpu = state->vk_device == "gpu";
+            job.driver_threads = driver_threads_option(state->driver_threads);
             job.out = state->out;
             return run_vulkan_render(job);
         }
@@ -344,7 +352,7 @@ Runner add_render_command(CLI::App& app) {
         if (automatic && object_level->sets_objects())
             throw Error("--object-occlusion: a query method decides per object itself; not with --cull auto");
 
-        gl::GlContext context = gl::GlContext::create_headless();
+        gl::GlContext context = gl::GlContext::create_headless(driver_threads_option(state->driver_threads));
         gl::CullPipeline pipeline(context);
         struct ReleaseGuard {  // GlReleaseGuard for the object level of the frame
             std::unique_ptr<ObjectLevelRun>& run;
@@ -523,6 +531,8 @@ Runner add_render_command(CLI::App& app) {
             out["detail_cull"] = state->objects.detail_pixels;
             out["environment_objects"] = scene.environment.size();
             out["renderer"] = context.renderer();
+            out["driver_threads"] = state->driver_threads;
+            out["pinned_driver_threads"] = context.pinned_driver_threads();
             out["frames"] = frames;
             out["false_culls"] = total_false;
             if (!hiz_dump.is_null()) out["hiz_dump"] = hiz_dump;

@@ -48,6 +48,19 @@ const char* compact_option_name(gl::CompactMethod method) {
     return method == gl::CompactMethod::atomic_append ? "append" : "scan";
 }
 
+CLI::Option* add_driver_threads_option(CLI::App& command, std::string& target) {
+    return add_choice_option(command, "--driver-threads", target, {"spread", "os"},
+                             "on a software rasterizer (llvmpipe, lavapipe): pin each thread the driver starts to a "
+                             "CPU of its own (spread, the default: the scheduler often puts two compute workers on "
+                             "one CPU) or leave them to the operating system (os)");
+}
+
+DriverThreads driver_threads_option(const std::string& text) {
+    return text == "os" ? DriverThreads::os : DriverThreads::spread;
+}
+
+const char* driver_threads_name(DriverThreads threads) { return threads == DriverThreads::os ? "os" : "spread"; }
+
 void add_displace_options(CLI::App& command, DisplaceOptions& options) {
     CLI::Option* displace = add_text_option(
         command, "--displace", options.displace,

@@ -7,6 +7,7 @@
 
 #include "cli_fwd.h"
 #include "patchcull/core/displaced_bounds.h"
+#include "patchcull/core/thread_placement.h"
 #include "patchcull/gl/gl_compaction.h"
 #include "patchcull/gl/gl_renderer.h"
 #include "patchcull/import/scene_model.h"
@@ -55,6 +56,16 @@ CLI::Option* add_compact_option(CLI::App& command, std::string& target);
 gl::CompactMethod parse_compact_option(const std::string& text);
 /// --compact's text of a method ("scan", "append", "fused"), e.g. for a JSON report.
 const char* compact_option_name(gl::CompactMethod method);
+
+/// --driver-threads spread|os of `render` and `view` (target keeps the text, default "spread"): on a
+/// software rasterizer, each thread the driver starts pinned to a CPU of its own, or left to the
+/// operating system (core/thread_placement.h's DriverThreads). A bad value is one line naming the
+/// flag (exit 2).
+CLI::Option* add_driver_threads_option(CLI::App& command, std::string& target);
+/// The DriverThreads of --driver-threads' text: "os" is os, anything else spread.
+DriverThreads driver_threads_option(const std::string& text);
+/// --driver-threads' text of a choice ("spread", "os"), e.g. for a JSON report.
+const char* driver_threads_name(DriverThreads threads);
 
 /// --displace, --displace-scale, --bound and --cone of `render` and `view` (Niessner & Loop §4.2, §6):
 /// displaced patches tested against the frustum and the running pipeline's Hi-Z with the chosen

@@ -44,7 +44,7 @@ int run_osd_table_render(const OsdTableRender& o) {
     settings.draw = o.indirect ? gl_osd::OsdDrawMode::indirect : gl_osd::OsdDrawMode::flags;
     settings.compact = o.compact;
 
-    gl::GlContext context = gl::GlContext::create_headless();
+    gl::GlContext context = gl::GlContext::create_headless(o.driver_threads);
     struct BufferGuard {  // the vertex buffer, deleted before the context
         GLuint name = 0;
         ~BufferGuard() {
@@ -132,6 +132,8 @@ int run_osd_table_render(const OsdTableRender& o) {
         out["backpatch"] = settings.backpatch ? backpatch_method_name(*settings.backpatch) : "off";
         out["verified"] = o.verify;
         out["renderer"] = context.renderer();
+        out["driver_threads"] = driver_threads_name(o.driver_threads);
+        out["pinned_driver_threads"] = context.pinned_driver_threads();
         out["frames"] = frames;
         out["false_culls"] = total_false;
         std::cout << out.dump() << "\n";

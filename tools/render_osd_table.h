@@ -39,6 +39,7 @@ struct OsdTableRender {
     bool indirect = false;  ///< --draw indirect (else flags)
     gl::CompactMethod compact = gl::CompactMethod::prefix_scan;
     bool verify = false, json = false;
+    DriverThreads driver_threads = DriverThreads::spread;  ///< --driver-threads
 };
 
 /// Runs it; returns the exit status (1 when --verify found a false cull). Throws Error for a bad

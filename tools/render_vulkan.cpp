@@ -55,6 +55,7 @@ int run_vulkan_render(const VulkanRenderJob& job) {
     vk::HeadlessDeviceOptions device_options;
     device_options.validation = job.validation;
     if (job.prefer_gpu) device_options.prefer = vk::HeadlessDeviceOptions::Prefer::gpu;
+    device_options.driver_threads = job.driver_threads;
     vk::HeadlessDevice device(device_options);
     auto renderer_owner = std::make_unique<vk::CullRenderer>(device);  // destroyed before the last messages
     vk::CullRenderer& renderer = *renderer_owner;
@@ -153,6 +154,8 @@ int run_vulkan_render(const VulkanRenderJob& job) {
         out["draw"] = job.draw_name;
         out["compact"] = job.compact_name;
         out["renderer"] = device.name();
+        out["driver_threads"] = driver_threads_name(job.driver_threads);
+        out["pinned_driver_threads"] = device.pinned_driver_threads();
         out["validation"] = job.validation;
         out["validation_messages"] = messages;
         out["frames"] = frames;

@@ -33,8 +33,9 @@ struct VulkanRenderJob {
     std::string bound_name, cone_name, frustum_name, draw_name, compact_name;
     bool frustum_aabb = false, fused_pass = false, indirect = true, scan = true;
     bool aggressive = false, verify = false, json = false, validation = false;
-    bool prefer_gpu = false;  ///< --vk-device gpu
-    std::string out;          ///< PNG of the last frame's colour, or empty
+    bool prefer_gpu = false;                               ///< --vk-device gpu
+    DriverThreads driver_threads = DriverThreads::spread;  ///< --driver-threads
+    std::string out;                                       ///< PNG of the last frame's colour, or empty
 };
 
 /// Runs the frames; returns the exit status (1 on a false cull or a validation message).

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "patchcull/core/error.h"
+#include "patchcull/core/thread_placement.h"
 #include "patchcull/gl/gl_context.h"
 #include "png_file.h"
 
@@ -57,6 +58,7 @@ struct GlContext::Impl {
     const GlfwApi* glfw = nullptr;  // the loaded GLFW of a window context
     std::string renderer, vendor, version, platform;
     bool software = false;
+    std::size_t pinned_driver_threads = 0;
     ~Impl();
 };
 
@@ -156,6 +158,12 @@ std::string try_candidate(const Candidate& c, PFNEGLGETPLATFORMDISPLAYEXTPROC ge
     return {};
 }
 
+// Pins the threads started since `before` when asked to and the context is a software one.
+void place_driver_threads(GlContext::Impl& impl, DriverThreads threads, const std::vector<int>& before) {
+    if (threads != DriverThreads::spread || !impl.software) return;
+    impl.pinned_driver_threads = spread_threads(threads_started(before, process_thread_ids()));
+}
+
 }  // namespace
 
 // The last GLFW error, for one-line messages (GLFW reports through a callback).
@@ -209,7 +217,8 @@ GlContext::Impl::~Impl() {
     if (display != EGL_NO_DISPLAY) release_display(display);
 }
 
-GlContext GlContext::create_headless() {
+GlContext GlContext::create_headless(DriverThreads threads) {
+    const std::vector<int> threads_before = process_thread_ids();
     static const char* const egl_names[] = {"libEGL.so.1", "libEGL.so", nullptr};
     static const char* const gl_names[] = {"libOpenGL.so.0", "libGL.so.1", "libOpenGL.so", "libGL.so", nullptr};
     require_library(egl_names, "the EGL library");
@@ -250,14 +259,18 @@ GlContext GlContext::create_headless() {
     for (const Candidate& c : candidates) {
         auto impl = std::make_unique<Impl>();
         const std::string why = try_candidate(c, get_platform_display, *impl);
-        if (why.empty()) return GlContext(std::move(impl));
+        if (why.empty()) {
+            place_driver_threads(*impl, threads, threads_before);
+            return GlContext(std::move(impl));
+        }
         reasons += (reasons.empty() ? "" : "; ") + why;
     }
     throw Error("EGL: no OpenGL 4.5 core context: " + reasons);
 }
 
-GlContext GlContext::create_window(int width, int height, const std::string& title) {
+GlContext GlContext::create_window(int width, int height, const std::string& title, DriverThreads threads) {
     if (width < 1 || height < 1) throw Error("GLFW: window size must be positive");
+    const std::vector<int> threads_before = process_thread_ids();
     const GlfwApi& glfw = glfw_api();
     glfw.set_error_callback(remember_glfw_error);
     g_glfw_error.clear();
@@ -290,6 +303,7 @@ GlContext GlContext::create_window(int width, int height, const std::string& tit
     impl->software = impl->renderer.find("llvmpipe") != std::string::npos ||
                      impl->renderer.find("softpipe") != std::string::npos ||
                      impl->renderer.find("swrast") != std::string::npos;
+    place_driver_threads(*impl, threads, threads_before);
     return GlContext(std::move(impl));
 }
 
@@ -346,5 +360,6 @@ const std::string& GlContext::vendor() const { return impl_->vendor; }
 const std::string& GlContext::version() const { return impl_->version; }
 const std::string& GlContext::platform() const { return impl_->platform; }
 bool GlContext::is_software() const { return impl_->software; }
+std::size_t GlContext::pinned_driver_threads() const { return impl_->pinned_driver_threads; }
 
 }  // namespace patchcull::gl

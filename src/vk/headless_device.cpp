@@ -94,6 +94,7 @@ std::string missing_requirement(VkPhysicalDevice device) {
 }  // namespace
 
 HeadlessDevice::HeadlessDevice(const HeadlessDeviceOptions& options) {
+    const std::vector<int> threads_before = process_thread_ids();
     const char* layer = "VK_LAYER_KHRONOS_validation";
     if (options.validation && !has_layer(layer))
         throw Error("Vulkan: no VK_LAYER_KHRONOS_validation for validation (Debian: vulkan-validationlayers)");
@@ -205,6 +206,8 @@ HeadlessDevice::HeadlessDevice(const HeadlessDeviceOptions& options) {
         pool.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
         pool.queueFamilyIndex = queue_family_;
         check(vkCreateCommandPool(device_, &pool, nullptr, &pool_), "vkCreateCommandPool");
+        if (options.driver_threads == DriverThreads::spread && software_)
+            pinned_driver_threads_ = spread_threads(threads_started(threads_before, process_thread_ids()));
     } catch (...) {
         release();
         throw;

@@ -1,8 +1,15 @@
 // GlContext: the headless context comes up on this machine (Mesa llvmpipe through EGL, or a GPU
-// through an EGL device) with OpenGL 4.5 core, and the renderer's embedded shaders compile.
+// through an EGL device) with OpenGL 4.5 core, the renderer's embedded shaders compile, and the
+// driver's threads are placed as asked.
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include "gl_test_util.h"
+#include "patchcull/core/thread_placement.h"
 
 using namespace patchcull::gl;
 
@@ -46,4 +53,53 @@ TEST(GlContext, SecondContextInSameProcess) {
     PatchRenderer r(first);
     r.render(RenderParams{});
     EXPECT_EQ(r.read_ids().size(), 256u * 256u);
+}
+
+namespace {
+
+// True when llvmpipe's threads run in this process already (a context was made before).
+bool llvmpipe_threads_running() {
+    for (int id : patchcull::process_thread_ids()) {
+        std::ifstream comm("/proc/self/task/" + std::to_string(id) + "/comm");
+        std::string name;
+        if (std::getline(comm, name) && name.rfind("llvmpipe", 0) == 0) return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+// DriverThreads: on llvmpipe the threads the driver starts with the process's first context (its
+// screen's: a second context on the same display starts none) are pinned one CPU each (spread,
+// the default), or left alone (os); the calling thread keeps its CPUs either way. Each context is
+// the only one while it lives, so each starts the driver anew.
+TEST(GlContext, SpreadsTheDriversThreadsOnASoftwareRasterizer) {
+    if (llvmpipe_threads_running()) GTEST_SKIP() << "a context was made before in this process: run this test alone";
+    const int me = static_cast<int>(gettid());
+    const int cpus = patchcull::thread_cpu_count(me);
+    for (DriverThreads mode : {DriverThreads::spread, DriverThreads::os}) {
+        const std::vector<int> before = patchcull::process_thread_ids();
+        GlContext c = GlContext::create_headless(mode);
+        if (!c.is_software()) {
+            EXPECT_EQ(c.pinned_driver_threads(), 0u) << "a GPU: its driver's threads are left alone";
+            continue;
+        }
+        const std::vector<int> started = patchcull::threads_started(before, patchcull::process_thread_ids());
+        ASSERT_FALSE(started.empty()) << "llvmpipe starts its rasterizer and compute threads";
+        const bool spread = mode == DriverThreads::spread && cpus >= 2;
+        EXPECT_EQ(c.pinned_driver_threads(), spread ? started.size() : 0u);
+        for (int id : started) {
+            // Left alone, a thread runs where the driver lets it (Mesa starts its threads on every
+            // CPU, whatever the caller's own set).
+            if (spread) {
+                EXPECT_EQ(patchcull::thread_cpu_count(id), 1) << id;
+            } else {
+                EXPECT_GE(patchcull::thread_cpu_count(id), cpus) << id;
+            }
+        }
+        EXPECT_EQ(patchcull::thread_cpu_count(me), cpus);
+        PatchRenderer r(c);  // a pinned context still renders
+        r.render(RenderParams{});
+        EXPECT_EQ(r.read_ids().size(), 256u * 256u);
+    }
 }

@@ -1,7 +1,12 @@
 // The Vulkan tests' own context (vk_test_util.h): lavapipe with the validation layers, and a
-// messenger that does catch what the layers report (so VkTest's "no message" means something).
+// messenger that does catch what the layers report (so VkTest's "no message" means something),
+// and the placement of the driver's threads.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <vector>
+
+#include "patchcull/core/thread_placement.h"
 #include "vk/vk_test_util.h"
 
 using namespace patchcull::vk;
@@ -26,4 +31,34 @@ TEST(VkContext, LavapipeWithValidationThatReportsAnInvalidCall) {
     const std::vector<std::string> messages = vk.take_messages();
     ASSERT_FALSE(messages.empty());
     EXPECT_NE(messages.front().find("usage"), std::string::npos) << messages.front();
+}
+
+// DriverThreads: on lavapipe the threads the driver starts for a device are pinned one CPU each
+// (spread, the default), or left alone (os); the calling thread keeps its CPUs either way.
+TEST(VkContext, SpreadsTheDriversThreadsOnACpuDevice) {
+    const int me = static_cast<int>(gettid());
+    const int cpus = patchcull::thread_cpu_count(me);
+    if (cpus < 2) GTEST_SKIP() << "one CPU: nothing to spread";
+    for (patchcull::DriverThreads mode : {patchcull::DriverThreads::os, patchcull::DriverThreads::spread}) {
+        const std::vector<int> before = patchcull::process_thread_ids();
+        HeadlessDeviceOptions options;
+        options.driver_threads = mode;
+        HeadlessDevice device(options);
+        ASSERT_TRUE(device.is_software()) << device.name();
+        const std::vector<int> started = patchcull::threads_started(before, patchcull::process_thread_ids());
+        ASSERT_FALSE(started.empty()) << "lavapipe starts its worker threads per device";
+        const bool spread = mode == patchcull::DriverThreads::spread;
+        EXPECT_EQ(device.pinned_driver_threads(), spread ? started.size() : 0u);
+        for (int id : started) {
+            // Left alone, a thread runs where the driver lets it (Mesa starts its threads on every
+            // CPU, whatever the caller's own set).
+            if (spread) {
+                EXPECT_EQ(patchcull::thread_cpu_count(id), 1) << id;
+            } else {
+                EXPECT_GE(patchcull::thread_cpu_count(id), cpus) << id;
+            }
+        }
+        EXPECT_EQ(patchcull::thread_cpu_count(me), cpus);
+        device.submit([](VkCommandBuffer) {});  // a pinned device still runs work
+    }
 }

@@ -9,6 +9,7 @@
 // patches and tessellation scales, drawn by both APIs); the flags Vulkan cannot take are refused.
 #include <gtest/gtest.h>
 #include <stb_image.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <string>
@@ -16,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_test_util.h"
+#include "patchcull/core/thread_placement.h"
 
 using namespace patchcull::cli_test;
 
@@ -38,6 +40,14 @@ VulkanTotals vulkan_render(const std::string& args, bool strict = true) {
     const nlohmann::json j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["api"], "vulkan") << command;
     EXPECT_EQ(j["validation_messages"], 0) << command << "\n" << r.err;
+    // lavapipe's threads: pinned one CPU each unless --driver-threads os (or one CPU).
+    const bool os = args.find("--driver-threads os") != std::string::npos;
+    EXPECT_EQ(j["driver_threads"], os ? "os" : "spread") << command;
+    if (os || patchcull::thread_cpu_count(static_cast<int>(gettid())) < 2) {
+        EXPECT_EQ(j["pinned_driver_threads"], 0) << command;
+    } else {
+        EXPECT_GT(j["pinned_driver_threads"].get<int>(), 0) << command;
+    }
     for (const nlohmann::json& f : j["frames"]) {
         const std::string where = command + ", frame " + f["frame"].dump();
         const long submitted = f["submitted"]["pass1"].get<long>() + f["submitted"]["pass2"].get<long>();
@@ -81,6 +91,7 @@ TEST(VulkanRenderCli, TwoPassFramesVerifyOnTheDefaultSceneAndTheSmallCity) {
 // bounds' other kinds.
 TEST(VulkanRenderCli, OnePassFramesAndEveryBackpatchMethodVerify) {
     EXPECT_GT(vulkan_render("default --frames 2 --tess 4 --cull frustum").frustum, 0);
+    EXPECT_GT(vulkan_render("default --frames 1 --tess 4 --cull frustum --driver-threads os").frustum, 0);
     EXPECT_GT(vulkan_render("default --frames 1 --tess 4 --cull backpatch --backpatch ptp").backpatch, 0);
     EXPECT_GT(vulkan_render("default --frames 2 --tess 4 --backpatch ncone --fused-pass").backpatch, 0);
     EXPECT_GT(vulkan_render(small_city() + " --frames 2 --tess 2 --frustum aabb --bound oobb --cone con").occlusion, 0);

@@ -18,14 +18,20 @@
 // render"). patchcull prints nothing (Mesa itself may write driver warnings to stderr).
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <string>
 
 #include "patchcull/core/error.h"
+#include "patchcull/core/thread_placement.h"
 
 struct GLFWwindow;  // GLFW's window type (GlContext::glfw_window); GLFW's header is not needed here
 
 namespace patchcull::gl {
+
+/// What create_headless and create_window do with the threads the driver starts
+/// (core/thread_placement.h; default: spread them on a software rasterizer).
+using patchcull::DriverThreads;
 
 /// An OpenGL 4.5 core context: headless (EGL) or in a window (GLFW).
 class GlContext {
@@ -35,7 +41,7 @@ public:
     /// Mesa's surfaceless platform (EGL_MESA_platform_surfaceless: llvmpipe without a GPU), then
     /// the software EGL device. Throws patchcull::Error with a one-line message naming the last
     /// failure when none gives a GL 4.5 core context (e.g. "EGL: no display: ...").
-    static GlContext create_headless();
+    static GlContext create_headless(DriverThreads threads = DriverThreads::spread);
 
     GlContext(GlContext&&) noexcept;
     GlContext& operator=(GlContext&&) noexcept;
@@ -50,7 +56,8 @@ public:
     /// server (`xvfb-run -a -s "-screen 0 1280x1024x24" ...`, llvmpipe). At most one window
     /// context at a time. Throws patchcull::Error with one line ("GLFW: ...") when libglfw.so.3 is
     /// missing, there is no X display or no 4.5 core context.
-    static GlContext create_window(int width, int height, const std::string& title);
+    static GlContext create_window(int width, int height, const std::string& title,
+                                   DriverThreads threads = DriverThreads::spread);
 
     /// Makes this context current on the calling thread (needed only after another context was).
     void make_current() const;
@@ -77,6 +84,9 @@ public:
     const std::string& platform() const;
     /// True for a software rasterizer (llvmpipe, softpipe, swrast).
     bool is_software() const;
+    /// How many driver threads this context pinned (DriverThreads::spread on a software
+    /// rasterizer with two CPUs or more); 0 otherwise.
+    std::size_t pinned_driver_threads() const;
 
     struct Impl;
 

@@ -20,11 +20,14 @@
 
 #include <vulkan/vulkan.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "patchcull/core/thread_placement.h"
 
 namespace patchcull::vk {
 
@@ -35,6 +38,9 @@ struct HeadlessDeviceOptions {
     /// The kind of physical device tried first (any other with what is needed after it).
     enum class Prefer { cpu, gpu };
     Prefer prefer = Prefer::cpu;
+    /// The threads the driver starts while the device is made: on a CPU device, each pinned to a
+    /// CPU of its own in turn (core/thread_placement.h), or left to the operating system.
+    DriverThreads driver_threads = DriverThreads::spread;
 };
 
 class HeadlessDevice {
@@ -53,6 +59,9 @@ public:
     const std::string& name() const { return name_; }
     /// True for a CPU device (lavapipe).
     bool is_software() const { return software_; }
+    /// How many driver threads the device pinned (DriverThreads::spread on a CPU device with two
+    /// CPUs or more); 0 otherwise.
+    std::size_t pinned_driver_threads() const { return pinned_driver_threads_; }
     /// Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod); 0 when the queue
     /// has no timestamps.
     double timestamp_period_ns() const { return timestamp_period_ns_; }
@@ -77,6 +86,7 @@ private:
     VkDevice device_ = VK_NULL_HANDLE;
     VkQueue queue_ = VK_NULL_HANDLE;
     std::uint32_t queue_family_ = 0;
+    std::size_t pinned_driver_threads_ = 0;
     VkCommandPool pool_ = VK_NULL_HANDLE;
     std::string name_;
     bool software_ = false;
