@@ -1,7 +1,8 @@
 // Frustum cull pass (FrustumPass, src/gl/frustum_pass.cpp), one invocation per patch: the GPU twin
 // of cull_frustum_scalar (include/patchcull/core/frustum.h, src/core/frustum.cpp). Same arithmetic,
 // operation by operation, so the decisions are identical (the test itself is shaders/frustum_test.h,
-// shared with occlusion.comp.glsl). A link of the flag chain (gl_passes.h): a patch that an earlier
+// shared with occlusion.comp.glsl; without plane values it stops at the point that settles the
+// verdict, which is then the same). A link of the flag chain (gl_passes.h): a patch that an earlier
 // pass of the frame culled is left as it is; otherwise a culled patch gets the reason kCullFrustum.
 // With PC_PATCH_SOURCE the points come from the caller's patch source (patch_source.h: Bezier or
 // converted B-spline points, or with PC_PATCH_SOURCE_GREGORY a Gregory patch's 20 points, all
@@ -35,7 +36,8 @@ layout(local_size_x = kCullGroupSize) in;
 void pc_frustum_patch(uint p) {
     const float d = pc_margin(p, frustum.has_margins);
     float mx[6];
-    if (pc_frustum_culled(p, PC_HAS_MARGINS(frustum.has_margins), d, mx)) pc_chain_cull(p, kCullFrustum);
+    const bool want_maxima = frustum.write_plane_values != 0u;
+    if (pc_frustum_culled(p, PC_HAS_MARGINS(frustum.has_margins), d, want_maxima, mx)) pc_chain_cull(p, kCullFrustum);
     if (frustum.write_plane_values != 0u)
         for (int q = 0; q < 6; ++q) plane_values[6u * p + uint(q)] = mx[q];
 }

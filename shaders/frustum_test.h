@@ -60,15 +60,36 @@ vec4 pc_clip_point(const vec4 P) {
     return c;
 }
 
-// True when patch p, with displacement margin d when with_margins, lies outside one plane; mx
-// receives the six maxima.
-bool pc_frustum_culled(uint p, bool with_margins, float d, out float mx[6]) {
+// True when the maxima so far keep every plane from culling (m >= 0, the far one >= far_limit:
+// false for NaN).
+bool pc_frustum_settled(const float m[6]) {
+    bool settled = m[5] >= u_plane_depth.z;
+    for (int q = 0; q < 5; ++q) settled = settled && m[q] >= 0.0;
+    return settled;
+}
+
+// True when patch p, with displacement margin d when with_margins, lies outside one plane. With
+// want_maxima, mx receives the six maxima over all points. Without, mx is undefined and the loop
+// over the points stops once the verdict cannot change, which gives the same verdict: (a) once a
+// near value was non-finite the patch is kept whatever follows; (b) once every plane's maximum is
+// settled (pc_frustum_settled), a later point can only raise a maximum, unless one of its values
+// is NaN, and with a finite matrix, near_w, far_w and margins a NaN value needs an infinite clip
+// w or z (c = M P rounds to +-inf, never NaN, for finite P and M; a non-finite P makes every row
+// non-finite), which makes that point's near value non-finite: (a) again. A non-finite matrix,
+// near_w, far_w or margin never stops early.
+bool pc_frustum_culled(uint p, bool with_margins, float d, bool want_maxima, out float mx[6]) {
     precise float margin[6];
     precise float m[6];
+    bool margins_finite = true;
     for (int q = 0; q < 6; ++q) {
         margin[q] = d * u_plane_normal_length[q >> 2][q & 3];
+        margins_finite = margins_finite && !pc_non_finite(margin[q]);
         m[q] = uintBitsToFloat(0xFF800000u);  // -infinity
     }
+    bool uniforms_finite = !pc_non_finite(u_plane_depth.x) && !pc_non_finite(u_plane_depth.y);
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) uniforms_finite = uniforms_finite && !pc_non_finite(u_clip_rows[r][c]);
+    const bool may_stop = !want_maxima && uniforms_finite && (!with_margins || margins_finite);
     bool non_finite = false;
     for (uint k = 0u; k < PC_PATCH_POINT_COUNT; ++k) {
         const vec4 point = PC_PATCH_POINT(p, k);
@@ -80,6 +101,7 @@ bool pc_frustum_culled(uint p, bool with_margins, float d, out float mx[6]) {
             m[q] = m[q] > value ? m[q] : value;
             if (q == 4) non_finite = non_finite || pc_non_finite(value);
         }
+        if (may_stop && (non_finite || pc_frustum_settled(m))) break;
     }
     for (int q = 0; q < 6; ++q) mx[q] = m[q];
     return pc_frustum_outside(m, non_finite);

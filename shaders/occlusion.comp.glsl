@@ -71,7 +71,7 @@ void pc_occlusion_patch(uint p) {
 #endif
     if (with_frustum) {
         float mx[6];
-        if (pc_frustum_culled(p, PC_HAS_MARGINS(occlusion.has_margins), d, mx)) {
+        if (pc_frustum_culled(p, PC_HAS_MARGINS(occlusion.has_margins), d, false, mx)) {
             pc_chain_cull(p, kCullFrustum);
             return;
         }

@@ -2,7 +2,11 @@
 #include "patchcull/core/thread_placement.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
+#include <fstream>
+#include <string>
+#include <thread>
 
 #ifdef __linux__
 #include <dirent.h>
@@ -33,6 +37,21 @@ std::vector<int> threads_started(std::span<const int> before, std::span<const in
     return started;
 }
 
+namespace {
+
+#ifdef __linux__
+// True when thread tid is not running or runnable (its state in /proc is not 'R'), or is gone.
+bool thread_waits(int tid) {
+    std::ifstream stat("/proc/self/task/" + std::to_string(tid) + "/stat");
+    std::string line;
+    if (!std::getline(stat, line)) return true;
+    const std::size_t paren = line.rfind(')');
+    return paren == std::string::npos || paren + 2 >= line.size() || line[paren + 2] != 'R';
+}
+#endif
+
+}  // namespace
+
 std::size_t spread_threads(std::span<const int> threads) {
 #ifdef __linux__
     cpu_set_t allowed;
@@ -42,6 +61,12 @@ std::size_t spread_threads(std::span<const int> threads) {
     for (int c = 0; c < CPU_SETSIZE; ++c)
         if (CPU_ISSET(c, &allowed)) cpus.push_back(c);
     if (cpus.size() < 2) return 0;
+    // A thread just started may still be running its start-up code, which can set its own CPUs
+    // (Mesa's queue threads ask for every CPU): wait until each has gone to sleep, 200 ms at most.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+    for (int tid : threads)
+        while (!thread_waits(tid) && std::chrono::steady_clock::now() < deadline)
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
     std::size_t pinned = 0;
     for (std::size_t i = 0; i < threads.size(); ++i) {
         cpu_set_t one;

@@ -94,9 +94,13 @@ TEST(GpuFrustumCull, SameDecisionsAsCpuKernelOnRandomInputs) {
         attributes.max_displacement = c.displacement;
         r.set_patches(c.patches, attributes);
         const FrustumPlanes planes = make_frustum_planes(c.object_to_clip, ClipDepth::zero_to_one);
+        // Without plane values the pass stops at the point that settles a patch's verdict.
+        test::cull_frustum(r, planes);
+        const std::vector<std::uint32_t> gpu_stopping = r.read_cull_flags();
         std::vector<float> gpu_values;
         test::cull_frustum(r, planes, &gpu_values);
         const std::vector<std::uint32_t> gpu = r.read_cull_flags();
+        ASSERT_EQ(gpu_stopping, gpu) << "seed " << seed;
 
         const PatchBatch batch = test::unchecked_batch(c.patches);
         std::vector<std::uint8_t> cpu(c.patches.size());
@@ -127,6 +131,84 @@ TEST(GpuFrustumCull, SameDecisionsAsCpuKernelOnRandomInputs) {
     // Both outcomes are well represented.
     EXPECT_GT(culled_total, total / 10);
     EXPECT_LT(culled_total, total * 9 / 10);
+}
+
+// The early stop (frustum_test.h: a patch's loop over its points ends once its verdict cannot
+// change) keeps the CPU kernel's verdicts where a later point's value could turn a plane's maximum
+// back: a NaN or infinite coordinate after inside points, coordinates that overflow the clip
+// values to infinity, infinite, NaN and overflowing margins, and matrices with infinite or NaN
+// entries (next to zeros: 0 * inf is NaN in one row only).
+TEST(GpuFrustumCull, EarlyStopKeepsTheVerdictOnNonFiniteAndOverflowingInput) {
+    PatchRenderer r(test::context());
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    const float specials[] = {inf, -inf, nan, 3e38f, -3e38f, 1e20f, 0.0f};
+    std::mt19937 rng(7);
+    std::uniform_int_distribution<int> pick(0, 6), point(0, 15), coord(0, 3);
+    std::size_t compared = 0;
+    for (int m = 0; m < 6; ++m) {
+        RandomCase c = random_case(100 + static_cast<std::uint32_t>(m), 2000);
+        if (c.displacement.empty()) c.displacement.assign(c.patches.size(), 0.01f);
+        if (m >= 3) {  // a matrix with one special entry (the rest as the camera made it)
+            const float v = m == 3 ? inf : m == 4 ? nan : -inf;
+            c.object_to_clip.at(m % 4, (m + 1) % 4) = v;
+        }
+        // Coordinate i of v set to x; a weight stays positive (the renderer refuses others) but
+        // may be huge, infinite or NaN.
+        auto set = [](Vec4& v, int i, float x) {
+            if (i == 3) {
+                v.w = x == 0.0f ? 1e20f : std::fabs(x);
+            } else {
+                (i == 0 ? v.x : i == 1 ? v.y : v.z) = x;
+            }
+        };
+        for (std::size_t p = 0; p < c.patches.size(); ++p) {
+            BezierPatch& patch = c.patches[p];
+            switch (p % 5) {
+                case 0:  // one special coordinate at a late point
+                    set(patch.cp[8 + point(rng) / 2], coord(rng), specials[pick(rng)]);
+                    break;
+                case 1:  // huge coordinates: clip values overflow
+                    for (int k = 4; k < 16; k += 3) set(patch.cp[k], coord(rng), specials[3 + pick(rng) % 3]);
+                    break;
+                case 2:  // a special margin
+                    c.displacement[p] = specials[pick(rng)];
+                    break;
+                default:
+                    break;
+            }
+        }
+        PatchAttributes attributes;
+        attributes.max_displacement = c.displacement;
+        r.set_patches(c.patches, attributes);
+        const FrustumPlanes planes = make_frustum_planes(c.object_to_clip, ClipDepth::zero_to_one);
+        test::cull_frustum(r, planes);
+        const std::vector<std::uint32_t> gpu = r.read_cull_flags();
+        const PatchBatch batch = test::unchecked_batch(c.patches);
+        std::vector<std::uint8_t> cpu(c.patches.size());
+        cull_frustum_scalar(batch.view(), c.displacement.data(), planes, cpu.data());
+        ASSERT_EQ(gpu.size(), cpu.size());
+        for (std::size_t p = 0; p < cpu.size(); ++p)
+            ASSERT_EQ(gpu[p] != 0, cpu[p] != 0) << "matrix case " << m << " patch " << p << " (kind " << p % 5 << ")";
+        compared += cpu.size();
+    }
+    EXPECT_EQ(compared, 6u * 2000u);
+
+    // Built to turn a settled maximum back: with an infinite x-row entry for y, a point with y > 0
+    // and one with y < 0 give planes 0 and 1 the maxima +inf (every other plane is met), then y = 0
+    // gives both NaN (0 * inf), and the points after it, y > 0 again, leave plane 1 at -inf: the
+    // CPU culls the patch (its near values are finite), and so must the pass.
+    Mat4 skewed;  // identity, clip z = z, clip w = w
+    skewed.at(0, 1) = inf;
+    BezierPatch turned;
+    for (int k = 0; k < 16; ++k) turned.cp[k] = {0.1f, k == 1 ? -0.5f : k == 2 ? 0.0f : 0.5f, 0.5f, 1.0f};
+    const std::vector<BezierPatch> one{turned};
+    r.set_patches(one, PatchAttributes{});
+    const FrustumPlanes skewed_planes = make_frustum_planes(skewed, ClipDepth::zero_to_one);
+    test::cull_frustum(r, skewed_planes);
+    std::uint8_t cpu_turned = 0;
+    cull_frustum_scalar(test::unchecked_batch(one).view(), nullptr, skewed_planes, &cpu_turned);
+    EXPECT_EQ(cpu_turned, 1);
+    EXPECT_EQ(r.read_cull_flags().at(0) != 0, cpu_turned != 0);
 }
 
 TEST(GpuFrustumCull, MultiplyAddIsRoundedOnceOnHardCases) {

@@ -35,8 +35,10 @@ std::vector<int> threads_started(std::span<const int> before, std::span<const in
 
 /// Pins thread threads[i] to the (i mod n)-th of the n CPUs the calling thread may run on, so
 /// that consecutive threads share no CPU while there are CPUs left. Returns how many it pinned:
-/// 0 when the calling thread may run on fewer than two CPUs. A thread that has ended meanwhile
-/// is skipped. The calling thread's own placement is not changed.
+/// 0 when the calling thread may run on fewer than two CPUs. First waits until each thread is
+/// asleep, 200 ms at most in all (a thread just started may still run start-up code that sets
+/// its own CPUs, as Mesa's queue threads do). A thread that has ended meanwhile is skipped. The
+/// calling thread's own placement is not changed.
 std::size_t spread_threads(std::span<const int> threads);
 
 /// The number of CPUs thread `tid` may run on (0 when it cannot be read, e.g. it has ended).
