@@ -17,9 +17,11 @@ namespace patchcull {
 /// What a context or device of patchcull's own (gl::GlContext, vk::HeadlessDevice) does with the
 /// threads its driver starts while it is made.
 enum class DriverThreads {
-    /// On a software rasterizer (llvmpipe, lavapipe): pin each thread the driver started while
-    /// the context or device was made (its rasterizer and compute workers) to a CPU of its own,
-    /// in turn (spread_threads). A GPU driver's threads are left alone, as is the calling thread.
+    /// On a software rasterizer (llvmpipe, lavapipe): pin each thread started while the context
+    /// or device was made (the driver's rasterizer and compute workers, and any thread another
+    /// thread of the process started meanwhile) to a CPU of its own, in turn (spread_threads).
+    /// A GPU driver's threads are left alone, as is the calling thread. Threads started later,
+    /// e.g. by a second context that shares the driver's screen, are not pinned.
     spread,
     /// Leave their placement to the operating system.
     os,
