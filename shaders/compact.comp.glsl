@@ -18,6 +18,8 @@
 //   groups kCompactGroupSize at a time; the total n into sums[group_count].
 // - kCompactScatter: each survivor at list[list_first + sums[g] + its rank within group g]
 //   (a scan of the invocations' counts, then each writes its run's survivors in order).
+// - kCompactSingleGroup (one work group, a range of at most kCompactSingleGroupPatches): the
+//   three above in a loop over the range 2048 patches at a time, then the finish: one dispatch.
 // Both end with kCompactFinish: one invocation per command (group_base: the dispatch's first
 // command; group_count: the word of sums holding n). CullStatusPass's fused append
 // (cull_status.comp.glsl's PC_STATUS_APPEND) ends with it too, its total at word 0 of its own
@@ -88,6 +90,41 @@ uint group_inclusive_scan(uint v) {
 }
 #endif
 
+#ifdef PC_COMPACT_SCAN
+// The survivors among the kCompactScanRun patches of the range from index run_first on: their
+// bits (bit k: patch run_first + k) and their count.
+uint run_survivors(uint run_first, out uint count) {
+    uint bits = 0u;
+    count = 0u;
+    for (uint k = 0u; k < kCompactScanRun; ++k) {
+        const uint index = run_first + k;
+        if (index < compact.patch_count && (cull_flags[compact.first_patch + index] & compact.mask) == compact.value) {
+            bits |= 1u << k;
+            ++count;
+        }
+    }
+    return bits;
+}
+
+// Writes the survivors of bits (a run from index run_first on) to the list from entry at on.
+void write_run(uint bits, uint run_first, uint at) {
+    for (uint k = 0u; k < kCompactScanRun; ++k)
+        if ((bits & (1u << k)) != 0u) draw_list[at++] = compact.first_patch + run_first + k;
+}
+#endif
+
+// The range's commands c = first, first + stride, ... and (by c == 0) its draw count, for n survivors.
+void write_commands(uint first, uint stride, uint n) {
+    // patch_count: the range's; K <= max(patch_count, 1), so no sum below overflows.
+    const uint k = compact.patches_per_command;
+    const uint commands = max(1u, (compact.patch_count + k - 1u) / k);
+    for (uint c = first; c < commands; c += stride) {
+        const uint start = c * k;
+        write_command(c, n > start ? min(k, n - start) : 0u, compact.list_first + start);
+    }
+    if (first == 0u && compact.write_count != 0u) draw_count[compact.count_word] = (n + k - 1u) / k;
+}
+
 void main() {
     const uint mode = compact.mode;
     if (mode == kCompactInit) {
@@ -95,19 +132,28 @@ void main() {
         return;
     }
     if (mode == kCompactFinish) {
-        // patch_count: the range's; K <= max(patch_count, 1), so no sum below overflows.
-        const uint k = compact.patches_per_command;
-        const uint commands = max(1u, (compact.patch_count + k - 1u) / k);
-        const uint c = compact.group_base + gl_GlobalInvocationID.x;
-        const uint n = group_sums[compact.group_count];
-        if (c < commands) {
-            const uint start = c * k;
-            write_command(c, n > start ? min(k, n - start) : 0u, compact.list_first + start);
-        }
-        if (c == 0u && compact.write_count != 0u) draw_count[compact.count_word] = (n + k - 1u) / k;
+        // One command per invocation: a stride of max(patch_count, 1) >= the command count ends the
+        // loop after it (no wrap: both are below 2^31).
+        write_commands(compact.group_base + gl_GlobalInvocationID.x, max(compact.patch_count, 1u),
+                       group_sums[compact.group_count]);
         return;
     }
     const uint lid = gl_LocalInvocationIndex;
+#ifdef PC_COMPACT_SCAN
+    if (mode == kCompactSingleGroup) {
+        uint carry = 0u;  // survivors of the chunks before
+        for (uint chunk = 0u; chunk < compact.patch_count; chunk += kCompactGroupSize * kCompactScanRun) {
+            const uint run_first = chunk + lid * kCompactScanRun;
+            uint count;
+            const uint bits = run_survivors(run_first, count);
+            write_run(bits, run_first, compact.list_first + carry + group_inclusive_scan(count) - count);
+            carry += s_scan[kCompactGroupSize - 1u];
+            barrier();  // every invocation has read s_scan before the next chunk writes it
+        }
+        write_commands(lid, kCompactGroupSize, carry);
+        return;
+    }
+#endif
 #ifdef PC_COMPACT_SCAN
     if (mode == kCompactScanSums) {
         uint carry = 0u;
@@ -127,15 +173,8 @@ void main() {
     // Invocation lid of group g holds kCompactScanRun consecutive patches of the range, from
     // index (g kCompactGroupSize + lid) kCompactScanRun on: its survivors' bits and their count.
     const uint run_first = (gl_WorkGroupID.x * kCompactGroupSize + lid) * kCompactScanRun;
-    uint bits = 0u;
-    uint count = 0u;
-    for (uint k = 0u; k < kCompactScanRun; ++k) {
-        const uint index = run_first + k;
-        if (index < compact.patch_count && (cull_flags[compact.first_patch + index] & compact.mask) == compact.value) {
-            bits |= 1u << k;
-            ++count;
-        }
-    }
+    uint count;
+    const uint bits = run_survivors(run_first, count);
     if (mode == kCompactGroupCounts) {
         if (lid == 0u) s_total = 0u;
         barrier();
@@ -145,10 +184,9 @@ void main() {
         return;
     }
     // kCompactScatter: the runs' survivors in order, after those of the groups and runs before.
-    uint at = compact.list_first + group_sums[compact.group_base + gl_WorkGroupID.x] +
-              group_inclusive_scan(count) - count;
-    for (uint k = 0u; k < kCompactScanRun; ++k)
-        if ((bits & (1u << k)) != 0u) draw_list[at++] = compact.first_patch + run_first + k;
+    write_run(bits, run_first,
+              compact.list_first + group_sums[compact.group_base + gl_WorkGroupID.x] + group_inclusive_scan(count) -
+                  count);
 #else
     // kCompactAppend
     const uint index = gl_GlobalInvocationID.x;

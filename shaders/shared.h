@@ -137,6 +137,10 @@ PATCHCULL_CONST uint kCompactFinish = 2u;
 PATCHCULL_CONST uint kCompactGroupCounts = 3u;
 PATCHCULL_CONST uint kCompactScanSums = 4u;
 PATCHCULL_CONST uint kCompactScatter = 5u;
+// The scan of a range of at most kCompactSingleGroupPatches in one dispatch of one work group
+// (counts, scan, scatter and finish in a loop over its runs of 2048: fewer dispatches).
+PATCHCULL_CONST uint kCompactSingleGroup = 6u;
+PATCHCULL_CONST uint kCompactSingleGroupPatches = 16384u;
 // Control points a compacted draw pulls per patch (gl_VertexID / kDrawListPatchVertices indexes the list).
 PATCHCULL_CONST uint kDrawListPatchVertices = 16u;
 

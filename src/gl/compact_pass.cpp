@@ -142,6 +142,15 @@ struct CompactPass::Impl {
         // Earlier shader writes to the flags (the chain's passes) and to these buffers are seen.
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shared::kBindingCompactSums, sums);
+        if (scan && patches.count <= shared::kCompactSingleGroupPatches) {
+            // A small range: the whole scan and the finish in one dispatch of one work group.
+            params.first_patch = static_cast<pp::uint>(patches.first);
+            params.patch_count = static_cast<pp::uint>(patches.count);
+            dispatch_one(params, shared::kCompactSingleGroup);
+            glMemoryBarrier(GL_COMMAND_BARRIER_BIT);
+            detail::finish_pass(who);
+            return;
+        }
         if (scan) {
             if (patches.count) {
                 params.mode = shared::kCompactGroupCounts;

@@ -101,6 +101,14 @@ void CompactPass::run(VkCommandBuffer cmd, const PatchBuffers& patches, std::uin
         push();
         context.vk.CmdDispatch(cmd, 1, 1, 1);
     };
+    if (scan && patches.count <= shared::kCompactSingleGroupPatches) {
+        // A small range: the whole scan and the finish in one dispatch of one work group.
+        params.first_patch = static_cast<pp::uint>(patches.first);
+        params.patch_count = static_cast<pp::uint>(patches.count);
+        dispatch_one(shared::kCompactSingleGroup);
+        context.barrier_after(cmd);
+        return;
+    }
     if (scan) {
         if (patches.count) {
             params.mode = shared::kCompactGroupCounts;
