@@ -57,7 +57,7 @@ gl::CompactMethod parse_compact_option(const std::string& text);
 /// --compact's text of a method ("scan", "append", "fused"), e.g. for a JSON report.
 const char* compact_option_name(gl::CompactMethod method);
 
-/// --driver-threads spread|os of `render` and `view` (target keeps the text, default "spread"): on a
+/// --driver-threads spread|os of `render` (target keeps the text, default "spread"): on a
 /// software rasterizer, each thread the driver starts pinned to a CPU of its own, or left to the
 /// operating system (core/thread_placement.h's DriverThreads). A bad value is one line naming the
 /// flag (exit 2).

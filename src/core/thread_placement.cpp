@@ -11,6 +11,7 @@
 #ifdef __linux__
 #include <dirent.h>
 #include <sched.h>
+#include <unistd.h>
 #endif
 
 namespace patchcull {
@@ -40,13 +41,14 @@ std::vector<int> threads_started(std::span<const int> before, std::span<const in
 namespace {
 
 #ifdef __linux__
-// True when thread tid is not running or runnable (its state in /proc is not 'R'), or is gone.
-bool thread_waits(int tid) {
+// Thread tid's state letter in /proc ('R' running or runnable, 'S' asleep, ...), 0 when it is not
+// a thread of this process (any more).
+char thread_state(int tid) {
     std::ifstream stat("/proc/self/task/" + std::to_string(tid) + "/stat");
     std::string line;
-    if (!std::getline(stat, line)) return true;
+    if (!std::getline(stat, line)) return 0;
     const std::size_t paren = line.rfind(')');
-    return paren == std::string::npos || paren + 2 >= line.size() || line[paren + 2] != 'R';
+    return paren == std::string::npos || paren + 2 >= line.size() ? 0 : line[paren + 2];
 }
 #endif
 
@@ -62,16 +64,19 @@ std::size_t spread_threads(std::span<const int> threads) {
         if (CPU_ISSET(c, &allowed)) cpus.push_back(c);
     if (cpus.size() < 2) return 0;
     // A thread just started may still be running its start-up code, which can set its own CPUs
-    // (Mesa's queue threads ask for every CPU): wait until each has gone to sleep, 200 ms at most.
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(200);
+    // (Mesa's queue threads ask for every CPU): wait until each has gone to sleep, 1 s at most.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
     for (int tid : threads)
-        while (!thread_waits(tid) && std::chrono::steady_clock::now() < deadline)
+        while (thread_state(tid) == 'R' && std::chrono::steady_clock::now() < deadline)
             std::this_thread::sleep_for(std::chrono::microseconds(200));
+    // Concurrent processes start at different CPUs.
+    const std::size_t offset = static_cast<std::size_t>(getpid()) % cpus.size();
     std::size_t pinned = 0;
     for (std::size_t i = 0; i < threads.size(); ++i) {
+        if (thread_state(threads[i]) == 0) continue;  // ended: its id is not ours any more
         cpu_set_t one;
         CPU_ZERO(&one);
-        CPU_SET(cpus[i % cpus.size()], &one);
+        CPU_SET(cpus[(offset + i) % cpus.size()], &one);
         if (sched_setaffinity(threads[i], sizeof one, &one) == 0) ++pinned;
     }
     return pinned;

@@ -118,11 +118,10 @@ TEST(ThreadPlacement, AThreadThatIsGoneIsSkipped) {
         WaitingThreads waiting(1);
         gone = waiting.ids();
     }
-    // A joined thread's id is not listed and cannot be pinned (the id could only be reused by a
-    // thread started since, and none was).
+    // A joined thread's id is no longer one of this process's threads: neither listed nor pinned,
+    // even if another process's new thread got the id meanwhile.
     const std::vector<int> now = process_thread_ids();
     ASSERT_FALSE(std::binary_search(now.begin(), now.end(), gone[0]));
     EXPECT_EQ(spread_threads(gone), 0u);
-    EXPECT_EQ(thread_cpu_count(gone[0]), 0);
 }
 #endif

@@ -147,9 +147,11 @@ TEST(GpuCompaction, ListCommandAndCountMatchTheCpuSelection) {
         std::size_t first, count;
     };
     // Empty, single, one group less/more, several groups, more than 256 groups (the scan of the
-    // sums loops), odd sizes, first > 0.
-    const Range ranges[] = {{0, 0},   {11, 0},   {0, 1},       {79999, 1}, {5, 255},   {0, 256},
-                            {9, 257}, {1, 4097}, {333, 12345}, {0, 80000}, {17, 79983}};
+    // sums loops), odd sizes, first > 0, and both sides of the scan's one-work-group limit
+    // (kCompactSingleGroupPatches = 16384: whole chunks of 2048, and one patch past it).
+    static_assert(sh::kCompactSingleGroupPatches == 16384);
+    const Range ranges[] = {{0, 0},    {11, 0},   {0, 1},       {79999, 1}, {5, 255},   {0, 256},   {9, 257},
+                            {0, 2048}, {1, 4097}, {333, 12345}, {0, 16384}, {3, 16385}, {0, 80000}, {17, 79983}};
     for (const Range& r : ranges)
         for (const Selection& s : kSelections)
             for (const CompactMethod m : kMethods)

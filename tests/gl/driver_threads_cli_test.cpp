@@ -17,7 +17,7 @@ using namespace patchcull::cli_test;
 namespace {
 
 // `render ARGS --json`: exit 0; returns the JSON.
-nlohmann::json render_json(const std::string& args) {
+nlohmann::json driver_threads_run(const std::string& args) {
     const CliRun r = run("render " + args + " --json");
     EXPECT_EQ(r.status, 0) << args << "\n" << r.err;
     return r.out.empty() ? nlohmann::json::object() : nlohmann::json::parse(r.out);
@@ -28,8 +28,9 @@ bool several_cpus() { return patchcull::thread_cpu_count(static_cast<int>(gettid
 }  // namespace
 
 TEST(DriverThreadsCli, SpreadByDefaultOsLeavesThemAloneBothVerify) {
-    const nlohmann::json spread = render_json("default --frames 2 --tess 2 --size 80x48 --verify");
-    const nlohmann::json os = render_json("default --frames 2 --tess 2 --size 80x48 --verify --driver-threads os");
+    const nlohmann::json spread = driver_threads_run("default --frames 2 --tess 2 --size 80x48 --verify");
+    const nlohmann::json os =
+        driver_threads_run("default --frames 2 --tess 2 --size 80x48 --verify --driver-threads os");
     ASSERT_TRUE(spread.contains("driver_threads") && os.contains("driver_threads"));
     EXPECT_EQ(spread["driver_threads"], "spread");
     EXPECT_EQ(os["driver_threads"], "os");
@@ -45,7 +46,7 @@ TEST(DriverThreadsCli, SpreadByDefaultOsLeavesThemAloneBothVerify) {
 }
 
 TEST(DriverThreadsCli, OsdTablePathTakesTheFlag) {
-    const nlohmann::json j = render_json(
+    const nlohmann::json j = driver_threads_run(
         "bigguy --scheme osd --patch-source osd-table --frames 1 --tess 2 --size 64x48 --driver-threads os");
     EXPECT_EQ(j.value("driver_threads", ""), "os");
     EXPECT_EQ(j.value("pinned_driver_threads", -1), 0);

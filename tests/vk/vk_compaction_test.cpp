@@ -60,7 +60,9 @@ class VkCompaction : public VkTest {};
 
 TEST_F(VkCompaction, ListCommandsAndCountFollowTheContract) {
     std::mt19937 rng(17);
-    const std::size_t n = 5000;  // the scan: 3 work groups of 2048
+    // Ranges of 4700 (the scan in one work group: at most kCompactSingleGroupPatches) and 20000
+    // patches (its dispatches: 10 work groups of 2048).
+    const std::size_t n = 20100;
     std::vector<std::uint32_t> words(n);
     const std::uint32_t kinds[] = {0u,
                                    kCullFrustum,
@@ -76,38 +78,41 @@ TEST_F(VkCompaction, ListCommandsAndCountFollowTheContract) {
                                     {shared::kDrawMaskFirstPass, shared::kDrawValueFirstPass},
                                     {shared::kDrawMaskSecondPass, shared::kDrawValueSecondPass},
                                     {0u, 0u}};
-    const std::size_t first = 37, count = 4700, list_first = 11;
-    for (const CompactMethod method : {CompactMethod::prefix_scan, CompactMethod::atomic_append})
-        for (const Selection& s : selections)
-            for (const std::size_t k : {std::size_t{0}, std::size_t{1}, std::size_t{7}, count + 5}) {
-                const Compacted got = vk_compact(vk(), words, first, count, s.mask, s.value, list_first, k, method);
-                std::vector<std::uint32_t> kept;
-                for (std::size_t p = first; p < first + count; ++p)
-                    if ((words[p] & s.mask) == s.value) kept.push_back(static_cast<std::uint32_t>(p));
-                const std::size_t survivors = kept.size();
-                std::vector<std::uint32_t> listed(
-                    got.list.begin() + static_cast<std::ptrdiff_t>(list_first),
-                    got.list.begin() + static_cast<std::ptrdiff_t>(list_first + survivors));
-                if (method == CompactMethod::atomic_append) std::sort(listed.begin(), listed.end());
-                const std::string where = std::string(method == CompactMethod::prefix_scan ? "scan" : "append") +
-                                          " mask " + std::to_string(s.mask) + " K " + std::to_string(k);
-                ASSERT_EQ(listed, kept) << where;
-                for (std::size_t e = 0; e < got.list.size(); ++e) {
-                    if (e < list_first || e >= list_first + survivors) {
-                        ASSERT_EQ(got.list[e], 0xDEADBEEFu) << where;
+    const std::size_t first = 37, list_first = 11;
+    static_assert(shared::kCompactSingleGroupPatches >= 4700 && shared::kCompactSingleGroupPatches < 20000);
+    for (const std::size_t count : {std::size_t{4700}, std::size_t{20000}})
+        for (const CompactMethod method : {CompactMethod::prefix_scan, CompactMethod::atomic_append})
+            for (const Selection& s : selections)
+                for (const std::size_t k : {std::size_t{0}, std::size_t{1}, std::size_t{7}, count + 5}) {
+                    const Compacted got = vk_compact(vk(), words, first, count, s.mask, s.value, list_first, k, method);
+                    std::vector<std::uint32_t> kept;
+                    for (std::size_t p = first; p < first + count; ++p)
+                        if ((words[p] & s.mask) == s.value) kept.push_back(static_cast<std::uint32_t>(p));
+                    const std::size_t survivors = kept.size();
+                    std::vector<std::uint32_t> listed(
+                        got.list.begin() + static_cast<std::ptrdiff_t>(list_first),
+                        got.list.begin() + static_cast<std::ptrdiff_t>(list_first + survivors));
+                    if (method == CompactMethod::atomic_append) std::sort(listed.begin(), listed.end());
+                    const std::string where = std::string(method == CompactMethod::prefix_scan ? "scan" : "append") +
+                                              " count " + std::to_string(count) + " mask " + std::to_string(s.mask) +
+                                              " K " + std::to_string(k);
+                    ASSERT_EQ(listed, kept) << where;
+                    for (std::size_t e = 0; e < got.list.size(); ++e) {
+                        if (e < list_first || e >= list_first + survivors) {
+                            ASSERT_EQ(got.list[e], 0xDEADBEEFu) << where;
+                        }
                     }
+                    const std::size_t kk = k == 0 ? count : std::min(k, count);
+                    const std::size_t commands = compact_command_count(count, k);
+                    for (std::size_t c = 0; c < commands; ++c) {
+                        const std::size_t m = survivors > c * kk ? std::min(kk, survivors - c * kk) : 0;
+                        EXPECT_EQ(got.commands[4 * c + 0], 16 * m) << where << " command " << c;
+                        EXPECT_EQ(got.commands[4 * c + 1], 1u) << where << " command " << c;
+                        EXPECT_EQ(got.commands[4 * c + 2], 16 * (list_first + c * kk)) << where << " command " << c;
+                        EXPECT_EQ(got.commands[4 * c + 3], 0u) << where << " command " << c;
+                    }
+                    EXPECT_EQ(got.draw_count, (survivors + kk - 1) / kk) << where;
                 }
-                const std::size_t kk = k == 0 ? count : std::min(k, count);
-                const std::size_t commands = compact_command_count(count, k);
-                for (std::size_t c = 0; c < commands; ++c) {
-                    const std::size_t m = survivors > c * kk ? std::min(kk, survivors - c * kk) : 0;
-                    EXPECT_EQ(got.commands[4 * c + 0], 16 * m) << where << " command " << c;
-                    EXPECT_EQ(got.commands[4 * c + 1], 1u) << where << " command " << c;
-                    EXPECT_EQ(got.commands[4 * c + 2], 16 * (list_first + c * kk)) << where << " command " << c;
-                    EXPECT_EQ(got.commands[4 * c + 3], 0u) << where << " command " << c;
-                }
-                EXPECT_EQ(got.draw_count, (survivors + kk - 1) / kk) << where;
-            }
 }
 
 TEST_F(VkCompaction, EmptyRangeWritesOneEmptyCommand) {

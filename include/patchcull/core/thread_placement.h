@@ -5,7 +5,7 @@
 // contexts use these to give each such worker a CPU of its own.
 //
 // Linux only (/proc/self/task, sched_setaffinity); elsewhere the list is empty and nothing is
-// pinned. Neither function throws.
+// pinned. None of these throws, except std::bad_alloc.
 #pragma once
 
 #include <cstddef>
@@ -35,12 +35,13 @@ std::vector<int> process_thread_ids();
 /// process_thread_ids() calls, whoever started them.
 std::vector<int> threads_started(std::span<const int> before, std::span<const int> after);
 
-/// Pins thread threads[i] to the (i mod n)-th of the n CPUs the calling thread may run on, so
-/// that consecutive threads share no CPU while there are CPUs left. Returns how many it pinned:
-/// 0 when the calling thread may run on fewer than two CPUs. First waits until each thread is
-/// asleep, 200 ms at most in all (a thread just started may still run start-up code that sets
-/// its own CPUs, as Mesa's queue threads do). A thread that has ended meanwhile is skipped. The
-/// calling thread's own placement is not changed.
+/// Pins thread threads[i] to the ((i + pid) mod n)-th of the n CPUs the calling thread may run
+/// on, so that consecutive threads share no CPU while there are CPUs left (and concurrent
+/// processes start at different CPUs). Returns how many it pinned: 0 when the calling thread may
+/// run on fewer than two CPUs. First waits until each thread is asleep, 1 s at most in all (a
+/// thread just started may still run start-up code that sets its own CPUs, as Mesa's queue
+/// threads do). An id that is no longer a thread of this process is skipped. The calling
+/// thread's own placement is not changed.
 std::size_t spread_threads(std::span<const int> threads);
 
 /// The number of CPUs thread `tid` may run on (0 when it cannot be read, e.g. it has ended).

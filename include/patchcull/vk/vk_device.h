@@ -38,8 +38,9 @@ struct HeadlessDeviceOptions {
     /// The kind of physical device tried first (any other with what is needed after it).
     enum class Prefer { cpu, gpu };
     Prefer prefer = Prefer::cpu;
-    /// The threads the driver starts while the device is made: on a CPU device, each pinned to a
-    /// CPU of its own in turn (core/thread_placement.h), or left to the operating system.
+    /// The threads started while the device is made (the driver's workers, and any other thread
+    /// the process starts meanwhile): on a CPU device, each pinned to a CPU of its own in turn
+    /// (core/thread_placement.h), or left to the operating system.
     DriverThreads driver_threads = DriverThreads::spread;
 };
 
