@@ -37,8 +37,9 @@ void pc_frustum_patch(uint p) {
     const float d = pc_margin(p, frustum.has_margins);
     float mx[6];
     const bool want_maxima = frustum.write_plane_values != 0u;
-    if (pc_frustum_culled(p, PC_HAS_MARGINS(frustum.has_margins), d, want_maxima, mx)) pc_chain_cull(p, kCullFrustum);
-    if (frustum.write_plane_values != 0u)
+    if (pc_frustum_culled(p, PC_HAS_MARGINS(frustum.has_margins), d, want_maxima, mx))
+        pc_chain_cull(p, kCullFrustum);
+    if (want_maxima)
         for (int q = 0; q < 6; ++q) plane_values[6u * p + uint(q)] = mx[q];
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "core/driver_thread_checks.h"
 #include "gl_test_util.h"
 #include "patchcull/core/thread_placement.h"
 
@@ -85,18 +86,8 @@ TEST(GlContext, SpreadsTheDriversThreadsOnASoftwareRasterizer) {
             continue;
         }
         const std::vector<int> started = patchcull::threads_started(before, patchcull::process_thread_ids());
-        ASSERT_FALSE(started.empty()) << "llvmpipe starts its rasterizer and compute threads";
         const bool spread = mode == DriverThreads::spread && cpus >= 2;
-        EXPECT_EQ(c.pinned_driver_threads(), spread ? started.size() : 0u);
-        for (int id : started) {
-            // Left alone, a thread runs where the driver lets it (Mesa starts its threads on every
-            // CPU, whatever the caller's own set).
-            if (spread) {
-                EXPECT_EQ(patchcull::thread_cpu_count(id), 1) << id;
-            } else {
-                EXPECT_GE(patchcull::thread_cpu_count(id), cpus) << id;
-            }
-        }
+        patchcull::placement_test::expect_driver_threads_placed(started, c.pinned_driver_threads(), spread, cpus);
         EXPECT_EQ(patchcull::thread_cpu_count(me), cpus);
         PatchRenderer r(c);  // a pinned context still renders
         r.render(RenderParams{});

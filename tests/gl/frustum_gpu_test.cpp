@@ -77,6 +77,14 @@ std::vector<float> cpu_plane_values(const std::vector<BezierPatch>& patches, con
     return out;
 }
 
+// cull_frustum_scalar's decisions for a case (its margins, when it has them) under planes.
+std::vector<std::uint8_t> cpu_frustum_decisions(const RandomCase& c, const FrustumPlanes& planes) {
+    const PatchBatch batch = test::unchecked_batch(c.patches);
+    std::vector<std::uint8_t> cpu(c.patches.size());
+    cull_frustum_scalar(batch.view(), c.displacement.empty() ? nullptr : c.displacement.data(), planes, cpu.data());
+    return cpu;
+}
+
 std::uint32_t bits(float f) {
     std::uint32_t b;
     std::memcpy(&b, &f, 4);
@@ -102,9 +110,7 @@ TEST(GpuFrustumCull, SameDecisionsAsCpuKernelOnRandomInputs) {
         const std::vector<std::uint32_t> gpu = r.read_cull_flags();
         ASSERT_EQ(gpu_stopping, gpu) << "seed " << seed;
 
-        const PatchBatch batch = test::unchecked_batch(c.patches);
-        std::vector<std::uint8_t> cpu(c.patches.size());
-        cull_frustum_scalar(batch.view(), c.displacement.empty() ? nullptr : c.displacement.data(), planes, cpu.data());
+        const std::vector<std::uint8_t> cpu = cpu_frustum_decisions(c, planes);
         ASSERT_EQ(gpu.size(), cpu.size());
         for (std::size_t p = 0; p < cpu.size(); ++p) {
             ASSERT_EQ(gpu[p] != 0, cpu[p] != 0) << "seed " << seed << " patch " << p;
@@ -183,9 +189,7 @@ TEST(GpuFrustumCull, EarlyStopKeepsTheVerdictOnNonFiniteAndOverflowingInput) {
         const FrustumPlanes planes = make_frustum_planes(c.object_to_clip, ClipDepth::zero_to_one);
         test::cull_frustum(r, planes);
         const std::vector<std::uint32_t> gpu = r.read_cull_flags();
-        const PatchBatch batch = test::unchecked_batch(c.patches);
-        std::vector<std::uint8_t> cpu(c.patches.size());
-        cull_frustum_scalar(batch.view(), c.displacement.data(), planes, cpu.data());
+        const std::vector<std::uint8_t> cpu = cpu_frustum_decisions(c, planes);
         ASSERT_EQ(gpu.size(), cpu.size());
         for (std::size_t p = 0; p < cpu.size(); ++p)
             ASSERT_EQ(gpu[p] != 0, cpu[p] != 0) << "matrix case " << m << " patch " << p << " (kind " << p % 5 << ")";

@@ -6,6 +6,7 @@
 
 #include <vector>
 
+#include "core/driver_thread_checks.h"
 #include "patchcull/core/thread_placement.h"
 #include "vk/vk_test_util.h"
 
@@ -46,18 +47,8 @@ TEST(VkContext, SpreadsTheDriversThreadsOnACpuDevice) {
         HeadlessDevice device(options);
         ASSERT_TRUE(device.is_software()) << device.name();
         const std::vector<int> started = patchcull::threads_started(before, patchcull::process_thread_ids());
-        ASSERT_FALSE(started.empty()) << "lavapipe starts its worker threads per device";
         const bool spread = mode == patchcull::DriverThreads::spread;
-        EXPECT_EQ(device.pinned_driver_threads(), spread ? started.size() : 0u);
-        for (int id : started) {
-            // Left alone, a thread runs where the driver lets it (Mesa starts its threads on every
-            // CPU, whatever the caller's own set).
-            if (spread) {
-                EXPECT_EQ(patchcull::thread_cpu_count(id), 1) << id;
-            } else {
-                EXPECT_GE(patchcull::thread_cpu_count(id), cpus) << id;
-            }
-        }
+        patchcull::placement_test::expect_driver_threads_placed(started, device.pinned_driver_threads(), spread, cpus);
         EXPECT_EQ(patchcull::thread_cpu_count(me), cpus);
         device.submit([](VkCommandBuffer) {});  // a pinned device still runs work
     }

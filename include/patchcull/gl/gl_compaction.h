@@ -39,8 +39,9 @@
 // decides, in the end's own dispatch (cull_status.comp.glsl's PC_STATUS_APPEND: one atomicAdd per
 // work group, as the append) and a dispatch of this pass's commands step. Ranges of any size up to 2^28 patches
 // (list_first + count < 2^28, so that 16 (list_first + count) fits in 32 bits) are covered by dispatches of at most
-// 65535 work groups (the scan of a range of at most kCompactSingleGroupPatches: one dispatch); the flags up to first + count and the list up to list_first + count must fit
-// GL_MAX_SHADER_STORAGE_BLOCK_SIZE (read once per PassContext; 128 MiB on llvmpipe: 2^25 patches).
+// 65535 work groups (the scan of a range of at most kCompactSingleGroupPatches: one dispatch); the flags up to
+// first + count and the list up to list_first + count must fit GL_MAX_SHADER_STORAGE_BLOCK_SIZE (read once per
+// PassContext; 128 MiB on llvmpipe: 2^25 patches).
 // Errors: patchcull::Error with one line ("GL: CompactPass: ..."): a buffer that
 // is not one or too small (the command buffer must hold C commands), an offset not a multiple of 4,
 // a range past 2^28 or past the block size.
